@@ -1,0 +1,1 @@
+//! Bogie physics and FMU.

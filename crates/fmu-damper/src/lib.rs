@@ -1,0 +1,1 @@
+//! Yaw damper physics and FMUs.
