@@ -229,4 +229,65 @@ mod tests {
         assert!(d.advance(-1.0).is_err());
         assert!(d.advance(f64::NAN).is_err());
     }
+
+    /// FMU state save/restore: a serialised and restored controller continues identically.
+    #[test]
+    fn state_round_trips_through_serde() {
+        let mut m = Mppt::new(MpptParams::mppt2()).unwrap();
+        let mut s = SkyHook::new(SkyHookParams::default()).unwrap();
+        let mut c = Idf::new(IdfParams::default()).unwrap();
+        let drive = |k: usize| (k as f64 * 0.0237).sin();
+        for k in 0..2500 {
+            let a = 3.0 * drive(k);
+            m.step(
+                1e-3,
+                &MpptInputs {
+                    bogie_accel_mps2: a,
+                    damper_force_n: 1e3 * a,
+                },
+            )
+            .unwrap();
+            s.step(
+                1e-3,
+                &SkyHookInputs {
+                    end_accel_mps2: a,
+                    abs_velocity_mps: 0.0,
+                    elongation_velocity_mps: 0.01 * a,
+                },
+            )
+            .unwrap();
+            c.step(
+                1e-3,
+                &IdfInputs {
+                    elongation_velocity_mps: 0.01 * a,
+                    measured_force_n: 100.0,
+                },
+            )
+            .unwrap();
+        }
+        let m2: Mppt = serde_json::from_str(&serde_json::to_string(&m).unwrap()).unwrap();
+        let s2: SkyHook = serde_json::from_str(&serde_json::to_string(&s).unwrap()).unwrap();
+        let c2: Idf = serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
+        let (mut m2, mut s2, mut c2) = (m2, s2, c2);
+        for k in 2500..4000 {
+            let a = 3.0 * drive(k);
+            let mi = MpptInputs {
+                bogie_accel_mps2: a,
+                damper_force_n: 1e3 * a,
+            };
+            assert_eq!(m.step(1e-3, &mi).unwrap(), m2.step(1e-3, &mi).unwrap());
+            let si = SkyHookInputs {
+                end_accel_mps2: a,
+                abs_velocity_mps: 0.0,
+                elongation_velocity_mps: 0.01 * a,
+            };
+            assert_eq!(s.step(1e-3, &si).unwrap(), s2.step(1e-3, &si).unwrap());
+            let ci = IdfInputs {
+                elongation_velocity_mps: 0.01 * a,
+                measured_force_n: 100.0,
+            };
+            assert_eq!(c.step(1e-3, &ci).unwrap(), c2.step(1e-3, &ci).unwrap());
+        }
+        assert_eq!(m.outputs().updates, 4);
+    }
 }
