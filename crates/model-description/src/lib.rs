@@ -1,1 +1,44 @@
-//! FMI 2.0 export glue.
+//! FMI 2.0 co-simulation export glue, written once for every model of the project.
+//!
+//! A model crate implements [`FmuModel`] (its variables, defaults, initialisation and step) and
+//! invokes [`export_fmus!`]; from that one declaration come
+//! - `modelDescription.xml` ([`xml::model_description`]): units, ModelStructure with explicit
+//!   dependencies, capability flags, a GUID derived from the interface;
+//! - the C API ([`capi`]) with the FMI state machine ([`component::Component`]), value checks,
+//!   logging through the host's callback, FMU state save/restore/serialisation;
+//! - the packaged `.fmu` ([`package`], binary `package-fmus`).
+
+pub mod capi;
+pub mod component;
+pub mod erased;
+pub mod model;
+pub mod package;
+pub mod units;
+pub mod variable;
+pub mod xml;
+
+pub use component::{CollectLog, Component, FmiState, Status};
+pub use model::{
+    DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo, StepError,
+};
+pub use variable::{Causality, VarType, Variability, Variable, VariableList};
+
+/// Create a component for `M` driven from Rust (tests, tools): the same state machine and
+/// checks as through the C API, with log messages collected in the returned [`CollectLog`].
+pub fn rust_component<M: FmuModel>(
+    ctx: InstanceContext,
+) -> Result<(Component, CollectLog), ModelError> {
+    let model = erased::Typed::<M>::new(&ctx)?;
+    let log = CollectLog::default();
+    let component = Component::new(Box::new(model), ctx, Box::new(log.clone()), true);
+    Ok((component, log))
+}
+
+/// Value reference of the variable `name` of `M` (declaration order per type).
+pub fn value_reference<M: FmuModel>(name: &str) -> Option<u32> {
+    let vars = M::variables();
+    let vrs = xml::value_references(&vars);
+    vars.iter()
+        .position(|v| v.meta.name == name)
+        .map(|i| vrs[i])
+}

@@ -1,0 +1,854 @@
+//! The FMI 2.0 co-simulation C API, written once. `export_fmus!` (invoked by each FMU crate,
+//! behind its `fmi-export` feature) defines the `fmi2*` symbols as one-line forwards to the
+//! functions here. One binary may carry several models; `fmi2Instantiate` picks the model by
+//! GUID, so the same library is shipped in each model's FMU under its modelIdentifier.
+//!
+//! Every function catches panics (none crosses the C boundary), checks its pointers, and
+//! reports failures through the host's logger with the message passed as a `%s` argument.
+
+#![allow(clippy::missing_safety_doc)]
+
+use std::ffi::{c_char, c_void, CStr, CString};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use ffi::{
+    fmi2Boolean, fmi2CallbackFunctions, fmi2CallbackLogger, fmi2Component,
+    fmi2ComponentEnvironment, fmi2FMUstate, fmi2Integer, fmi2Real, fmi2Status, fmi2StatusKind,
+    fmi2String, fmi2Type, fmi2ValueReference,
+};
+pub use fmi_sys::fmi2 as ffi;
+
+use crate::component::{Component, LogSink, Snapshot, Status};
+use crate::erased::{ErasedModel, Typed};
+use crate::model::{FmuModel, InstanceContext, ModelError};
+use crate::xml::{self, DeclarationError};
+
+pub const FMI2_OK: fmi2Status = ffi::fmi2Status_fmi2OK;
+pub const FMI2_WARNING: fmi2Status = ffi::fmi2Status_fmi2Warning;
+pub const FMI2_DISCARD: fmi2Status = ffi::fmi2Status_fmi2Discard;
+pub const FMI2_ERROR: fmi2Status = ffi::fmi2Status_fmi2Error;
+pub const FMI2_FATAL: fmi2Status = ffi::fmi2Status_fmi2Fatal;
+
+fn to_c(status: Status) -> fmi2Status {
+    match status {
+        Status::Ok => FMI2_OK,
+        Status::Warning => FMI2_WARNING,
+        Status::Discard => FMI2_DISCARD,
+        Status::Error => FMI2_ERROR,
+        Status::Fatal => FMI2_FATAL,
+    }
+}
+
+/// One model a binary can instantiate.
+pub struct ModelEntry {
+    pub name: &'static str,
+    pub create: fn(&InstanceContext) -> Result<Box<dyn ErasedModel>, ModelError>,
+    pub describe: fn() -> Result<xml::Description, DeclarationError>,
+    pub document: fn() -> Result<String, DeclarationError>,
+    pub resources: &'static [(&'static str, &'static [u8])],
+}
+
+fn create_erased<M: FmuModel>(ctx: &InstanceContext) -> Result<Box<dyn ErasedModel>, ModelError> {
+    Ok(Box::new(Typed::<M>::new(ctx)?))
+}
+
+impl ModelEntry {
+    pub const fn of<M: FmuModel>() -> Self {
+        ModelEntry {
+            name: M::INFO.name,
+            create: create_erased::<M>,
+            describe: xml::model_description::<M>,
+            document: xml::documentation_html::<M>,
+            resources: M::INFO.resources,
+        }
+    }
+}
+
+/// What the packager reads from a binary (via `rfmi_manifest`).
+#[derive(Serialize, Deserialize, Debug)]
+pub struct PackagedModel {
+    pub identifier: String,
+    pub model_description_xml: String,
+    pub documentation_html: String,
+    pub resources: Vec<(String, Vec<u8>)>,
+}
+
+/// Build the manifest (bincode of `Vec<Result<PackagedModel, String>>`).
+pub fn manifest(registry: &[ModelEntry]) -> Vec<u8> {
+    let models: Vec<Result<PackagedModel, String>> = registry
+        .iter()
+        .map(|e| {
+            let d = (e.describe)().map_err(|err| err.to_string())?;
+            let html = (e.document)().map_err(|err| err.to_string())?;
+            Ok(PackagedModel {
+                identifier: e.name.to_string(),
+                model_description_xml: d.xml,
+                documentation_html: html,
+                resources: e
+                    .resources
+                    .iter()
+                    .map(|(p, b)| (p.to_string(), b.to_vec()))
+                    .collect(),
+            })
+        })
+        .collect();
+    bincode::serialize(&models).unwrap_or_default()
+}
+
+/// Logger that forwards to the host's fmi2CallbackLogger.
+struct HostLogger {
+    callback: fmi2CallbackLogger,
+    env: SendPtr,
+    instance_name: CString,
+}
+
+struct SendPtr(fmi2ComponentEnvironment);
+// SAFETY: the environment pointer is opaque to us; we only hand it back to the host's logger,
+// which the standard requires to accept it from the thread that calls into the FMU.
+unsafe impl Send for SendPtr {}
+
+fn c_string_lossy(s: &str) -> CString {
+    CString::new(s.replace('\0', " ")).unwrap_or_default()
+}
+
+impl LogSink for HostLogger {
+    fn log(&mut self, status: Status, category: &str, message: &str) {
+        if let Some(cb) = self.callback {
+            let category = c_string_lossy(category);
+            let message = c_string_lossy(message);
+            // SAFETY: a logger the host gave us; the message goes in as a "%s" argument, never
+            // as the format string, so '%' in a message cannot be misread.
+            unsafe {
+                cb(
+                    self.env.0,
+                    self.instance_name.as_ptr(),
+                    to_c(status),
+                    category.as_ptr(),
+                    c"%s".as_ptr(),
+                    message.as_ptr(),
+                );
+            }
+        }
+    }
+}
+
+/// The heap object behind an fmi2Component.
+pub struct CComponent {
+    component: Component,
+    /// Cached bytes of the last serialised state (size query, then serialise).
+    serialized: Option<(usize, Vec<u8>)>,
+}
+
+unsafe fn str_arg<'a>(p: *const c_char) -> Option<&'a str> {
+    if p.is_null() {
+        None
+    } else {
+        CStr::from_ptr(p).to_str().ok()
+    }
+}
+
+/// Turn a resource location URI into a path. Accepts file:///abs, file:/abs and
+/// file://localhost/abs with %-escapes; other schemes are ignored (None).
+pub fn resource_path(uri: &str) -> Option<PathBuf> {
+    let rest = uri
+        .strip_prefix("file://localhost")
+        .or_else(|| uri.strip_prefix("file://"))
+        .or_else(|| uri.strip_prefix("file:"))?;
+    let bytes = rest.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' && i + 2 < bytes.len() {
+            let hex = std::str::from_utf8(&bytes[i + 1..i + 3]).ok()?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    let path = String::from_utf8(out).ok()?;
+    Some(PathBuf::from(path))
+}
+
+/// Log through the callback before a component exists (instantiate failures).
+unsafe fn early_log(functions: *const fmi2CallbackFunctions, name: *const c_char, msg: &str) {
+    if functions.is_null() {
+        return;
+    }
+    let f = &*functions;
+    if let Some(cb) = f.logger {
+        let message = c_string_lossy(msg);
+        let fallback = c"";
+        let name = if name.is_null() {
+            fallback.as_ptr()
+        } else {
+            name
+        };
+        cb(
+            f.componentEnvironment,
+            name,
+            FMI2_ERROR,
+            c"logStatusError".as_ptr(),
+            c"%s".as_ptr(),
+            message.as_ptr(),
+        );
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+pub unsafe fn instantiate(
+    registry: &[ModelEntry],
+    instance_name: fmi2String,
+    fmu_type: fmi2Type,
+    guid: fmi2String,
+    resource_location: fmi2String,
+    functions: *const fmi2CallbackFunctions,
+    _visible: fmi2Boolean,
+    logging_on: fmi2Boolean,
+) -> fmi2Component {
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        let fail = |msg: &str| {
+            early_log(functions, instance_name, &format!("fmi2Instantiate: {msg}"));
+            std::ptr::null_mut()
+        };
+        if functions.is_null() {
+            return std::ptr::null_mut();
+        }
+        let Some(name) = str_arg(instance_name).filter(|s| !s.is_empty()) else {
+            return fail("instanceName must be a non-empty string");
+        };
+        if fmu_type != ffi::fmi2Type_fmi2CoSimulation {
+            return fail("this FMU supports co-simulation only (fmuType must be fmi2CoSimulation)");
+        }
+        let Some(guid) = str_arg(guid) else {
+            return fail("fmuGUID is missing");
+        };
+        let mut entry = None;
+        for e in registry {
+            match (e.describe)() {
+                Ok(d) if d.guid == guid => {
+                    entry = Some(e);
+                    break;
+                }
+                Ok(_) => {}
+                Err(err) => return fail(&err.to_string()),
+            }
+        }
+        let Some(entry) = entry else {
+            let known: Vec<&str> = registry.iter().map(|e| e.name).collect();
+            return fail(&format!(
+                "GUID {guid} matches none of the models in this binary ({}); \
+                 the modelDescription.xml and the binary are from different builds",
+                known.join(", ")
+            ));
+        };
+        let ctx = InstanceContext {
+            instance_name: name.to_string(),
+            resource_dir: str_arg(resource_location).and_then(resource_path),
+        };
+        let model = match (entry.create)(&ctx) {
+            Ok(m) => m,
+            Err(e) => return fail(&e.to_string()),
+        };
+        let f = &*functions;
+        let logger = HostLogger {
+            callback: f.logger,
+            env: SendPtr(f.componentEnvironment),
+            instance_name: c_string_lossy(name),
+        };
+        let component = Component::new(model, ctx, Box::new(logger), logging_on != 0);
+        Box::into_raw(Box::new(CComponent {
+            component,
+            serialized: None,
+        })) as fmi2Component
+    }));
+    result.unwrap_or(std::ptr::null_mut())
+}
+
+pub unsafe fn free_instance(c: fmi2Component) {
+    if c.is_null() {
+        return;
+    }
+    let _ = catch_unwind(AssertUnwindSafe(|| {
+        drop(Box::from_raw(c as *mut CComponent));
+    }));
+}
+
+/// Run `f` on the component behind `c`, catching panics (the instance then goes to Error).
+pub unsafe fn with(
+    c: fmi2Component,
+    call: &str,
+    f: impl FnOnce(&mut CComponent) -> Status,
+) -> fmi2Status {
+    if c.is_null() {
+        return FMI2_ERROR;
+    }
+    let cc = &mut *(c as *mut CComponent);
+    cc.component.trace(call);
+    match catch_unwind(AssertUnwindSafe(|| f(&mut *cc))) {
+        Ok(s) => to_c(s),
+        Err(_) => {
+            let cc = &mut *(c as *mut CComponent);
+            let _ = catch_unwind(AssertUnwindSafe(|| {
+                cc.component.error(&format!(
+                    "{call}: internal error (panic caught at the C boundary)"
+                ));
+            }));
+            FMI2_ERROR
+        }
+    }
+}
+
+unsafe fn slice<'a, T>(p: *const T, n: usize) -> Option<&'a [T]> {
+    if n == 0 {
+        Some(&[])
+    } else if p.is_null() {
+        None
+    } else {
+        Some(std::slice::from_raw_parts(p, n))
+    }
+}
+
+unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> Option<&'a mut [T]> {
+    if n == 0 {
+        Some(&mut [])
+    } else if p.is_null() {
+        None
+    } else {
+        Some(std::slice::from_raw_parts_mut(p, n))
+    }
+}
+
+fn null_arg(cc: &mut CComponent, call: &str) -> Status {
+    cc.component
+        .error(&format!("{call}: a required pointer argument is NULL"))
+}
+
+pub unsafe fn set_debug_logging(
+    c: fmi2Component,
+    on: fmi2Boolean,
+    n: usize,
+    categories: *const fmi2String,
+) -> fmi2Status {
+    with(c, "fmi2SetDebugLogging", |cc| {
+        let Some(cats) = slice(categories, n) else {
+            return null_arg(cc, "fmi2SetDebugLogging");
+        };
+        let mut names = Vec::with_capacity(n);
+        for &p in cats {
+            match str_arg(p) {
+                Some(s) => names.push(s),
+                None => return null_arg(cc, "fmi2SetDebugLogging"),
+            }
+        }
+        cc.component.set_debug_logging(on != 0, &names)
+    })
+}
+
+pub unsafe fn setup_experiment(
+    c: fmi2Component,
+    _tolerance_defined: fmi2Boolean,
+    _tolerance: fmi2Real,
+    start: fmi2Real,
+    stop_defined: fmi2Boolean,
+    stop: fmi2Real,
+) -> fmi2Status {
+    with(c, "fmi2SetupExperiment", |cc| {
+        cc.component
+            .setup_experiment(start, (stop_defined != 0).then_some(stop))
+    })
+}
+
+pub unsafe fn enter_initialization_mode(c: fmi2Component) -> fmi2Status {
+    with(c, "fmi2EnterInitializationMode", |cc| {
+        cc.component.enter_initialization_mode()
+    })
+}
+
+pub unsafe fn exit_initialization_mode(c: fmi2Component) -> fmi2Status {
+    with(c, "fmi2ExitInitializationMode", |cc| {
+        cc.component.exit_initialization_mode()
+    })
+}
+
+pub unsafe fn terminate(c: fmi2Component) -> fmi2Status {
+    with(c, "fmi2Terminate", |cc| cc.component.terminate())
+}
+
+pub unsafe fn reset(c: fmi2Component) -> fmi2Status {
+    with(c, "fmi2Reset", |cc| {
+        cc.serialized = None;
+        cc.component.reset()
+    })
+}
+
+pub unsafe fn get_real(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *mut fmi2Real,
+) -> fmi2Status {
+    with(c, "fmi2GetReal", |cc| {
+        match (slice(vr, n), slice_mut(value, n)) {
+            (Some(vr), Some(value)) => cc.component.get_real(vr, value),
+            _ => null_arg(cc, "fmi2GetReal"),
+        }
+    })
+}
+
+pub unsafe fn get_integer(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *mut fmi2Integer,
+) -> fmi2Status {
+    with(c, "fmi2GetInteger", |cc| {
+        match (slice(vr, n), slice_mut(value, n)) {
+            (Some(vr), Some(value)) => cc.component.get_integer(vr, value),
+            _ => null_arg(cc, "fmi2GetInteger"),
+        }
+    })
+}
+
+pub unsafe fn get_boolean(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *mut fmi2Boolean,
+) -> fmi2Status {
+    with(c, "fmi2GetBoolean", |cc| {
+        match (slice(vr, n), slice_mut(value, n)) {
+            (Some(vr), Some(value)) => {
+                let mut buf = vec![false; n];
+                let s = cc.component.get_boolean(vr, &mut buf);
+                if s <= Status::Warning {
+                    for (o, b) in value.iter_mut().zip(buf) {
+                        *o = fmi2Boolean::from(b);
+                    }
+                }
+                s
+            }
+            _ => null_arg(cc, "fmi2GetBoolean"),
+        }
+    })
+}
+
+pub unsafe fn get_string(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *mut fmi2String,
+) -> fmi2Status {
+    with(c, "fmi2GetString", |cc| {
+        match (slice(vr, n), slice_mut(value, n)) {
+            (Some(vr), Some(value)) => {
+                let mut buf = vec![String::new(); n];
+                let s = cc.component.get_string(vr, &mut buf);
+                if s <= Status::Warning {
+                    // Valid until the next call on this instance (FMI 2.0, 2.1.7).
+                    cc.component.string_buffer = buf.iter().map(|b| c_string_lossy(b)).collect();
+                    for (o, b) in value.iter_mut().zip(&cc.component.string_buffer) {
+                        *o = b.as_ptr();
+                    }
+                }
+                s
+            }
+            _ => null_arg(cc, "fmi2GetString"),
+        }
+    })
+}
+
+pub unsafe fn set_real(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *const fmi2Real,
+) -> fmi2Status {
+    with(c, "fmi2SetReal", |cc| {
+        match (slice(vr, n), slice(value, n)) {
+            (Some(vr), Some(value)) => cc.component.set_real(vr, value),
+            _ => null_arg(cc, "fmi2SetReal"),
+        }
+    })
+}
+
+pub unsafe fn set_integer(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *const fmi2Integer,
+) -> fmi2Status {
+    with(c, "fmi2SetInteger", |cc| {
+        match (slice(vr, n), slice(value, n)) {
+            (Some(vr), Some(value)) => cc.component.set_integer(vr, value),
+            _ => null_arg(cc, "fmi2SetInteger"),
+        }
+    })
+}
+
+pub unsafe fn set_boolean(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *const fmi2Boolean,
+) -> fmi2Status {
+    with(c, "fmi2SetBoolean", |cc| {
+        match (slice(vr, n), slice(value, n)) {
+            (Some(vr), Some(value)) => {
+                let b: Vec<bool> = value.iter().map(|v| *v != 0).collect();
+                cc.component.set_boolean(vr, &b)
+            }
+            _ => null_arg(cc, "fmi2SetBoolean"),
+        }
+    })
+}
+
+pub unsafe fn set_string(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    n: usize,
+    value: *const fmi2String,
+) -> fmi2Status {
+    with(c, "fmi2SetString", |cc| {
+        match (slice(vr, n), slice(value, n)) {
+            (Some(vr), Some(value)) => {
+                let mut strs = Vec::with_capacity(n);
+                for &p in value {
+                    match str_arg(p) {
+                        Some(s) => strs.push(s),
+                        None => {
+                            return cc
+                                .component
+                                .error("fmi2SetString: a value is NULL or not valid UTF-8")
+                        }
+                    }
+                }
+                cc.component.set_string(vr, &strs)
+            }
+            _ => null_arg(cc, "fmi2SetString"),
+        }
+    })
+}
+
+pub unsafe fn get_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
+    with(c, "fmi2GetFMUstate", |cc| {
+        if state.is_null() {
+            return null_arg(cc, "fmi2GetFMUstate");
+        }
+        if (*state).is_null() {
+            match cc.component.get_fmu_state() {
+                Ok(snapshot) => {
+                    *state = Box::into_raw(snapshot) as fmi2FMUstate;
+                    Status::Ok
+                }
+                Err(s) => s,
+            }
+        } else {
+            let snapshot = &mut *((*state) as *mut Snapshot);
+            cc.component.update_fmu_state(snapshot)
+        }
+    })
+}
+
+pub unsafe fn set_fmu_state(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status {
+    with(c, "fmi2SetFMUstate", |cc| {
+        if state.is_null() {
+            return null_arg(cc, "fmi2SetFMUstate");
+        }
+        cc.component.set_fmu_state(&*(state as *const Snapshot))
+    })
+}
+
+pub unsafe fn free_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
+    with(c, "fmi2FreeFMUstate", |cc| {
+        if state.is_null() {
+            return null_arg(cc, "fmi2FreeFMUstate");
+        }
+        if !(*state).is_null() {
+            let ptr = (*state) as *mut Snapshot;
+            if cc
+                .serialized
+                .as_ref()
+                .is_some_and(|(p, _)| *p == ptr as usize)
+            {
+                cc.serialized = None;
+            }
+            drop(Box::from_raw(ptr));
+            *state = std::ptr::null_mut();
+        }
+        Status::Ok
+    })
+}
+
+unsafe fn serialized_bytes<'a>(
+    cc: &'a mut CComponent,
+    state: fmi2FMUstate,
+) -> Result<&'a [u8], Status> {
+    let key = state as usize;
+    let cached = cc.serialized.as_ref().is_some_and(|(p, _)| *p == key);
+    if !cached {
+        let bytes = cc
+            .component
+            .serialize_fmu_state(&*(state as *const Snapshot))?;
+        cc.serialized = Some((key, bytes));
+    }
+    match &cc.serialized {
+        Some((_, b)) => Ok(b.as_slice()),
+        None => Err(Status::Error),
+    }
+}
+
+pub unsafe fn serialized_fmu_state_size(
+    c: fmi2Component,
+    state: fmi2FMUstate,
+    size: *mut usize,
+) -> fmi2Status {
+    with(c, "fmi2SerializedFMUstateSize", |cc| {
+        if state.is_null() || size.is_null() {
+            return null_arg(cc, "fmi2SerializedFMUstateSize");
+        }
+        // Always re-serialise here: the state may have been updated in place since.
+        cc.serialized = None;
+        match serialized_bytes(cc, state) {
+            Ok(b) => {
+                *size = b.len();
+                Status::Ok
+            }
+            Err(s) => s,
+        }
+    })
+}
+
+pub unsafe fn serialize_fmu_state(
+    c: fmi2Component,
+    state: fmi2FMUstate,
+    buffer: *mut ffi::fmi2Byte,
+    size: usize,
+) -> fmi2Status {
+    with(c, "fmi2SerializeFMUstate", |cc| {
+        if state.is_null() || buffer.is_null() {
+            return null_arg(cc, "fmi2SerializeFMUstate");
+        }
+        let bytes = match serialized_bytes(cc, state) {
+            Ok(b) => b.to_vec(),
+            Err(s) => return s,
+        };
+        cc.serialized = None;
+        if bytes.len() > size {
+            return cc.component.error(&format!(
+                "fmi2SerializeFMUstate: buffer of {size} bytes is too small ({} needed)",
+                bytes.len()
+            ));
+        }
+        std::ptr::copy_nonoverlapping(bytes.as_ptr(), buffer as *mut u8, bytes.len());
+        Status::Ok
+    })
+}
+
+pub unsafe fn deserialize_fmu_state(
+    c: fmi2Component,
+    buffer: *const ffi::fmi2Byte,
+    size: usize,
+    state: *mut fmi2FMUstate,
+) -> fmi2Status {
+    with(c, "fmi2DeSerializeFMUstate", |cc| {
+        if state.is_null() {
+            return null_arg(cc, "fmi2DeSerializeFMUstate");
+        }
+        let Some(bytes) = slice(buffer as *const u8, size) else {
+            return null_arg(cc, "fmi2DeSerializeFMUstate");
+        };
+        match cc.component.deserialize_fmu_state(bytes) {
+            Ok(snapshot) => {
+                if !(*state).is_null() {
+                    drop(Box::from_raw((*state) as *mut Snapshot));
+                }
+                *state = Box::into_raw(snapshot) as fmi2FMUstate;
+                Status::Ok
+            }
+            Err(s) => s,
+        }
+    })
+}
+
+/// Not supported (providesDirectionalDerivative = false).
+pub unsafe fn unsupported(c: fmi2Component, call: &'static str, why: &'static str) -> fmi2Status {
+    with(c, call, |cc| cc.component.error(&format!("{call}: {why}")))
+}
+
+pub unsafe fn do_step(c: fmi2Component, t: fmi2Real, h: fmi2Real) -> fmi2Status {
+    with(c, "fmi2DoStep", |cc| cc.component.do_step(t, h))
+}
+
+pub unsafe fn get_status(
+    c: fmi2Component,
+    kind: fmi2StatusKind,
+    value: *mut fmi2Status,
+) -> fmi2Status {
+    with(c, "fmi2GetStatus", |cc| {
+        if value.is_null() {
+            return null_arg(cc, "fmi2GetStatus");
+        }
+        let _ = kind;
+        // Steps are never asynchronous, so there is no pending status to report.
+        cc.component
+            .error("fmi2GetStatus: no asynchronous step (canRunAsynchronuously = false)")
+    })
+}
+
+pub unsafe fn get_real_status(
+    c: fmi2Component,
+    kind: fmi2StatusKind,
+    value: *mut fmi2Real,
+) -> fmi2Status {
+    with(c, "fmi2GetRealStatus", |cc| {
+        if value.is_null() {
+            return null_arg(cc, "fmi2GetRealStatus");
+        }
+        if kind == ffi::fmi2StatusKind_fmi2LastSuccessfulTime {
+            *value = cc.component.last_successful_time();
+            Status::Ok
+        } else {
+            cc.component
+                .error("fmi2GetRealStatus: only fmi2LastSuccessfulTime is available")
+        }
+    })
+}
+
+pub unsafe fn get_boolean_status(
+    c: fmi2Component,
+    kind: fmi2StatusKind,
+    value: *mut fmi2Boolean,
+) -> fmi2Status {
+    with(c, "fmi2GetBooleanStatus", |cc| {
+        if value.is_null() {
+            return null_arg(cc, "fmi2GetBooleanStatus");
+        }
+        if kind == ffi::fmi2StatusKind_fmi2Terminated {
+            // The models never ask to end the simulation early.
+            *value = 0;
+            Status::Ok
+        } else {
+            cc.component
+                .error("fmi2GetBooleanStatus: only fmi2Terminated is available")
+        }
+    })
+}
+
+pub fn types_platform() -> *const c_char {
+    c"default".as_ptr()
+}
+
+pub fn version() -> *const c_char {
+    c"2.0".as_ptr()
+}
+
+/// Keeps `c_void` in the public signature list used by the macro.
+pub type Opaque = c_void;
+
+/// Define the FMI 2.0 co-simulation symbols of a binary carrying the given models.
+///
+/// Invoke once per FMU crate, behind its `fmi-export` feature (two crates exporting the same
+/// `fmi2*` symbols cannot be linked into one program, e.g. the master).
+#[macro_export]
+macro_rules! export_fmus {
+    ($($model:ty),+ $(,)?) => {
+        #[doc(hidden)]
+        pub static __FMU_REGISTRY: &[$crate::capi::ModelEntry] =
+            &[$($crate::capi::ModelEntry::of::<$model>()),+];
+
+        #[doc(hidden)]
+        pub mod __fmi2_exports {
+            #![allow(non_snake_case, clippy::missing_safety_doc)]
+            use $crate::capi as c;
+            use $crate::capi::ffi::*;
+            use std::os::raw::c_char;
+
+            /// Packaging manifest (not an FMI function): bincode of the models' descriptions.
+            #[no_mangle]
+            pub unsafe extern "C" fn rfmi_manifest(len: *mut usize) -> *const u8 {
+                static MANIFEST: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+                let bytes = MANIFEST.get_or_init(|| {
+                    std::panic::catch_unwind(|| c::manifest(super::__FMU_REGISTRY))
+                        .unwrap_or_default()
+                });
+                if !len.is_null() {
+                    *len = bytes.len();
+                }
+                bytes.as_ptr()
+            }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetTypesPlatform() -> *const c_char { c::types_platform() }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetVersion() -> *const c_char { c::version() }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetDebugLogging(c_: fmi2Component, on: fmi2Boolean, n: usize, cats: *const fmi2String) -> fmi2Status { c::set_debug_logging(c_, on, n, cats) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2Instantiate(name: fmi2String, ty: fmi2Type, guid: fmi2String, res: fmi2String, f: *const fmi2CallbackFunctions, visible: fmi2Boolean, logging: fmi2Boolean) -> fmi2Component { c::instantiate(super::__FMU_REGISTRY, name, ty, guid, res, f, visible, logging) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2FreeInstance(c_: fmi2Component) { c::free_instance(c_) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetupExperiment(c_: fmi2Component, tol_def: fmi2Boolean, tol: fmi2Real, start: fmi2Real, stop_def: fmi2Boolean, stop: fmi2Real) -> fmi2Status { c::setup_experiment(c_, tol_def, tol, start, stop_def, stop) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2EnterInitializationMode(c_: fmi2Component) -> fmi2Status { c::enter_initialization_mode(c_) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2ExitInitializationMode(c_: fmi2Component) -> fmi2Status { c::exit_initialization_mode(c_) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2Terminate(c_: fmi2Component) -> fmi2Status { c::terminate(c_) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2Reset(c_: fmi2Component) -> fmi2Status { c::reset(c_) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetReal(c_: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *mut fmi2Real) -> fmi2Status { c::get_real(c_, vr, n, v) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetInteger(c_: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *mut fmi2Integer) -> fmi2Status { c::get_integer(c_, vr, n, v) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetBoolean(c_: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *mut fmi2Boolean) -> fmi2Status { c::get_boolean(c_, vr, n, v) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetString(c_: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *mut fmi2String) -> fmi2Status { c::get_string(c_, vr, n, v) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetReal(c_: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *const fmi2Real) -> fmi2Status { c::set_real(c_, vr, n, v) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetInteger(c_: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *const fmi2Integer) -> fmi2Status { c::set_integer(c_, vr, n, v) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetBoolean(c_: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *const fmi2Boolean) -> fmi2Status { c::set_boolean(c_, vr, n, v) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetString(c_: fmi2Component, vr: *const fmi2ValueReference, n: usize, v: *const fmi2String) -> fmi2Status { c::set_string(c_, vr, n, v) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetFMUstate(c_: fmi2Component, s: *mut fmi2FMUstate) -> fmi2Status { c::get_fmu_state(c_, s) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetFMUstate(c_: fmi2Component, s: fmi2FMUstate) -> fmi2Status { c::set_fmu_state(c_, s) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2FreeFMUstate(c_: fmi2Component, s: *mut fmi2FMUstate) -> fmi2Status { c::free_fmu_state(c_, s) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SerializedFMUstateSize(c_: fmi2Component, s: fmi2FMUstate, size: *mut usize) -> fmi2Status { c::serialized_fmu_state_size(c_, s, size) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SerializeFMUstate(c_: fmi2Component, s: fmi2FMUstate, buf: *mut fmi2Byte, size: usize) -> fmi2Status { c::serialize_fmu_state(c_, s, buf, size) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2DeSerializeFMUstate(c_: fmi2Component, buf: *const fmi2Byte, size: usize, s: *mut fmi2FMUstate) -> fmi2Status { c::deserialize_fmu_state(c_, buf, size, s) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetDirectionalDerivative(c_: fmi2Component, _u: *const fmi2ValueReference, _nu: usize, _z: *const fmi2ValueReference, _nz: usize, _dv: *const fmi2Real, _dz: *mut fmi2Real) -> fmi2Status { c::unsupported(c_, "fmi2GetDirectionalDerivative", "not provided (providesDirectionalDerivative = false)") }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2SetRealInputDerivatives(c_: fmi2Component, _vr: *const fmi2ValueReference, _n: usize, _order: *const fmi2Integer, _v: *const fmi2Real) -> fmi2Status { c::unsupported(c_, "fmi2SetRealInputDerivatives", "inputs are held constant over a step (canInterpolateInputs = false)") }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(c_: fmi2Component, _vr: *const fmi2ValueReference, _n: usize, _order: *const fmi2Integer, _v: *mut fmi2Real) -> fmi2Status { c::unsupported(c_, "fmi2GetRealOutputDerivatives", "not provided (maxOutputDerivativeOrder = 0)") }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2DoStep(c_: fmi2Component, t: fmi2Real, h: fmi2Real, _no_prior: fmi2Boolean) -> fmi2Status { c::do_step(c_, t, h) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2CancelStep(c_: fmi2Component) -> fmi2Status { c::unsupported(c_, "fmi2CancelStep", "steps are never asynchronous (canRunAsynchronuously = false)") }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetStatus(c_: fmi2Component, k: fmi2StatusKind, v: *mut fmi2Status) -> fmi2Status { c::get_status(c_, k, v) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetRealStatus(c_: fmi2Component, k: fmi2StatusKind, v: *mut fmi2Real) -> fmi2Status { c::get_real_status(c_, k, v) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetIntegerStatus(c_: fmi2Component, _k: fmi2StatusKind, _v: *mut fmi2Integer) -> fmi2Status { c::unsupported(c_, "fmi2GetIntegerStatus", "no integer status is defined for co-simulation") }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetBooleanStatus(c_: fmi2Component, k: fmi2StatusKind, v: *mut fmi2Boolean) -> fmi2Status { c::get_boolean_status(c_, k, v) }
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi2GetStringStatus(c_: fmi2Component, _k: fmi2StatusKind, _v: *mut fmi2String) -> fmi2Status { c::unsupported(c_, "fmi2GetStringStatus", "no pending status (canRunAsynchronuously = false)") }
+        }
+    };
+}

@@ -1,0 +1,733 @@
+//! One FMU instance: the FMI 2.0 co-simulation state machine, value checks, logging and FMU
+//! state, written once for every model. The C API (`capi`) is a thin shell over this; Rust tests
+//! can drive a `Component` directly.
+
+use std::any::Any;
+use std::ffi::CString;
+
+use serde::{Deserialize, Serialize};
+
+use crate::erased::{ErasedModel, VrIndex};
+use crate::model::{Diagnostics, InstanceContext, StepError};
+use crate::variable::{Causality, VarType, Variability};
+
+/// Result status of a call (fmi2Status without Pending, which needs asynchronous stepping).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Status {
+    Ok,
+    Warning,
+    Discard,
+    Error,
+    Fatal,
+}
+
+/// The FMI 2.0 co-simulation states (FMI 2.0.4, section 4.2.4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum FmiState {
+    Instantiated,
+    InitializationMode,
+    StepComplete,
+    StepFailed,
+    Terminated,
+    Error,
+}
+
+/// Where log messages go.
+pub trait LogSink: Send {
+    fn log(&mut self, status: Status, category: &str, message: &str);
+}
+
+/// A sink that keeps messages, shareable with the caller (for Rust-side tests and tools).
+#[derive(Default, Debug, Clone)]
+pub struct CollectLog {
+    pub messages: std::sync::Arc<std::sync::Mutex<Vec<(Status, String, String)>>>,
+}
+
+impl CollectLog {
+    /// The messages so far (status, category, text).
+    pub fn take(&self) -> Vec<(Status, String, String)> {
+        match self.messages.lock() {
+            Ok(mut g) => std::mem::take(&mut *g),
+            Err(_) => Vec::new(),
+        }
+    }
+}
+
+impl LogSink for CollectLog {
+    fn log(&mut self, status: Status, category: &str, message: &str) {
+        if let Ok(mut g) = self.messages.lock() {
+            g.push((status, category.to_string(), message.to_string()));
+        }
+    }
+}
+
+/// A saved FMU state (fmi2FMUstate points to one of these).
+pub struct Snapshot {
+    model: Box<dyn Any + Send>,
+    time: f64,
+    state: FmiState,
+    start_time: f64,
+    stop_time: Option<f64>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct SnapshotHeader {
+    magic: [u8; 4],
+    time: f64,
+    state: FmiState,
+    start_time: f64,
+    stop_time: Option<f64>,
+    model: Vec<u8>,
+}
+
+const MAGIC: [u8; 4] = *b"RFM2";
+
+/// An FMU instance.
+pub struct Component {
+    model: Box<dyn ErasedModel>,
+    index: VrIndex,
+    ctx: InstanceContext,
+    sink: Box<dyn LogSink>,
+    logging_on: bool,
+    log_events: bool,
+    log_calls: bool,
+    state: FmiState,
+    time: f64,
+    start_time: f64,
+    stop_time: Option<f64>,
+    last_successful_time: f64,
+    outputs_dirty: bool,
+    diag: Diagnostics,
+    /// Strings returned by fmi2GetString stay valid until the next call on this instance.
+    pub(crate) string_buffer: Vec<CString>,
+}
+
+fn state_name(s: FmiState) -> &'static str {
+    match s {
+        FmiState::Instantiated => "Instantiated",
+        FmiState::InitializationMode => "InitializationMode",
+        FmiState::StepComplete => "StepComplete",
+        FmiState::StepFailed => "StepFailed",
+        FmiState::Terminated => "Terminated",
+        FmiState::Error => "Error",
+    }
+}
+
+impl Component {
+    pub fn new(
+        model: Box<dyn ErasedModel>,
+        ctx: InstanceContext,
+        sink: Box<dyn LogSink>,
+        logging_on: bool,
+    ) -> Self {
+        let index = VrIndex::new(model.metas());
+        Component {
+            model,
+            index,
+            ctx,
+            sink,
+            logging_on,
+            log_events: logging_on,
+            log_calls: false,
+            state: FmiState::Instantiated,
+            time: 0.0,
+            start_time: 0.0,
+            stop_time: None,
+            last_successful_time: 0.0,
+            outputs_dirty: true,
+            diag: Diagnostics::default(),
+            string_buffer: Vec::new(),
+        }
+    }
+
+    pub fn state(&self) -> FmiState {
+        self.state
+    }
+
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    pub fn instance_name(&self) -> &str {
+        &self.ctx.instance_name
+    }
+
+    /// Log an error (always forwarded: a host needs to know why a call failed).
+    pub fn error(&mut self, message: &str) -> Status {
+        self.sink.log(Status::Error, "logStatusError", message);
+        Status::Error
+    }
+
+    fn warning(&mut self, message: &str) {
+        self.sink.log(Status::Warning, "logStatusWarning", message);
+    }
+
+    /// Trace an FMI call in the `logCalls` category (only when enabled: it formats a string).
+    pub fn trace(&mut self, call: &str) {
+        if self.logging_on && self.log_calls {
+            let msg = format!(
+                "{call} (state {}, t = {})",
+                state_name(self.state),
+                self.time
+            );
+            self.sink.log(Status::Ok, "logCalls", &msg);
+        }
+    }
+
+    fn wrong_state(&mut self, call: &str) -> Status {
+        let msg = format!(
+            "{call} is not allowed in state {} (FMI 2.0 co-simulation state machine)",
+            state_name(self.state)
+        );
+        self.error(&msg)
+    }
+
+    /// Forward what the model reported; returns Warning if it warned.
+    fn flush_diagnostics(&mut self) -> Status {
+        if self.diag.is_empty() {
+            return Status::Ok;
+        }
+        let mut status = Status::Ok;
+        let warnings = std::mem::take(&mut self.diag.warnings);
+        for w in &warnings {
+            self.warning(w);
+            status = Status::Warning;
+        }
+        let events = std::mem::take(&mut self.diag.events);
+        if self.logging_on && self.log_events {
+            for e in &events {
+                self.sink.log(Status::Ok, "logEvents", e);
+            }
+        }
+        // Give the buffers back so the next call does not allocate.
+        self.diag.warnings = warnings;
+        self.diag.warnings.clear();
+        self.diag.events = events;
+        self.diag.events.clear();
+        status
+    }
+
+    pub fn set_debug_logging(&mut self, logging_on: bool, categories: &[&str]) -> Status {
+        for c in categories {
+            if !crate::xml::LOG_CATEGORIES.iter().any(|(n, _)| n == c) {
+                let msg = format!("fmi2SetDebugLogging: unknown log category '{c}'");
+                return self.error(&msg);
+            }
+        }
+        self.logging_on = logging_on;
+        if categories.is_empty() {
+            self.log_events = logging_on;
+            self.log_calls = logging_on;
+        } else {
+            self.log_events = categories.contains(&"logEvents");
+            self.log_calls = categories.contains(&"logCalls");
+        }
+        Status::Ok
+    }
+
+    pub fn setup_experiment(&mut self, start_time: f64, stop_time: Option<f64>) -> Status {
+        if self.state != FmiState::Instantiated {
+            return self.wrong_state("fmi2SetupExperiment");
+        }
+        if !start_time.is_finite() || stop_time.is_some_and(|s| !s.is_finite() || s < start_time) {
+            let msg = format!(
+                "fmi2SetupExperiment: invalid times (start {start_time}, stop {stop_time:?})"
+            );
+            return self.error(&msg);
+        }
+        self.start_time = start_time;
+        self.time = start_time;
+        self.last_successful_time = start_time;
+        self.stop_time = stop_time;
+        Status::Ok
+    }
+
+    pub fn enter_initialization_mode(&mut self) -> Status {
+        if self.state != FmiState::Instantiated {
+            return self.wrong_state("fmi2EnterInitializationMode");
+        }
+        self.state = FmiState::InitializationMode;
+        self.outputs_dirty = true;
+        Status::Ok
+    }
+
+    pub fn exit_initialization_mode(&mut self) -> Status {
+        if self.state != FmiState::InitializationMode {
+            return self.wrong_state("fmi2ExitInitializationMode");
+        }
+        if let Err(e) = self.model.exit_initialization(&mut self.diag) {
+            let _ = self.flush_diagnostics();
+            let msg = format!("fmi2ExitInitializationMode: {e}");
+            return self.error(&msg);
+        }
+        if let Err(e) = self.model.update_outputs(&mut self.diag) {
+            let _ = self.flush_diagnostics();
+            let msg = format!("fmi2ExitInitializationMode: {e}");
+            return self.error(&msg);
+        }
+        self.outputs_dirty = false;
+        self.state = FmiState::StepComplete;
+        self.flush_diagnostics()
+    }
+
+    pub fn terminate(&mut self) -> Status {
+        match self.state {
+            FmiState::StepComplete | FmiState::StepFailed => {
+                self.state = FmiState::Terminated;
+                Status::Ok
+            }
+            _ => self.wrong_state("fmi2Terminate"),
+        }
+    }
+
+    /// Back to the just-instantiated state: a fresh model with default values.
+    pub fn reset(&mut self) -> Status {
+        if let Err(e) = self.model.reset(&self.ctx) {
+            let msg = format!("fmi2Reset: {e}");
+            self.state = FmiState::Error;
+            return self.error(&msg);
+        }
+        self.state = FmiState::Instantiated;
+        self.time = 0.0;
+        self.start_time = 0.0;
+        self.stop_time = None;
+        self.last_successful_time = 0.0;
+        self.outputs_dirty = true;
+        self.string_buffer.clear();
+        Status::Ok
+    }
+
+    fn can_get(&self) -> bool {
+        matches!(
+            self.state,
+            FmiState::InitializationMode
+                | FmiState::StepComplete
+                | FmiState::StepFailed
+                | FmiState::Terminated
+                | FmiState::Error
+        )
+    }
+
+    fn refresh_outputs(&mut self, call: &str) -> Status {
+        if self.outputs_dirty
+            && matches!(
+                self.state,
+                FmiState::InitializationMode | FmiState::StepComplete
+            )
+        {
+            if let Err(e) = self.model.update_outputs(&mut self.diag) {
+                let _ = self.flush_diagnostics();
+                let msg = format!("{call}: {e}");
+                return self.error(&msg);
+            }
+            self.outputs_dirty = false;
+            return self.flush_diagnostics();
+        }
+        Status::Ok
+    }
+
+    fn resolve(&mut self, call: &str, var_type: VarType, vr: u32) -> Result<usize, Status> {
+        match self.index.lookup(var_type, vr) {
+            Some(i) => Ok(i),
+            None => {
+                let msg = format!(
+                    "{call}: unknown value reference {vr} for type {}",
+                    var_type.xml_name()
+                );
+                Err(self.error(&msg))
+            }
+        }
+    }
+
+    fn check_get(&mut self, call: &str, nvr: usize, nvalue: usize) -> Status {
+        if !self.can_get() {
+            return self.wrong_state(call);
+        }
+        if nvr != nvalue {
+            let msg = format!("{call}: {nvr} value references but {nvalue} values");
+            return self.error(&msg);
+        }
+        self.refresh_outputs(call)
+    }
+
+    pub fn get_real(&mut self, vrs: &[u32], values: &mut [f64]) -> Status {
+        let status = self.check_get("fmi2GetReal", vrs.len(), values.len());
+        if status > Status::Warning {
+            return status;
+        }
+        for (vr, out) in vrs.iter().zip(values.iter_mut()) {
+            let i = match self.resolve("fmi2GetReal", VarType::Real, *vr) {
+                Ok(i) => i,
+                Err(s) => return s,
+            };
+            match self.model.get_real(i) {
+                Some(v) => *out = v,
+                None => return self.error("fmi2GetReal: internal type mismatch"),
+            }
+        }
+        status
+    }
+
+    pub fn get_integer(&mut self, vrs: &[u32], values: &mut [i32]) -> Status {
+        let status = self.check_get("fmi2GetInteger", vrs.len(), values.len());
+        if status > Status::Warning {
+            return status;
+        }
+        for (vr, out) in vrs.iter().zip(values.iter_mut()) {
+            let i = match self.resolve("fmi2GetInteger", VarType::Integer, *vr) {
+                Ok(i) => i,
+                Err(s) => return s,
+            };
+            match self.model.get_integer(i) {
+                Some(v) => *out = v,
+                None => return self.error("fmi2GetInteger: internal type mismatch"),
+            }
+        }
+        status
+    }
+
+    pub fn get_boolean(&mut self, vrs: &[u32], values: &mut [bool]) -> Status {
+        let status = self.check_get("fmi2GetBoolean", vrs.len(), values.len());
+        if status > Status::Warning {
+            return status;
+        }
+        for (vr, out) in vrs.iter().zip(values.iter_mut()) {
+            let i = match self.resolve("fmi2GetBoolean", VarType::Boolean, *vr) {
+                Ok(i) => i,
+                Err(s) => return s,
+            };
+            match self.model.get_boolean(i) {
+                Some(v) => *out = v,
+                None => return self.error("fmi2GetBoolean: internal type mismatch"),
+            }
+        }
+        status
+    }
+
+    pub fn get_string(&mut self, vrs: &[u32], values: &mut [String]) -> Status {
+        let status = self.check_get("fmi2GetString", vrs.len(), values.len());
+        if status > Status::Warning {
+            return status;
+        }
+        for (vr, out) in vrs.iter().zip(values.iter_mut()) {
+            let i = match self.resolve("fmi2GetString", VarType::String, *vr) {
+                Ok(i) => i,
+                Err(s) => return s,
+            };
+            match self.model.get_string(i) {
+                Some(v) => *out = v,
+                None => return self.error("fmi2GetString: internal type mismatch"),
+            }
+        }
+        status
+    }
+
+    /// Whether variable `i` may be set now (FMI 2.0 rules for co-simulation).
+    fn check_settable(&mut self, call: &str, i: usize) -> Result<(), Status> {
+        let meta = &self.model.metas()[i];
+        let (causality, variability) = (meta.causality, meta.variability);
+        let allowed = match self.state {
+            FmiState::Instantiated | FmiState::InitializationMode => {
+                matches!(causality, Causality::Parameter | Causality::Input)
+                    && variability != Variability::Constant
+            }
+            FmiState::StepComplete => {
+                causality == Causality::Input
+                    || (causality == Causality::Parameter && variability == Variability::Tunable)
+            }
+            _ => {
+                return Err(self.wrong_state(call));
+            }
+        };
+        if allowed {
+            return Ok(());
+        }
+        let name = self.model.metas()[i].name.clone();
+        let msg = match (causality, variability, self.state) {
+            (Causality::Parameter, Variability::Fixed, FmiState::StepComplete) => format!(
+                "{call}: '{name}' is a fixed parameter; it can only be set before fmi2ExitInitializationMode"
+            ),
+            _ => format!(
+                "{call}: '{name}' has causality {} and cannot be set",
+                causality.xml_name()
+            ),
+        };
+        Err(self.error(&msg))
+    }
+
+    fn check_range(&mut self, call: &str, i: usize, value: f64) -> Result<(), Status> {
+        let meta = &self.model.metas()[i];
+        if !value.is_finite() {
+            let msg = format!("{call}: '{}' = {value} is not a finite number", meta.name);
+            return Err(self.error(&msg));
+        }
+        if meta.min.is_some_and(|lo| value < lo) || meta.max.is_some_and(|hi| value > hi) {
+            let msg = format!(
+                "{call}: '{}' = {value} is outside its range [{}, {}]",
+                meta.name,
+                meta.min.map_or("-inf".into(), |v| v.to_string()),
+                meta.max.map_or("+inf".into(), |v| v.to_string())
+            );
+            return Err(self.error(&msg));
+        }
+        Ok(())
+    }
+
+    fn check_set_common(&mut self, call: &str, nvr: usize, nvalue: usize) -> Result<(), Status> {
+        if !matches!(
+            self.state,
+            FmiState::Instantiated | FmiState::InitializationMode | FmiState::StepComplete
+        ) {
+            return Err(self.wrong_state(call));
+        }
+        if nvr != nvalue {
+            let msg = format!("{call}: {nvr} value references but {nvalue} values");
+            return Err(self.error(&msg));
+        }
+        Ok(())
+    }
+
+    /// Set Reals. All values are checked before any is applied: a rejected call changes nothing.
+    pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Status {
+        const CALL: &str = "fmi2SetReal";
+        if let Err(s) = self.check_set_common(CALL, vrs.len(), values.len()) {
+            return s;
+        }
+        for (vr, v) in vrs.iter().zip(values) {
+            let checked = self
+                .resolve(CALL, VarType::Real, *vr)
+                .and_then(|i| self.check_settable(CALL, i).map(|_| i))
+                .and_then(|i| self.check_range(CALL, i, *v));
+            if let Err(s) = checked {
+                return s;
+            }
+        }
+        for (vr, v) in vrs.iter().zip(values) {
+            if let Some(i) = self.index.lookup(VarType::Real, *vr) {
+                self.model.set_real(i, *v);
+            }
+        }
+        self.outputs_dirty = true;
+        Status::Ok
+    }
+
+    pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> Status {
+        const CALL: &str = "fmi2SetInteger";
+        if let Err(s) = self.check_set_common(CALL, vrs.len(), values.len()) {
+            return s;
+        }
+        for (vr, v) in vrs.iter().zip(values) {
+            let checked = self
+                .resolve(CALL, VarType::Integer, *vr)
+                .and_then(|i| self.check_settable(CALL, i).map(|_| i))
+                .and_then(|i| self.check_range(CALL, i, f64::from(*v)));
+            if let Err(s) = checked {
+                return s;
+            }
+        }
+        for (vr, v) in vrs.iter().zip(values) {
+            if let Some(i) = self.index.lookup(VarType::Integer, *vr) {
+                self.model.set_integer(i, *v);
+            }
+        }
+        self.outputs_dirty = true;
+        Status::Ok
+    }
+
+    pub fn set_boolean(&mut self, vrs: &[u32], values: &[bool]) -> Status {
+        const CALL: &str = "fmi2SetBoolean";
+        if let Err(s) = self.check_set_common(CALL, vrs.len(), values.len()) {
+            return s;
+        }
+        for vr in vrs {
+            let checked = self
+                .resolve(CALL, VarType::Boolean, *vr)
+                .and_then(|i| self.check_settable(CALL, i));
+            if let Err(s) = checked {
+                return s;
+            }
+        }
+        for (vr, v) in vrs.iter().zip(values) {
+            if let Some(i) = self.index.lookup(VarType::Boolean, *vr) {
+                self.model.set_boolean(i, *v);
+            }
+        }
+        self.outputs_dirty = true;
+        Status::Ok
+    }
+
+    pub fn set_string(&mut self, vrs: &[u32], values: &[&str]) -> Status {
+        const CALL: &str = "fmi2SetString";
+        if let Err(s) = self.check_set_common(CALL, vrs.len(), values.len()) {
+            return s;
+        }
+        for vr in vrs {
+            let checked = self
+                .resolve(CALL, VarType::String, *vr)
+                .and_then(|i| self.check_settable(CALL, i));
+            if let Err(s) = checked {
+                return s;
+            }
+        }
+        for (vr, v) in vrs.iter().zip(values) {
+            if let Some(i) = self.index.lookup(VarType::String, *vr) {
+                self.model.set_string(i, v);
+            }
+        }
+        self.outputs_dirty = true;
+        Status::Ok
+    }
+
+    /// Tolerance for comparing a host's communication point with our time: hosts accumulate
+    /// t += h and drift by a few ulps per step.
+    fn time_tolerance(&self, step: f64) -> f64 {
+        1.0e-9 * self.time.abs().max(1.0) + 1.0e-6 * step.abs()
+    }
+
+    pub fn do_step(&mut self, current: f64, step: f64) -> Status {
+        const CALL: &str = "fmi2DoStep";
+        if self.state != FmiState::StepComplete {
+            return self.wrong_state(CALL);
+        }
+        if !current.is_finite() || !step.is_finite() || step < 0.0 {
+            let msg = format!("{CALL}: invalid communication point {current} or step {step}");
+            return self.error(&msg);
+        }
+        let tol = self.time_tolerance(step);
+        if (current - self.time).abs() > tol {
+            let msg = format!(
+                "{CALL}: communication point {current} does not match the instance time {} \
+                 (restore an FMU state to go back in time)",
+                self.time
+            );
+            return self.error(&msg);
+        }
+        let target = current + step;
+        if let Some(stop) = self.stop_time {
+            if target > stop + tol {
+                let msg = format!("{CALL}: step to {target} goes beyond the stop time {stop}");
+                return self.error(&msg);
+            }
+        }
+        // Step from our own time to the host's target, so drift never accumulates.
+        let effective = target - self.time;
+        if effective > 0.0 {
+            match self.model.do_step(self.time, effective, &mut self.diag) {
+                Ok(()) => {}
+                Err(StepError::Discard(reason)) => {
+                    let _ = self.flush_diagnostics();
+                    self.state = FmiState::StepFailed;
+                    let msg = format!(
+                        "{CALL}: step from {} over {effective} s discarded: {reason}",
+                        self.time
+                    );
+                    self.sink.log(Status::Discard, "logStatusDiscard", &msg);
+                    return Status::Discard;
+                }
+                Err(StepError::Error(e)) => {
+                    let _ = self.flush_diagnostics();
+                    self.state = FmiState::Error;
+                    let msg = format!("{CALL}: step from {} failed: {e}", self.time);
+                    return self.error(&msg);
+                }
+            }
+        }
+        self.time = target;
+        self.last_successful_time = target;
+        self.outputs_dirty = true;
+        self.flush_diagnostics()
+    }
+
+    pub fn last_successful_time(&self) -> f64 {
+        self.last_successful_time
+    }
+
+    pub fn is_terminated(&self) -> bool {
+        self.state == FmiState::Terminated
+    }
+
+    fn can_handle_state(&self) -> bool {
+        !matches!(self.state, FmiState::Error)
+    }
+
+    pub fn get_fmu_state(&mut self) -> Result<Box<Snapshot>, Status> {
+        if !self.can_handle_state() {
+            return Err(self.wrong_state("fmi2GetFMUstate"));
+        }
+        Ok(Box::new(Snapshot {
+            model: self.model.snapshot(),
+            time: self.time,
+            state: self.state,
+            start_time: self.start_time,
+            stop_time: self.stop_time,
+        }))
+    }
+
+    /// fmi2GetFMUstate with an existing state: overwrite it without a new allocation.
+    pub fn update_fmu_state(&mut self, snapshot: &mut Snapshot) -> Status {
+        if !self.can_handle_state() {
+            return self.wrong_state("fmi2GetFMUstate");
+        }
+        if !self.model.update_snapshot(snapshot.model.as_mut()) {
+            return self.error("fmi2GetFMUstate: the given FMU state belongs to another model");
+        }
+        snapshot.time = self.time;
+        snapshot.state = self.state;
+        snapshot.start_time = self.start_time;
+        snapshot.stop_time = self.stop_time;
+        Status::Ok
+    }
+
+    pub fn set_fmu_state(&mut self, snapshot: &Snapshot) -> Status {
+        if !self.model.restore(snapshot.model.as_ref()) {
+            return self.error("fmi2SetFMUstate: the given FMU state belongs to another model");
+        }
+        self.time = snapshot.time;
+        self.last_successful_time = snapshot.time;
+        self.state = snapshot.state;
+        self.start_time = snapshot.start_time;
+        self.stop_time = snapshot.stop_time;
+        self.outputs_dirty = true;
+        Status::Ok
+    }
+
+    pub fn serialize_fmu_state(&mut self, snapshot: &Snapshot) -> Result<Vec<u8>, Status> {
+        let Some(model) = self.model.serialize(snapshot.model.as_ref()) else {
+            return Err(self.error("fmi2SerializeFMUstate: the FMU state cannot be serialised"));
+        };
+        let header = SnapshotHeader {
+            magic: MAGIC,
+            time: snapshot.time,
+            state: snapshot.state,
+            start_time: snapshot.start_time,
+            stop_time: snapshot.stop_time,
+            model,
+        };
+        bincode::serialize(&header).map_err(|e| self.error(&format!("fmi2SerializeFMUstate: {e}")))
+    }
+
+    pub fn deserialize_fmu_state(&mut self, bytes: &[u8]) -> Result<Box<Snapshot>, Status> {
+        let header: SnapshotHeader = match bincode::deserialize(bytes) {
+            Ok(h) => h,
+            Err(e) => {
+                let msg = format!("fmi2DeSerializeFMUstate: not a serialised state: {e}");
+                return Err(self.error(&msg));
+            }
+        };
+        if header.magic != MAGIC {
+            return Err(self.error("fmi2DeSerializeFMUstate: not a serialised state of this FMU"));
+        }
+        let Some(model) = self.model.deserialize(&header.model) else {
+            return Err(self.error(
+                "fmi2DeSerializeFMUstate: the serialised state belongs to another model or version",
+            ));
+        };
+        Ok(Box::new(Snapshot {
+            model,
+            time: header.time,
+            state: header.state,
+            start_time: header.start_time,
+            stop_time: header.stop_time,
+        }))
+    }
+}

@@ -1,0 +1,233 @@
+//! Type erasure: one non-generic view of any `FmuModel`, so the state machine and the C API
+//! are written once.
+
+use std::any::Any;
+
+use serde::{Deserialize, Serialize};
+
+use crate::model::{Diagnostics, FmuModel, InstanceContext, ModelError, StepError};
+use crate::variable::{Access, VarMeta, VarType, Variable};
+
+/// What the component needs from a model, without knowing its type.
+pub trait ErasedModel: Send {
+    fn metas(&self) -> &[VarMeta];
+    fn get_real(&self, index: usize) -> Option<f64>;
+    fn get_integer(&self, index: usize) -> Option<i32>;
+    fn get_boolean(&self, index: usize) -> Option<bool>;
+    fn get_string(&self, index: usize) -> Option<String>;
+    /// Returns false if the variable has no setter of that type.
+    fn set_real(&mut self, index: usize, value: f64) -> bool;
+    fn set_integer(&mut self, index: usize, value: i32) -> bool;
+    fn set_boolean(&mut self, index: usize, value: bool) -> bool;
+    fn set_string(&mut self, index: usize, value: &str) -> bool;
+    fn reset(&mut self, ctx: &InstanceContext) -> Result<(), ModelError>;
+    fn exit_initialization(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError>;
+    fn update_outputs(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError>;
+    fn do_step(&mut self, time: f64, step: f64, diag: &mut Diagnostics) -> Result<(), StepError>;
+    fn snapshot(&self) -> Box<dyn Any + Send>;
+    /// Restore from a snapshot taken from an instance of the same model.
+    fn restore(&mut self, snapshot: &(dyn Any + Send)) -> bool;
+    /// Overwrite an existing snapshot in place (fmi2GetFMUstate with a non-null state).
+    fn update_snapshot(&self, snapshot: &mut (dyn Any + Send)) -> bool;
+    fn serialize(&self, snapshot: &(dyn Any + Send)) -> Option<Vec<u8>>;
+    fn deserialize(&self, bytes: &[u8]) -> Option<Box<dyn Any + Send>>;
+}
+
+/// A model value plus its variable table.
+pub struct Typed<M: FmuModel> {
+    pub model: M,
+    vars: Vec<Variable<M>>,
+    metas: Vec<VarMeta>,
+}
+
+impl<M: FmuModel> Typed<M> {
+    pub fn new(ctx: &InstanceContext) -> Result<Self, ModelError> {
+        let vars = M::variables();
+        let metas = vars.iter().map(|v| v.meta.clone()).collect();
+        Ok(Typed {
+            model: M::instantiate(ctx)?,
+            vars,
+            metas,
+        })
+    }
+}
+
+/// The serialised form of a model snapshot: tagged so that bytes from another model are
+/// rejected rather than misread.
+#[derive(Serialize, Deserialize)]
+struct Tagged<M> {
+    model_name: String,
+    model: M,
+}
+
+impl<M: FmuModel> ErasedModel for Typed<M> {
+    fn metas(&self) -> &[VarMeta] {
+        &self.metas
+    }
+
+    fn get_real(&self, index: usize) -> Option<f64> {
+        match &self.vars.get(index)?.access {
+            Access::Real { get, .. } => Some(get(&self.model)),
+            _ => None,
+        }
+    }
+
+    fn get_integer(&self, index: usize) -> Option<i32> {
+        match &self.vars.get(index)?.access {
+            Access::Integer { get, .. } => Some(get(&self.model)),
+            _ => None,
+        }
+    }
+
+    fn get_boolean(&self, index: usize) -> Option<bool> {
+        match &self.vars.get(index)?.access {
+            Access::Boolean { get, .. } => Some(get(&self.model)),
+            _ => None,
+        }
+    }
+
+    fn get_string(&self, index: usize) -> Option<String> {
+        match &self.vars.get(index)?.access {
+            Access::String { get, .. } => Some(get(&self.model)),
+            _ => None,
+        }
+    }
+
+    fn set_real(&mut self, index: usize, value: f64) -> bool {
+        match self.vars.get(index).map(|v| &v.access) {
+            Some(Access::Real { set: Some(set), .. }) => {
+                set(&mut self.model, value);
+                true
+            }
+            _ => false,
+        }
+    }
+
+    fn set_integer(&mut self, index: usize, value: i32) -> bool {
+        match self.vars.get(index).map(|v| &v.access) {
+            Some(Access::Integer { set: Some(set), .. }) => {
+                set(&mut self.model, value);
+                true
+            }
+            _ => false,
+        }
+    }
+
+    fn set_boolean(&mut self, index: usize, value: bool) -> bool {
+        match self.vars.get(index).map(|v| &v.access) {
+            Some(Access::Boolean { set: Some(set), .. }) => {
+                set(&mut self.model, value);
+                true
+            }
+            _ => false,
+        }
+    }
+
+    fn set_string(&mut self, index: usize, value: &str) -> bool {
+        match self.vars.get(index).map(|v| &v.access) {
+            Some(Access::String { set: Some(set), .. }) => {
+                set(&mut self.model, value);
+                true
+            }
+            _ => false,
+        }
+    }
+
+    fn reset(&mut self, ctx: &InstanceContext) -> Result<(), ModelError> {
+        self.model = M::instantiate(ctx)?;
+        Ok(())
+    }
+
+    fn exit_initialization(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError> {
+        self.model.exit_initialization(diag)
+    }
+
+    fn update_outputs(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError> {
+        self.model.update_outputs(diag)
+    }
+
+    fn do_step(&mut self, time: f64, step: f64, diag: &mut Diagnostics) -> Result<(), StepError> {
+        self.model.do_step(time, step, diag)
+    }
+
+    fn snapshot(&self) -> Box<dyn Any + Send> {
+        Box::new(self.model.clone())
+    }
+
+    fn restore(&mut self, snapshot: &(dyn Any + Send)) -> bool {
+        match snapshot.downcast_ref::<M>() {
+            Some(m) => {
+                self.model = m.clone();
+                true
+            }
+            None => false,
+        }
+    }
+
+    fn update_snapshot(&self, snapshot: &mut (dyn Any + Send)) -> bool {
+        match snapshot.downcast_mut::<M>() {
+            Some(m) => {
+                m.clone_from(&self.model);
+                true
+            }
+            None => false,
+        }
+    }
+
+    fn serialize(&self, snapshot: &(dyn Any + Send)) -> Option<Vec<u8>> {
+        let model = snapshot.downcast_ref::<M>()?;
+        bincode::serialize(&Tagged {
+            model_name: M::INFO.name.to_string(),
+            model,
+        })
+        .ok()
+    }
+
+    fn deserialize(&self, bytes: &[u8]) -> Option<Box<dyn Any + Send>> {
+        let tagged: Tagged<M> = bincode::deserialize(bytes).ok()?;
+        if tagged.model_name != M::INFO.name {
+            return None;
+        }
+        Some(Box::new(tagged.model))
+    }
+}
+
+/// Index lookup from (type, value reference) to declaration index, built once per instance.
+#[derive(Clone, Debug, Default)]
+pub struct VrIndex {
+    by_type: [Vec<usize>; 4],
+}
+
+const NONE: usize = usize::MAX;
+
+impl VrIndex {
+    pub fn new(metas: &[VarMeta]) -> Self {
+        let mut index = VrIndex::default();
+        let mut counters = [0usize; 4];
+        for (i, m) in metas.iter().enumerate() {
+            let t = type_slot(m.var_type);
+            let vr = counters[t];
+            counters[t] += 1;
+            let table = &mut index.by_type[t];
+            if table.len() <= vr {
+                table.resize(vr + 1, NONE);
+            }
+            table[vr] = i;
+        }
+        index
+    }
+
+    pub fn lookup(&self, var_type: VarType, vr: u32) -> Option<usize> {
+        let i = *self.by_type[type_slot(var_type)].get(vr as usize)?;
+        (i != NONE).then_some(i)
+    }
+}
+
+fn type_slot(t: VarType) -> usize {
+    match t {
+        VarType::Real => 0,
+        VarType::Integer => 1,
+        VarType::Boolean => 2,
+        VarType::String => 3,
+    }
+}
