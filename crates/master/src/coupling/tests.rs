@@ -1,0 +1,491 @@
+//! Coupling tests on plain-Rust slaves: the two-mass oscillator the example FMUs
+//! `MassSpring` and `SpringDamperMass` will implement.
+
+use super::*;
+use crate::slave::{ScalarType, VarRef};
+use std::cell::RefCell;
+use std::rc::Rc;
+use std::sync::Arc;
+
+pub type CallLog = Rc<RefCell<Vec<String>>>;
+
+/// Common behaviour of the test slaves.
+#[derive(Default)]
+pub struct Hooks {
+    pub log: CallLog,
+    pub discard_above: Option<f64>,
+    pub can_state: bool,
+    pub cancel_after: Option<(usize, Arc<AtomicBool>)>,
+    pub step_times: Vec<(f64, f64)>,
+}
+
+/// Dynamics: state (x, v), values by value reference.
+pub trait Model {
+    fn deriv(&self, x: f64, v: f64) -> (f64, f64);
+    fn values(&mut self) -> &mut Vec<f64>;
+    fn state(&mut self) -> (&mut f64, &mut f64);
+    fn outputs(&mut self);
+}
+
+pub struct Mock<M: Model + Clone> {
+    pub name: String,
+    pub m: M,
+    pub saved: Option<M>,
+    pub hooks: Hooks,
+}
+
+/// MassSpring: vr 0 m, 1 k, 2 d, 3 force (in), 4 position, 5 velocity (out, no feedthrough).
+#[derive(Clone)]
+pub struct MassSpring {
+    pub vals: Vec<f64>,
+    pub x: f64,
+    pub v: f64,
+}
+impl MassSpring {
+    pub fn new(m: f64, k: f64, d: f64, x0: f64) -> Self {
+        MassSpring {
+            vals: vec![m, k, d, 0.0, x0, 0.0],
+            x: x0,
+            v: 0.0,
+        }
+    }
+}
+impl Model for MassSpring {
+    fn deriv(&self, x: f64, v: f64) -> (f64, f64) {
+        let (m, k, d, f) = (self.vals[0], self.vals[1], self.vals[2], self.vals[3]);
+        (v, (-k * x - d * v + f) / m)
+    }
+    fn values(&mut self) -> &mut Vec<f64> {
+        &mut self.vals
+    }
+    fn state(&mut self) -> (&mut f64, &mut f64) {
+        (&mut self.x, &mut self.v)
+    }
+    fn outputs(&mut self) {
+        self.vals[4] = self.x;
+        self.vals[5] = self.v;
+    }
+}
+
+/// SpringDamperMass: vr 0 m, 1 k, 2 d, 3 input_position, 4 input_velocity (in),
+/// 5 coupling_force (out, direct feedthrough), 6 position, 7 velocity (out).
+#[derive(Clone)]
+pub struct SpringDamperMass {
+    pub vals: Vec<f64>,
+    pub x: f64,
+    pub v: f64,
+}
+impl SpringDamperMass {
+    pub fn new(m: f64, k: f64, d: f64) -> Self {
+        SpringDamperMass {
+            vals: vec![m, k, d, 0.0, 0.0, 0.0, 0.0, 0.0],
+            x: 0.0,
+            v: 0.0,
+        }
+    }
+}
+impl Model for SpringDamperMass {
+    fn deriv(&self, x: f64, v: f64) -> (f64, f64) {
+        let (m, k, d, xi, vi) = (
+            self.vals[0],
+            self.vals[1],
+            self.vals[2],
+            self.vals[3],
+            self.vals[4],
+        );
+        (v, -(k * (x - xi) + d * (v - vi)) / m)
+    }
+    fn values(&mut self) -> &mut Vec<f64> {
+        &mut self.vals
+    }
+    fn state(&mut self) -> (&mut f64, &mut f64) {
+        (&mut self.x, &mut self.v)
+    }
+    fn outputs(&mut self) {
+        let (k, d, xi, vi) = (self.vals[1], self.vals[2], self.vals[3], self.vals[4]);
+        self.vals[5] = k * (self.x - xi) + d * (self.v - vi);
+        self.vals[6] = self.x;
+        self.vals[7] = self.v;
+    }
+}
+
+impl<M: Model + Clone> Mock<M> {
+    pub fn new(name: &str, m: M) -> Self {
+        Mock {
+            name: name.into(),
+            m,
+            saved: None,
+            hooks: Hooks {
+                can_state: true,
+                ..Default::default()
+            },
+        }
+    }
+    fn note(&self, s: &str) {
+        self.hooks
+            .log
+            .borrow_mut()
+            .push(format!("{}:{s}", self.name));
+    }
+}
+
+impl<M: Model + Clone> Slave for Mock<M> {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn setup_experiment(&mut self, _: f64, _: f64) -> Result<(), SlaveError> {
+        self.note("setup");
+        Ok(())
+    }
+    fn enter_initialization_mode(&mut self) -> Result<(), SlaveError> {
+        self.note("enter");
+        // start values of outputs define the initial state (initial="exact" for position)
+        let x0 = self.m.values().get(4).copied().unwrap_or(0.0);
+        let is_ms = self.m.values().len() == 6;
+        if is_ms {
+            *self.m.state().0 = x0;
+        }
+        self.m.outputs();
+        Ok(())
+    }
+    fn exit_initialization_mode(&mut self) -> Result<(), SlaveError> {
+        self.note("exit");
+        Ok(())
+    }
+    fn get(&mut self, vars: &[VarRef], out: &mut [f64]) -> Result<(), SlaveError> {
+        self.m.outputs();
+        for (v, o) in vars.iter().zip(out) {
+            *o = self.m.values()[v.vr as usize];
+        }
+        Ok(())
+    }
+    fn set(&mut self, vars: &[VarRef], values: &[f64]) -> Result<(), SlaveError> {
+        for (v, x) in vars.iter().zip(values) {
+            self.m.values()[v.vr as usize] = *x;
+        }
+        Ok(())
+    }
+    fn do_step(&mut self, t: f64, h: f64) -> Result<StepStatus, SlaveError> {
+        self.hooks.step_times.push((t, h));
+        if let Some((n, flag)) = &self.hooks.cancel_after {
+            if self.hooks.step_times.len() >= *n {
+                flag.store(true, Ordering::Relaxed);
+            }
+        }
+        if self.hooks.discard_above.is_some_and(|hmax| h > hmax) {
+            return Ok(StepStatus::Discard);
+        }
+        // RK4 with 10 internal steps, inputs held
+        let n = 10;
+        let dt = h / n as f64;
+        for _ in 0..n {
+            let (x, v) = (*self.m.state().0, *self.m.state().1);
+            let k1 = self.m.deriv(x, v);
+            let k2 = self.m.deriv(x + 0.5 * dt * k1.0, v + 0.5 * dt * k1.1);
+            let k3 = self.m.deriv(x + 0.5 * dt * k2.0, v + 0.5 * dt * k2.1);
+            let k4 = self.m.deriv(x + dt * k3.0, v + dt * k3.1);
+            let (xs, vs) = self.m.state();
+            *xs = x + dt / 6.0 * (k1.0 + 2.0 * k2.0 + 2.0 * k3.0 + k4.0);
+            *vs = v + dt / 6.0 * (k1.1 + 2.0 * k2.1 + 2.0 * k3.1 + k4.1);
+        }
+        self.m.outputs();
+        Ok(StepStatus::Ok)
+    }
+    fn can_save_state(&self) -> bool {
+        self.hooks.can_state
+    }
+    fn save_state(&mut self) -> Result<(), SlaveError> {
+        self.saved = Some(self.m.clone());
+        Ok(())
+    }
+    fn restore_state(&mut self) -> Result<(), SlaveError> {
+        if let Some(s) = &self.saved {
+            self.m = s.clone();
+        }
+        self.note("restore");
+        Ok(())
+    }
+    fn terminate(&mut self) -> Result<(), SlaveError> {
+        self.note("terminate");
+        Ok(())
+    }
+}
+
+fn r(vr: u32) -> VarRef {
+    VarRef::real(vr)
+}
+
+/// MassSpring (x0 = 0.1 m) coupled to SpringDamperMass; `order` as given.
+pub fn two_mass_plan(alg: Algorithm, order: Vec<usize>, h: f64, stop: f64) -> CouplingPlan {
+    let conn = |fi, f, ti, t, l: &str| PlanConnection {
+        from_instance: fi,
+        from: r(f),
+        to_instance: ti,
+        to: r(t),
+        label: l.into(),
+    };
+    CouplingPlan {
+        start_time: 0.0,
+        stop_time: stop,
+        step: h,
+        instances: vec![
+            PlanInstance {
+                name: "ms".into(),
+                step_multiple: 1,
+                parameters: vec![(r(0), 1.0), (r(1), 100.0), (r(2), 0.5), (r(4), 0.1)],
+            },
+            PlanInstance {
+                name: "sdm".into(),
+                step_multiple: 1,
+                parameters: vec![(r(0), 0.5), (r(1), 200.0), (r(2), 1.0)],
+            },
+        ],
+        connections: vec![
+            conn(0, 4, 1, 3, "ms.position"),
+            conn(0, 5, 1, 4, "ms.velocity"),
+            conn(1, 5, 0, 3, "sdm.coupling_force"),
+        ],
+        algorithm: alg,
+        order,
+        record: vec![
+            Recorded {
+                instance: 0,
+                var: r(4),
+                label: "ms.position [m]".into(),
+            },
+            Recorded {
+                instance: 1,
+                var: r(6),
+                label: "sdm.position [m]".into(),
+            },
+            Recorded {
+                instance: 0,
+                var: r(3),
+                label: "ms.force [N]".into(),
+            },
+        ],
+        init_sweeps: 3,
+        max_step_halvings: 0,
+    }
+}
+
+fn slaves() -> (Mock<MassSpring>, Mock<SpringDamperMass>) {
+    (
+        Mock::new("ms", MassSpring::new(1.0, 1.0, 1.0, 0.0)),
+        Mock::new("sdm", SpringDamperMass::new(1.0, 1.0, 1.0)),
+    )
+}
+
+/// Monolithic reference: RK4 with a small step on the coupled 4-state system.
+fn reference(stop: f64) -> (f64, f64) {
+    let (m1, k1, d1, m2, k2, d2) = (1.0, 100.0, 0.5, 0.5, 200.0, 1.0);
+    let f = |s: [f64; 4]| {
+        let fc = k2 * (s[2] - s[0]) + d2 * (s[3] - s[1]);
+        [s[1], (-k1 * s[0] - d1 * s[1] + fc) / m1, s[3], -fc / m2]
+    };
+    let mut s = [0.1, 0.0, 0.0, 0.0];
+    let n = (stop / 1e-5).round() as usize;
+    let h = stop / n as f64;
+    for _ in 0..n {
+        let a = f(s);
+        let b = f(std::array::from_fn(|i| s[i] + 0.5 * h * a[i]));
+        let c = f(std::array::from_fn(|i| s[i] + 0.5 * h * b[i]));
+        let d = f(std::array::from_fn(|i| s[i] + h * c[i]));
+        s = std::array::from_fn(|i| s[i] + h / 6.0 * (a[i] + 2.0 * b[i] + 2.0 * c[i] + d[i]));
+    }
+    (s[0], s[2])
+}
+
+fn run(plan: &CouplingPlan) -> (SimOutput, Mock<MassSpring>, Mock<SpringDamperMass>) {
+    let (mut a, mut b) = slaves();
+    let out = simulate(plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap();
+    (out, a, b)
+}
+
+fn final_error(plan: &CouplingPlan) -> f64 {
+    let (out, _, _) = run(plan);
+    let (x1, x2) = reference(plan.stop_time);
+    let last = out.rows().last().unwrap().to_vec();
+    (last[1] - x1).abs().max((last[2] - x2).abs())
+}
+
+#[test]
+fn both_algorithms_converge_to_the_monolithic_solution() {
+    for alg in [Algorithm::Jacobi, Algorithm::GaussSeidel] {
+        let e1 = final_error(&two_mass_plan(alg, vec![0, 1], 2e-3, 1.0));
+        let e2 = final_error(&two_mass_plan(alg, vec![0, 1], 1e-3, 1.0));
+        // first-order coupling error: halving h roughly halves the error
+        assert!(e2 < 0.7 * e1 && e2 > 0.3 * e1, "{alg:?}: {e1} -> {e2}");
+        assert!(e2 < 5e-3, "{alg:?}: {e2}");
+    }
+}
+
+#[test]
+fn gauss_seidel_in_feedthrough_order_beats_jacobi() {
+    let ej = final_error(&two_mass_plan(Algorithm::Jacobi, vec![0, 1], 2e-3, 1.0));
+    let eg = final_error(&two_mass_plan(
+        Algorithm::GaussSeidel,
+        vec![0, 1],
+        2e-3,
+        1.0,
+    ));
+    assert!(eg < ej, "GS {eg} vs Jacobi {ej}");
+}
+
+#[test]
+fn initialisation_propagates_feedthrough_outputs() {
+    let plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.01);
+    let (out, _, _) = run(&plan);
+    let first = out.rows().next().unwrap();
+    assert_eq!(first[0], 0.0);
+    assert_eq!(first[1], 0.1);
+    // force on ms = k2 (x2 - x1) = 200 * (0 - 0.1) = -20 N, consistent at t0
+    assert!((first[3] + 20.0).abs() < 1e-12, "{}", first[3]);
+}
+
+#[test]
+fn communication_points_do_not_drift_and_end_at_stop() {
+    let plan = two_mass_plan(Algorithm::Jacobi, vec![0, 1], 0.1, 100.0);
+    let (out, a, _) = run(&plan);
+    assert_eq!(a.hooks.step_times.len(), 1000);
+    for (k, &(t, _)) in a.hooks.step_times.iter().enumerate() {
+        assert_eq!(t, k as f64 * 0.1, "step {k}");
+    }
+    let (t_last, h_last) = *a.hooks.step_times.last().unwrap();
+    assert_eq!(t_last + h_last, 100.0);
+    assert_eq!(out.rows().last().unwrap()[0], 100.0);
+    assert_eq!(out.rows().count(), 1001);
+    assert_eq!(out.summary.steps, 1000);
+}
+
+#[test]
+fn step_multiples() {
+    let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.0105);
+    plan.stop_time = 0.011;
+    plan.instances[1].step_multiple = 4;
+    let (_, a, b) = run(&plan);
+    assert_eq!(a.hooks.step_times.len(), 11);
+    // sdm steps at k = 0, 4, 8; the last window is shortened to end at the stop time
+    let t: Vec<(f64, f64)> = b.hooks.step_times.clone();
+    assert_eq!(t.len(), 3);
+    assert!((t[1].0 - 0.004).abs() < 1e-15 && (t[1].1 - 0.004).abs() < 1e-15);
+    assert!((t[2].0 + t[2].1 - 0.011).abs() < 1e-15, "{t:?}");
+}
+
+#[test]
+fn discard_is_retried_with_halved_steps() {
+    let plan = {
+        let mut p = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 4e-3, 0.2);
+        p.max_step_halvings = 3;
+        p
+    };
+    let (mut a, mut b) = slaves();
+    b.hooks.discard_above = Some(1.1e-3); // needs two halvings
+    let out = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap();
+    assert_eq!(out.summary.rejected_steps, 2 * 50);
+    // the retried run equals a plain run at h/4 with the same exchange pattern closely
+    let fine = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.2);
+    let (ref_out, _, _) = run(&fine);
+    let last = out.rows().last().unwrap();
+    let last_ref = ref_out.rows().last().unwrap();
+    assert!(
+        (last[1] - last_ref[1]).abs() < 1e-12,
+        "{} vs {}",
+        last[1],
+        last_ref[1]
+    );
+    // and ms was restored too
+    assert!(a.hooks.log.borrow().iter().any(|s| s == "ms:restore"));
+}
+
+#[test]
+fn discard_without_state_support_or_retry_is_an_error_and_terminates() {
+    let mut plan = two_mass_plan(Algorithm::Jacobi, vec![0, 1], 4e-3, 0.2);
+    plan.max_step_halvings = 3;
+    let (mut a, mut b) = slaves();
+    let log = CallLog::default();
+    a.hooks.log = log.clone();
+    b.hooks.log = log.clone();
+    a.hooks.can_state = false;
+    b.hooks.discard_above = Some(1e-3);
+    let e = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        msg.contains("'sdm'") && msg.contains("'ms' does not support"),
+        "{msg}"
+    );
+    assert!(log.borrow().contains(&"ms:terminate".to_string()));
+    assert!(log.borrow().contains(&"sdm:terminate".to_string()));
+
+    plan.max_step_halvings = 0;
+    let (mut a, mut b) = slaves();
+    b.hooks.discard_above = Some(1e-3);
+    let e = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap_err();
+    assert!(matches!(e, SimError::Discarded { ref instance, .. } if instance == "sdm"));
+
+    plan.max_step_halvings = 1;
+    let (mut a, mut b) = slaves();
+    b.hooks.discard_above = Some(1e-4);
+    let e = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("after 1 halvings"), "{e}");
+}
+
+#[test]
+fn cancel_flag_stops_and_terminates_everything() {
+    let plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 1.0);
+    let flag = Arc::new(AtomicBool::new(false));
+    let (mut a, mut b) = slaves();
+    let log = CallLog::default();
+    a.hooks.log = log.clone();
+    b.hooks.log = log.clone();
+    a.hooks.cancel_after = Some((10, flag.clone()));
+    let opts = RunOptions {
+        cancel: Some(&flag),
+        progress: None,
+    };
+    let e = simulate(&plan, &mut [&mut a, &mut b], &opts).unwrap_err();
+    assert!(
+        matches!(e, SimError::Cancelled { time } if (time - 0.01).abs() < 1e-12),
+        "{e}"
+    );
+    let l = log.borrow();
+    assert_eq!(l.iter().filter(|s| s.ends_with(":terminate")).count(), 2);
+    assert_eq!(a.hooks.step_times.len(), 10);
+}
+
+#[test]
+fn non_finite_values_are_errors() {
+    let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.01);
+    plan.instances[0].parameters[0].1 = 0.0; // zero mass -> inf acceleration
+    let (mut a, mut b) = slaves();
+    let e = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap_err();
+    assert!(matches!(e, SimError::NonFinite { .. }), "{e}");
+}
+
+#[test]
+fn plan_checks() {
+    let mut plan = two_mass_plan(Algorithm::Jacobi, vec![0, 1], 3e-3, 0.01);
+    let (mut a, mut b) = slaves();
+    let e = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("not an integer multiple"), "{e}");
+    plan.step = 1e-3;
+    plan.order = vec![0, 0];
+    let e = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("permutation"), "{e}");
+    plan.order = vec![0, 1];
+    let e = simulate(&plan, &mut [&mut a], &RunOptions::default()).unwrap_err();
+    assert!(matches!(e, SimError::Plan(_)));
+}
+
+#[test]
+fn topological_order_is_stable_and_breaks_cycles() {
+    assert_eq!(topological_order(3, &[]), (vec![0, 1, 2], vec![]));
+    assert_eq!(
+        topological_order(3, &[(2, 0), (1, 0)]),
+        (vec![1, 2, 0], vec![])
+    );
+    let (o, b) = topological_order(3, &[(0, 1), (1, 2), (2, 0)]);
+    assert_eq!(o, vec![0, 1, 2]);
+    assert_eq!(b, vec![0]);
+    let _ = ScalarType::Integer;
+}

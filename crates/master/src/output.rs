@@ -1,0 +1,168 @@
+//! Atomic file output: every result file (CSV, SVG, JSON summary) is written to a temporary
+//! file in the destination folder, fsync'ed and renamed over the destination, so a reader never
+//! sees a half-written file and a failed run leaves nothing behind.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Failure to write an output file.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error("cannot write '{path}': {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("CSV '{path}': row {row} has {got} values but the header has {expected} columns")]
+    RowLength {
+        path: PathBuf,
+        row: usize,
+        got: usize,
+        expected: usize,
+    },
+    #[error("cannot serialise '{path}': {source}")]
+    Json {
+        path: PathBuf,
+        #[source]
+        source: serde_json::Error,
+    },
+}
+
+fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
+    move |source| OutputError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// Writes `path` atomically: `fill` writes the content into a buffered temporary file in the
+/// same folder, which is flushed, fsync'ed and renamed onto `path` only if `fill` succeeded.
+/// On any error the temporary file is removed and `path` is left untouched.
+pub fn write_atomic<F>(path: &Path, fill: F) -> Result<(), OutputError>
+where
+    F: FnOnce(&mut dyn Write) -> Result<(), OutputError>,
+{
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let tmp = tempfile::Builder::new()
+        .prefix(".tmp-")
+        .tempfile_in(&dir)
+        .map_err(io_err(path))?;
+    {
+        let mut w = std::io::BufWriter::new(tmp.as_file());
+        fill(&mut w)?;
+        w.flush().map_err(io_err(path))?;
+    }
+    tmp.as_file().sync_all().map_err(io_err(path))?;
+    tmp.persist(path).map_err(|e| OutputError::Io {
+        path: path.to_path_buf(),
+        source: e.error,
+    })?;
+    Ok(())
+}
+
+/// Writes a whole byte string atomically.
+pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    write_atomic(path, |w| w.write_all(bytes).map_err(io_err(path)))
+}
+
+/// Writes a value as pretty JSON atomically.
+pub fn write_json_atomic<T: serde::Serialize>(path: &Path, value: &T) -> Result<(), OutputError> {
+    let text = serde_json::to_string_pretty(value).map_err(|source| OutputError::Json {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    write_bytes_atomic(path, text.as_bytes())
+}
+
+/// Quotes a CSV field if it contains a separator, quote or newline (RFC 4180).
+pub fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// Writes a numeric CSV table atomically. Every row must have `header.len()` values.
+/// Numbers are written with Rust's shortest round-trip formatting (no precision loss).
+pub fn write_csv_atomic<'a, I>(path: &Path, header: &[String], rows: I) -> Result<(), OutputError>
+where
+    I: IntoIterator<Item = &'a [f64]>,
+{
+    write_atomic(path, |w| {
+        let head: Vec<String> = header.iter().map(|h| csv_field(h)).collect();
+        writeln!(w, "{}", head.join(",")).map_err(io_err(path))?;
+        for (i, row) in rows.into_iter().enumerate() {
+            if row.len() != header.len() {
+                return Err(OutputError::RowLength {
+                    path: path.to_path_buf(),
+                    row: i,
+                    got: row.len(),
+                    expected: header.len(),
+                });
+            }
+            let mut first = true;
+            for v in row {
+                if !first {
+                    w.write_all(b",").map_err(io_err(path))?;
+                }
+                first = false;
+                write!(w, "{v}").map_err(io_err(path))?;
+            }
+            w.write_all(b"\n").map_err(io_err(path))?;
+        }
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_round_trip_and_quoting() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.csv");
+        let header = vec!["time [s]".to_string(), "x,y [m]".to_string()];
+        let rows = [vec![0.0, 1.5], vec![0.1, -2.25e-7]];
+        write_csv_atomic(&p, &header, rows.iter().map(|r| r.as_slice())).unwrap();
+        let text = std::fs::read_to_string(&p).unwrap();
+        assert_eq!(text, "time [s],\"x,y [m]\"\n0,1.5\n0.1,-0.000000225\n");
+        // only the result is left in the folder, no temporary file
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn failed_write_leaves_no_file_and_keeps_old_content() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.csv");
+        let header = vec!["t".to_string(), "x".to_string()];
+        let bad = [vec![0.0, 1.0], vec![1.0]];
+        let err = write_csv_atomic(&p, &header, bad.iter().map(|r| r.as_slice())).unwrap_err();
+        assert!(matches!(
+            err,
+            OutputError::RowLength {
+                row: 1,
+                got: 1,
+                expected: 2,
+                ..
+            }
+        ));
+        assert!(!p.exists());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+        // an existing file survives a failed rewrite untouched
+        std::fs::write(&p, "old").unwrap();
+        let _ = write_csv_atomic(&p, &header, bad.iter().map(|r| r.as_slice()));
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "old");
+    }
+
+    #[test]
+    fn missing_folder_is_an_io_error_naming_the_path() {
+        let err = write_bytes_atomic(Path::new("/nonexistent-dir-xyz/a.csv"), b"x").unwrap_err();
+        assert!(err.to_string().contains("/nonexistent-dir-xyz/a.csv"));
+    }
+}
