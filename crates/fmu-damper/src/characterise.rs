@@ -1,0 +1,331 @@
+//! Characterisation of the models (seed sections 3.3.4 and 3.4.4): hysteresis loops,
+//! force/displacement FRFs with equivalent stiffness and damping, and actuator FRFs.
+//! Functions return data only (no files).
+//!
+//! Method: the model is driven by a sinusoid until the first harmonic of the response
+//! changes by less than 1e-6 (relative) from one period to the next (at least 3,
+//! at most 60 periods); the first harmonic is taken over the last period. The input is
+//! sampled at the middle of each communication step (second-order accurate hold), so
+//! the measured phase is not biased by the zero-order hold.
+//!
+//! Conventions: displacement `x = X sin(wt)`; `H = F1 / X1` with complex first
+//! harmonics, so a spring gives `H = k` (0 deg), a viscous damper `H = i c w` (90 deg);
+//! `k_eq = Re H`, `c_eq = Im H / w`.
+
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+use crate::complex::Complex;
+use crate::error::{check_opening_input, positive_input, StepError};
+use crate::full_active::{
+    dead_zone_describing_gain, Actuator, ActuatorInputs, ActuatorModel, ActuatorParams, RodMode,
+};
+use crate::semi_active::{SemiActiveDamper, SemiActiveInputs, SemiActiveParams};
+
+/// Samples per period of the sinusoidal tests (communication steps).
+pub const STEPS_PER_PERIOD: usize = 400;
+const MIN_PERIODS: usize = 3;
+const MAX_PERIODS: usize = 60;
+const CONVERGENCE: f64 = 1e-6;
+
+/// One steady-state period of a sinusoidal stroke.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HysteresisLoop {
+    /// Valve opening, 0..1.
+    pub opening: f64,
+    /// Stroke frequency, Hz.
+    pub freq_hz: f64,
+    /// Displacement amplitude, m.
+    pub amplitude_m: f64,
+    /// Time since the start of the analysed period, s.
+    pub time_s: Vec<f64>,
+    /// Displacement (elongation), m.
+    pub displacement_m: Vec<f64>,
+    /// Velocity, m/s.
+    pub velocity_mps: Vec<f64>,
+    /// Force, N (tension positive).
+    pub force_n: Vec<f64>,
+    /// Largest |force| over the period, N.
+    pub peak_force_n: f64,
+    /// First-harmonic force/displacement ratio, N/m.
+    pub transfer: Complex,
+}
+
+/// One point of the damper force/displacement FRF.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DamperFrfPoint {
+    /// Frequency, Hz.
+    pub freq_hz: f64,
+    /// |F1/X1|, N/m.
+    pub modulus_n_per_m: f64,
+    /// arg(F1/X1), degrees.
+    pub phase_deg: f64,
+    /// Equivalent stiffness Re(F1/X1), N/m.
+    pub k_eq_n_per_m: f64,
+    /// Equivalent damping Im(F1/X1)/w, N s/m.
+    pub c_eq_ns_per_m: f64,
+}
+
+fn first_harmonic(samples: &[f64], times: &[f64], omega: f64) -> Complex {
+    let n = samples.len() as f64;
+    let mut acc = Complex::default();
+    for (s, t) in samples.iter().zip(times) {
+        acc = acc + Complex::new((omega * t).cos(), -(omega * t).sin()).scale(*s);
+    }
+    acc.scale(2.0 / n)
+}
+
+/// Runs the damper with the valve fixed at `opening` under `x = X sin(2 pi f t)` to a
+/// periodic steady state and returns the last period.
+pub fn hysteresis_loop(
+    params: &SemiActiveParams,
+    opening: f64,
+    freq_hz: f64,
+    amplitude_m: f64,
+) -> Result<HysteresisLoop, StepError> {
+    check_opening_input("opening", opening)?;
+    positive_input("freq_hz", freq_hz)?;
+    positive_input("amplitude_m", amplitude_m)?;
+    let mut damper = SemiActiveDamper::new(params.with_fixed_opening(opening))?;
+    let omega = 2.0 * PI * freq_hz;
+    let n = STEPS_PER_PERIOD;
+    let h = 1.0 / (freq_hz * n as f64);
+    let mut time = vec![0.0; n];
+    let mut xs = vec![0.0; n];
+    let mut vs = vec![0.0; n];
+    let mut fs = vec![0.0; n];
+    let mut prev: Option<Complex> = None;
+    let mut transfer = Complex::default();
+    let x1 = Complex::new(0.0, -amplitude_m); // phasor of X sin(wt)
+    for period in 0..MAX_PERIODS {
+        let t0 = period as f64 / freq_hz;
+        for k in 0..n {
+            let tm = t0 + (k as f64 + 0.5) * h;
+            let inputs = SemiActiveInputs {
+                elongation_m: amplitude_m * (omega * tm).sin(),
+                elongation_velocity_mps: amplitude_m * omega * (omega * tm).cos(),
+                valve_command_v: 0.0,
+            };
+            let out = damper.step(h, &inputs)?;
+            let t = (k as f64 + 1.0) * h;
+            time[k] = t;
+            xs[k] = amplitude_m * (omega * t).sin();
+            vs[k] = amplitude_m * omega * (omega * t).cos();
+            fs[k] = out.force_n;
+        }
+        transfer = first_harmonic(&fs, &time, omega) / x1;
+        if let Some(p) = prev {
+            if period + 1 >= MIN_PERIODS && (transfer - p).abs() <= CONVERGENCE * transfer.abs() {
+                break;
+            }
+        }
+        prev = Some(transfer);
+    }
+    let peak = fs.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+    Ok(HysteresisLoop {
+        opening,
+        freq_hz,
+        amplitude_m,
+        time_s: time,
+        displacement_m: xs,
+        velocity_mps: vs,
+        force_n: fs,
+        peak_force_n: peak,
+        transfer,
+    })
+}
+
+/// Hysteresis loops of the seed's Figures 3.10-3.13: strokes of 1 and 3 mm at 4 Hz
+/// for openings 0, 20, 50 and 100 %.
+pub fn seed_hysteresis_loops(params: &SemiActiveParams) -> Result<Vec<HysteresisLoop>, StepError> {
+    let mut out = Vec::new();
+    for opening in [0.0, 0.2, 0.5, 1.0] {
+        for amp in [1e-3, 3e-3] {
+            out.push(hysteresis_loop(params, opening, 4.0, amp)?);
+        }
+    }
+    Ok(out)
+}
+
+/// Force/displacement FRF point at one frequency.
+pub fn damper_frf_point(
+    params: &SemiActiveParams,
+    opening: f64,
+    freq_hz: f64,
+    amplitude_m: f64,
+) -> Result<DamperFrfPoint, StepError> {
+    let l = hysteresis_loop(params, opening, freq_hz, amplitude_m)?;
+    let omega = 2.0 * PI * freq_hz;
+    Ok(DamperFrfPoint {
+        freq_hz,
+        modulus_n_per_m: l.transfer.abs(),
+        phase_deg: l.transfer.arg_deg(),
+        k_eq_n_per_m: l.transfer.re,
+        c_eq_ns_per_m: l.transfer.im / omega,
+    })
+}
+
+/// Force/displacement FRF over `freqs_hz` (seed Fig. 3.14-3.15 use 1 mm).
+pub fn damper_frf(
+    params: &SemiActiveParams,
+    opening: f64,
+    freqs_hz: &[f64],
+    amplitude_m: f64,
+) -> Result<Vec<DamperFrfPoint>, StepError> {
+    freqs_hz
+        .iter()
+        .map(|&f| damper_frf_point(params, opening, f, amplitude_m))
+        .collect()
+}
+
+/// Frequencies of the seed's damper FRF: 0.5 to 20 Hz, `n` log-spaced points.
+pub fn log_space(f_lo: f64, f_hi: f64, n: usize) -> Vec<f64> {
+    if n < 2 {
+        return vec![f_lo];
+    }
+    (0..n)
+        .map(|i| f_lo * (f_hi / f_lo).powf(i as f64 / (n - 1) as f64))
+        .collect()
+}
+
+/// Equivalent stiffness (N/m) and damping (N s/m) of the damper at a fixed opening,
+/// from the first harmonic of the steady-state response to `X sin(2 pi f t)`.
+/// Used by the bogie calibration and the sky-hook controller table.
+pub fn equivalent_stiffness_damping(
+    params: &SemiActiveParams,
+    opening: f64,
+    freq_hz: f64,
+    amplitude_m: f64,
+) -> Result<(f64, f64), StepError> {
+    let p = damper_frf_point(params, opening, freq_hz, amplitude_m)?;
+    Ok((p.k_eq_n_per_m, p.c_eq_ns_per_m))
+}
+
+/// One point of an actuator FRF `u -> rod velocity`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ActuatorFrfPoint {
+    /// Frequency, Hz.
+    pub freq_hz: f64,
+    /// Angular frequency, rad/s.
+    pub omega_radps: f64,
+    /// |xdot1 / u1|, (m/s)/m = 1/s.
+    pub modulus_per_s: f64,
+    /// arg(xdot1 / u1), degrees.
+    pub phase_deg: f64,
+}
+
+/// FRF `u -> rod velocity` of the full- or reduced-order actuator (rod free, F_L = 0)
+/// from the first harmonic of the steady-state response to `u = U sin(wt)`.
+pub fn actuator_frf(
+    params: &ActuatorParams,
+    model: ActuatorModel,
+    amplitude_m: f64,
+    freqs_hz: &[f64],
+) -> Result<Vec<ActuatorFrfPoint>, StepError> {
+    positive_input("amplitude_m", amplitude_m)?;
+    let p = ActuatorParams {
+        model,
+        rod: RodMode::Free,
+        ..*params
+    };
+    let mut out = Vec::with_capacity(freqs_hz.len());
+    for &f in freqs_hz {
+        positive_input("freq_hz", f)?;
+        let mut act = Actuator::new(p)?;
+        let omega = 2.0 * PI * f;
+        // Keep the communication step inside 1e-4..5e-3 s.
+        let n = ((1.0 / (f * 5e-3)).ceil() as usize).clamp(64, 400);
+        let h = 1.0 / (f * n as f64);
+        let mut time = vec![0.0; n];
+        let mut vel = vec![0.0; n];
+        let mut prev: Option<Complex> = None;
+        let mut g = Complex::default();
+        let u1 = Complex::new(0.0, -amplitude_m);
+        for period in 0..MAX_PERIODS {
+            let t0 = period as f64 / f;
+            for k in 0..n {
+                let tm = t0 + (k as f64 + 0.5) * h;
+                let inputs = ActuatorInputs {
+                    spool_command_m: amplitude_m * (omega * tm).sin(),
+                    ..ActuatorInputs::default()
+                };
+                let o = act.step(h, &inputs)?;
+                time[k] = (k as f64 + 1.0) * h;
+                vel[k] = o.rod_velocity_mps;
+            }
+            g = first_harmonic(&vel, &time, omega) / u1;
+            if let Some(pv) = prev {
+                // Absolute floor: inside the dead zone the response is ~0.
+                if period + 1 >= MIN_PERIODS && (g - pv).abs() <= 1e-4 * g.abs() + 1e-9 {
+                    break;
+                }
+            }
+            prev = Some(g);
+        }
+        out.push(ActuatorFrfPoint {
+            freq_hz: f,
+            omega_radps: omega,
+            modulus_per_s: g.abs(),
+            phase_deg: g.arg_deg(),
+        });
+    }
+    Ok(out)
+}
+
+/// FRF `u -> rod velocity` of the linearised reduced-order model (3.73), linearised at
+/// `z_hat = h(U)` and `P_L_hat = load_pressure_hat_pa` (seed: 0.75 P_S). The dead zone
+/// enters through its describing-function gain at amplitude `U` (a linear model has
+/// no dead zone; this makes it comparable with the non-linear FRFs).
+pub fn linearised_actuator_frf(
+    params: &ActuatorParams,
+    amplitude_m: f64,
+    load_pressure_hat_pa: f64,
+    freqs_hz: &[f64],
+) -> Result<Vec<ActuatorFrfPoint>, StepError> {
+    positive_input("amplitude_m", amplitude_m)?;
+    params.validate()?;
+    let z_hat = params.dead_zone(amplitude_m);
+    let n_dz = dead_zone_describing_gain(params, amplitude_m);
+    Ok(freqs_hz
+        .iter()
+        .map(|&f| {
+            let omega = 2.0 * PI * f;
+            let g = params
+                .linearised_tf(Complex::jw(omega), z_hat, load_pressure_hat_pa)
+                .scale(n_dz);
+            ActuatorFrfPoint {
+                freq_hz: f,
+                omega_radps: omega,
+                modulus_per_s: g.abs(),
+                phase_deg: g.arg_deg(),
+            }
+        })
+        .collect())
+}
+
+/// The seed's actuator FRF set (Figures 3.18-3.22): 1..320 Hz, |u| = alpha and
+/// 0.3 alpha, for the full-order, reduced-order and linearised (P_L_hat = 0.75 P_S)
+/// models. Returns `(amplitude_m, full, reduced, linearised)` per amplitude.
+#[allow(clippy::type_complexity)]
+pub fn seed_actuator_frfs(
+    params: &ActuatorParams,
+    n_freqs: usize,
+) -> Result<
+    Vec<(
+        f64,
+        Vec<ActuatorFrfPoint>,
+        Vec<ActuatorFrfPoint>,
+        Vec<ActuatorFrfPoint>,
+    )>,
+    StepError,
+> {
+    let freqs = log_space(1.0, 320.0, n_freqs);
+    let mut out = Vec::new();
+    for amp in [params.alpha_m, 0.3 * params.alpha_m] {
+        let full = actuator_frf(params, ActuatorModel::FullOrder, amp, &freqs)?;
+        let red = actuator_frf(params, ActuatorModel::ReducedOrder, amp, &freqs)?;
+        let lin = linearised_actuator_frf(params, amp, 0.75 * params.supply_pressure_pa, &freqs)?;
+        out.push((amp, full, red, lin));
+    }
+    Ok(out)
+}

@@ -1,0 +1,397 @@
+//! Semi-active yaw damper: simplified Ferdek-Luczko model with a by-pass proportional
+//! valve, seed section 3.3.2-3.3.3, equations (3.38)-(3.45).
+//!
+//! # Model
+//! One hydraulic state, the pressure difference `dP = P_A - P_B` (rebound minus
+//! compression chamber), plus the valve opening `x_v` when the valve is not ideal:
+//!
+//! ```text
+//! F      = A_eff dP                                                   (3.38)
+//! Q_f    = C_f  g(dP)                 piston (internal valve) flow    (3.42)
+//! Q_v    = c_d A_v x_v sqrt(2/rho) g(dP)   by-pass valve flow         (3.44)
+//! dP'    = K/V0 ( f(v) - Q_f - Q_v )                                  (3.43)/(3.45)
+//! g(dP)  = dP / (dP^2 + dP_t^2)^(1/4)  ~ sqrt(|dP|) sign(dP) for |dP| >> dP_t
+//! f(v)   = Q_ref v / ( v_ref^(1/3) (v^2 + v_lin^2)^(1/3) ) ~ Q_ref cbrt(v / v_ref)
+//! ```
+//!
+//! Interpretations (the seed is wrong or silent):
+//! * **(3.45) applies the square root twice** (`c_d A_v x_v sqrt(2 dP/rho) sqrt(dP)`),
+//!   which is dimensionally wrong; we use the by-pass flow exactly as in (3.44).
+//! * **Regularisation**: the orifice law `sqrt(|dP|) sign(dP)` has infinite slope at
+//!   `dP = 0`; `g` replaces it by a laminar (linear) law for `|dP| << dP_t` and is
+//!   smooth everywhere (`dP_t` = `laminar_pressure_pa`). The cubic-root velocity
+//!   function of (3.43)/Fig. 3.8 is likewise given a linear core below `v_lin`.
+//! * **Signs**: elongation velocity `v > 0` is extension; it compresses the rebound
+//!   chamber A, so `f(v) > 0` raises `dP` and the force `F = A_eff dP` is positive in
+//!   **tension** (opposing extension: `F ~ +c v`).
+//! * The constants `C_f`, `K`, `f`, `c_d A_v` are not in the seed: they are calibrated
+//!   (see [`SemiActiveParams::default`]) against R1-R2 with Table 3-1's area and a 1 l
+//!   chamber; the effective bulk modulus is well below pure oil (entrained air, hoses).
+//! * Outputs: `dissipated_power_w = dP (Q_f + Q_v) >= 0` (orifice losses) and
+//!   `mechanical_power_w = F v` (power taken from the vehicle; momentarily negative when
+//!   the oil compliance gives energy back). The simplified model is not
+//!   energy-consistent (f is not `A v`), so their cycle means differ.
+//! * The elongation input is not used by the simplified model (force depends on the
+//!   velocity history only); it is accepted for interface uniformity.
+//!
+//! Numerics: see [`crate::ode`] (Rosenbrock ode23s with error control, inputs held).
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{finite_input, non_negative, positive, ParamError, StepError};
+use crate::ode::{integrate, Rhs, SolverSettings};
+use crate::valve::{check_opening, ValveModel, ValveParams};
+
+/// Parameters of the simplified semi-active damper (SI units).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SemiActiveParams {
+    /// `A_eff` of (3.38), m^2. Table 3-1 piston (annulus) area 25.16 cm^2.
+    pub effective_area_m2: f64,
+    /// `V0` of (3.41), m^3. Table 3-1 chamber volume 1 l.
+    pub chamber_volume_m3: f64,
+    /// Effective bulk modulus `K`, Pa. Calibrated (R1-R2); pure oil is ~1.5e9 Pa.
+    pub bulk_modulus_pa: f64,
+    /// `C_f` of (3.42), m^3/(s Pa^0.5). Calibrated (R1 at 0 % opening).
+    pub piston_flow_coeff: f64,
+    /// `f(v_ref)` of the cubic-root velocity function (3.43), m^3/s. Calibrated.
+    pub velocity_flow_ref_m3ps: f64,
+    /// Reference velocity `v_ref` of `f`, m/s.
+    pub velocity_ref_mps: f64,
+    /// Linear-core velocity `v_lin` of `f`, m/s (regularisation).
+    pub velocity_linear_mps: f64,
+    /// `c_d` of (3.44), discharge (contraction) coefficient.
+    pub valve_discharge_coeff: f64,
+    /// `A_v` of (3.44), by-pass passage area when fully open, m^2. Calibrated (R1 at 100 %).
+    pub valve_area_m2: f64,
+    /// `rho` of (3.44), kg/m^3. Table 3-2 oil density 844.4.
+    pub oil_density_kgpm3: f64,
+    /// `dP_t`, laminar/turbulent transition pressure of the regularised orifices, Pa.
+    pub laminar_pressure_pa: f64,
+    /// If set, the valve is fixed at this opening (0..1) and the command is ignored
+    /// (passive reference damper: 0.3, seed section 4.3).
+    pub fixed_opening: Option<f64>,
+    /// Command-to-opening dynamics.
+    pub valve: ValveParams,
+    /// Internal integrator settings.
+    pub solver: SolverSettings,
+}
+
+impl Default for SemiActiveParams {
+    /// Calibrated (examples/search.rs, examples/calibrate.rs) so that at 4 Hz, +-1 mm
+    /// and +-3 mm the peak force is 12-20 kN at 0 % and 0.5-1 kN at 100 % opening (R1)
+    /// with the equivalent stiffness at 0 % peaking as high in frequency as R1 allows
+    /// (about 4.7 Hz, see the crate docs). Only the products `K Q_ref`, `K C_f`,
+    /// `K c_d A_v` matter for `dP`; `K` is fixed at 3e8 Pa, a fifth of pure oil
+    /// (entrained air and hose compliance, REFERENCE.md) and the rest follows.
+    fn default() -> Self {
+        Self {
+            effective_area_m2: 25.16e-4,    // Table 3-1 piston (annulus) area
+            chamber_volume_m3: 1e-3,        // Table 3-1 chamber volume
+            bulk_modulus_pa: 3.0e8,         // chosen: ~K_oil/5 (air, hoses)
+            piston_flow_coeff: 1.6e-7,      // calibrated, R1 at 0 %
+            velocity_flow_ref_m3ps: 7.9e-4, // calibrated, R1 at 0 % and k_eq peak
+            velocity_ref_mps: 0.1,          // scale of f only
+            velocity_linear_mps: 1e-4,      // regularisation of the cubic root
+            valve_discharge_coeff: 0.7,     // typical sharp-edged orifice
+            valve_area_m2: 3.7e-5,          // calibrated, R1 at 100 % (~6.9 mm bore)
+            oil_density_kgpm3: 844.4,       // Table 3-2
+            laminar_pressure_pa: 3e5,       // 3 bar laminar core, R1 at 100 % (see docs)
+            fixed_opening: None,
+            valve: ValveParams::default(),
+            solver: SolverSettings::default(),
+        }
+    }
+}
+
+impl SemiActiveParams {
+    /// Passive reference damper: the semi-active damper with the valve fixed at 30 %
+    /// (seed section 4.3).
+    pub fn passive_reference() -> Self {
+        Self::default().with_fixed_opening(0.3)
+    }
+
+    /// The same parameters with the valve fixed at `opening` (0..1), ideal valve.
+    pub fn with_fixed_opening(self, opening: f64) -> Self {
+        Self {
+            fixed_opening: Some(opening),
+            valve: ValveParams {
+                model: ValveModel::Ideal,
+                ..self.valve
+            },
+            ..self
+        }
+    }
+
+    /// Checks every parameter; the error names the first bad one.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        positive("effective_area_m2", self.effective_area_m2)?;
+        positive("chamber_volume_m3", self.chamber_volume_m3)?;
+        positive("bulk_modulus_pa", self.bulk_modulus_pa)?;
+        non_negative("piston_flow_coeff", self.piston_flow_coeff)?;
+        non_negative("velocity_flow_ref_m3ps", self.velocity_flow_ref_m3ps)?;
+        positive("velocity_ref_mps", self.velocity_ref_mps)?;
+        positive("velocity_linear_mps", self.velocity_linear_mps)?;
+        non_negative("valve_discharge_coeff", self.valve_discharge_coeff)?;
+        non_negative("valve_area_m2", self.valve_area_m2)?;
+        positive("oil_density_kgpm3", self.oil_density_kgpm3)?;
+        positive("laminar_pressure_pa", self.laminar_pressure_pa)?;
+        if self.piston_flow_coeff == 0.0 && self.valve_area_m2 * self.valve_discharge_coeff == 0.0 {
+            return Err(ParamError::OutOfRange {
+                name: "piston_flow_coeff",
+                value: 0.0,
+                reason: "with a closed by-pass the damper needs C_f > 0",
+            });
+        }
+        if let Some(x) = self.fixed_opening {
+            check_opening("fixed_opening", x)?;
+        }
+        self.valve.validate()?;
+        self.solver.validate()?;
+        Ok(())
+    }
+
+    /// `K/V0`, 1/s per (m^3/s) -> Pa/s per m^3/s.
+    pub fn stiffness_ratio(&self) -> f64 {
+        self.bulk_modulus_pa / self.chamber_volume_m3
+    }
+
+    /// By-pass coefficient at full opening, `c_d A_v sqrt(2/rho)`, m^3/(s Pa^0.5).
+    pub fn valve_flow_coeff(&self) -> f64 {
+        self.valve_discharge_coeff * self.valve_area_m2 * (2.0 / self.oil_density_kgpm3).sqrt()
+    }
+
+    /// Regularised signed square root `g(dP)`, Pa^0.5.
+    pub fn orifice_law(&self, dp: f64) -> f64 {
+        orifice_law(dp, self.laminar_pressure_pa)
+    }
+
+    /// Velocity function `f(v)` of (3.43), m^3/s (cubic-root shaped).
+    pub fn velocity_flow(&self, v: f64) -> f64 {
+        let vl = self.velocity_linear_mps;
+        self.velocity_flow_ref_m3ps * v / (self.velocity_ref_mps.cbrt() * (v * v + vl * vl).cbrt())
+    }
+
+    /// Total orifice coefficient at opening `x` (piston + by-pass), m^3/(s Pa^0.5).
+    pub fn total_flow_coeff(&self, x: f64) -> f64 {
+        self.piston_flow_coeff + self.valve_flow_coeff() * x.clamp(0.0, 1.0)
+    }
+}
+
+/// `g(dP) = dP / (dP^2 + dP_t^2)^(1/4)`: signed square root with a laminar core.
+pub fn orifice_law(dp: f64, dp_t: f64) -> f64 {
+    dp / (dp * dp + dp_t * dp_t).sqrt().sqrt()
+}
+
+/// Inputs of one communication step (held constant over the step).
+#[derive(Clone, Copy, Debug, PartialEq, Default, Serialize, Deserialize)]
+pub struct SemiActiveInputs {
+    /// Damper elongation, m (positive = extension). Not used by the simplified model.
+    pub elongation_m: f64,
+    /// Elongation velocity, m/s (positive = extension).
+    pub elongation_velocity_mps: f64,
+    /// Valve command, V (0 = closed, 10 = fully open).
+    pub valve_command_v: f64,
+}
+
+/// Outputs at the current time.
+#[derive(Clone, Copy, Debug, PartialEq, Default, Serialize, Deserialize)]
+pub struct SemiActiveOutputs {
+    /// Damper force, N, positive in tension (opposes extension).
+    pub force_n: f64,
+    /// Pressure difference `P_A - P_B`, Pa.
+    pub pressure_difference_pa: f64,
+    /// Actual valve opening, 0..1.
+    pub valve_opening: f64,
+    /// Commanded valve opening after clamping, 0..1.
+    pub valve_opening_command: f64,
+    /// True if the last command was outside 0..10 V and was clamped (log a warning).
+    pub command_clamped: bool,
+    /// Orifice loss power `dP (Q_f + Q_v)`, W (>= 0).
+    pub dissipated_power_w: f64,
+    /// Power taken from the vehicle `F v`, W.
+    pub mechanical_power_w: f64,
+}
+
+/// Semi-active (or passive, with a fixed opening) yaw damper: parameters + state.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SemiActiveDamper {
+    params: SemiActiveParams,
+    /// Pressure difference `dP`, Pa.
+    dp_pa: f64,
+    /// Actual valve opening, 0..1.
+    opening: f64,
+    /// Simulated time, s.
+    time_s: f64,
+    /// Last proposed internal step size, s.
+    h_internal_s: f64,
+    /// Inputs used for the outputs (last step's).
+    inputs: SemiActiveInputs,
+    /// Last commanded opening and clamp flag.
+    opening_command: f64,
+    command_clamped: bool,
+}
+
+struct SemiRhs<'a> {
+    p: &'a SemiActiveParams,
+    k_over_v: f64,
+    cf: f64,
+    cv: f64,
+    q_in: f64,
+    x_cmd: f64,
+}
+
+impl Rhs<2> for SemiRhs<'_> {
+    fn rhs(&self, y: &[f64; 2]) -> [f64; 2] {
+        let x = y[1].clamp(0.0, 1.0);
+        let g = orifice_law(y[0], self.p.laminar_pressure_pa);
+        // (3.43) + (3.44): piston flow and by-pass flow leave the pressure difference.
+        let dp_dot = self.k_over_v * (self.q_in - (self.cf + self.cv * x) * g);
+        [dp_dot, self.p.valve.opening_rate(y[1], self.x_cmd)]
+    }
+}
+
+impl SemiActiveDamper {
+    /// New damper at rest (`dP = 0`), valve at the fixed opening or closed.
+    pub fn new(params: SemiActiveParams) -> Result<Self, ParamError> {
+        params.validate()?;
+        let opening = params.fixed_opening.unwrap_or(0.0);
+        Ok(Self {
+            params,
+            dp_pa: 0.0,
+            opening,
+            time_s: 0.0,
+            h_internal_s: 1e-4,
+            inputs: SemiActiveInputs::default(),
+            opening_command: opening,
+            command_clamped: false,
+        })
+    }
+
+    /// Passive reference damper (30 % fixed opening).
+    pub fn passive_reference() -> Result<Self, ParamError> {
+        Self::new(SemiActiveParams::passive_reference())
+    }
+
+    /// Parameters in use.
+    pub fn params(&self) -> &SemiActiveParams {
+        &self.params
+    }
+
+    /// Simulated time, s.
+    pub fn time_s(&self) -> f64 {
+        self.time_s
+    }
+
+    /// Sets the actual valve opening (initialisation), 0..1.
+    pub fn set_opening(&mut self, opening: f64) -> Result<(), ParamError> {
+        check_opening("opening", opening)?;
+        self.opening = opening;
+        self.opening_command = opening;
+        Ok(())
+    }
+
+    /// Sets the pressure difference state (initialisation), Pa.
+    pub fn set_pressure_difference(&mut self, dp_pa: f64) -> Result<(), ParamError> {
+        if !dp_pa.is_finite() {
+            return Err(ParamError::NotFinite {
+                name: "pressure_difference_pa",
+                value: dp_pa,
+            });
+        }
+        self.dp_pa = dp_pa;
+        Ok(())
+    }
+
+    /// Sets the inputs seen by [`Self::outputs`] without stepping (initialisation).
+    /// Also applies the command to an ideal valve.
+    pub fn set_inputs(&mut self, inputs: &SemiActiveInputs) -> Result<(), StepError> {
+        let x_cmd = self.check_inputs(inputs)?;
+        self.inputs = *inputs;
+        if self.params.valve.model == ValveModel::Ideal {
+            self.opening = x_cmd;
+        }
+        Ok(())
+    }
+
+    fn check_inputs(&mut self, inputs: &SemiActiveInputs) -> Result<f64, StepError> {
+        finite_input("elongation_m", inputs.elongation_m)?;
+        finite_input("elongation_velocity_mps", inputs.elongation_velocity_mps)?;
+        let (x_cmd, clamped) = match self.params.fixed_opening {
+            Some(x) => (x, false),
+            None => {
+                let c = self.params.valve.command(inputs.valve_command_v)?;
+                (c.opening, c.clamped)
+            }
+        };
+        self.opening_command = x_cmd;
+        self.command_clamped = clamped;
+        Ok(x_cmd)
+    }
+
+    /// Advances the model by `h` seconds with inputs held constant.
+    pub fn step(
+        &mut self,
+        h: f64,
+        inputs: &SemiActiveInputs,
+    ) -> Result<SemiActiveOutputs, StepError> {
+        if !(h.is_finite() && h > 0.0) {
+            return Err(StepError::BadStepSize { h });
+        }
+        let x_cmd = self.check_inputs(inputs)?;
+        self.inputs = *inputs;
+        if self.params.valve.model == ValveModel::Ideal {
+            self.opening = x_cmd;
+        }
+        let p = &self.params;
+        let sys = SemiRhs {
+            p,
+            k_over_v: p.stiffness_ratio(),
+            cf: p.piston_flow_coeff,
+            cv: p.valve_flow_coeff(),
+            q_in: p.velocity_flow(inputs.elongation_velocity_mps),
+            x_cmd,
+        };
+        let mut y = [self.dp_pa, self.opening];
+        // Absolute tolerances: 1 Pa (0.0025 N of force), 1e-9 of opening.
+        let atol = [1.0, 1e-9];
+        let mut h_int = self.h_internal_s;
+        integrate(&sys, &mut y, &atol, h, &mut h_int, &p.solver)?;
+        if !(y[0].is_finite() && y[1].is_finite()) {
+            return Err(StepError::NonFinite {
+                name: "pressure_difference_pa",
+            });
+        }
+        self.dp_pa = y[0];
+        self.opening = y[1].clamp(0.0, 1.0);
+        self.h_internal_s = h_int;
+        self.time_s += h;
+        self.outputs()
+    }
+
+    /// Outputs at the current time (no stepping).
+    pub fn outputs(&self) -> Result<SemiActiveOutputs, StepError> {
+        let p = &self.params;
+        let dp = self.dp_pa;
+        let force = p.effective_area_m2 * dp; // (3.38)
+        let q = p.total_flow_coeff(self.opening) * orifice_law(dp, p.laminar_pressure_pa);
+        let out = SemiActiveOutputs {
+            force_n: force,
+            pressure_difference_pa: dp,
+            valve_opening: self.opening,
+            valve_opening_command: self.opening_command,
+            command_clamped: self.command_clamped,
+            dissipated_power_w: dp * q,
+            mechanical_power_w: force * self.inputs.elongation_velocity_mps,
+        };
+        for (name, v) in [
+            ("force_n", out.force_n),
+            ("dissipated_power_w", out.dissipated_power_w),
+            ("mechanical_power_w", out.mechanical_power_w),
+        ] {
+            if !v.is_finite() {
+                return Err(StepError::NonFinite { name });
+            }
+        }
+        Ok(out)
+    }
+}
