@@ -1,0 +1,28 @@
+# Sourced by the scripts: installs the system package and the Python tools the project needs.
+VENV="$PWD/.venv"
+
+step() { printf '\n==> %s\n' "$*"; }
+
+as_root() {
+  if [ "$(id -u)" = 0 ]; then "$@"; elif command -v sudo >/dev/null; then sudo "$@"; else
+    echo "need root to run: $*" >&2; return 1; fi
+}
+
+# libclang: fmi-sys generates its FMI 2.0 bindings with bindgen at build time.
+if ! ldconfig -p 2>/dev/null | grep -q 'libclang\(-[0-9.]*\)\?\.so'; then
+  step "installing libclang-dev (needed by fmi-sys/bindgen)"
+  as_root apt-get update -qq
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libclang-dev >/dev/null
+fi
+
+# fmpy in a local virtual environment (validation and the cross-checks).
+if [ ! -x "$VENV/bin/fmpy" ]; then
+  step "creating $VENV with fmpy"
+  python3 -m venv "$VENV"
+  "$VENV/bin/pip" install -q --upgrade pip >/dev/null
+  "$VENV/bin/pip" install -q "fmpy==0.3.32" >/dev/null
+fi
+
+package_fmus() {
+  cargo run --release -q -p model-description --bin package-fmus
+}

@@ -1,0 +1,61 @@
+"""Validate every FMU in a folder with fmpy and simulate it over its default experiment.
+
+Usage: python check_fmus.py DIST_DIR OUT_DIR
+Writes OUT_DIR/<model>.csv (time and every output) for the Rust cross-check
+(tests/tests/fmpy_agreement.rs). Exits non-zero on any validation problem or failed simulation.
+"""
+import csv
+import os
+import sys
+
+from fmpy import read_model_description, simulate_fmu
+from fmpy.validation import validate_fmu
+
+
+def main(dist, out):
+    os.makedirs(out, exist_ok=True)
+    fmus = sorted(f for f in os.listdir(dist) if f.endswith(".fmu"))
+    if not fmus:
+        print(f"no FMU in {dist}", file=sys.stderr)
+        return 1
+    failed = 0
+    for name in fmus:
+        path = os.path.join(dist, name)
+        problems = validate_fmu(path)
+        if problems:
+            failed += 1
+            print(f"{name}: {len(problems)} validation problem(s)")
+            for p in problems:
+                print(f"  {p}")
+            continue
+        md = read_model_description(path)
+        de = md.defaultExperiment
+        start, stop, step = float(de.startTime), float(de.stopTime), float(de.stepSize)
+        outputs = [v.name for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+        try:
+            result = simulate_fmu(
+                path,
+                fmi_type="CoSimulation",
+                start_time=start,
+                stop_time=stop,
+                step_size=step,
+                output_interval=step,
+                output=outputs,
+            )
+        except Exception as e:  # report and go on with the other FMUs
+            failed += 1
+            print(f"{name}: simulation failed: {e}")
+            continue
+        model = name[:-4]
+        with open(os.path.join(out, model + ".csv"), "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["time"] + outputs)
+            for row in result:
+                w.writerow([repr(float(x)) for x in row])
+        print(f"{name}: valid; simulated {start}..{stop} s, {len(result)} rows, {len(outputs)} outputs")
+    print(f"{len(fmus) - failed} passed, {failed} failed")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1], sys.argv[2]))
