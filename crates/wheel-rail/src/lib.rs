@@ -1,1 +1,71 @@
-//! Wheel/rail contact geometry.
+//! Wheel/rail contact geometry from real profiles (issue 8): rigid contact search, rolling radius
+//! difference Δr(y), contact angles, roll angle and the EN 15302 equivalent conicity.
+//!
+//! # API (what the master's `contact-geometry` command calls)
+//! ```no_run
+//! use wheel_rail::{compute_table, equivalent_conicity, ContactSetup, Profile};
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let wheel = Profile::from_file("RUIC519A.dat")?; // mm, see `profile` for the formats
+//! let rail = Profile::from_file("SUIC519A.dat")?;
+//! let setup = ContactSetup::symmetric(wheel, rail, 0.46, 1.43516); // or fill the struct
+//! let table = compute_table(&setup, -10e-3, 10e-3, 0.05e-3)?; // SI units
+//! let c = equivalent_conicity(&table, 3e-3)?; // c.tan_gamma_e, c.wavelength_m
+//! std::fs::write("wheel_rail.csv", table.to_bogie_csv())?;
+//! # Ok(()) }
+//! ```
+//! `cargo run -p wheel-rail --release --example bogie_table` regenerates
+//! `crates/fmu-bogie2dof/resources/wheel_rail_A_A.csv` (E1 case).
+//!
+//! # Coordinate conventions (established from the EN 15302 benchmark data, `data/`)
+//! * **Profile files**: lateral coordinate positive towards the FIELD side (away from the track
+//!   centre; the wheel flange is at negative lateral values: flange tip of wheel A at -55 mm,
+//!   back of flange at -70 mm), vertical positive UP, millimetres.
+//! * **Wheel origin** = nominal rolling circle (taping line, 70 mm from the back face for wheel A):
+//!   rolling radius at lateral s is `r0 - z(s)`.
+//! * **Rail origin**: a point of the rail head (z = 0 at s = 0, top of rail at z = +0.49 mm,
+//!   s = +14.3 mm). In the E1 set-up the rail origins sit at ±750 mm, i.e. at the same lateral
+//!   position as the wheel taping lines of the centred wheelset (profile origins 1500 mm apart);
+//!   the gauge 1435.16 mm measured 14 mm below the top of rail places them at ±749.98 mm, which is
+//!   what [`ContactSetup::symmetric`] does (gauge face point at s = -32.40 mm).
+//! * **Rail inclination is already in the rail file.** Circle fits of the 60E1 head arcs in
+//!   SUIC519A.dat (R13 corners centred at (-19.65, -15.88) and (26.34, -13.60) mm, R80 at
+//!   (-1.06, -80.40) and (14.30, -79.50), R300 at (17.58, -299.18)) all lie on one axis tilted by
+//!   0.0496 rad (≈ 1:20) towards the track centre. Applying any additional rotation makes the E1
+//!   agreement worse (±0.001 rad doubles the RMS error), so [`ContactSetup::rail_inclination`] is
+//!   the rotation to APPLY to a profile given upright (e.g. 1/40), and 0 for the benchmark rail.
+//! * **Track frame**: Y positive to the RIGHT, Z up; the right rail at Y > 0; left-side profiles
+//!   are mirrored.
+//! * **y** = wheelset lateral displacement, positive to the RIGHT, i.e. the right wheel moves
+//!   towards its flange contact, so Δr = r_right - r_left > 0 for y > 0 (the E1 reference file is
+//!   antisymmetric with Δr > 0 for y > 0, consistent with this). y is measured at RAIL LEVEL (centre
+//!   plane of the wheelset at the height of the nominal rolling circles); measuring it at the axle
+//!   centre shifts it by r0·sin(roll) and worsens the E1 agreement from 0.058 to 0.26 mm RMS, so
+//!   rail level is the benchmark's convention ([`LateralReference`]).
+//! * **Roll** positive = right wheel up. **Contact angle** tanγ of each wheel is the slope of the
+//!   contact tangent in the track frame, positive when the surface rises towards the field side
+//!   (conical tread), large on the flange (wheel A: up to 2.79 = 70°).
+//!
+//! # Method and limits
+//! Rigid, single-point contact per wheel, piecewise-linear profiles (see [`contact`]); the flange
+//! limit is the steepest point of the flange (E1: |y| = 7.45 mm), beyond it the table repeats the
+//! last row. The equivalent conicity follows EN 15302 Annex B (see [`conicity`]).
+//!
+//! E1 results: Δr within 0.1 mm of the reference for 111 of 121 points with |y| <= 6 mm (RMS 0.058
+//! mm, max 0.20 mm at |y| = 5.9 mm in the nearly conformal flange-root zone; all points within
+//! 0.1 mm for |y| <= 3 mm); tread-to-flange-root jump at 6.21-6.22 mm (reference 6.2-6.3), flange
+//! contact (tanγ > 1) from 6.61 mm, largest Δr jump 9.3 -> 12.1 mm at 6.68-6.69 mm; tanγe = 0.126 /
+//! 0.192 / 0.260 / 0.525 at 1 / 3 / 5 / 7 mm (EN 15302 Annex E: 0.125 / 0.188 / 0.254 / 0.505).
+//!
+//! This crate is offline geometry (no time stepping), so it has no `Params`/`step` model; the
+//! bogie FMU reads the generated CSV.
+
+pub mod conicity;
+pub mod contact;
+pub mod profile;
+
+pub use conicity::{equivalent_conicity, harmonic_linearisation, Conicity, ConicityError, DeltaR};
+pub use contact::{
+    compute_table, solve_contact, ContactError, ContactRow, ContactSetup, ContactTable,
+    LateralReference, RailPlacement, WheelContact, WheelPlacement, BOGIE_CSV_HEADER,
+};
+pub use profile::{Profile, ProfileError, MIN_POINTS};

@@ -1,0 +1,37 @@
+//! Writes the wheel/rail table of the bogie model for EN 15302 case E1 (wheel A / rail A both
+//! sides, 920 mm wheels, gauge 1435.16 mm): y from -10 to +10 mm in 0.05 mm steps.
+//!
+//! `cargo run -p wheel-rail --release --example bogie_table [output.csv]`
+//! (default output: crates/fmu-bogie2dof/resources/wheel_rail_A_A.csv).
+
+use wheel_rail::{compute_table, equivalent_conicity, ContactSetup, Profile};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let here = env!("CARGO_MANIFEST_DIR");
+    let out = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| format!("{here}/../fmu-bogie2dof/resources/wheel_rail_A_A.csv"));
+    let wheel = Profile::from_file(format!("{here}/data/RUIC519A.dat"))?;
+    let rail = Profile::from_file(format!("{here}/data/SUIC519A.dat"))?;
+    let setup = ContactSetup::symmetric(wheel, rail, 0.920 / 2.0, 1.43516);
+    let table = compute_table(&setup, -10e-3, 10e-3, 0.05e-3)?;
+    if let Some(dir) = std::path::Path::new(&out).parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    std::fs::write(&out, table.to_bogie_csv())?;
+    println!(
+        "wrote {out}: {} rows, reachable y in [{:.2}, {:.2}] mm (flange limit), e0 = {:.2} mm",
+        table.rows.len(),
+        table.y_reachable_min_m * 1e3,
+        table.y_reachable_max_m * 1e3,
+        table.e0_m * 1e3
+    );
+    for a_mm in [1.0, 3.0, 5.0, 7.0] {
+        let c = equivalent_conicity(&table, a_mm * 1e-3)?;
+        println!(
+            "equivalent conicity at {a_mm} mm: {:.4} (wavelength {:.2} m)",
+            c.tan_gamma_e, c.wavelength_m
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,857 @@
+//! Rigid wheel/rail contact search over the wheelset lateral displacement.
+//!
+//! Track frame: lateral `Y` positive to the RIGHT (looking in the direction of travel), vertical `Z`
+//! positive UP, origin on the track centre line at the height of the rail-profile origins.
+//! The right rail lies at `Y > 0`. A profile point `(s, z)` (lateral towards the field side, up) of
+//! the right side maps to `Y = offset + s`, of the left side to `Y = -(offset + s)` (mirror image).
+//!
+//! Wheelset: wheel profile point `(s, z)` is at `Ŷ = ±(d + s)`, `Ẑ = z - r0` relative to the axle
+//! centre (`d` = half distance of the profile origins, `r0` = nominal radius of that wheel), so the
+//! rolling radius at `s` is `r0 - z(s)`. The wheelset is displaced by `y` laterally and rolled by
+//! `φ` (positive = right wheel up) about a pivot on its centre plane, at rail level (default,
+//! [`LateralReference::RailLevel`]) or at the axle centre. For each `y` the roll angle and the
+//! vertical position are solved so that the minimum VERTICAL gap between the wheel and rail
+//! polylines is zero on both sides (rigid, single-point contact per side; the global minimum is
+//! taken, so the jump from tread to flange contact appears as a jump of the contact point).
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::profile::{Profile, ProfileError};
+
+/// Half width of the central difference used for the contact-angle slope [m].
+const SLOPE_HALF_WINDOW_M: f64 = 0.25e-3;
+/// A wheel whose steepest rising segment exceeds this slope is considered flanged; its flange limit
+/// is the steepest point of the active flange face.
+const FLANGE_MIN_SLOPE: f64 = 1.0;
+
+/// Errors of the contact geometry.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ContactError {
+    /// A setup parameter is invalid.
+    #[error("invalid parameter `{name}` = {value}: {reason}")]
+    Param {
+        /// Parameter name.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+        /// Why it is invalid.
+        reason: &'static str,
+    },
+    /// A profile problem (e.g. rail not single-valued after applying the inclination).
+    #[error(transparent)]
+    Profile(#[from] ProfileError),
+    /// A reference point (gauge point, flange face point) was not found on a profile.
+    #[error("{profile}: {what} not found")]
+    ReferencePoint {
+        /// Profile name.
+        profile: String,
+        /// What was searched.
+        what: String,
+    },
+    /// The wheel and rail do not overlap laterally, or the rolled wheel is not single-valued.
+    #[error("no contact on the {side} side at y = {y_m} m: {reason}")]
+    NoContact {
+        /// "left" or "right".
+        side: &'static str,
+        /// Lateral displacement.
+        y_m: f64,
+        /// Reason.
+        reason: &'static str,
+    },
+    /// The roll angle equation could not be solved.
+    #[error("roll angle not found at y = {y_m} m (searched up to |phi| = {limit_rad} rad)")]
+    RollNotFound {
+        /// Lateral displacement.
+        y_m: f64,
+        /// Search limit.
+        limit_rad: f64,
+    },
+}
+
+/// How the wheels are placed laterally on the axle.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum WheelPlacement {
+    /// Lateral distance between the origins of the two wheel profiles (nominal rolling circles),
+    /// e.g. 1.500 m for the EN 15302 benchmark profiles.
+    RollingCircleDistance {
+        /// Distance [m].
+        distance_m: f64,
+    },
+    /// Back-to-back distance of the wheels plus the lateral distance from each wheel's back face
+    /// to its profile origin (S1002: 70 mm): origin distance = B + 2 * offset.
+    BackToBack {
+        /// Back-to-back distance [m] (1.360 m nominal for standard gauge).
+        back_to_back_m: f64,
+        /// Back face to profile origin (taping line) [m].
+        back_face_to_origin_m: f64,
+    },
+    /// Distance between the active flange faces, each measured `measuring_depth_m` below the
+    /// profile origin (e.g. 10 mm below the tread datum).
+    FlangeFaces {
+        /// Distance [m].
+        distance_m: f64,
+        /// Measuring depth below the profile origin [m].
+        measuring_depth_m: f64,
+    },
+}
+
+/// How the rails are placed laterally.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum RailPlacement {
+    /// Track gauge between the gauge faces, measured `measuring_depth_m` (14 mm) below the highest
+    /// point of each (inclined) rail head. The gauge point is the first crossing of that level
+    /// coming from the gauge side of the rail profile.
+    Gauge {
+        /// Gauge [m].
+        gauge_m: f64,
+        /// Measuring depth below the top of rail [m].
+        measuring_depth_m: f64,
+    },
+    /// Lateral distance between the origins of the two rail profiles [m].
+    OriginDistance {
+        /// Distance [m].
+        distance_m: f64,
+    },
+}
+
+/// Where the wheelset lateral displacement `y` is measured (only differs by `h * sin(roll)`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LateralReference {
+    /// Centre plane of the wheelset at the level of the nominal rolling circles (rail level).
+    /// This is the convention that reproduces the EN 15302 E1 reference.
+    RailLevel,
+    /// Axle centre.
+    AxleCentre,
+}
+
+/// Everything that defines a contact-geometry computation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactSetup {
+    /// Left wheel profile (in its own frame: lateral towards the field side, vertical up).
+    pub wheel_left: Profile,
+    /// Right wheel profile.
+    pub wheel_right: Profile,
+    /// Left rail profile.
+    pub rail_left: Profile,
+    /// Right rail profile.
+    pub rail_right: Profile,
+    /// Nominal rolling radius of the left wheel at its profile origin [m] (diameter / 2).
+    pub nominal_radius_left_m: f64,
+    /// Nominal rolling radius of the right wheel [m].
+    pub nominal_radius_right_m: f64,
+    /// Lateral placement of the wheels on the axle.
+    pub wheel_placement: WheelPlacement,
+    /// Lateral placement of the rails.
+    pub rail_placement: RailPlacement,
+    /// Rail inclination to APPLY to the rail profiles as read, as a tangent (e.g. 1/40), positive
+    /// = rail head tilted towards the track centre. 0 for profiles already given in track
+    /// orientation, such as the EN 15302 rail A (which already contains its inclination).
+    pub rail_inclination: f64,
+    /// Where `y` is measured.
+    pub lateral_reference: LateralReference,
+}
+
+impl ContactSetup {
+    /// Same wheel profile on both sides, same rail on both sides, EN 15302 benchmark placement:
+    /// profile origins 1.500 m apart, gauge measured 14 mm below the top of rail, no additional
+    /// rail inclination, `y` measured at rail level.
+    pub fn symmetric(wheel: Profile, rail: Profile, nominal_radius_m: f64, gauge_m: f64) -> Self {
+        Self {
+            wheel_left: wheel.clone(),
+            wheel_right: wheel,
+            rail_left: rail.clone(),
+            rail_right: rail,
+            nominal_radius_left_m: nominal_radius_m,
+            nominal_radius_right_m: nominal_radius_m,
+            wheel_placement: WheelPlacement::RollingCircleDistance { distance_m: 1.5 },
+            rail_placement: RailPlacement::Gauge {
+                gauge_m,
+                measuring_depth_m: 0.014,
+            },
+            rail_inclination: 0.0,
+            lateral_reference: LateralReference::RailLevel,
+        }
+    }
+
+    /// Checks the numeric parameters; the error names the parameter.
+    pub fn validate(&self) -> Result<(), ContactError> {
+        let check = |name: &'static str, v: f64, lo: f64, hi: f64, reason: &'static str| {
+            if v.is_finite() && v > lo && v < hi {
+                Ok(())
+            } else {
+                Err(ContactError::Param {
+                    name,
+                    value: v,
+                    reason,
+                })
+            }
+        };
+        check(
+            "nominal_radius_left_m",
+            self.nominal_radius_left_m,
+            0.1,
+            2.0,
+            "must be a finite radius in (0.1, 2) m",
+        )?;
+        check(
+            "nominal_radius_right_m",
+            self.nominal_radius_right_m,
+            0.1,
+            2.0,
+            "must be a finite radius in (0.1, 2) m",
+        )?;
+        check(
+            "rail_inclination",
+            self.rail_inclination,
+            -0.2,
+            0.2,
+            "must be a finite tangent in (-0.2, 0.2)",
+        )?;
+        match self.wheel_placement {
+            WheelPlacement::RollingCircleDistance { distance_m } => check(
+                "wheel_placement.distance_m",
+                distance_m,
+                0.3,
+                3.0,
+                "must be in (0.3, 3) m",
+            )?,
+            WheelPlacement::BackToBack {
+                back_to_back_m,
+                back_face_to_origin_m,
+            } => {
+                check(
+                    "wheel_placement.back_to_back_m",
+                    back_to_back_m,
+                    0.3,
+                    3.0,
+                    "must be in (0.3, 3) m",
+                )?;
+                check(
+                    "wheel_placement.back_face_to_origin_m",
+                    back_face_to_origin_m,
+                    0.0,
+                    0.3,
+                    "must be in (0, 0.3) m",
+                )?;
+            }
+            WheelPlacement::FlangeFaces {
+                distance_m,
+                measuring_depth_m,
+            } => {
+                check(
+                    "wheel_placement.distance_m",
+                    distance_m,
+                    0.3,
+                    3.0,
+                    "must be in (0.3, 3) m",
+                )?;
+                check(
+                    "wheel_placement.measuring_depth_m",
+                    measuring_depth_m,
+                    0.0,
+                    0.05,
+                    "must be in (0, 0.05) m",
+                )?;
+            }
+        }
+        match self.rail_placement {
+            RailPlacement::Gauge {
+                gauge_m,
+                measuring_depth_m,
+            } => {
+                check(
+                    "rail_placement.gauge_m",
+                    gauge_m,
+                    0.3,
+                    3.0,
+                    "must be in (0.3, 3) m",
+                )?;
+                check(
+                    "rail_placement.measuring_depth_m",
+                    measuring_depth_m,
+                    0.0,
+                    0.05,
+                    "must be in (0, 0.05) m",
+                )?;
+            }
+            RailPlacement::OriginDistance { distance_m } => check(
+                "rail_placement.distance_m",
+                distance_m,
+                0.3,
+                3.0,
+                "must be in (0.3, 3) m",
+            )?,
+        }
+        Ok(())
+    }
+}
+
+/// Contact point of one wheel.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct WheelContact {
+    /// Contact position on the wheel profile, in the wheel profile's own lateral coordinate [m].
+    pub wheel_lateral_m: f64,
+    /// Contact position on the rail profile, in the rail file's own lateral coordinate [m].
+    pub rail_lateral_m: f64,
+    /// Contact point in the track frame: lateral [m] (positive right).
+    pub track_lateral_m: f64,
+    /// Contact point in the track frame: vertical [m] (rail surface height).
+    pub track_vertical_m: f64,
+    /// Rolling radius [m].
+    pub rolling_radius_m: f64,
+    /// Rolling radius minus the nominal radius of this wheel [m].
+    pub delta_radius_m: f64,
+    /// Tangent of the contact angle in the track frame, positive when the surface rises towards
+    /// the field side (conical tread), large on the flange.
+    pub tan_gamma: f64,
+}
+
+/// Contact state at one lateral displacement.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ContactRow {
+    /// Wheelset lateral displacement [m], positive to the right.
+    pub y_m: f64,
+    /// Left wheel contact.
+    pub left: WheelContact,
+    /// Right wheel contact.
+    pub right: WheelContact,
+    /// Roll angle [rad], positive = right wheel up.
+    pub roll_rad: f64,
+    /// Height of the axle centre above the rail-profile origin level [m].
+    pub axle_centre_height_m: f64,
+    /// Rolling radius difference r_right - r_left [m].
+    pub delta_r_m: f64,
+    /// True if this row lies beyond the flange limit (or the profiles' extent) and repeats the
+    /// last reachable row.
+    pub beyond_flange_limit: bool,
+}
+
+/// Rolling-radius-difference table over a uniform grid of lateral displacements.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ContactTable {
+    /// Rows, increasing `y`.
+    pub rows: Vec<ContactRow>,
+    /// Nominal radius of the left wheel [m].
+    pub nominal_radius_left_m: f64,
+    /// Nominal radius of the right wheel [m].
+    pub nominal_radius_right_m: f64,
+    /// Half the lateral distance between the left and right contact points at y = 0 [m].
+    pub e0_m: f64,
+    /// Smallest reachable `y` of the table (rows below repeat this one) [m].
+    pub y_reachable_min_m: f64,
+    /// Largest reachable `y` [m].
+    pub y_reachable_max_m: f64,
+}
+
+/// Exact header of [`ContactTable::to_bogie_csv`].
+pub const BOGIE_CSV_HEADER: &str =
+    "y_m,delta_r_left_m,delta_r_right_m,tan_gamma_left,tan_gamma_right";
+
+impl ContactTable {
+    /// The table as the bogie model's CSV (header [`BOGIE_CSV_HEADER`], SI units, one row per
+    /// grid point, rows beyond the flange limit repeat the last reachable values).
+    pub fn to_bogie_csv(&self) -> String {
+        let mut out = String::with_capacity(64 * (self.rows.len() + 1));
+        out.push_str(BOGIE_CSV_HEADER);
+        out.push('\n');
+        for r in &self.rows {
+            out.push_str(&format!(
+                "{:.7},{:.9},{:.9},{:.6},{:.6}\n",
+                r.y_m,
+                r.left.delta_radius_m,
+                r.right.delta_radius_m,
+                r.left.tan_gamma,
+                r.right.tan_gamma
+            ));
+        }
+        out
+    }
+
+    /// Rows within the reachable range.
+    pub fn reachable_rows(&self) -> impl Iterator<Item = &ContactRow> {
+        self.rows.iter().filter(|r| !r.beyond_flange_limit)
+    }
+
+    /// Mean nominal radius [m].
+    pub fn nominal_radius_mean_m(&self) -> f64 {
+        0.5 * (self.nominal_radius_left_m + self.nominal_radius_right_m)
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Side {
+    Left,
+    Right,
+}
+
+impl Side {
+    fn sign(self) -> f64 {
+        match self {
+            Side::Left => -1.0,
+            Side::Right => 1.0,
+        }
+    }
+    fn name(self) -> &'static str {
+        match self {
+            Side::Left => "left",
+            Side::Right => "right",
+        }
+    }
+}
+
+/// One side, prepared for the search.
+#[derive(Debug, Clone)]
+struct PreparedSide {
+    side: Side,
+    wheel: Profile,
+    r0: f64,
+    /// Half distance of the wheel profile origin from the wheelset centre plane.
+    d: f64,
+    /// Rail in the track frame, increasing Y: (Y, Z, lateral in the rail file frame).
+    rail: Vec<(f64, f64, f64)>,
+    /// Flange limit on the wheel profile (steepest point of the flange), if flanged.
+    flange_s: Option<f64>,
+}
+
+#[derive(Debug, Clone)]
+struct Prepared {
+    left: PreparedSide,
+    right: PreparedSide,
+    pivot_depth: f64,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct SideGap {
+    gap: f64,
+    s_wheel: f64,
+    s_rail: f64,
+    y_track: f64,
+    z_rail: f64,
+    at_end: bool,
+}
+
+/// Gauge point: first crossing of (top - depth) coming from the low-lateral (gauge) side.
+fn gauge_point(rail: &Profile, depth: f64) -> Result<f64, ContactError> {
+    let top = rail
+        .vertical_m
+        .iter()
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max);
+    let level = top - depth;
+    let xs = &rail.lateral_m;
+    let zs = &rail.vertical_m;
+    for i in 1..xs.len() {
+        if (zs[i - 1] - level) * (zs[i] - level) <= 0.0 && zs[i] != zs[i - 1] {
+            let t = (level - zs[i - 1]) / (zs[i] - zs[i - 1]);
+            return Ok(xs[i - 1] + t * (xs[i] - xs[i - 1]));
+        }
+    }
+    Err(ContactError::ReferencePoint {
+        profile: rail.name.clone(),
+        what: format!("gauge point {depth} m below the top of rail"),
+    })
+}
+
+/// Active flange face point: first crossing of z = -depth going from the origin towards the flange.
+fn flange_face_point(wheel: &Profile, depth: f64) -> Result<f64, ContactError> {
+    let xs = &wheel.lateral_m;
+    let zs = &wheel.vertical_m;
+    let level = -depth;
+    let start = xs.partition_point(|&x| x <= 0.0).min(xs.len() - 1);
+    for i in (1..=start).rev() {
+        if (zs[i - 1] - level) * (zs[i] - level) <= 0.0 && zs[i] != zs[i - 1] {
+            let t = (level - zs[i - 1]) / (zs[i] - zs[i - 1]);
+            return Ok(xs[i - 1] + t * (xs[i] - xs[i - 1]));
+        }
+    }
+    Err(ContactError::ReferencePoint {
+        profile: wheel.name.clone(),
+        what: format!("active flange face {depth} m below the profile origin"),
+    })
+}
+
+fn prepare(setup: &ContactSetup) -> Result<Prepared, ContactError> {
+    setup.validate()?;
+    let incl = setup.rail_inclination.atan();
+    let mk = |side: Side| -> Result<PreparedSide, ContactError> {
+        let (wheel, rail_file, r0) = match side {
+            Side::Left => (
+                &setup.wheel_left,
+                &setup.rail_left,
+                setup.nominal_radius_left_m,
+            ),
+            Side::Right => (
+                &setup.wheel_right,
+                &setup.rail_right,
+                setup.nominal_radius_right_m,
+            ),
+        };
+        let rail = if incl != 0.0 {
+            rail_file.rotated(incl)?
+        } else {
+            rail_file.clone()
+        };
+        let d = match setup.wheel_placement {
+            WheelPlacement::RollingCircleDistance { distance_m } => 0.5 * distance_m,
+            WheelPlacement::BackToBack {
+                back_to_back_m,
+                back_face_to_origin_m,
+            } => 0.5 * back_to_back_m + back_face_to_origin_m,
+            WheelPlacement::FlangeFaces {
+                distance_m,
+                measuring_depth_m,
+            } => 0.5 * distance_m - flange_face_point(wheel, measuring_depth_m)?,
+        };
+        let offset = match setup.rail_placement {
+            RailPlacement::Gauge {
+                gauge_m,
+                measuring_depth_m,
+            } => 0.5 * gauge_m - gauge_point(&rail, measuring_depth_m)?,
+            RailPlacement::OriginDistance { distance_m } => 0.5 * distance_m,
+        };
+        // Rail lateral coordinate in the file frame for reporting: undo the inclination.
+        let (sn, cs) = incl.sin_cos();
+        let sg = side.sign();
+        let mut pts: Vec<(f64, f64, f64)> = rail
+            .lateral_m
+            .iter()
+            .zip(&rail.vertical_m)
+            .map(|(&s, &z)| (sg * (offset + s), z, s * cs + z * sn))
+            .collect();
+        if side == Side::Left {
+            pts.reverse();
+        }
+        let (fs, fm) = wheel.max_slope();
+        Ok(PreparedSide {
+            side,
+            wheel: wheel.clone(),
+            r0,
+            d,
+            rail: pts,
+            flange_s: (fm > FLANGE_MIN_SLOPE).then_some(fs),
+        })
+    };
+    let left = mk(Side::Left)?;
+    let right = mk(Side::Right)?;
+    let pivot_depth = match setup.lateral_reference {
+        LateralReference::RailLevel => 0.5 * (left.r0 + right.r0),
+        LateralReference::AxleCentre => 0.0,
+    };
+    Ok(Prepared {
+        left,
+        right,
+        pivot_depth,
+    })
+}
+
+impl PreparedSide {
+    /// Minimum vertical gap for the wheelset at (y, roll), axle reference height 0.
+    fn min_gap(
+        &self,
+        y: f64,
+        phi: f64,
+        h: f64,
+        buf: &mut Vec<(f64, f64, f64)>,
+    ) -> Result<SideGap, ContactError> {
+        let (sn, cs) = phi.sin_cos();
+        let sg = self.side.sign();
+        buf.clear();
+        let n = self.wheel.len();
+        for k in 0..n {
+            // ascending Y: right side in profile order, left side reversed
+            let i = if sg > 0.0 { k } else { n - 1 - k };
+            let s = self.wheel.lateral_m[i];
+            let yh = sg * (self.d + s);
+            let zh = self.wheel.vertical_m[i] - self.r0 + h;
+            buf.push((y + yh * cs - zh * sn, yh * sn + zh * cs - h, s));
+        }
+        let no_contact = |reason| ContactError::NoContact {
+            side: self.side.name(),
+            y_m: y,
+            reason,
+        };
+        if buf.windows(2).any(|w| w[1].0 <= w[0].0) {
+            return Err(no_contact("rolled wheel profile is not single-valued"));
+        }
+        let rail = &self.rail;
+        let lo = buf[0].0.max(rail[0].0);
+        let hi = buf[buf.len() - 1].0.min(rail[rail.len() - 1].0);
+        if hi <= lo {
+            return Err(no_contact(
+                "wheel and rail profiles do not overlap laterally",
+            ));
+        }
+        let mut best: Option<SideGap> = None;
+        let consider = |best: &mut Option<SideGap>, g: SideGap| match best {
+            Some(b) if b.gap <= g.gap => {}
+            _ => *best = Some(g),
+        };
+        // wheel vertices against the rail polyline
+        let mut j = 1;
+        for &(yw, zw, sw) in buf.iter() {
+            if yw < lo || yw > hi {
+                continue;
+            }
+            while j < rail.len() - 1 && rail[j].0 < yw {
+                j += 1;
+            }
+            let (a, b) = (rail[j - 1], rail[j]);
+            let t = ((yw - a.0) / (b.0 - a.0)).clamp(0.0, 1.0);
+            let zr = a.1 + t * (b.1 - a.1);
+            consider(
+                &mut best,
+                SideGap {
+                    gap: zw - zr,
+                    s_wheel: sw,
+                    s_rail: a.2 + t * (b.2 - a.2),
+                    y_track: yw,
+                    z_rail: zr,
+                    at_end: false,
+                },
+            );
+        }
+        // rail vertices against the wheel polyline
+        let mut i = 1;
+        for &(yr, zr, sr) in rail.iter() {
+            if yr < lo || yr > hi {
+                continue;
+            }
+            while i < buf.len() - 1 && buf[i].0 < yr {
+                i += 1;
+            }
+            let (a, b) = (buf[i - 1], buf[i]);
+            let t = ((yr - a.0) / (b.0 - a.0)).clamp(0.0, 1.0);
+            consider(
+                &mut best,
+                SideGap {
+                    gap: a.1 + t * (b.1 - a.1) - zr,
+                    s_wheel: a.2 + t * (b.2 - a.2),
+                    s_rail: sr,
+                    y_track: yr,
+                    z_rail: zr,
+                    at_end: false,
+                },
+            );
+        }
+        let mut g = best.ok_or_else(|| no_contact("no overlapping points"))?;
+        // contact at the edge of the overlap: the profiles are exhausted there
+        let tol = 1e-9;
+        g.at_end = g.y_track <= lo + tol || g.y_track >= hi - tol;
+        Ok(g)
+    }
+
+    fn contact(&self, g: &SideGap, phi: f64) -> Result<WheelContact, ContactError> {
+        let z = self.wheel.vertical_at(g.s_wheel).unwrap_or(0.0);
+        let slope = self
+            .wheel
+            .slope_at(g.s_wheel, SLOPE_HALF_WINDOW_M)
+            .ok_or_else(|| ContactError::ReferencePoint {
+                profile: self.wheel.name.clone(),
+                what: "slope at the contact point".to_string(),
+            })?;
+        // right: angle = atan(slope) + phi; left (mirrored): atan(slope) - phi
+        let tan_gamma = (slope.atan() + self.side.sign() * phi).tan();
+        Ok(WheelContact {
+            wheel_lateral_m: g.s_wheel,
+            rail_lateral_m: g.s_rail,
+            track_lateral_m: g.y_track,
+            track_vertical_m: g.z_rail,
+            rolling_radius_m: self.r0 - z,
+            delta_radius_m: -z,
+            tan_gamma,
+        })
+    }
+
+    fn beyond_limit(&self, g: &SideGap) -> bool {
+        g.at_end || self.flange_s.is_some_and(|fs| g.s_wheel < fs)
+    }
+}
+
+struct Solved {
+    row: ContactRow,
+    beyond: bool,
+}
+
+fn solve_at(p: &Prepared, y: f64, phi_guess: f64) -> Result<Solved, ContactError> {
+    let h = p.pivot_depth;
+    let mut buf = Vec::with_capacity(p.left.wheel.len().max(p.right.wheel.len()));
+    let mut f = |phi: f64| -> Result<(f64, SideGap, SideGap), ContactError> {
+        let gl = p.left.min_gap(y, phi, h, &mut buf)?;
+        let gr = p.right.min_gap(y, phi, h, &mut buf)?;
+        Ok((gr.gap - gl.gap, gl, gr))
+    };
+    // bracket the root of F(phi) = gap_right - gap_left (increasing in phi)
+    let limit = 0.1;
+    let mut w = 1e-3;
+    let (mut a, mut b);
+    let (mut fa, mut fb);
+    loop {
+        a = phi_guess - w;
+        b = phi_guess + w;
+        fa = f(a)?.0;
+        fb = f(b)?.0;
+        if fa <= 0.0 && fb >= 0.0 {
+            break;
+        }
+        w *= 2.0;
+        if w > limit {
+            return Err(ContactError::RollNotFound {
+                y_m: y,
+                limit_rad: limit,
+            });
+        }
+    }
+    // Illinois (modified regula falsi); `phi` is the latest iterate, the bracket always holds
+    // the root.
+    let mut retained = 0i8;
+    let mut phi = 0.5 * (a + b);
+    for _ in 0..200 {
+        if b - a < 1e-13 {
+            phi = 0.5 * (a + b);
+            break;
+        }
+        let c = if fb != fa {
+            (a * fb - b * fa) / (fb - fa)
+        } else {
+            0.5 * (a + b)
+        };
+        phi = if c > a && c < b { c } else { 0.5 * (a + b) };
+        let fc = f(phi)?.0;
+        if fc.abs() < 1e-14 {
+            break;
+        }
+        if fc < 0.0 {
+            a = phi;
+            fa = fc;
+            if retained == 1 {
+                fb *= 0.5;
+            }
+            retained = 1; // b retained
+        } else {
+            b = phi;
+            fb = fc;
+            if retained == -1 {
+                fa *= 0.5;
+            }
+            retained = -1; // a retained
+        }
+        phi = 0.5 * (a + b);
+    }
+    let (_, gl, gr) = f(phi)?;
+    let zc = -0.5 * (gl.gap + gr.gap);
+    let left = p.left.contact(&gl, phi)?;
+    let right = p.right.contact(&gr, phi)?;
+    let beyond = p.left.beyond_limit(&gl) || p.right.beyond_limit(&gr);
+    Ok(Solved {
+        row: ContactRow {
+            y_m: y,
+            left,
+            right,
+            roll_rad: phi,
+            axle_centre_height_m: zc + h * phi.cos() - h,
+            delta_r_m: right.rolling_radius_m - left.rolling_radius_m,
+            beyond_flange_limit: beyond,
+        },
+        beyond,
+    })
+}
+
+/// Contact state at a single lateral displacement `y_m` (no flange-limit clamping; check
+/// `beyond_flange_limit`).
+pub fn solve_contact(setup: &ContactSetup, y_m: f64) -> Result<ContactRow, ContactError> {
+    if !y_m.is_finite() {
+        return Err(ContactError::Param {
+            name: "y_m",
+            value: y_m,
+            reason: "must be finite",
+        });
+    }
+    let p = prepare(setup)?;
+    Ok(solve_at(&p, y_m, 0.0)?.row)
+}
+
+/// Contact table on the uniform grid `y_min_m, y_min_m + step_m, ..., y_max_m`.
+///
+/// The search marches outwards from the grid point nearest to y = 0. On each side, the first row
+/// whose contact lies beyond the flange limit (contact point past the steepest point of the
+/// flange, i.e. flange climbing) or at the end of a profile, or where no contact is found, ends
+/// the reachable range: it and all rows further out repeat the last reachable row (with their
+/// own `y_m` and `beyond_flange_limit = true`).
+pub fn compute_table(
+    setup: &ContactSetup,
+    y_min_m: f64,
+    y_max_m: f64,
+    step_m: f64,
+) -> Result<ContactTable, ContactError> {
+    let bad = |name, value, reason| ContactError::Param {
+        name,
+        value,
+        reason,
+    };
+    if !(step_m.is_finite() && step_m > 0.0) {
+        return Err(bad("step_m", step_m, "must be finite and > 0"));
+    }
+    if !(y_min_m.is_finite() && y_max_m.is_finite() && y_max_m >= y_min_m) {
+        return Err(bad("y_max_m", y_max_m, "must be finite and >= y_min_m"));
+    }
+    let nf = ((y_max_m - y_min_m) / step_m).round();
+    if nf > 1e6 {
+        return Err(bad("step_m", step_m, "gives more than 1e6 rows"));
+    }
+    let n = nf as usize + 1;
+    let p = prepare(setup)?;
+    let ys: Vec<f64> = (0..n).map(|i| y_min_m + i as f64 * step_m).collect();
+    let centre = ys
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .map(|(i, _)| i)
+        .unwrap_or(0);
+    let first = solve_at(&p, ys[centre], 0.0)?;
+    if first.beyond {
+        return Err(ContactError::NoContact {
+            side: "either",
+            y_m: ys[centre],
+            reason: "the central row already lies beyond the flange limit",
+        });
+    }
+    let mut rows: Vec<Option<ContactRow>> = vec![None; n];
+    rows[centre] = Some(first.row);
+    let mut reach = [ys[centre], ys[centre]];
+    for (dir, range) in [
+        (0usize, (centre + 1..n).collect::<Vec<_>>()),
+        (1usize, (0..centre).rev().collect::<Vec<_>>()),
+    ] {
+        let mut last = first.row;
+        let mut clamped = false;
+        for i in range {
+            if !clamped {
+                match solve_at(&p, ys[i], last.roll_rad) {
+                    Ok(s) if !s.beyond => {
+                        last = s.row;
+                        reach[dir] = ys[i];
+                        rows[i] = Some(s.row);
+                        continue;
+                    }
+                    _ => clamped = true,
+                }
+            }
+            rows[i] = Some(ContactRow {
+                y_m: ys[i],
+                beyond_flange_limit: true,
+                ..last
+            });
+        }
+    }
+    let rows: Vec<ContactRow> = rows.into_iter().flatten().collect();
+    let at0 = solve_at(&p, 0.0, 0.0)?.row;
+    Ok(ContactTable {
+        rows,
+        nominal_radius_left_m: setup.nominal_radius_left_m,
+        nominal_radius_right_m: setup.nominal_radius_right_m,
+        e0_m: 0.5 * (at0.right.track_lateral_m - at0.left.track_lateral_m),
+        y_reachable_min_m: reach[1],
+        y_reachable_max_m: reach[0],
+    })
+}

@@ -1,0 +1,296 @@
+//! Wheel and rail profiles: reading and basic queries.
+//!
+//! Accepted text format (one point per line):
+//! - two numeric fields `lateral vertical` in **millimetres**, separated by whitespace (spaces/tabs),
+//!   a comma or a semicolon (`-32.5 -14`, `-32.5,-14`, `-32.5; -14`);
+//! - `#` starts a comment (whole line or end of line); blank lines are ignored; CRLF is fine and
+//!   the last line may lack a line break;
+//! - the first non-comment line may be a header if *none* of its fields is a number
+//!   (`y_mm,z_mm`); any later non-numeric field is an error;
+//! - the lateral coordinate must be strictly monotonic; increasing is the native order, a file that
+//!   is strictly decreasing throughout is reversed on reading;
+//! - at least [`MIN_POINTS`] points.
+//!
+//! Errors name the file (or the source name given to [`Profile::parse_str`]) and the 1-based line.
+//!
+//! Coordinates are converted to metres on reading. The meaning of the axes is the one of the
+//! EN 15302 benchmark files, see the crate documentation: lateral positive towards the field side
+//! (away from the track centre, so the wheel flange lies at negative lateral coordinates), vertical
+//! positive upwards.
+
+use std::path::Path;
+
+use thiserror::Error;
+
+/// Minimum number of points of a profile.
+pub const MIN_POINTS: usize = 3;
+
+/// Errors of profile reading / construction.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ProfileError {
+    /// The file could not be read.
+    #[error("{source_name}: cannot read file: {message}")]
+    Io {
+        /// File name.
+        source_name: String,
+        /// OS error message.
+        message: String,
+    },
+    /// A field is not a finite number, or the line does not have exactly two fields.
+    #[error("{source_name}:{line}: {message}")]
+    Malformed {
+        /// File name.
+        source_name: String,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// The lateral coordinate is not strictly monotonic.
+    #[error(
+        "{source_name}:{line}: lateral coordinate {value_mm} mm is not strictly {direction} \
+         (previous point {previous_mm} mm); profiles must be single-valued in the lateral coordinate"
+    )]
+    NonMonotonic {
+        /// File name.
+        source_name: String,
+        /// 1-based line number of the offending point.
+        line: usize,
+        /// Offending lateral coordinate [mm].
+        value_mm: f64,
+        /// Previous lateral coordinate [mm].
+        previous_mm: f64,
+        /// "increasing" or "decreasing".
+        direction: &'static str,
+    },
+    /// Not enough points.
+    #[error("{source_name}: only {count} point(s) (line {last_line} is the last), at least {min} needed")]
+    TooFewPoints {
+        /// File name.
+        source_name: String,
+        /// Number of points read.
+        count: usize,
+        /// Last line read.
+        last_line: usize,
+        /// Required minimum.
+        min: usize,
+    },
+}
+
+/// A wheel or rail profile: a polyline with strictly increasing lateral coordinate, in metres.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Profile {
+    /// Where the profile came from (file name or a label), used in error messages.
+    pub name: String,
+    /// Lateral coordinate [m], strictly increasing, positive towards the field side.
+    pub lateral_m: Vec<f64>,
+    /// Vertical coordinate [m], positive upwards.
+    pub vertical_m: Vec<f64>,
+}
+
+impl Profile {
+    /// Reads a profile file (millimetres, format in the module docs).
+    pub fn from_file(path: impl AsRef<Path>) -> Result<Self, ProfileError> {
+        let path = path.as_ref();
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| ProfileError::Io {
+            source_name: name.clone(),
+            message: e.to_string(),
+        })?;
+        Self::parse_str(&text, &name)
+    }
+
+    /// Parses profile text (millimetres); `source_name` is used in error messages.
+    pub fn parse_str(text: &str, source_name: &str) -> Result<Self, ProfileError> {
+        let malformed = |line: usize, message: String| ProfileError::Malformed {
+            source_name: source_name.to_string(),
+            line,
+            message,
+        };
+        // (line number, lateral mm, vertical mm)
+        let mut pts: Vec<(usize, f64, f64)> = Vec::new();
+        let mut seen_content = false;
+        let mut last_line = 0;
+        for (idx, raw) in text.lines().enumerate() {
+            let line_no = idx + 1;
+            last_line = line_no;
+            let content = raw.split('#').next().unwrap_or("").trim();
+            if content.is_empty() {
+                continue;
+            }
+            let fields: Vec<&str> = content
+                .split(|c: char| c.is_whitespace() || c == ',' || c == ';')
+                .filter(|f| !f.is_empty())
+                .collect();
+            let parsed: Vec<Result<f64, _>> = fields.iter().map(|f| f.parse::<f64>()).collect();
+            let first_content = !seen_content;
+            seen_content = true;
+            if first_content && parsed.iter().all(|p| p.is_err()) {
+                continue; // header line
+            }
+            if fields.len() != 2 {
+                return Err(malformed(
+                    line_no,
+                    format!(
+                        "expected 2 fields (lateral vertical, mm), found {}: {content:?}",
+                        fields.len()
+                    ),
+                ));
+            }
+            let mut vals = [0.0; 2];
+            for (k, (f, p)) in fields.iter().zip(parsed.iter()).enumerate() {
+                match p {
+                    Ok(v) if v.is_finite() => vals[k] = *v,
+                    _ => {
+                        let which = if k == 0 { "lateral" } else { "vertical" };
+                        return Err(malformed(
+                            line_no,
+                            format!("{which} coordinate {f:?} is not a finite number"),
+                        ));
+                    }
+                }
+            }
+            pts.push((line_no, vals[0], vals[1]));
+        }
+        if pts.len() < MIN_POINTS {
+            return Err(ProfileError::TooFewPoints {
+                source_name: source_name.to_string(),
+                count: pts.len(),
+                last_line,
+                min: MIN_POINTS,
+            });
+        }
+        let increasing = pts[1].1 > pts[0].1;
+        for w in pts.windows(2) {
+            let ok = if increasing {
+                w[1].1 > w[0].1
+            } else {
+                w[1].1 < w[0].1
+            };
+            if !ok {
+                return Err(ProfileError::NonMonotonic {
+                    source_name: source_name.to_string(),
+                    line: w[1].0,
+                    value_mm: w[1].1,
+                    previous_mm: w[0].1,
+                    direction: if increasing {
+                        "increasing"
+                    } else {
+                        "decreasing"
+                    },
+                });
+            }
+        }
+        if !increasing {
+            pts.reverse();
+        }
+        Ok(Self {
+            name: source_name.to_string(),
+            lateral_m: pts.iter().map(|p| p.1 * 1e-3).collect(),
+            vertical_m: pts.iter().map(|p| p.2 * 1e-3).collect(),
+        })
+    }
+
+    /// Builds a profile from points in metres (e.g. synthetic profiles). Same checks as the reader;
+    /// the "line" in errors is the 1-based point index.
+    pub fn from_points(name: &str, points_m: &[(f64, f64)]) -> Result<Self, ProfileError> {
+        let text: String = points_m
+            .iter()
+            .map(|(y, z)| format!("{} {}\n", y * 1e3, z * 1e3))
+            .collect();
+        Self::parse_str(&text, name)
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.lateral_m.len()
+    }
+
+    /// True if the profile has no points (never the case for a constructed profile).
+    pub fn is_empty(&self) -> bool {
+        self.lateral_m.is_empty()
+    }
+
+    /// Vertical coordinate at lateral `s` [m] by linear interpolation, `None` outside the profile.
+    pub fn vertical_at(&self, s: f64) -> Option<f64> {
+        let xs = &self.lateral_m;
+        let n = xs.len();
+        if n < 2 || !(s >= xs[0] && s <= xs[n - 1]) {
+            return None;
+        }
+        let i = xs.partition_point(|&x| x <= s).clamp(1, n - 1);
+        let t = (s - xs[i - 1]) / (xs[i] - xs[i - 1]);
+        Some(self.vertical_m[i - 1] + t * (self.vertical_m[i] - self.vertical_m[i - 1]))
+    }
+
+    /// Slope dz/ds at `s` by a central difference over +-`half_window_m` (clamped to the profile).
+    pub fn slope_at(&self, s: f64, half_window_m: f64) -> Option<f64> {
+        let n = self.len();
+        if n < 2 {
+            return None;
+        }
+        let lo = (s - half_window_m).max(self.lateral_m[0]);
+        let hi = (s + half_window_m).min(self.lateral_m[n - 1]);
+        if hi <= lo {
+            return None;
+        }
+        Some((self.vertical_at(hi)? - self.vertical_at(lo)?) / (hi - lo))
+    }
+
+    /// Lateral position and value of the steepest rising segment (max dz/ds). On a flanged wheel
+    /// profile this is the steepest point of the active flange face.
+    pub fn max_slope(&self) -> (f64, f64) {
+        let mut best = (self.lateral_m[0], f64::NEG_INFINITY);
+        for i in 1..self.len() {
+            let ds = self.lateral_m[i] - self.lateral_m[i - 1];
+            let m = (self.vertical_m[i] - self.vertical_m[i - 1]) / ds;
+            if m > best.1 {
+                best = (0.5 * (self.lateral_m[i] + self.lateral_m[i - 1]), m);
+            }
+        }
+        best
+    }
+
+    /// The profile rotated by `angle_rad` about its origin (counter-clockwise in the
+    /// (lateral towards field side, vertical up) plane, i.e. positive tilts the top towards the
+    /// track centre). Fails if the result is no longer single-valued in the lateral coordinate.
+    pub fn rotated(&self, angle_rad: f64) -> Result<Self, ProfileError> {
+        let (s, c) = angle_rad.sin_cos();
+        let pts: Vec<(f64, f64)> = self
+            .lateral_m
+            .iter()
+            .zip(&self.vertical_m)
+            .map(|(&y, &z)| (y * c - z * s, y * s + z * c))
+            .collect();
+        Self::from_points(&format!("{} rotated by {angle_rad} rad", self.name), &pts)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_whitespace_comma_comments_header() {
+        let txt = "# comment\ny_mm, z_mm\n-1.0 0.5 # tail\n\n0,0\r\n1;\t-0.5";
+        let p = Profile::parse_str(txt, "t").unwrap();
+        assert_eq!(p.len(), 3);
+        assert!((p.lateral_m[0] + 1e-3).abs() < 1e-15);
+        assert!((p.vertical_m[2] + 0.5e-3).abs() < 1e-15);
+    }
+
+    #[test]
+    fn decreasing_file_is_reversed() {
+        let p = Profile::parse_str("2 0\n1 1\n0 2\n", "t").unwrap();
+        assert!(p.lateral_m[0] < p.lateral_m[2]);
+        assert!((p.vertical_m[0] - 2e-3).abs() < 1e-15);
+    }
+
+    #[test]
+    fn interpolation_and_slope() {
+        let p = Profile::from_points("lin", &[(-0.01, -0.001), (0.0, 0.0), (0.01, 0.001)]).unwrap();
+        assert!((p.vertical_at(0.005).unwrap() - 0.0005).abs() < 1e-12);
+        assert!(p.vertical_at(0.02).is_none());
+        assert!((p.slope_at(0.0, 0.001).unwrap() - 0.1).abs() < 1e-12);
+    }
+}

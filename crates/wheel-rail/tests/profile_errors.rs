@@ -1,0 +1,86 @@
+//! Profile reading errors name the file and the line.
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
+
+use std::io::Write;
+use wheel_rail::{Profile, ProfileError};
+
+fn write(content: &str) -> tempfile::NamedTempFile {
+    let mut f = tempfile::NamedTempFile::new().unwrap();
+    f.write_all(content.as_bytes()).unwrap();
+    f
+}
+
+#[test]
+fn malformed_number_names_file_and_line() {
+    let f = write("# wheel\n0.0 0.0\n1.0 0.1\n2.0 0,2x\n3.0 0.3\n");
+    let e = Profile::from_file(f.path()).unwrap_err();
+    let msg = e.to_string();
+    let path = f.path().display().to_string();
+    assert!(msg.contains(&path) && msg.contains(":4:"), "{msg}");
+    assert!(
+        matches!(e, ProfileError::Malformed { line: 4, .. }),
+        "{e:?}"
+    );
+    let e = Profile::from_file(write("0 0\n1 nan\n2 2\n3 3\n").path()).unwrap_err();
+    assert!(
+        matches!(e, ProfileError::Malformed { line: 2, .. }),
+        "{e:?}"
+    );
+    let e = Profile::from_file(write("0 0\n1 1 1\n2 2\n").path()).unwrap_err();
+    assert!(
+        matches!(e, ProfileError::Malformed { line: 2, .. }),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn non_monotonic_names_file_and_line() {
+    let f = write("-2 0\n-1 0\n\n# gap\n-1.5 0\n0 0\n");
+    let e = Profile::from_file(f.path()).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        msg.contains(&f.path().display().to_string()) && msg.contains(":5:"),
+        "{msg}"
+    );
+    assert!(matches!(e, ProfileError::NonMonotonic { line: 5, .. }));
+    // repeated lateral coordinate is not strictly monotonic either
+    let e = Profile::from_file(write("0 0\n1 0\n1 1\n").path()).unwrap_err();
+    assert!(matches!(e, ProfileError::NonMonotonic { line: 3, .. }));
+}
+
+#[test]
+fn too_few_points_names_file() {
+    let f = write("# only two\n0 0\n1 1\n");
+    let e = Profile::from_file(f.path()).unwrap_err();
+    let msg = e.to_string();
+    assert!(msg.contains(&f.path().display().to_string()), "{msg}");
+    assert!(
+        matches!(
+            e,
+            ProfileError::TooFewPoints {
+                count: 2,
+                last_line: 3,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn missing_file_is_an_io_error_naming_it() {
+    let e = Profile::from_file("/nonexistent/profile.dat").unwrap_err();
+    assert!(e.to_string().contains("/nonexistent/profile.dat"));
+}
+
+#[test]
+fn benchmark_files_read() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/data");
+    let w = Profile::from_file(format!("{dir}/RUIC519A.dat")).unwrap();
+    let r = Profile::from_file(format!("{dir}/SUIC519A.dat")).unwrap();
+    assert_eq!(w.len(), 1001); // 1000 line breaks, last line without one
+    assert_eq!(r.len(), 1001);
+    assert!((w.lateral_m[0] + 0.070).abs() < 1e-12);
+    assert!((r.lateral_m[1000] - 0.039).abs() < 1e-12);
+}
