@@ -3,7 +3,14 @@ use fmu_damper::characterise::{actuator_frf, linearised_actuator_frf};
 use fmu_damper::{ActuatorModel, ActuatorParams};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let p = ActuatorParams::default();
+    let mut p = ActuatorParams::default();
+    if let Some(cl) = std::env::args().nth(1).and_then(|s| s.parse().ok()) {
+        p.leakage_coeff_m3ps_per_pa = cl;
+    }
+    if std::env::var("NO_COULOMB").is_ok() {
+        p.coulomb_friction_n = 0.0;
+        p.stribeck_friction_n = 0.0;
+    }
     println!(
         "omega_c = {:.2} rad/s, xi_c = {:.3}",
         p.cylinder_eigenfrequency_radps(),

@@ -60,6 +60,11 @@ use crate::error::{finite_input, non_negative, positive, ParamError, StepError};
 use crate::ode::{integrate, Rhs, SolverSettings};
 use crate::semi_active::orifice_law;
 
+/// `C_L` if Table 3-2's "7e-10 l/s" is read as litres per second per pascal
+/// (7e-13 m^3/(s Pa), a typical servo-cylinder value). The default follows the
+/// project's reading, 7e-10 m^3/(s Pa); see the crate docs for the consequence.
+pub const LEAKAGE_LITRE_READING_M3PS_PER_PA: f64 = 7e-13;
+
 /// Which actuator model to integrate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum ActuatorModel {

@@ -393,3 +393,24 @@ fn serde_roundtrip_continues_identically() {
         assert_eq!(a, b);
     }
 }
+
+/// Fig. 3.14: over 0.5-20 Hz (1 mm) the FRF modulus falls as the valve opens, at
+/// every frequency, and the phase stays within (0, 90] deg.
+#[test]
+fn frf_modulus_falls_with_opening() {
+    use fmu_damper::characterise::{damper_frf, log_space};
+    let p = SemiActiveParams::default();
+    let freqs = log_space(0.5, 20.0, 7);
+    let frfs: Vec<_> = [0.0, 0.2, 0.5, 1.0]
+        .iter()
+        .map(|&o| damper_frf(&p, o, &freqs, 1e-3).unwrap())
+        .collect();
+    for i in 0..freqs.len() {
+        for w in frfs.windows(2) {
+            assert!(w[1][i].modulus_n_per_m < w[0][i].modulus_n_per_m);
+        }
+        for f in &frfs {
+            assert!(f[i].phase_deg > 0.0 && f[i].phase_deg <= 90.0, "{:?}", f[i]);
+        }
+    }
+}
