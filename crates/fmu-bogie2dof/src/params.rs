@@ -1,0 +1,247 @@
+//! Parameters of the 2-dof bogie (SI units), their sources and validation.
+//!
+//! Sources (numbers carried over, see `/work/shared/REFERENCE.md`):
+//! * seed thesis, section 5.3 and 4.2: wheelbase 2.5 m, bogie mass 6.1 t including the
+//!   wheelsets (EN 14363 limit a_lim = 5.39 m/s^2 = (12 - m/5)/2  =>  m = 6.1 t);
+//! * Manchester Benchmark passenger vehicle (Iwnicki 1998, VSD suppl. 31): wheel radius 0.46 m,
+//!   wheelset mass 1813 kg, wheelset yaw inertia 1120 kg m^2, spin inertia 112 kg m^2,
+//!   frame yaw inertia 3067 kg m^2, secondary lateral stiffness 160 kN/m per side;
+//! * Mathematical Problems in Engineering 2019 ("Numerical investigation into the critical
+//!   speed and frequency of the hunting motion ...", Table 2): half contact gauge 0.7465 m,
+//!   half wheelbase 1.25 m, yaw damper lateral arm 1.35 m;
+//! * Hertz + Kalker (see [`crate::contact::hertz_kalker`]) at 70 kN per wheel on a 0.46 m wheel
+//!   and a 0.30 m rail crown: f11 = 11.5 MN, f22 = 10.4 MN.
+//!
+//! Calibrated (free) parameters, see [`crate::calibration`]: `k_ssx_n_per_m` (effective
+//! longitudinal secondary stiffness per side at arm b: air spring + mountings, WITHOUT the yaw
+//! damper, whose elastic part comes with the damper representation) and `conicity`.
+
+use serde::{Deserialize, Serialize};
+
+/// A parameter is out of its admissible range; names the parameter and the reason.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("invalid parameter `{name}`: {reason}")]
+pub struct ParamError {
+    /// Field name as in [`Params`].
+    pub name: &'static str,
+    /// Why it was rejected.
+    pub reason: String,
+}
+
+impl ParamError {
+    pub(crate) fn new(name: &'static str, reason: impl Into<String>) -> Self {
+        Self {
+            name,
+            reason: reason.into(),
+        }
+    }
+}
+
+/// Which wheel/rail force law the time-domain model uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum ModelKind {
+    /// (5.1)-(5.18): Kalker linear creep, constant conicity, no spin dofs.
+    Linear,
+    /// (5.19)-(5.27): tabulated rolling radii and contact angles, Vermeulen-Johnson
+    /// saturation, gravitational/flange forces, two wheelset spin perturbation dofs.
+    #[default]
+    NonLinear,
+}
+
+/// Level of the ERRI B176 lateral alignment spectrum.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum PsdLevel {
+    /// A = 2.119e-7 m rad.
+    #[default]
+    Low,
+    /// A = 6.125e-7 m rad.
+    High,
+}
+
+/// Where the lateral track alignment comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum TrackSource {
+    /// Input `track_lateral_m` (value at the FRONT wheelset; the rear wheelset sees it
+    /// delayed by 2p/V).
+    #[default]
+    External,
+    /// Internal sum-of-cosines generator (ERRI B176 spectrum), reproducible from `seed`.
+    Internal {
+        /// Spectrum level.
+        level: PsdLevel,
+        /// Random seed for the phases (ChaCha8).
+        seed: u64,
+    },
+    /// Ideal straight track (y_track = 0), inputs ignored.
+    None,
+}
+
+/// All parameters of the bogie model (SI units).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Params {
+    /// Running speed V [m/s].
+    pub speed_mps: f64,
+    /// Linear or non-linear wheel/rail forces.
+    pub model: ModelKind,
+    /// m: bogie frame + two wheelsets [kg]. Seed 4.2: a_lim = 5.39 m/s^2 -> 6.1 t.
+    pub bogie_mass_kg: f64,
+    /// J: yaw inertia of frame + wheelsets about the bogie centre [kg m^2].
+    /// Manchester Benchmark: 3067 + 2*(1120 + 1813*1.25^2) = 10 973 kg m^2.
+    pub bogie_yaw_inertia_kgm2: f64,
+    /// J_w: spin inertia of one wheelset about its axle [kg m^2] (Manchester: 112).
+    pub wheelset_spin_inertia_kgm2: f64,
+    /// p: half wheelbase [m] (seed Table 4-1: wheelbase 2.5 m).
+    pub half_wheelbase_m: f64,
+    /// s: half distance between the contact points [m] (MPE 2019: 0.7465 m).
+    pub half_contact_gauge_m: f64,
+    /// b: lateral arm of the yaw dampers and of k_ssx [m] (MPE 2019: 1.35 m).
+    pub damper_arm_m: f64,
+    /// R0: nominal rolling radius [m] (Manchester: 0.46 m).
+    pub wheel_radius_m: f64,
+    /// k_ssy: secondary lateral stiffness per side [N/m] (Manchester: 160 kN/m).
+    pub k_ssy_n_per_m: f64,
+    /// k_ssx: effective longitudinal secondary stiffness per side at arm b [N/m]
+    /// (air spring + traction/damper mountings, without the yaw damper). CALIBRATED, see
+    /// [`crate::calibration`].
+    pub k_ssx_n_per_m: f64,
+    /// lambda: equivalent conicity of the linear model [-]. CALIBRATED.
+    pub conicity: f64,
+    /// Extra lateral gravitational stiffness per wheelset used by the LINEAR model [N/m]
+    /// (0 in the seed's (5.18); see [`crate::contact::ContactTable::linearise`]).
+    pub gravity_stiffness_n_per_m: f64,
+    /// f11: Kalker longitudinal creep coefficient per wheel [N] (Hertz+Kalker: 11.5 MN).
+    pub f11_n: f64,
+    /// f22: Kalker lateral creep coefficient per wheel [N] (Hertz+Kalker: 10.4 MN).
+    pub f22_n: f64,
+    /// P: vertical load per wheel [N] (~140 kN per wheelset; Table 4-1's 27.52 kN is
+    /// implausible, see REFERENCE.md).
+    pub wheel_load_n: f64,
+    /// mu: wheel/rail friction coefficient (0..1], dry rail 0.3-0.4.
+    pub friction_coefficient: f64,
+    /// Initial lateral displacement of the bogie centre [m].
+    pub initial_lateral_m: f64,
+    /// Initial yaw angle sigma (positive nose-left) [rad].
+    pub initial_yaw_rad: f64,
+    /// Track alignment source.
+    pub track: TrackSource,
+    /// Wheel/rail contact table (CSV) to load instead of the built-in one.
+    pub contact_table_path: Option<String>,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Self {
+            speed_mps: 250.0 / 3.6,
+            model: ModelKind::NonLinear,
+            bogie_mass_kg: 6100.0,
+            bogie_yaw_inertia_kgm2: 11_000.0,
+            wheelset_spin_inertia_kgm2: 112.0,
+            half_wheelbase_m: 1.25,
+            half_contact_gauge_m: 0.7465,
+            damper_arm_m: 1.35,
+            wheel_radius_m: 0.46,
+            k_ssy_n_per_m: 160e3,
+            k_ssx_n_per_m: crate::calibration::CALIBRATED_K_SSX_N_PER_M,
+            conicity: crate::calibration::CALIBRATED_CONICITY,
+            gravity_stiffness_n_per_m: 0.0,
+            f11_n: 11.5e6,
+            f22_n: 10.4e6,
+            wheel_load_n: 70e3,
+            friction_coefficient: crate::calibration::CALIBRATED_FRICTION,
+            initial_lateral_m: 0.0,
+            initial_yaw_rad: 0.0,
+            track: TrackSource::External,
+            contact_table_path: None,
+        }
+    }
+}
+
+fn finite(name: &'static str, v: f64) -> Result<(), ParamError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(ParamError::new(name, format!("must be finite, got {v}")))
+    }
+}
+
+fn positive(name: &'static str, v: f64) -> Result<(), ParamError> {
+    finite(name, v)?;
+    if v > 0.0 {
+        Ok(())
+    } else {
+        Err(ParamError::new(name, format!("must be > 0, got {v}")))
+    }
+}
+
+fn non_negative(name: &'static str, v: f64) -> Result<(), ParamError> {
+    finite(name, v)?;
+    if v >= 0.0 {
+        Ok(())
+    } else {
+        Err(ParamError::new(name, format!("must be >= 0, got {v}")))
+    }
+}
+
+impl Params {
+    /// Checks every field; the error names the first offending parameter.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        // Creepages are divided by V: a standing vehicle has no creep model.
+        positive("speed_mps", self.speed_mps)?;
+        if self.speed_mps > 200.0 {
+            return Err(ParamError::new(
+                "speed_mps",
+                format!(
+                    "{} m/s is beyond any rail vehicle (max 200)",
+                    self.speed_mps
+                ),
+            ));
+        }
+        positive("bogie_mass_kg", self.bogie_mass_kg)?;
+        positive("bogie_yaw_inertia_kgm2", self.bogie_yaw_inertia_kgm2)?;
+        positive(
+            "wheelset_spin_inertia_kgm2",
+            self.wheelset_spin_inertia_kgm2,
+        )?;
+        positive("half_wheelbase_m", self.half_wheelbase_m)?;
+        positive("half_contact_gauge_m", self.half_contact_gauge_m)?;
+        positive("damper_arm_m", self.damper_arm_m)?;
+        positive("wheel_radius_m", self.wheel_radius_m)?;
+        non_negative("k_ssy_n_per_m", self.k_ssy_n_per_m)?;
+        non_negative("k_ssx_n_per_m", self.k_ssx_n_per_m)?;
+        non_negative("conicity", self.conicity)?;
+        if self.conicity > 1.0 {
+            return Err(ParamError::new("conicity", "must be <= 1"));
+        }
+        non_negative("gravity_stiffness_n_per_m", self.gravity_stiffness_n_per_m)?;
+        positive("f11_n", self.f11_n)?;
+        positive("f22_n", self.f22_n)?;
+        positive("wheel_load_n", self.wheel_load_n)?;
+        finite("friction_coefficient", self.friction_coefficient)?;
+        if !(self.friction_coefficient > 0.0 && self.friction_coefficient <= 1.0) {
+            return Err(ParamError::new(
+                "friction_coefficient",
+                format!("must be in (0, 1], got {}", self.friction_coefficient),
+            ));
+        }
+        finite("initial_lateral_m", self.initial_lateral_m)?;
+        if self.initial_lateral_m.abs() > 0.05 {
+            return Err(ParamError::new(
+                "initial_lateral_m",
+                "must be within +-0.05 m (wheelset would be off the rails)",
+            ));
+        }
+        finite("initial_yaw_rad", self.initial_yaw_rad)?;
+        if self.initial_yaw_rad.abs() > 0.05 {
+            return Err(ParamError::new(
+                "initial_yaw_rad",
+                "must be within +-0.05 rad (small-angle model)",
+            ));
+        }
+        if let Some(p) = &self.contact_table_path {
+            if p.trim().is_empty() {
+                return Err(ParamError::new("contact_table_path", "empty path"));
+            }
+        }
+        Ok(())
+    }
+}
