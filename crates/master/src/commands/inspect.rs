@@ -1,0 +1,54 @@
+//! `master inspect FMU`: check an FMU and print its variables.
+
+use std::path::PathBuf;
+
+use super::{CommandError, Context};
+use crate::fmu::FmuArchive;
+
+/// Check an FMU (zip, FMI 2.0, co-simulation, binary) and list its variables.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The .fmu file.
+    pub fmu: PathBuf,
+    /// Print the parsed model description as JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
+    let a = FmuArchive::open(&args.fmu)?;
+    let md = &a.model;
+    if args.json {
+        let s = serde_json::to_string_pretty(md).map_err(|e| CommandError::Failed(e.to_string()))?;
+        println!("{s}");
+        return Ok(());
+    }
+    println!("model      {}", md.model_name);
+    println!("fmiVersion {}", md.fmi_version);
+    println!("guid       {}", md.guid);
+    if let Some(cs) = &md.co_simulation {
+        println!(
+            "co-simulation: modelIdentifier {}, canGetAndSetFMUstate {}, canHandleVariableCommunicationStepSize {}",
+            cs.model_identifier, cs.can_get_and_set_fmu_state, cs.can_handle_variable_communication_step_size
+        );
+    }
+    if let Some(d) = &md.default_experiment {
+        println!("default experiment: start {:?}, stop {:?}, step {:?}", d.start_time, d.stop_time, d.step_size);
+    }
+    println!();
+    println!("{:<32} {:>5} {:<12} {:<11} {:<8} {:<8} {:>10}  description", "name", "vr", "causality", "variability", "type", "unit", "start");
+    for v in &md.variables {
+        println!(
+            "{:<32} {:>5} {:<12} {:<11} {:<8} {:<8} {:>10}  {}",
+            v.name,
+            v.value_reference,
+            v.causality.to_string(),
+            v.variability.to_string(),
+            v.var_type.to_string(),
+            v.unit.as_deref().unwrap_or("-"),
+            v.start.as_deref().unwrap_or("-"),
+            v.description.as_deref().unwrap_or("")
+        );
+    }
+    Ok(())
+}

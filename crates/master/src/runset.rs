@@ -1,0 +1,340 @@
+//! Run sets: a base system plus parameter variations, run in parallel.
+//!
+//! ```json
+//! {
+//!   "base": "system.json",                       // or "system": { ...inline... }
+//!   "product": {"bogie.speed_mps": [60, 70, 80], "controller.mode": [0, 1]},
+//!   "runs": [{"name": "special", "parameters": {"bogie.speed_mps": 90}}]
+//! }
+//! ```
+//! Every combination of `product` (cartesian, keys in alphabetical order) and every entry of
+//! `runs` is one job; with neither, the base alone is run. Keys are `instance.variable`.
+//! Each job is self-contained (its resolved system description, FMU paths absolute) and is
+//! written to `<outdir>/<run>/system.json`, with `results.csv` and `summary.json` beside it.
+//! Jobs run on a rayon pool; each job instantiates its own FMU instances (never shared across
+//! threads) and frees them when done. A failed job is reported in its own summary and in
+//! `<outdir>/sweep.json`; the other jobs go on.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+use rayon::prelude::*;
+use serde_json::Value;
+
+use crate::coupling::{RunOptions, SimOutput, Summary};
+use crate::output::{write_csv_atomic, write_json_atomic, OutputError};
+use crate::system::{split_ref, LoadedSystem, SystemDescription, SystemError};
+
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunSet {
+    /// Path of the base system JSON (relative to the run-set file).
+    #[serde(default)]
+    pub base: Option<PathBuf>,
+    /// Inline base system (FMU paths relative to the run-set file).
+    #[serde(default)]
+    pub system: Option<SystemDescription>,
+    #[serde(default)]
+    pub product: BTreeMap<String, Vec<Value>>,
+    #[serde(default)]
+    pub runs: Vec<RunSpec>,
+}
+
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunSpec {
+    #[serde(default)]
+    pub name: Option<String>,
+    pub parameters: BTreeMap<String, Value>,
+}
+
+/// One self-contained run.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Job {
+    pub name: String,
+    pub parameters: BTreeMap<String, Value>,
+    pub system: SystemDescription,
+}
+
+/// Outcome of one job.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct RunReport {
+    pub name: String,
+    pub parameters: BTreeMap<String, Value>,
+    pub ok: bool,
+    pub error: Option<String>,
+    pub summary: Option<Summary>,
+    pub results: Option<PathBuf>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    #[error(transparent)]
+    System(#[from] SystemError),
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    #[error("cannot create '{path}': {source}")]
+    Dir {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("cannot start {jobs} worker threads: {reason}")]
+    Pool { jobs: usize, reason: String },
+}
+
+fn invalid(file: &str, field: String, reason: String) -> SystemError {
+    SystemError::Invalid {
+        file: file.to_string(),
+        line: None,
+        field,
+        reason,
+    }
+}
+
+/// Folder-safe run name.
+pub fn sanitize(name: &str) -> String {
+    name.chars()
+        .map(|c| if c.is_ascii_alphanumeric() || "._-=".contains(c) { c } else { '_' })
+        .collect()
+}
+
+impl RunSet {
+    /// Reads a run-set file and expands it into jobs.
+    pub fn load_jobs(path: &Path) -> Result<Vec<Job>, SystemError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SystemError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Self::jobs_from_str(&text, &base_dir, &path.display().to_string())
+    }
+
+    pub fn jobs_from_str(text: &str, base_dir: &Path, file: &str) -> Result<Vec<Job>, SystemError> {
+        let rs: RunSet = serde_json::from_str(text).map_err(|e| SystemError::Json {
+            file: file.to_string(),
+            line: e.line(),
+            column: e.column(),
+            message: e.to_string().split(" at line ").next().unwrap_or("").to_string(),
+        })?;
+        let base = match (&rs.base, &rs.system) {
+            (Some(p), None) => LoadedSystem::load(&base_dir.join(p))?,
+            (None, Some(s)) => LoadedSystem::from_description(s.clone(), base_dir, file),
+            _ => {
+                return Err(invalid(file, "base".into(), "give exactly one of 'base' (a path) or 'system' (inline)".into()))
+            }
+        };
+        rs.expand(&base, file)
+    }
+
+    /// Expands into jobs with resolved (absolute-path) system descriptions.
+    pub fn expand(&self, base: &LoadedSystem, file: &str) -> Result<Vec<Job>, SystemError> {
+        let resolved = base.resolved();
+        let mut sets: Vec<(Option<String>, BTreeMap<String, Value>, String)> = Vec::new();
+        if !self.product.is_empty() {
+            let keys: Vec<&String> = self.product.keys().collect();
+            for k in &keys {
+                if self.product[*k].is_empty() {
+                    return Err(invalid(file, format!("product.{k}"), "empty list of values".into()));
+                }
+            }
+            let total: usize = self.product.values().map(Vec::len).product();
+            for mut idx in 0..total {
+                let mut p = BTreeMap::new();
+                for k in keys.iter().rev() {
+                    let vals = &self.product[*k];
+                    p.insert((*k).clone(), vals[idx % vals.len()].clone());
+                    idx /= vals.len();
+                }
+                sets.push((None, p, "product".into()));
+            }
+        }
+        for (i, r) in self.runs.iter().enumerate() {
+            sets.push((r.name.clone(), r.parameters.clone(), format!("runs[{i}]")));
+        }
+        if sets.is_empty() {
+            sets.push((Some("base".into()), BTreeMap::new(), String::new()));
+        }
+        let mut jobs = Vec::new();
+        for (n, (name, params, field)) in sets.into_iter().enumerate() {
+            let mut sys = resolved.clone();
+            for (key, value) in &params {
+                let f = format!("{field}.{key}");
+                let Some((inst, var)) = split_ref(key) else {
+                    return Err(invalid(file, f, format!("'{key}' is not of the form 'instance.variable'")));
+                };
+                let Some(spec) = sys.instances.iter_mut().find(|i| i.name == inst) else {
+                    return Err(invalid(file, f, format!("unknown instance '{inst}'")));
+                };
+                spec.parameters.insert(var.to_string(), value.clone());
+            }
+            let name = sanitize(&name.unwrap_or_else(|| format!("run-{n:03}")));
+            if jobs.iter().any(|j: &Job| j.name == name) {
+                return Err(invalid(file, field, format!("run name '{name}' is used twice")));
+            }
+            jobs.push(Job { name, parameters: params, system: sys });
+        }
+        Ok(jobs)
+    }
+}
+
+/// Runs one job with real FMUs: validates, simulates, returns the output.
+pub fn run_job_fmu(job: &Job, cancel: &AtomicBool) -> Result<SimOutput, String> {
+    let sys = LoadedSystem::from_description(job.system.clone(), Path::new("/"), &format!("run '{}'", job.name));
+    let opts = RunOptions { cancel: Some(cancel), progress: None };
+    sys.run(&opts).map_err(|e| e.to_string())
+}
+
+/// Runs all jobs on `threads` workers with `runner`, writing each run's folder and
+/// `<outdir>/sweep.json`. Returns the reports in job order.
+pub fn execute<F>(jobs: &[Job], outdir: &Path, threads: usize, show_progress: bool, runner: F) -> Result<Vec<RunReport>, SweepError>
+where
+    F: Fn(&Job) -> Result<SimOutput, String> + Sync,
+{
+    std::fs::create_dir_all(outdir).map_err(|source| SweepError::Dir { path: outdir.to_path_buf(), source })?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.max(1))
+        .build()
+        .map_err(|e| SweepError::Pool { jobs: threads, reason: e.to_string() })?;
+    let bar = if show_progress {
+        indicatif::ProgressBar::new(jobs.len() as u64)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} elapsed, eta {eta} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let reports: Vec<RunReport> = pool.install(|| {
+        jobs.par_iter()
+            .map(|job| {
+                let r = run_one(job, outdir, &runner);
+                bar.inc(1);
+                if !r.ok {
+                    bar.println(format!("run '{}' failed: {}", r.name, r.error.as_deref().unwrap_or("")));
+                }
+                r
+            })
+            .collect()
+    });
+    bar.finish_and_clear();
+    write_json_atomic(&outdir.join("sweep.json"), &reports)?;
+    Ok(reports)
+}
+
+fn run_one<F>(job: &Job, outdir: &Path, runner: &F) -> RunReport
+where
+    F: Fn(&Job) -> Result<SimOutput, String>,
+{
+    let dir = outdir.join(&job.name);
+    let mut report = RunReport {
+        name: job.name.clone(),
+        parameters: job.parameters.clone(),
+        ok: false,
+        error: None,
+        summary: None,
+        results: None,
+    };
+    let result = (|| -> Result<(Summary, PathBuf), String> {
+        std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create '{}': {e}", dir.display()))?;
+        write_json_atomic(&dir.join("system.json"), &job.system).map_err(|e| e.to_string())?;
+        let out = runner(job)?;
+        let csv = dir.join("results.csv");
+        write_csv_atomic(&csv, &out.header, out.rows()).map_err(|e| e.to_string())?;
+        Ok((out.summary, csv))
+    })();
+    match result {
+        Ok((s, csv)) => {
+            report.ok = true;
+            report.summary = Some(s);
+            report.results = Some(csv);
+        }
+        Err(e) => report.error = Some(e),
+    }
+    if let Err(e) = write_json_atomic(&dir.join("summary.json"), &report) {
+        report.ok = false;
+        report.error = Some(format!("{}; also: {e}", report.error.unwrap_or_default()));
+    }
+    report
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::coupling::tests::{two_mass_plan, Mock, MassSpring, SpringDamperMass};
+    use crate::coupling::{simulate, Algorithm};
+
+    const BASE: &str = r#"{
+      "instances": [{"name": "ms", "fmu": "MassSpring.fmu"}, {"name": "sdm", "fmu": "SDM.fmu"}],
+      "stop_time": 0.1, "step": 0.001
+    }"#;
+
+    fn jobs(rs: &str) -> Result<Vec<Job>, SystemError> {
+        let base = LoadedSystem::from_json_str(BASE, Path::new("/d"), "base.json").unwrap();
+        let r: RunSet = serde_json::from_str(rs).unwrap();
+        r.expand(&base, "set.json")
+    }
+
+    #[test]
+    fn product_and_list_expand() {
+        let j = jobs(r#"{"product": {"ms.k": [1, 2, 3], "sdm.m": [true, false]},
+                          "runs": [{"name": "extra run", "parameters": {"ms.k": 9}}]}"#).unwrap();
+        assert_eq!(j.len(), 7);
+        assert_eq!(j[0].name, "run-000");
+        assert_eq!(j[6].name, "extra_run");
+        let ks: Vec<String> = j[..6].iter().map(|j| format!("{}{}", j.parameters["ms.k"], j.parameters["sdm.m"])).collect();
+        assert_eq!(ks, ["1true", "1false", "2true", "2false", "3true", "3false"]);
+        assert_eq!(j[3].system.instances[0].parameters["k"], serde_json::json!(2));
+        assert_eq!(j[3].system.instances[1].parameters["m"], serde_json::json!(false));
+        assert_eq!(j[0].system.instances[0].fmu, PathBuf::from("/d/MassSpring.fmu"));
+        assert_eq!(jobs("{}").unwrap().len(), 1);
+    }
+
+    #[test]
+    fn expansion_errors() {
+        let e = jobs(r#"{"product": {"xx.k": [1]}}"#).unwrap_err().to_string();
+        assert!(e.contains("product.xx.k: unknown instance 'xx'"), "{e}");
+        let e = jobs(r#"{"runs": [{"name": "a", "parameters": {}}, {"name": "a", "parameters": {}}]}"#).unwrap_err();
+        assert!(e.to_string().contains("used twice"));
+        let e = jobs(r#"{"product": {"ms.k": []}}"#).unwrap_err();
+        assert!(e.to_string().contains("empty list"));
+        let e = RunSet::jobs_from_str("{\"base\": \"a.json\", \"system\": null, \"bogus\": 1}", Path::new("/"), "s.json").unwrap_err();
+        assert!(e.to_string().contains("unknown field `bogus`"), "{e}");
+    }
+
+    #[test]
+    fn parallel_execution_keeps_every_result_and_reports_failures() {
+        let j = jobs(r#"{"product": {"ms.k": [50, 100, -1, 200]}}"#).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        // mock runner: the two-mass plan with ms.k from the job; k < 0 fails
+        let runner = |job: &Job| -> Result<SimOutput, String> {
+            let k = job.parameters["ms.k"].as_f64().unwrap();
+            if k < 0.0 {
+                return Err("negative stiffness".into());
+            }
+            let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.1);
+            plan.instances[0].parameters[1].1 = k;
+            let mut a = Mock::new("ms", MassSpring::new(1.0, 1.0, 1.0, 0.0));
+            let mut b = Mock::new("sdm", SpringDamperMass::new(1.0, 1.0, 1.0));
+            simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).map_err(|e| e.to_string())
+        };
+        let reports = execute(&j, dir.path(), 2, false, runner).unwrap();
+        assert_eq!(reports.len(), 4);
+        assert_eq!(reports.iter().filter(|r| r.ok).count(), 3);
+        assert_eq!(reports[2].error.as_deref(), Some("negative stiffness"));
+        for r in &reports {
+            let d = dir.path().join(&r.name);
+            assert!(d.join("system.json").exists() && d.join("summary.json").exists());
+            assert_eq!(d.join("results.csv").exists(), r.ok);
+        }
+        // different stiffness, different results
+        let a = std::fs::read_to_string(dir.path().join("run-000/results.csv")).unwrap();
+        let b = std::fs::read_to_string(dir.path().join("run-003/results.csv")).unwrap();
+        assert_ne!(a, b);
+        assert_eq!(a.lines().count(), 102);
+        let sweep: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("sweep.json")).unwrap()).unwrap();
+        assert_eq!(sweep.as_array().unwrap().len(), 4);
+        assert_eq!(sweep[2]["ok"], serde_json::json!(false));
+    }
+}
