@@ -1,6 +1,6 @@
 //! Prints the calibration numbers: linear critical speed and hunting mode (R5, R6) with the
 //! placeholder damper, and the non-linear response to a 3 mm initial perturbation (R7) at
-//! several speeds. Usage: `cargo run --release --example calibration_report [table.csv]`.
+//! several speeds. Usage: `cargo run --release --example calibration_report [table.csv [k_ssx [conicity [k_grav]]]]`.
 use fmu_bogie2dof::calibration::*;
 use fmu_bogie2dof::contact::ContactTable;
 use fmu_bogie2dof::eigen::critical_speed;
@@ -12,7 +12,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(path) => ContactTable::load(&path)?,
         None => fmu_bogie2dof::model::default_contact_table()?,
     };
-    let p = Params::default();
+    let mut p = Params::default();
+    if let Some(k) = std::env::args().nth(2) {
+        p.k_ssx_n_per_m = k.parse()?;
+    }
+    if let Some(l) = std::env::args().nth(3) {
+        p.conicity = l.parse()?;
+    }
+    if let Some(g) = std::env::args().nth(4) {
+        p.gravity_stiffness_n_per_m = g.parse()?;
+    }
     let c = critical_speed(&p, &placeholder_damper(), 5.0, 199.0)?;
     println!(
         "linear: V_cr {:.1} km/h, hunting {:.2} Hz (Im {:.2} rad/s)",

@@ -247,9 +247,8 @@ impl ContactTable {
         ContactPoint {
             delta_r_left_m: lerp(&self.dr_l),
             delta_r_right_m: lerp(&self.dr_r),
-            // a contact angle never changes sign, even when extrapolated
-            tan_gamma_left: lerp(&self.tg_l).max(0.0),
-            tan_gamma_right: lerp(&self.tg_r).max(0.0),
+            tan_gamma_left: lerp(&self.tg_l),
+            tan_gamma_right: lerp(&self.tg_r),
         }
     }
 

@@ -23,4 +23,4 @@ pub mod sim;
 pub mod track;
 
 pub use model::{Bogie, Inputs, ModelError, Outputs, StepError};
-pub use params::{ModelKind, ParamError, Params, PsdLevel, TrackSource};
+pub use params::{ContactSource, ModelKind, ParamError, Params, PsdLevel, TrackSource};

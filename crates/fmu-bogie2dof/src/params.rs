@@ -76,6 +76,32 @@ pub enum TrackSource {
     None,
 }
 
+/// Which wheel/rail contact table the non-linear model uses.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum ContactSource {
+    /// Built-in table of EN 15302 profiles A/A (wheel A on rail A, 1435 mm gauge),
+    /// `resources/wheel_rail_A_A.csv`, computed by the `wheel-rail` crate.
+    #[default]
+    ProfilesAA,
+    /// Synthetic cone of `conicity` with a steep flange at 7 mm (the profile with which R7
+    /// is reproduced, see `calibration`).
+    SyntheticCone,
+    /// CSV file at run time (format in [`crate::contact`]).
+    File(String),
+}
+
+impl ContactSource {
+    /// Mapping of an FMU string parameter: "" or "AA" -> ProfilesAA, "synthetic" ->
+    /// SyntheticCone, anything else is a file path.
+    pub fn from_path_str(s: &str) -> Self {
+        match s.trim() {
+            "" | "AA" => ContactSource::ProfilesAA,
+            "synthetic" => ContactSource::SyntheticCone,
+            p => ContactSource::File(p.to_string()),
+        }
+    }
+}
+
 /// All parameters of the bogie model (SI units).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Params {
@@ -124,8 +150,8 @@ pub struct Params {
     pub initial_yaw_rad: f64,
     /// Track alignment source.
     pub track: TrackSource,
-    /// Wheel/rail contact table (CSV) to load instead of the built-in one.
-    pub contact_table_path: Option<String>,
+    /// Wheel/rail contact table of the non-linear model.
+    pub contact: ContactSource,
 }
 
 impl Default for Params {
@@ -151,7 +177,7 @@ impl Default for Params {
             initial_lateral_m: 0.0,
             initial_yaw_rad: 0.0,
             track: TrackSource::External,
-            contact_table_path: None,
+            contact: ContactSource::ProfilesAA,
         }
     }
 }
@@ -237,9 +263,9 @@ impl Params {
                 "must be within +-0.05 rad (small-angle model)",
             ));
         }
-        if let Some(p) = &self.contact_table_path {
+        if let ContactSource::File(p) = &self.contact {
             if p.trim().is_empty() {
-                return Err(ParamError::new("contact_table_path", "empty path"));
+                return Err(ParamError::new("contact", "empty contact table path"));
             }
         }
         Ok(())
