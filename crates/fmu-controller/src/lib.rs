@@ -5,6 +5,10 @@
 //!   with the practical absolute-velocity estimate of section 2.3.2.
 //! * [`idf::Idf`]: ideal damper force controller of the full-active actuator, (3.14)-(3.15).
 //!
+//! [`fmu`] wraps each law as an FMI 2.0 co-simulation model (`MpptController`,
+//! `SkyHookController`, `IdealDamperForceController`), exported from this crate's one binary
+//! with the `fmi-export` feature.
+//!
 //! # Timing (common to all laws)
 //! Every controller is a sampled "board" with its own sample time `sample_time_s`. The host calls
 //! `step(h, inputs)` for the communication interval `[t, t+h)`; the inputs are held constant (zero-order
@@ -32,6 +36,7 @@
 //! count of dropped samples, which the shell can log. [`NanPolicy::Error`] makes `step` return
 //! [`StepError::NonFiniteInput`] instead (the general project rule).
 
+pub mod fmu;
 pub mod idf;
 pub mod mppt;
 pub mod signal;

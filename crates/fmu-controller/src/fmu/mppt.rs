@@ -1,0 +1,476 @@
+//! `MpptController` FMU: the MPPT board of [`crate::mppt`].
+
+use model_description::{
+    DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo, StepError,
+    Variable, VariableList,
+};
+use serde::{Deserialize, Serialize};
+
+use super::{param_error, sign_to_int, step_error, AUTHOR};
+use crate::mppt::{ForceNormaliser, Mppt, MpptInputs, MpptOutputs, MpptParams};
+
+/// Physics field -> FMI variable name (for error messages).
+const NAMES: &[(&str, &str)] = &[
+    ("sample_time_s", "sample_time"),
+    ("update_period_s", "period"),
+    ("rms_window_s", "rms_window"),
+    ("filter_order", "filter_order"),
+    ("band_low_hz", "band_low"),
+    ("band_high_hz", "band_high"),
+    ("k_acc", "k_acc"),
+    ("k_force", "k_F"),
+    ("k_j_v", "k_J"),
+    ("delta_v_v", "Delta_V"),
+    ("acc_threshold_mps2", "threshold"),
+    ("a_lim_mps2", "a_lim"),
+    ("force_norm_n", "F_norm"),
+    ("initial_command_v", "initial_command"),
+    ("initial_direction", "initial_direction"),
+    ("command_min_v", "command_min"),
+    ("command_max_v", "command_max"),
+];
+
+const INPUT_NAMES: &[(&str, &str)] = &[
+    ("bogie_accel_mps2", "bogie.lateral_acceleration"),
+    ("damper_force_n", "damper.force"),
+];
+
+/// What was last reported, so that the log shows changes only.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+struct Reported {
+    updates: u64,
+    override_active: bool,
+    input_fault: bool,
+    at_limit: bool,
+}
+
+/// MPPT valve controller FMU (plain data: FMU state save/restore clones it).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct MpptController {
+    params: MpptParams,
+    inputs: MpptInputs,
+    ctrl: Mppt,
+    out: MpptOutputs,
+    /// Set by exit_initialization; before it the outputs preview the parameters being set.
+    initialized: bool,
+    reported: Reported,
+}
+
+impl MpptController {
+    fn build(&mut self) -> Result<(), ModelError> {
+        self.ctrl = Mppt::new(self.params.clone()).map_err(|e| param_error(e, NAMES))?;
+        self.out = self.ctrl.outputs();
+        Ok(())
+    }
+
+    fn at_limit(&self, o: &MpptOutputs) -> bool {
+        o.command_v <= self.params.command_min_v || o.command_v >= self.params.command_max_v
+    }
+
+    /// Log what changed in this step (never once per sample).
+    fn report(&mut self, t_end: f64, o: &MpptOutputs, diag: &mut Diagnostics) {
+        let r = &mut self.reported;
+        if o.updates > r.updates {
+            diag.event(format!(
+                "t = {t_end:.6} s: valve update #{}: J = {:.6} (rms a = {:.4} m/s2, rms F = {:.1} N), \
+                 command {:.4} V, direction {:+}",
+                o.updates, o.cost, o.rms_accel_mps2, o.rms_force_n, o.command_v, o.direction
+            ));
+            r.updates = o.updates;
+        }
+        if o.override_active != r.override_active {
+            if o.override_active {
+                diag.warn(format!(
+                    "t = {t_end:.6} s: rms acceleration {:.3} m/s2 above the threshold {:.3} m/s2: \
+                     instability override (3.5), closing the valve by Delta_V = {} V per update",
+                    o.rms_accel_mps2, self.params.acc_threshold_mps2, self.params.delta_v_v
+                ));
+            } else {
+                diag.event(format!(
+                    "t = {t_end:.6} s: rms acceleration back below the threshold, hill climb resumed"
+                ));
+            }
+            r.override_active = o.override_active;
+        }
+        if o.input_fault != r.input_fault {
+            if o.input_fault {
+                diag.warn(format!(
+                    "t = {t_end:.6} s: non-finite input, samples dropped and command held \
+                     ({} dropped so far)",
+                    o.dropped_samples
+                ));
+            } else {
+                diag.event(format!("t = {t_end:.6} s: inputs finite again"));
+            }
+            r.input_fault = o.input_fault;
+        }
+        let at_limit = self.at_limit(o);
+        if at_limit != self.reported.at_limit {
+            diag.event(if at_limit {
+                format!(
+                    "t = {t_end:.6} s: valve command saturated at {} V",
+                    o.command_v
+                )
+            } else {
+                format!("t = {t_end:.6} s: valve command left its limit")
+            });
+            self.reported.at_limit = at_limit;
+        }
+    }
+}
+
+impl FmuModel for MpptController {
+    const INFO: ModelInfo = ModelInfo {
+        name: "MpptController",
+        description: "Semi-active yaw damper valve control by maximum power point tracking \
+                      (hill climbing on an acceleration/force cost, seed 3.2.1.1)",
+        author: AUTHOR,
+        version: env!("CARGO_PKG_VERSION"),
+        default_experiment: DefaultExperiment {
+            start_time: 0.0,
+            stop_time: 10.0,
+            step_size: 1e-3,
+        },
+        documentation_html: DOC,
+        resources: &[],
+    };
+
+    fn variables() -> Vec<Variable<Self>> {
+        let mut v = VariableList::<Self>::new();
+        v.parameter(
+            "k_acc",
+            "Weight k_x of the acceleration term of the cost (3.2); Table 4-2: 1",
+            |m| m.params.k_acc,
+            |m, x| m.params.k_acc = x,
+        )
+        .unit("1")
+        .min(0.0);
+        v.parameter(
+            "k_F",
+            "Weight k_F of the force term of the cost (3.2); Table 4-2: 0 = MPPT1, 4 = MPPT2",
+            |m| m.params.k_force,
+            |m, x| m.params.k_force = x,
+        )
+        .unit("1")
+        .min(0.0);
+        v.parameter(
+            "k_J",
+            "Cost gain k_J of the hill-climb step (3.3) (not in the seed)",
+            |m| m.params.k_j_v,
+            |m, x| m.params.k_j_v = x,
+        )
+        .unit("V")
+        .min(0.0);
+        v.parameter(
+            "period",
+            "Valve update period (seed: every second); integer multiple of sample_time",
+            |m| m.params.update_period_s,
+            |m, x| m.params.update_period_s = x,
+        )
+        .unit("s")
+        .min(0.0);
+        v.parameter(
+            "rms_window",
+            "Length of the moving rms windows of acceleration and force",
+            |m| m.params.rms_window_s,
+            |m, x| m.params.rms_window_s = x,
+        )
+        .unit("s")
+        .min(0.0);
+        v.parameter(
+            "Delta_V",
+            "Emergency closing step of the instability override (3.5) (not in the seed)",
+            |m| m.params.delta_v_v,
+            |m, x| m.params.delta_v_v = x,
+        )
+        .unit("V")
+        .min(0.0);
+        v.parameter(
+            "threshold",
+            "Instability threshold on the rms band-passed acceleration (3.5); default a_lim",
+            |m| m.params.acc_threshold_mps2,
+            |m, x| m.params.acc_threshold_mps2 = x,
+        )
+        .unit("m/s2")
+        .min(0.0);
+        v.parameter(
+            "a_lim",
+            "EN 14363 lateral acceleration limit normalising (3.2), (12 - m/5)/2 (seed 4.2)",
+            |m| m.params.a_lim_mps2,
+            |m, x| m.params.a_lim_mps2 = x,
+        )
+        .unit("m/s2")
+        .min(0.0);
+        v.parameter(
+            "F_norm",
+            "Force normaliser of (3.2) (fixed value, or start of the running maximum)",
+            |m| m.params.force_norm_n,
+            |m, x| m.params.force_norm_n = x,
+        )
+        .unit("N")
+        .display_unit("kN")
+        .min(0.0);
+        v.integer_parameter(
+            "force_normaliser",
+            "0 = fixed F_norm (default), 1 = running maximum of the rms force (seed literal)",
+            |m| match m.params.force_normaliser {
+                ForceNormaliser::Fixed => 0,
+                ForceNormaliser::RunningMax => 1,
+            },
+            |m, x| {
+                m.params.force_normaliser = if x == 1 {
+                    ForceNormaliser::RunningMax
+                } else {
+                    ForceNormaliser::Fixed
+                }
+            },
+        )
+        .range(0.0, 1.0);
+        v.parameter(
+            "initial_command",
+            "Valve command before the first update (0 V = closed, maximum damping)",
+            |m| m.params.initial_command_v,
+            |m, x| m.params.initial_command_v = x,
+        )
+        .unit("V")
+        .range(0.0, 10.0);
+        v.integer_parameter(
+            "initial_direction",
+            "Initial hill-climb direction: +1 opening, -1 closing",
+            |m| sign_to_int(m.params.initial_direction),
+            |m, x| m.params.initial_direction = f64::from(x),
+        )
+        .range(-1.0, 1.0);
+        v.parameter(
+            "command_min",
+            "Lower command saturation (seed 4.4.1: 0 V)",
+            |m| m.params.command_min_v,
+            |m, x| m.params.command_min_v = x,
+        )
+        .unit("V")
+        .range(0.0, 10.0);
+        v.parameter(
+            "command_max",
+            "Upper command saturation (seed 4.4.1: 10 V)",
+            |m| m.params.command_max_v,
+            |m, x| m.params.command_max_v = x,
+        )
+        .unit("V")
+        .range(0.0, 10.0);
+        v.parameter(
+            "sample_time",
+            "Board sample time (1 kHz board)",
+            |m| m.params.sample_time_s,
+            |m, x| m.params.sample_time_s = x,
+        )
+        .unit("s")
+        .display_unit("ms")
+        .min(0.0);
+        v.integer_parameter(
+            "filter_order",
+            "Order of the Butterworth band-pass on the acceleration: 2 or 4",
+            |m| i32::try_from(m.params.filter_order).unwrap_or(i32::MAX),
+            |m, x| m.params.filter_order = u32::try_from(x).unwrap_or(0),
+        )
+        .range(2.0, 4.0);
+        v.parameter(
+            "band_low",
+            "Band-pass lower -3 dB edge, f0 - 2 Hz (EN 14363 via seed 4.2)",
+            |m| m.params.band_low_hz,
+            |m, x| m.params.band_low_hz = x,
+        )
+        .unit("Hz")
+        .min(0.0);
+        v.parameter(
+            "band_high",
+            "Band-pass upper -3 dB edge, f0 + 2 Hz",
+            |m| m.params.band_high_hz,
+            |m, x| m.params.band_high_hz = x,
+        )
+        .unit("Hz")
+        .min(0.0);
+
+        v.input(
+            "bogie.lateral_acceleration",
+            "Bogie frame lateral acceleration (band-passed on the board)",
+            |m| m.inputs.bogie_accel_mps2,
+            |m, x| m.inputs.bogie_accel_mps2 = x,
+        )
+        .unit("m/s2");
+        v.input(
+            "damper.force",
+            "Yaw damper force, tension positive (only its rms is used)",
+            |m| m.inputs.damper_force_n,
+            |m, x| m.inputs.damper_force_n = x,
+        )
+        .unit("N")
+        .display_unit("kN");
+
+        v.output(
+            "valve.command",
+            "By-pass valve command, 0 V = closed (maximum damping) .. 10 V = open",
+            &[],
+            |m| m.out.command_v,
+        )
+        .unit("V")
+        .discrete();
+        v.output(
+            "valve.opening",
+            "Valve opening = command / 10 V",
+            &[],
+            |m| m.out.opening,
+        )
+        .unit("1")
+        .display_unit("%")
+        .discrete();
+        v.output("cost", "Cost J at the last update (3.2)", &[], |m| {
+            m.out.cost
+        })
+        .unit("1")
+        .discrete();
+        v.output(
+            "rms_acceleration",
+            "rms of the band-passed bogie acceleration at the last update",
+            &[],
+            |m| m.out.rms_accel_mps2,
+        )
+        .unit("m/s2")
+        .discrete();
+        v.output(
+            "rms_force",
+            "rms of the damper force at the last update",
+            &[],
+            |m| m.out.rms_force_n,
+        )
+        .unit("N")
+        .display_unit("kN")
+        .discrete();
+        v.output(
+            "filtered_acceleration",
+            "Latest band-passed acceleration sample",
+            &[],
+            |m| m.out.filtered_accel_mps2,
+        )
+        .unit("m/s2")
+        .discrete();
+        v.integer_output(
+            "direction",
+            "Hill-climb direction (3.4): +1 opening, -1 closing",
+            &[],
+            |m| sign_to_int(m.out.direction),
+        );
+        v.boolean_output(
+            "override_active",
+            "True if the last update was the instability override (3.5)",
+            &[],
+            |m| m.out.override_active,
+        );
+        v.integer_output("updates", "Number of valve updates performed", &[], |m| {
+            i32::try_from(m.out.updates).unwrap_or(i32::MAX)
+        });
+        v.boolean_output(
+            "input_fault",
+            "True if an input of the last step was not finite (sample dropped, command held)",
+            &[],
+            |m| m.out.input_fault,
+        );
+        v.integer_output(
+            "dropped_samples",
+            "Board samples dropped because of non-finite inputs since the start",
+            &[],
+            |m| i32::try_from(m.out.dropped_samples).unwrap_or(i32::MAX),
+        );
+        v.into_vec()
+    }
+
+    fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
+        // Single source of the start values: the physics crate's MPPT2 defaults.
+        let params = MpptParams::default();
+        let ctrl = Mppt::new(params.clone()).map_err(|e| param_error(e, NAMES))?;
+        let out = ctrl.outputs();
+        Ok(Self {
+            params,
+            inputs: MpptInputs::default(),
+            ctrl,
+            out,
+            initialized: false,
+            reported: Reported::default(),
+        })
+    }
+
+    fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
+        self.build()?;
+        self.reported = Reported {
+            at_limit: self.at_limit(&self.out),
+            ..Reported::default()
+        };
+        self.initialized = true;
+        Ok(())
+    }
+
+    fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
+        // No output depends on the current inputs (one-sample board delay). In initialization
+        // mode, preview the initial outputs of the parameters set so far; invalid values are
+        // reported by exit_initialization.
+        if !self.initialized {
+            let _ = self.build();
+        }
+        Ok(())
+    }
+
+    fn do_step(&mut self, time: f64, step: f64, diag: &mut Diagnostics) -> Result<(), StepError> {
+        let out = self
+            .ctrl
+            .step(step, &self.inputs)
+            .map_err(|e| step_error(e, INPUT_NAMES))?;
+        self.report(time + step, &out, diag);
+        self.out = out;
+        Ok(())
+    }
+}
+
+const DOC: &str = r#"
+<h2>Law</h2>
+<p>Maximum power point tracking of the semi-active yaw damper's by-pass valve, seed section
+3.2.1.1. A sampled board (period <code>sample_time</code>, default 1 ms) band-passes the bogie
+lateral acceleration (Butterworth, order <code>filter_order</code>, edges <code>band_low</code> ..
+<code>band_high</code> = f0 &plusmn; 2 Hz with f0 = 4 Hz, EN 14363 via seed 4.2), keeps moving
+rms values of the filtered acceleration and of the damper force over <code>rms_window</code>,
+and every <code>period</code> (default 1 s, "every one second") updates the command:</p>
+<pre>
+J = k_acc (rms_a / a_lim)^2 + k_F (rms_F / F_norm)^2                      (3.2)
+direction kept if J &lt; J_old, reversed if J &gt;= J_old                       (3.4)
+V = V_old + direction * k_J |J - J_old| / max(J, J_old)                    (3.3)
+V = V_old - Delta_V   if rms_a &gt; threshold  (then direction = closing)    (3.5)
+V saturated to [command_min, command_max] = [0, 10] V                      (seed 4.4.1)
+</pre>
+<p>The first update only measures J (no J_old yet); the override (3.5) applies from the first
+update. 0 V = valve closed = maximum damping (the safe power-up state, default initial command);
+10 V = fully open; <code>valve.opening</code> = command / 10 V.</p>
+<h2>Presets (Table 4-2)</h2>
+<ul>
+<li><b>MPPT1</b>: <code>k_acc = 1</code>, <code>k_F = 0</code> (acceleration only).</li>
+<li><b>MPPT2</b> (default): <code>k_acc = 1</code>, <code>k_F = 4</code> (acceleration and force).</li>
+</ul>
+<h2>Interpretations (seed silent or garbled)</h2>
+<ul>
+<li><code>max(RMS(F))</code> in (3.2) is a running maximum in the seed, which mixes normalisers
+between J and J_old. Default: fixed <code>F_norm</code> = 10 kN (about the rms force of a closed
+valve at hunting amplitude, R1); <code>force_normaliser = 1</code> gives the seed's running maximum
+starting from F_norm.</li>
+<li><code>k_J</code> = 1 V and <code>Delta_V</code> = 2 V are not given in the seed (2 V per update
+closes a fully open valve in 5 s, as in Fig. 4.18).</li>
+<li><code>threshold</code> = <code>a_lim</code> = 5.39 m/s2, the EN 14363 limit of the seed's bogie.</li>
+<li>An update period containing a dropped sample is skipped (command held, J_old kept).</li>
+</ul>
+<h2>Timing and co-simulation</h2>
+<p>Samples at <code>start_time + k sample_time</code>. The command computed from the inputs sampled at
+t_k is output from t_(k+1) on (one sample of computational delay, as on a real board), so no output
+depends on the inputs at the same instant: ModelStructure declares no direct feedthrough and a
+controller-damper loop has no algebraic loop. With a communication step that divides the sample
+time (1e-4 or 1e-3 s with the 1 ms board) the results do not depend on the step; coarser steps hold
+the inputs over the step. Inputs are held constant over a communication step.</p>
+<p>NaN/inf inputs are rejected when set (fmi2Error, variable named in the log). Logged: every valve
+update (logEvents), the start of an override (3.5) (warning) and its end, command saturation
+changes; the internal hold-and-warn path for non-finite samples (warning when it starts).</p>
+"#;
