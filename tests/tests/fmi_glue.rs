@@ -1,6 +1,8 @@
 //! The FMI 2.0 glue through the real C ABI of a packaged FMU (dist/MassSpring.fmu and
 //! dist/SpringDamperMass.fmu), as any third-party host drives it.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use tests::*;
 
 fn fmu() -> TestFmu {

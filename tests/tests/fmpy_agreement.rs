@@ -2,6 +2,8 @@
 //! command runs first and points to with RAIL_FMPY_RESULTS) agrees with the same model driven
 //! directly from Rust (same state machine, no FMI, no C ABI) to rounding.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use model_description::{rust_component, value_reference, FmuModel, InstanceContext, Status};
 
 fn results_dir() -> Option<std::path::PathBuf> {

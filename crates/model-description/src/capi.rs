@@ -584,10 +584,7 @@ pub unsafe fn free_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2
     })
 }
 
-unsafe fn serialized_bytes<'a>(
-    cc: &'a mut CComponent,
-    state: fmi2FMUstate,
-) -> Result<&'a [u8], Status> {
+unsafe fn serialized_bytes(cc: &mut CComponent, state: fmi2FMUstate) -> Result<&[u8], Status> {
     let key = state as usize;
     let cached = cc.serialized.as_ref().is_some_and(|(p, _)| *p == key);
     if !cached {

@@ -87,6 +87,8 @@ pub const UNITS: &[UnitDef] = &[
     ),
     unit("rad/s2", 0, 0, -2, 0, 1, &[]),
     unit("1/s", 0, 0, -1, 0, 0, &[]),
+    unit("m/N", -1, 0, 2, 0, 0, &[("mm/kN", 1.0e6, 0.0)]),
+    unit("m2/s2", 0, 2, -2, 0, 0, &[]),
 ];
 
 pub fn find(name: &str) -> Option<&'static UnitDef> {
