@@ -34,14 +34,20 @@ fn check<M: FmuModel>() {
 
     let de = M::INFO.default_experiment;
     let (mut c, _log) = rust_component::<M>(InstanceContext::default()).unwrap();
-    assert_eq!(c.setup_experiment(de.start_time, Some(de.stop_time)), Status::Ok);
+    assert_eq!(
+        c.setup_experiment(de.start_time, Some(de.stop_time)),
+        Status::Ok
+    );
     assert_eq!(c.enter_initialization_mode(), Status::Ok);
     assert!(c.exit_initialization_mode() <= Status::Warning);
     let mut out = vec![0.0; vrs.len()];
     let mut max_err: f64 = 0.0;
     for (k, row) in rows.iter().enumerate() {
         let t = de.start_time + k as f64 * de.step_size;
-        assert!((row[0] - t).abs() < 1e-9, "{name}: time grid differs at row {k}");
+        assert!(
+            (row[0] - t).abs() < 1e-9,
+            "{name}: time grid differs at row {k}"
+        );
         if k > 0 {
             let t_prev = de.start_time + (k - 1) as f64 * de.step_size;
             assert!(c.do_step(t_prev, t - t_prev) <= Status::Warning);
@@ -58,7 +64,10 @@ fn check<M: FmuModel>() {
         }
     }
     assert!(rows.len() > 10, "{name}: too few rows from fmpy");
-    eprintln!("{name}: {} rows agree, max relative difference {max_err:e}", rows.len());
+    eprintln!(
+        "{name}: {} rows agree, max relative difference {max_err:e}",
+        rows.len()
+    );
 }
 
 #[test]

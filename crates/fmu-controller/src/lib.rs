@@ -49,7 +49,7 @@ pub use idf::{Idf, IdfInputs, IdfOutputs, IdfParams};
 pub use mppt::{ForceNormaliser, Mppt, MpptInputs, MpptOutputs, MpptParams};
 pub use skyhook::{
     DampingTable, SkyHook, SkyHookInputs, SkyHookMode, SkyHookOutputs, SkyHookParams,
-    VelocitySource, PLACEHOLDER_DAMPING_TABLE_4HZ,
+    VelocitySource, DAMPING_TABLE_4HZ,
 };
 
 /// A parameter is invalid; names the parameter and the reason.

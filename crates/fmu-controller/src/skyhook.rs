@@ -39,21 +39,21 @@ use crate::{
     SampleClock, StepError,
 };
 
-/// PLACEHOLDER equivalent damping (N s/m) vs valve opening (0..1) of the semi-active damper at
-/// 4 Hz. NOT MEASURED: a geometric law from 400 kNs/m (closed) to 10 kNs/m (open), chosen to be
-/// consistent with R1 (12-20 kN peak at 0 % and 0.5-1 kN at 100 % for +-1..3 mm at 4 Hz, i.e.
-/// 25-75 mm/s) and with c about 130 kNs/m at 30 % (REFERENCE: c0 about 120 kNs/m).
-/// Replace with the table measured on the calibrated fmu-damper model.
-pub const PLACEHOLDER_DAMPING_TABLE_4HZ: [(f64, f64); 9] = [
-    (0.0, 400.0e3),
-    (0.1, 276.6e3),
-    (0.2, 191.3e3),
-    (0.3, 132.3e3),
-    (0.4, 91.5e3),
-    (0.5, 63.2e3),
-    (0.6, 43.7e3),
-    (0.8, 20.9e3),
-    (1.0, 10.0e3),
+/// Equivalent damping (N s/m) vs valve opening (0..1) of the project's semi-active damper at
+/// 4 Hz and 1 mm amplitude (c_eq = Im(F/x)/omega of the first harmonic), measured with
+/// `fmu_damper::characterise::equivalent_stiffness_damping` on its calibrated default
+/// parameters. The end-to-end test `tests/tests/controller_table.rs` re-measures it and fails if
+/// the damper calibration moves away from these numbers.
+pub const DAMPING_TABLE_4HZ: [(f64, f64); 9] = [
+    (0.0, 325.7e3),
+    (0.1, 241.1e3),
+    (0.2, 147.2e3),
+    (0.3, 95.6e3),
+    (0.4, 68.1e3),
+    (0.5, 52.3e3),
+    (0.6, 42.4e3),
+    (0.8, 30.8e3),
+    (1.0, 24.3e3),
 ];
 
 /// Equivalent damping vs opening: `(opening 0..1, c_eq N s/m)`, openings strictly increasing,
@@ -66,7 +66,7 @@ pub struct DampingTable {
 impl Default for DampingTable {
     fn default() -> Self {
         Self {
-            points: PLACEHOLDER_DAMPING_TABLE_4HZ.to_vec(),
+            points: DAMPING_TABLE_4HZ.to_vec(),
         }
     }
 }
@@ -451,25 +451,25 @@ mod tests {
     #[test]
     fn continuous_clips_to_bounds_and_inverts_table() {
         let mut s = ideal(SkyHookMode::Continuous);
-        // c = c_sky x'/v_e = 330 kNs/m: between 400 k (0 %) and 276.6 k (10 %)
-        let o = s.step(1e-3, &inp(0.1, 0.1)).unwrap();
-        assert_relative_eq!(o.c_desired_nspm, 330e3, max_relative = 1e-12);
-        let open = 0.1 * (400e3 - 330e3) / (400e3 - 276.6e3);
+        // c = c_sky x'/v_e = 0.8 * 330 = 264 kNs/m: between 325.7 k (0 %) and 241.1 k (10 %)
+        let o = s.step(1e-3, &inp(0.08, 0.1)).unwrap();
+        assert_relative_eq!(o.c_desired_nspm, 264e3, max_relative = 1e-12);
+        let open = 0.1 * (325.7e3 - 264e3) / (325.7e3 - 241.1e3);
         assert_relative_eq!(o.command_v, 10.0 * open, max_relative = 1e-12);
         // c = 3.3 MN s/m -> clipped to c_max -> closed
         let o = s.step(1e-3, &inp(0.1, 0.01)).unwrap();
-        assert_eq!(o.c_desired_nspm, 400e3);
+        assert_eq!(o.c_desired_nspm, 325.7e3);
         assert_eq!(o.command_v, 0.0);
         // c = 3.3 kNs/m -> clipped to c_min -> open
         let o = s.step(1e-3, &inp(0.001, 0.1)).unwrap();
-        assert_eq!(o.c_desired_nspm, 10e3);
+        assert_eq!(o.c_desired_nspm, 24.3e3);
         assert_eq!(o.command_v, 10.0);
         // condition < 0 -> c_min
         let o = s.step(1e-3, &inp(0.1, -0.1)).unwrap();
-        assert_eq!(o.c_desired_nspm, 10e3);
+        assert_eq!(o.c_desired_nspm, 24.3e3);
         // v_e = 0 with x' != 0: infinite demand -> c_max
         let o = s.step(1e-3, &inp(0.1, 0.0)).unwrap();
-        assert_eq!(o.c_desired_nspm, 400e3);
+        assert_eq!(o.c_desired_nspm, 325.7e3);
         // tighter bounds inside the table
         let mut t = SkyHook::new(SkyHookParams {
             mode: SkyHookMode::Continuous,
@@ -492,7 +492,7 @@ mod tests {
         }
         assert_eq!(t.opening_for(1e9), 0.0);
         assert_eq!(t.opening_for(1.0), 1.0);
-        assert_relative_eq!(t.damping_at(0.25), 0.5 * (191.3e3 + 132.3e3));
+        assert_relative_eq!(t.damping_at(0.25), 0.5 * (147.2e3 + 95.6e3));
     }
 
     /// Bogie-only model (car body fixed): damper end moves as x = X sin(wt); the ideal absolute

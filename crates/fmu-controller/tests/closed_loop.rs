@@ -6,7 +6,7 @@
 // Test-only helpers below are not #[test] fns, so the workspace lint allowance does not reach them.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use fmu_controller::skyhook::PLACEHOLDER_DAMPING_TABLE_4HZ;
+use fmu_controller::skyhook::DAMPING_TABLE_4HZ;
 use fmu_controller::{
     DampingTable, Idf, IdfInputs, IdfParams, Mppt, MpptInputs, MpptParams, SkyHook, SkyHookInputs,
     SkyHookMode, SkyHookParams, VelocitySource,
@@ -152,7 +152,7 @@ impl HuntingMode {
             x: 0.0,
             xd: 0.0,
             table: DampingTable {
-                points: PLACEHOLDER_DAMPING_TABLE_4HZ.to_vec(),
+                points: DAMPING_TABLE_4HZ.to_vec(),
             },
             phases,
         }

@@ -442,6 +442,9 @@ fn a_changed_table_is_used() {
         let name = format!("table.damping[{}]", i + 1);
         assert_eq!(set_r::<S>(&mut c, &name, 400e3 - 390e3 * o), Status::Ok);
     }
+    // c_min/c_max do not follow a changed table (documented): set them to its ends.
+    assert_eq!(set_r::<S>(&mut c, "c_max", 400e3), Status::Ok);
+    assert_eq!(set_r::<S>(&mut c, "c_min", 10e3), Status::Ok);
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
     let ins = [
         vr::<S>("damper_end.absolute_velocity"),

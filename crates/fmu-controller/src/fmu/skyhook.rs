@@ -10,11 +10,11 @@ use serde::{Deserialize, Serialize};
 use super::{invalid, param_error, sign_to_int, step_error, AUTHOR};
 use crate::skyhook::{
     DampingTable, SkyHook, SkyHookInputs, SkyHookMode, SkyHookOutputs, SkyHookParams,
-    VelocitySource, PLACEHOLDER_DAMPING_TABLE_4HZ,
+    VelocitySource, DAMPING_TABLE_4HZ,
 };
 
 /// Number of points of the damping table parameters (that of the placeholder table).
-pub const TABLE_LEN: usize = PLACEHOLDER_DAMPING_TABLE_4HZ.len();
+pub const TABLE_LEN: usize = DAMPING_TABLE_4HZ.len();
 
 const NAMES: &[(&str, &str)] = &[
     ("sample_time_s", "sample_time"),
