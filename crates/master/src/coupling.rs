@@ -14,8 +14,9 @@
 //!   slave can get/set its FMU state, all slaves are reset to the state saved before the macro
 //!   step and the step is redone as 2, 4, ... sub-steps (each active slave's step split into
 //!   equal parts, data exchanged after every part), up to `max_step_halvings` times.
-//! * Every exit path (success, error, cancellation) calls fmi2Terminate on each slave that was
-//!   initialised and did not report fmi2Fatal; freeing is the slaves' `Drop`.
+//! * Every exit path (success, error, cancellation) calls fmi2Terminate on each slave that
+//!   reached step mode (exitInitializationMode) and did not report fmi2Fatal; freeing
+//!   (fmi2FreeInstance, allowed in every state) is the slaves' `Drop`.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -36,6 +37,8 @@ pub struct PlanInstance {
     pub step_multiple: u32,
     /// Start values set before initialisation (value reference, value as f64).
     pub parameters: Vec<(VarRef, f64)>,
+    /// Names of `parameters` (same order) for messages; may be empty.
+    pub parameter_names: Vec<String>,
 }
 
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -125,6 +128,14 @@ impl SimOutput {
 pub enum SimError {
     #[error("invalid plan: {0}")]
     Plan(String),
+    #[error("instance '{instance}': setting start value '{name}' = {value} failed: {source}")]
+    StartValue {
+        instance: String,
+        name: String,
+        value: f64,
+        #[source]
+        source: SlaveError,
+    },
     #[error("at t = {time} s: {source}")]
     Slave {
         time: f64,
@@ -308,13 +319,24 @@ impl Engine<'_, '_, '_, '_> {
             self.slaves[i]
                 .setup_experiment(t0, plan.stop_time)
                 .map_err(|e| self.slave_err(t0, i, e))?;
-            for &(v, x) in &plan.instances[i].parameters {
-                self.set1(t0, i, v, x)?;
+            let inst = &plan.instances[i];
+            for (k, &(v, x)) in inst.parameters.iter().enumerate() {
+                self.slaves[i]
+                    .set(&[v], &[x])
+                    .map_err(|source| SimError::StartValue {
+                        instance: inst.name.clone(),
+                        name: inst
+                            .parameter_names
+                            .get(k)
+                            .cloned()
+                            .unwrap_or_else(|| format!("vr {}", v.vr)),
+                        value: x,
+                        source,
+                    })?;
             }
             self.slaves[i]
                 .enter_initialization_mode()
                 .map_err(|e| self.slave_err(t0, i, e))?;
-            self.initialised[i] = true;
         }
         for _ in 0..plan.init_sweeps.max(1) {
             let mut change: f64 = 0.0;
@@ -330,6 +352,9 @@ impl Engine<'_, '_, '_, '_> {
             self.slaves[i]
                 .exit_initialization_mode()
                 .map_err(|e| self.slave_err(t0, i, e))?;
+            // fmi2Terminate is allowed only from step mode (FMI 2.0 CS state machine); a slave
+            // stopped earlier is only freed
+            self.initialised[i] = true;
         }
         self.exchange_all(t0)
     }
@@ -346,7 +371,8 @@ impl Engine<'_, '_, '_, '_> {
             .iter()
             .map(|inst| {
                 let m = u64::from(inst.step_multiple.max(1));
-                (k % m == 0).then(|| (t, self.t((k + m).min(self.n_steps))))
+                k.is_multiple_of(m)
+                    .then(|| (t, self.t((k + m).min(self.n_steps))))
             })
             .collect();
         let sub = |(a, b): (f64, f64), j: u64| -> (f64, f64) {
@@ -361,8 +387,8 @@ impl Engine<'_, '_, '_, '_> {
         for j in 0..parts {
             match plan.algorithm {
                 Algorithm::Jacobi => {
-                    for i in 0..n {
-                        if let Some(w) = windows[i] {
+                    for (i, w) in windows.iter().enumerate().take(n) {
+                        if let Some(w) = *w {
                             let (ts, h) = sub(w, j);
                             match self.slaves[i].do_step(ts, h) {
                                 Ok(StepStatus::Ok) => {}

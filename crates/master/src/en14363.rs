@@ -86,11 +86,20 @@ pub struct Assessment {
     pub stable: bool,
 }
 
-fn param(name: &'static str, value: f64, ok: bool, reason: &'static str) -> Result<(), AssessError> {
+fn param(
+    name: &'static str,
+    value: f64,
+    ok: bool,
+    reason: &'static str,
+) -> Result<(), AssessError> {
     if ok && value.is_finite() {
         Ok(())
     } else {
-        Err(AssessError::InvalidParameter { name, value, reason })
+        Err(AssessError::InvalidParameter {
+            name,
+            value,
+            reason,
+        })
     }
 }
 
@@ -106,7 +115,12 @@ pub fn assess_rms(
     param("fs", fs, fs > 0.0, "sampling rate must be > 0")?;
     param("speed_mps", speed_mps, speed_mps > 0.0, "speed must be > 0")?;
     param("limit", limit, limit > 0.0, "limit must be > 0")?;
-    param("half_band_hz", s.half_band_hz, s.half_band_hz > 0.0, "must be > 0")?;
+    param(
+        "half_band_hz",
+        s.half_band_hz,
+        s.half_band_hz > 0.0,
+        "must be > 0",
+    )?;
     param("skip_s", s.skip_s, s.skip_s >= 0.0, "must be >= 0")?;
     let skip = ((s.skip_s * fs).round() as usize).min(signal.len());
     let x = &signal[skip..];
@@ -144,7 +158,12 @@ pub fn assess_lateral_acceleration(
     bogie_mass_t: f64,
     s: &StabilitySettings,
 ) -> Result<Assessment, AssessError> {
-    param("bogie_mass_t", bogie_mass_t, bogie_mass_t > 0.0 && bogie_mass_t < 60.0, "bogie mass must be in (0, 60) t")?;
+    param(
+        "bogie_mass_t",
+        bogie_mass_t,
+        bogie_mass_t > 0.0 && bogie_mass_t < 60.0,
+        "bogie mass must be in (0, 60) t",
+    )?;
     assess_rms(acc_mps2, fs, speed_mps, acceleration_limit(bogie_mass_t), s)
 }
 
@@ -157,9 +176,20 @@ pub fn assess_guiding_forces(
     static_wheel_load_n: f64,
     s: &StabilitySettings,
 ) -> Result<Assessment, AssessError> {
-    param("static_wheel_load_n", static_wheel_load_n, static_wheel_load_n > 0.0, "must be > 0")?;
+    param(
+        "static_wheel_load_n",
+        static_wheel_load_n,
+        static_wheel_load_n > 0.0,
+        "must be > 0",
+    )?;
     let kn: Vec<f64> = sum_y_n.iter().map(|v| v / 1000.0).collect();
-    assess_rms(&kn, fs, speed_mps, guiding_force_limit_kn(static_wheel_load_n / 1000.0), s)
+    assess_rms(
+        &kn,
+        fs,
+        speed_mps,
+        guiding_force_limit_kn(static_wheel_load_n / 1000.0),
+        s,
+    )
 }
 
 #[cfg(test)]
@@ -188,11 +218,20 @@ mod tests {
         let a = 6.0;
         // hunting at 3.5 Hz plus 0.5 Hz drift and 15 Hz vibration of the same amplitude
         let mut x = sine(a, 3.5, fs, 40.0);
-        for (v, (l, h)) in x.iter_mut().zip(sine(a, 0.5, fs, 40.0).iter().zip(sine(a, 15.0, fs, 40.0))) {
+        for (v, (l, h)) in x
+            .iter_mut()
+            .zip(sine(a, 0.5, fs, 40.0).iter().zip(sine(a, 15.0, fs, 40.0)))
+        {
             *v += 0.6 * l + 0.6 * h;
         }
-        let r = assess_lateral_acceleration(&x, fs, 300.0 / 3.6, 6.1, &StabilitySettings::default()).unwrap();
-        assert!((r.dominant_frequency_hz - 3.5).abs() < 0.05, "{}", r.dominant_frequency_hz);
+        let r =
+            assess_lateral_acceleration(&x, fs, 300.0 / 3.6, 6.1, &StabilitySettings::default())
+                .unwrap();
+        assert!(
+            (r.dominant_frequency_hz - 3.5).abs() < 0.05,
+            "{}",
+            r.dominant_frequency_hz
+        );
         // a window of T seconds that is not a whole number of periods changes the rms of a
         // sine by at most 1/(4 pi f T) relative; the filter passes |H(f)|^2 (0.993 at 3.5 Hz
         // for the 1.5-5.5 Hz band); what leaks of the 0.5 and 15 Hz parts (|H|^2 < 0.006)
@@ -211,13 +250,20 @@ mod tests {
     #[test]
     fn verdict_against_the_limit() {
         let fs = 200.0;
-        let s = StabilitySettings { dominant_frequency_hz: Some(4.0), ..Default::default() };
+        let s = StabilitySettings {
+            dominant_frequency_hz: Some(4.0),
+            ..Default::default()
+        };
         // rms 5.0 < 5.39: stable; rms 5.8 > 5.39: unstable
-        let ok = assess_lateral_acceleration(&sine(5.0 * 2f64.sqrt(), 4.0, fs, 30.0), fs, 70.0, 6.1, &s).unwrap();
+        let ok =
+            assess_lateral_acceleration(&sine(5.0 * 2f64.sqrt(), 4.0, fs, 30.0), fs, 70.0, 6.1, &s)
+                .unwrap();
         let tol = 1.0 / (4.0 * PI * 4.0 * (100.0 / 70.0)) + 0.005;
         assert_relative_eq!(ok.max_rms, 5.0, max_relative = tol);
         assert!(ok.stable);
-        let bad = assess_lateral_acceleration(&sine(5.8 * 2f64.sqrt(), 4.0, fs, 30.0), fs, 70.0, 6.1, &s).unwrap();
+        let bad =
+            assess_lateral_acceleration(&sine(5.8 * 2f64.sqrt(), 4.0, fs, 30.0), fs, 70.0, 6.1, &s)
+                .unwrap();
         assert!(!bad.stable);
         // 30 s at 70 m/s = 2100 m: (2100 - 100)/10 + 1 = 201 windows
         assert_eq!(ok.rms.len(), 201);
@@ -233,7 +279,10 @@ mod tests {
             .enumerate()
             .map(|(i, v)| if i < 4000 { 0.0 } else { v })
             .collect();
-        let s = StabilitySettings { dominant_frequency_hz: Some(4.0), ..Default::default() };
+        let s = StabilitySettings {
+            dominant_frequency_hz: Some(4.0),
+            ..Default::default()
+        };
         let r = assess_lateral_acceleration(&x, fs, 50.0, 6.1, &s).unwrap();
         let tol = 1.0 / (4.0 * PI * 4.0 * 2.0) + 0.005;
         assert_relative_eq!(r.max_rms, 8.0 / 2f64.sqrt(), max_relative = tol);
@@ -244,7 +293,10 @@ mod tests {
     #[test]
     fn guiding_forces_in_kn() {
         let fs = 200.0;
-        let s = StabilitySettings { dominant_frequency_hz: Some(3.0), ..Default::default() };
+        let s = StabilitySettings {
+            dominant_frequency_hz: Some(3.0),
+            ..Default::default()
+        };
         // 40 kN amplitude sum of guiding forces -> 28.3 kN rms, limit 30 kN at Q0 = 75 kN
         let r = assess_guiding_forces(&sine(40e3, 3.0, fs, 30.0), fs, 80.0, 75e3, &s).unwrap();
         assert_relative_eq!(r.limit, 30.0);
@@ -263,6 +315,9 @@ mod tests {
         assert!(e.to_string().contains("bogie_mass_t"));
         // 10 s at 50 m/s = 500 m is enough; at 100 m / 5 s windows, 2 s is not
         let e = assess_lateral_acceleration(&x[..400], 200.0, 20.0, 6.1, &s).unwrap_err();
-        assert!(matches!(e, AssessError::Signal(SignalError::TooShort { .. })), "{e}");
+        assert!(
+            matches!(e, AssessError::Signal(SignalError::TooShort { .. })),
+            "{e}"
+        );
     }
 }

@@ -50,7 +50,7 @@ pub enum FmuError {
     ModelDescription {
         path: PathBuf,
         #[source]
-        source: ModelDescriptionError,
+        source: Box<ModelDescriptionError>,
     },
     #[error("FMU '{path}' is FMI version '{version}', only 2.0 is supported")]
     UnsupportedVersion { path: PathBuf, version: String },
@@ -137,7 +137,7 @@ impl FmuArchive {
         }
         let model = ModelDescription::parse(&xml).map_err(|source| FmuError::ModelDescription {
             path: pb.clone(),
-            source,
+            source: Box::new(source),
         })?;
         if model.fmi_version.trim() != "2.0" {
             return Err(FmuError::UnsupportedVersion {

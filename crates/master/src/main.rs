@@ -10,7 +10,11 @@ use master::commands::{self, CommandError, Context};
 static CANCEL: AtomicBool = AtomicBool::new(false);
 
 #[derive(Debug, Parser)]
-#[command(name = "master", version, about = "FMI 2.0 co-simulation master for the bogie / yaw damper FMUs")]
+#[command(
+    name = "master",
+    version,
+    about = "FMI 2.0 co-simulation master for the bogie / yaw damper FMUs"
+)]
 struct Cli {
     /// Log level of the master and of FMU logger messages (error, warn, info, debug, trace).
     #[arg(long, global = true, default_value = "info")]

@@ -18,6 +18,9 @@ pub enum PlotError {
     Output(#[from] OutputError),
 }
 
+/// (min, max) of an axis.
+type Range = (f64, f64);
+
 /// One named series of (x, y) points.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Series {
@@ -64,7 +67,7 @@ impl Chart {
         self
     }
 
-    fn ranges(&self) -> Result<((f64, f64), (f64, f64)), PlotError> {
+    fn ranges(&self) -> Result<(Range, Range), PlotError> {
         let pts = self.series.iter().flat_map(|s| s.points.iter());
         let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
         let mut any = false;
@@ -88,7 +91,11 @@ impl Chart {
             y1 = y1.max(*v);
         }
         let pad = |a: f64, b: f64| {
-            let d = if b > a { (b - a) * 0.05 } else { a.abs().max(1.0) * 0.05 };
+            let d = if b > a {
+                (b - a) * 0.05
+            } else {
+                a.abs().max(1.0) * 0.05
+            };
             (a - d, b + d)
         };
         let xr = if x1 > x0 { (x0, x1) } else { pad(x0, x1) };
@@ -104,7 +111,8 @@ impl Chart {
         };
         let mut svg = String::new();
         {
-            let root = SVGBackend::with_string(&mut svg, (self.width, self.height)).into_drawing_area();
+            let root =
+                SVGBackend::with_string(&mut svg, (self.width, self.height)).into_drawing_area();
             root.fill(&WHITE).map_err(|e| draw(&e))?;
             let mut chart = ChartBuilder::on(&root)
                 .caption(&self.title, ("sans-serif", 20))
@@ -121,7 +129,11 @@ impl Chart {
                 .map_err(|e| draw(&e))?;
             for (i, s) in self.series.iter().enumerate() {
                 let color = Palette99::pick(i).to_rgba();
-                let pts = s.points.iter().copied().filter(|(x, y)| x.is_finite() && y.is_finite());
+                let pts = s
+                    .points
+                    .iter()
+                    .copied()
+                    .filter(|(x, y)| x.is_finite() && y.is_finite());
                 if scatter {
                     chart
                         .draw_series(pts.map(|p| Circle::new(p, 3, color.filled())))
@@ -133,7 +145,9 @@ impl Chart {
                         .draw_series(LineSeries::new(pts, color.stroke_width(2)))
                         .map_err(|e| draw(&e))?
                         .label(&s.name)
-                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+                        .legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                        });
                 }
             }
             if let Some((v, label)) = &self.limit {
@@ -179,22 +193,39 @@ mod tests {
             .with_series("MPPT", vec![(200.0, 0.5), (300.0, 2.0)])
             .with_limit(5.39, "EN 14363 limit");
         let svg = c.to_svg(false).unwrap();
-        for s in ["rms vs speed", "speed [km/h]", "passive", "MPPT", "EN 14363 limit", "<svg"] {
+        for s in [
+            "rms vs speed",
+            "speed [km/h]",
+            "passive",
+            "MPPT",
+            "EN 14363 limit",
+            "<svg",
+        ] {
             assert!(svg.contains(s), "missing {s}");
         }
         let d = tempfile::tempdir().unwrap();
         let p = d.path().join("a.svg");
         c.write_lines(&p).unwrap();
-        assert!(std::fs::read_to_string(&p).unwrap().contains("polyline") || std::fs::read_to_string(&p).unwrap().contains("path"));
+        assert!(
+            std::fs::read_to_string(&p).unwrap().contains("polyline")
+                || std::fs::read_to_string(&p).unwrap().contains("path")
+        );
     }
 
     #[test]
     fn scatter_and_empty_data() {
-        let c = Chart::new("root locus", "Re [1/s]", "Im [rad/s]").with_series("poles", vec![(-1.0, 21.0), (0.2, 20.0)]);
+        let c = Chart::new("root locus", "Re [1/s]", "Im [rad/s]")
+            .with_series("poles", vec![(-1.0, 21.0), (0.2, 20.0)]);
         assert!(c.to_svg(true).unwrap().contains("circle"));
-        let e = Chart::new("empty", "x", "y").with_series("s", vec![(f64::NAN, 1.0)]).to_svg(false).unwrap_err();
+        let e = Chart::new("empty", "x", "y")
+            .with_series("s", vec![(f64::NAN, 1.0)])
+            .to_svg(false)
+            .unwrap_err();
         assert!(e.to_string().contains("empty") && e.to_string().contains("no finite points"));
         // one single point still gets a valid range
-        assert!(Chart::new("one", "x", "y").with_series("s", vec![(1.0, 1.0)]).to_svg(false).is_ok());
+        assert!(Chart::new("one", "x", "y")
+            .with_series("s", vec![(1.0, 1.0)])
+            .to_svg(false)
+            .is_ok());
     }
 }

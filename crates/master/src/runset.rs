@@ -96,7 +96,13 @@ fn invalid(file: &str, field: String, reason: String) -> SystemError {
 /// Folder-safe run name.
 pub fn sanitize(name: &str) -> String {
     name.chars()
-        .map(|c| if c.is_ascii_alphanumeric() || "._-=".contains(c) { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "._-=".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect()
 }
 
@@ -116,13 +122,22 @@ impl RunSet {
             file: file.to_string(),
             line: e.line(),
             column: e.column(),
-            message: e.to_string().split(" at line ").next().unwrap_or("").to_string(),
+            message: e
+                .to_string()
+                .split(" at line ")
+                .next()
+                .unwrap_or("")
+                .to_string(),
         })?;
         let base = match (&rs.base, &rs.system) {
             (Some(p), None) => LoadedSystem::load(&base_dir.join(p))?,
             (None, Some(s)) => LoadedSystem::from_description(s.clone(), base_dir, file),
             _ => {
-                return Err(invalid(file, "base".into(), "give exactly one of 'base' (a path) or 'system' (inline)".into()))
+                return Err(invalid(
+                    file,
+                    "base".into(),
+                    "give exactly one of 'base' (a path) or 'system' (inline)".into(),
+                ))
             }
         };
         rs.expand(&base, file)
@@ -136,7 +151,11 @@ impl RunSet {
             let keys: Vec<&String> = self.product.keys().collect();
             for k in &keys {
                 if self.product[*k].is_empty() {
-                    return Err(invalid(file, format!("product.{k}"), "empty list of values".into()));
+                    return Err(invalid(
+                        file,
+                        format!("product.{k}"),
+                        "empty list of values".into(),
+                    ));
                 }
             }
             let total: usize = self.product.values().map(Vec::len).product();
@@ -162,7 +181,11 @@ impl RunSet {
             for (key, value) in &params {
                 let f = format!("{field}.{key}");
                 let Some((inst, var)) = split_ref(key) else {
-                    return Err(invalid(file, f, format!("'{key}' is not of the form 'instance.variable'")));
+                    return Err(invalid(
+                        file,
+                        f,
+                        format!("'{key}' is not of the form 'instance.variable'"),
+                    ));
                 };
                 let Some(spec) = sys.instances.iter_mut().find(|i| i.name == inst) else {
                     return Err(invalid(file, f, format!("unknown instance '{inst}'")));
@@ -171,9 +194,17 @@ impl RunSet {
             }
             let name = sanitize(&name.unwrap_or_else(|| format!("run-{n:03}")));
             if jobs.iter().any(|j: &Job| j.name == name) {
-                return Err(invalid(file, field, format!("run name '{name}' is used twice")));
+                return Err(invalid(
+                    file,
+                    field,
+                    format!("run name '{name}' is used twice"),
+                ));
             }
-            jobs.push(Job { name, parameters: params, system: sys });
+            jobs.push(Job {
+                name,
+                parameters: params,
+                system: sys,
+            });
         }
         Ok(jobs)
     }
@@ -181,30 +212,51 @@ impl RunSet {
 
 /// Runs one job with real FMUs: validates, simulates, returns the output.
 pub fn run_job_fmu(job: &Job, cancel: &AtomicBool) -> Result<SimOutput, String> {
-    let sys = LoadedSystem::from_description(job.system.clone(), Path::new("/"), &format!("run '{}'", job.name));
-    let opts = RunOptions { cancel: Some(cancel), progress: None };
+    let sys = LoadedSystem::from_description(
+        job.system.clone(),
+        Path::new("/"),
+        &format!("run '{}'", job.name),
+    );
+    let opts = RunOptions {
+        cancel: Some(cancel),
+        progress: None,
+    };
     sys.run(&opts).map_err(|e| e.to_string())
 }
 
 /// Runs all jobs on `threads` workers with `runner`, writing each run's folder and
 /// `<outdir>/sweep.json`. Returns the reports in job order.
-pub fn execute<F>(jobs: &[Job], outdir: &Path, threads: usize, show_progress: bool, runner: F) -> Result<Vec<RunReport>, SweepError>
+pub fn execute<F>(
+    jobs: &[Job],
+    outdir: &Path,
+    threads: usize,
+    show_progress: bool,
+    runner: F,
+) -> Result<Vec<RunReport>, SweepError>
 where
     F: Fn(&Job) -> Result<SimOutput, String> + Sync,
 {
-    std::fs::create_dir_all(outdir).map_err(|source| SweepError::Dir { path: outdir.to_path_buf(), source })?;
+    std::fs::create_dir_all(outdir).map_err(|source| SweepError::Dir {
+        path: outdir.to_path_buf(),
+        source,
+    })?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.max(1))
         .build()
-        .map_err(|e| SweepError::Pool { jobs: threads, reason: e.to_string() })?;
+        .map_err(|e| SweepError::Pool {
+            jobs: threads,
+            reason: e.to_string(),
+        })?;
     let bar = if show_progress {
         indicatif::ProgressBar::new(jobs.len() as u64)
     } else {
         indicatif::ProgressBar::hidden()
     };
     bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} elapsed, eta {eta} {msg}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} runs, {elapsed} elapsed, eta {eta} {msg}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     let reports: Vec<RunReport> = pool.install(|| {
         jobs.par_iter()
@@ -212,7 +264,11 @@ where
                 let r = run_one(job, outdir, &runner);
                 bar.inc(1);
                 if !r.ok {
-                    bar.println(format!("run '{}' failed: {}", r.name, r.error.as_deref().unwrap_or("")));
+                    bar.println(format!(
+                        "run '{}' failed: {}",
+                        r.name,
+                        r.error.as_deref().unwrap_or("")
+                    ));
                 }
                 r
             })
@@ -237,7 +293,8 @@ where
         results: None,
     };
     let result = (|| -> Result<(Summary, PathBuf), String> {
-        std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create '{}': {e}", dir.display()))?;
+        std::fs::create_dir_all(&dir)
+            .map_err(|e| format!("cannot create '{}': {e}", dir.display()))?;
         write_json_atomic(&dir.join("system.json"), &job.system).map_err(|e| e.to_string())?;
         let out = runner(job)?;
         let csv = dir.join("results.csv");
@@ -262,7 +319,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::coupling::tests::{two_mass_plan, Mock, MassSpring, SpringDamperMass};
+    use crate::coupling::tests::{two_mass_plan, MassSpring, Mock, SpringDamperMass};
     use crate::coupling::{simulate, Algorithm};
 
     const BASE: &str = r#"{
@@ -278,28 +335,55 @@ mod tests {
 
     #[test]
     fn product_and_list_expand() {
-        let j = jobs(r#"{"product": {"ms.k": [1, 2, 3], "sdm.m": [true, false]},
-                          "runs": [{"name": "extra run", "parameters": {"ms.k": 9}}]}"#).unwrap();
+        let j = jobs(
+            r#"{"product": {"ms.k": [1, 2, 3], "sdm.m": [true, false]},
+                          "runs": [{"name": "extra run", "parameters": {"ms.k": 9}}]}"#,
+        )
+        .unwrap();
         assert_eq!(j.len(), 7);
         assert_eq!(j[0].name, "run-000");
         assert_eq!(j[6].name, "extra_run");
-        let ks: Vec<String> = j[..6].iter().map(|j| format!("{}{}", j.parameters["ms.k"], j.parameters["sdm.m"])).collect();
-        assert_eq!(ks, ["1true", "1false", "2true", "2false", "3true", "3false"]);
-        assert_eq!(j[3].system.instances[0].parameters["k"], serde_json::json!(2));
-        assert_eq!(j[3].system.instances[1].parameters["m"], serde_json::json!(false));
-        assert_eq!(j[0].system.instances[0].fmu, PathBuf::from("/d/MassSpring.fmu"));
+        let ks: Vec<String> = j[..6]
+            .iter()
+            .map(|j| format!("{}{}", j.parameters["ms.k"], j.parameters["sdm.m"]))
+            .collect();
+        assert_eq!(
+            ks,
+            ["1true", "1false", "2true", "2false", "3true", "3false"]
+        );
+        assert_eq!(
+            j[3].system.instances[0].parameters["k"],
+            serde_json::json!(2)
+        );
+        assert_eq!(
+            j[3].system.instances[1].parameters["m"],
+            serde_json::json!(false)
+        );
+        assert_eq!(
+            j[0].system.instances[0].fmu,
+            PathBuf::from("/d/MassSpring.fmu")
+        );
         assert_eq!(jobs("{}").unwrap().len(), 1);
     }
 
     #[test]
     fn expansion_errors() {
-        let e = jobs(r#"{"product": {"xx.k": [1]}}"#).unwrap_err().to_string();
+        let e = jobs(r#"{"product": {"xx.k": [1]}}"#)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("product.xx.k: unknown instance 'xx'"), "{e}");
-        let e = jobs(r#"{"runs": [{"name": "a", "parameters": {}}, {"name": "a", "parameters": {}}]}"#).unwrap_err();
+        let e =
+            jobs(r#"{"runs": [{"name": "a", "parameters": {}}, {"name": "a", "parameters": {}}]}"#)
+                .unwrap_err();
         assert!(e.to_string().contains("used twice"));
         let e = jobs(r#"{"product": {"ms.k": []}}"#).unwrap_err();
         assert!(e.to_string().contains("empty list"));
-        let e = RunSet::jobs_from_str("{\"base\": \"a.json\", \"system\": null, \"bogus\": 1}", Path::new("/"), "s.json").unwrap_err();
+        let e = RunSet::jobs_from_str(
+            "{\"base\": \"a.json\", \"system\": null, \"bogus\": 1}",
+            Path::new("/"),
+            "s.json",
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("unknown field `bogus`"), "{e}");
     }
 
@@ -317,7 +401,8 @@ mod tests {
             plan.instances[0].parameters[1].1 = k;
             let mut a = Mock::new("ms", MassSpring::new(1.0, 1.0, 1.0, 0.0));
             let mut b = Mock::new("sdm", SpringDamperMass::new(1.0, 1.0, 1.0));
-            simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).map_err(|e| e.to_string())
+            simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default())
+                .map_err(|e| e.to_string())
         };
         let reports = execute(&j, dir.path(), 2, false, runner).unwrap();
         assert_eq!(reports.len(), 4);
@@ -333,7 +418,9 @@ mod tests {
         let b = std::fs::read_to_string(dir.path().join("run-003/results.csv")).unwrap();
         assert_ne!(a, b);
         assert_eq!(a.lines().count(), 102);
-        let sweep: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("sweep.json")).unwrap()).unwrap();
+        let sweep: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join("sweep.json")).unwrap())
+                .unwrap();
         assert_eq!(sweep.as_array().unwrap().len(), 4);
         assert_eq!(sweep[2]["ok"], serde_json::json!(false));
     }

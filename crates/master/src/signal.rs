@@ -2,6 +2,7 @@
 //! band-pass (zero-phase), rms over sliding distance windows.
 
 use std::f64::consts::PI;
+use std::ops::{Add, Div, Mul, Sub};
 
 /// A signal-processing input problem, naming the parameter.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -24,11 +25,20 @@ pub enum SignalError {
     NoPeak { f_min: f64, f_max: f64 },
 }
 
-fn check(name: &'static str, value: f64, ok: bool, reason: &'static str) -> Result<(), SignalError> {
+fn check(
+    name: &'static str,
+    value: f64,
+    ok: bool,
+    reason: &'static str,
+) -> Result<(), SignalError> {
     if ok && value.is_finite() {
         Ok(())
     } else {
-        Err(SignalError::InvalidParameter { name, value, reason })
+        Err(SignalError::InvalidParameter {
+            name,
+            value,
+            reason,
+        })
     }
 }
 
@@ -50,21 +60,8 @@ impl C64 {
     pub const fn new(re: f64, im: f64) -> Self {
         C64 { re, im }
     }
-    pub fn add(self, o: C64) -> C64 {
-        C64::new(self.re + o.re, self.im + o.im)
-    }
-    pub fn sub(self, o: C64) -> C64 {
-        C64::new(self.re - o.re, self.im - o.im)
-    }
-    pub fn mul(self, o: C64) -> C64 {
-        C64::new(self.re * o.re - self.im * o.im, self.re * o.im + self.im * o.re)
-    }
     pub fn scale(self, s: f64) -> C64 {
         C64::new(self.re * s, self.im * s)
-    }
-    pub fn div(self, o: C64) -> C64 {
-        let d = o.re * o.re + o.im * o.im;
-        C64::new((self.re * o.re + self.im * o.im) / d, (self.im * o.re - self.re * o.im) / d)
     }
     pub fn abs(self) -> f64 {
         self.re.hypot(self.im)
@@ -77,6 +74,41 @@ impl C64 {
     }
     pub fn expj(theta: f64) -> C64 {
         C64::new(theta.cos(), theta.sin())
+    }
+}
+
+impl std::ops::Add for C64 {
+    type Output = C64;
+    fn add(self, o: C64) -> C64 {
+        C64::new(self.re + o.re, self.im + o.im)
+    }
+}
+
+impl std::ops::Sub for C64 {
+    type Output = C64;
+    fn sub(self, o: C64) -> C64 {
+        C64::new(self.re - o.re, self.im - o.im)
+    }
+}
+
+impl std::ops::Mul for C64 {
+    type Output = C64;
+    fn mul(self, o: C64) -> C64 {
+        C64::new(
+            self.re * o.re - self.im * o.im,
+            self.re * o.im + self.im * o.re,
+        )
+    }
+}
+
+impl std::ops::Div for C64 {
+    type Output = C64;
+    fn div(self, o: C64) -> C64 {
+        let d = o.re * o.re + o.im * o.im;
+        C64::new(
+            (self.re * o.re + self.im * o.im) / d,
+            (self.im * o.re - self.re * o.im) / d,
+        )
     }
 }
 
@@ -163,7 +195,11 @@ pub fn dominant_frequency(x: &[f64], fs: f64, f_min: f64, f_max: f64) -> Result<
     check("f_max", f_max, f_max > f_min, "must be > f_min")?;
     let seg = ((10.0 * fs) as usize).min(x.len()).max(8);
     // largest power of two not above the signal length, so at least one segment fits
-    let seg = if seg.is_power_of_two() { seg } else { seg.next_power_of_two() / 2 };
+    let seg = if seg.is_power_of_two() {
+        seg
+    } else {
+        seg.next_power_of_two() / 2
+    };
     let (f, p) = welch(x, fs, seg)?;
     let best = (1..p.len() - 1)
         .filter(|&k| f[k] >= f_min && f[k] <= f_max)
@@ -194,7 +230,9 @@ impl Biquad {
         let num = C64::new(self.b[0], 0.0)
             .add(z1.scale(self.b[1]))
             .add(z2.scale(self.b[2]));
-        let den = C64::new(1.0, 0.0).add(z1.scale(self.a[0])).add(z2.scale(self.a[1]));
+        let den = C64::new(1.0, 0.0)
+            .add(z1.scale(self.a[0]))
+            .add(z2.scale(self.a[1]));
         num.div(den)
     }
 }
@@ -212,8 +250,18 @@ impl BandPass {
     pub fn butterworth(order: usize, f_lo: f64, f_hi: f64, fs: f64) -> Result<Self, SignalError> {
         check("fs", fs, fs > 0.0, "sampling rate must be > 0")?;
         check("f_lo", f_lo, f_lo > 0.0, "lower band edge must be > 0")?;
-        check("f_hi", f_hi, f_hi > f_lo && f_hi < fs / 2.0, "upper band edge must lie between f_lo and fs/2")?;
-        check("order", order as f64, (1..=10).contains(&order), "filter order must be 1..=10")?;
+        check(
+            "f_hi",
+            f_hi,
+            f_hi > f_lo && f_hi < fs / 2.0,
+            "upper band edge must lie between f_lo and fs/2",
+        )?;
+        check(
+            "order",
+            order as f64,
+            (1..=10).contains(&order),
+            "filter order must be 1..=10",
+        )?;
         let w1 = 2.0 * fs * (PI * f_lo / fs).tan();
         let w2 = 2.0 * fs * (PI * f_hi / fs).tan();
         let w0 = (w1 * w2).sqrt();
@@ -328,7 +376,12 @@ pub fn sliding_rms_distance(
 ) -> Result<Vec<(f64, f64)>, SignalError> {
     check("fs", fs, fs > 0.0, "sampling rate must be > 0")?;
     check("speed_mps", speed_mps, speed_mps > 0.0, "speed must be > 0")?;
-    check("window_m", window_m, window_m > 0.0, "window length must be > 0")?;
+    check(
+        "window_m",
+        window_m,
+        window_m > 0.0,
+        "window length must be > 0",
+    )?;
     check("step_m", step_m, step_m > 0.0, "window step must be > 0")?;
     check_finite(x)?;
     let win = (window_m / speed_mps * fs).round() as usize;
@@ -432,7 +485,11 @@ mod tests {
             let w1 = 2.0 * fs * (PI * 2.0 / fs).tan();
             let w2 = 2.0 * fs * (PI * 6.0 / fs).tan();
             let q = (w * w - w1 * w2) / (w * (w2 - w1));
-            assert_relative_eq!(bp.gain(f), 1.0 / (1.0 + q.powi(4)).sqrt(), max_relative = 1e-9);
+            assert_relative_eq!(
+                bp.gain(f),
+                1.0 / (1.0 + q.powi(4)).sqrt(),
+                max_relative = 1e-9
+            );
         }
         assert!(bp.gain(0.5) < 0.03 && bp.gain(20.0) < 0.045);
         assert!(BandPass::butterworth(2, 2.0, 300.0, fs).is_err());
@@ -451,7 +508,9 @@ mod tests {
         assert_relative_eq!(rms(core), expected, max_relative = 1e-3);
         assert_relative_eq!(rms(core), a / 2f64.sqrt(), max_relative = 0.01);
         // zero phase: peaks stay where they were
-        let i = (0..core.len()).max_by(|&p, &q| core[p].total_cmp(&core[q])).unwrap();
+        let i = (0..core.len())
+            .max_by(|&p, &q| core[p].total_cmp(&core[q]))
+            .unwrap();
         assert!((core[i] - x[2500 + i]).abs() < 0.03 * a);
         let out = sine(a, 25.0, fs, 40.0, 0.0);
         let y = bp.filtfilt(&out, 1000);
@@ -474,7 +533,14 @@ mod tests {
         // half and half: sqrt((1 + 9)/2)
         assert_relative_eq!(w[5].1, 5f64.sqrt(), epsilon = 1e-12);
         let e = sliding_rms_distance(&x[..100], fs, 20.0, 100.0, 10.0).unwrap_err();
-        assert!(matches!(e, SignalError::TooShort { samples: 100, needed: 500, .. }));
+        assert!(matches!(
+            e,
+            SignalError::TooShort {
+                samples: 100,
+                needed: 500,
+                ..
+            }
+        ));
         let e = sliding_rms_distance(&x, fs, 0.0, 100.0, 10.0).unwrap_err();
         assert!(e.to_string().contains("speed_mps"));
         let mut bad = x.clone();

@@ -125,7 +125,7 @@ pub enum SystemError {
         file: String,
         field: String,
         #[source]
-        source: FmuError,
+        source: Box<FmuError>,
     },
 }
 
@@ -204,7 +204,12 @@ impl LoadedSystem {
                 file: file.to_string(),
                 line: e.line(),
                 column: e.column(),
-                message: e.to_string().split(" at line ").next().unwrap_or("").to_string(),
+                message: e
+                    .to_string()
+                    .split(" at line ")
+                    .next()
+                    .unwrap_or("")
+                    .to_string(),
             })?;
         Ok(LoadedSystem {
             desc,
@@ -232,7 +237,12 @@ impl LoadedSystem {
         Some(text[..pos].matches('\n').count() + 1)
     }
 
-    fn invalid(&self, field: impl Into<String>, needle: &str, reason: impl Into<String>) -> SystemError {
+    fn invalid(
+        &self,
+        field: impl Into<String>,
+        needle: &str,
+        reason: impl Into<String>,
+    ) -> SystemError {
         SystemError::Invalid {
             file: self.file.clone(),
             line: self.line_of(needle),
@@ -273,7 +283,7 @@ impl LoadedSystem {
                     let a = FmuArchive::open(&p).map_err(|source| SystemError::Fmu {
                         file: self.file.clone(),
                         field: format!("instances[{i}].fmu"),
-                        source,
+                        source: Box::new(source),
                     })?;
                     cache.insert(p, a.clone());
                     a
@@ -296,10 +306,19 @@ impl LoadedSystem {
         models: &[&'m ModelDescription],
     ) -> Result<(usize, usize, &'m crate::model_description::Variable), SystemError> {
         let Some((inst, var)) = split_ref(s) else {
-            return Err(self.invalid(field, s, format!("'{s}' is not of the form 'instance.variable'")));
+            return Err(self.invalid(
+                field,
+                s,
+                format!("'{s}' is not of the form 'instance.variable'"),
+            ));
         };
         let Some(i) = self.instance_index(inst) else {
-            let names: Vec<&str> = self.desc.instances.iter().map(|i| i.name.as_str()).collect();
+            let names: Vec<&str> = self
+                .desc
+                .instances
+                .iter()
+                .map(|i| i.name.as_str())
+                .collect();
             let hint = names
                 .iter()
                 .filter(|n| crate::model_description::edit_distance(n, inst) <= 2)
@@ -319,7 +338,10 @@ impl LoadedSystem {
                 Err(self.invalid(
                     field,
                     s,
-                    format!("unknown variable '{s}' in instance '{inst}' (model '{}'){hint}", md.model_name),
+                    format!(
+                        "unknown variable '{s}' in instance '{inst}' (model '{}'){hint}",
+                        md.model_name
+                    ),
                 ))
             }
         }
@@ -333,16 +355,27 @@ impl LoadedSystem {
             return Err(self.invalid("instances", "instances", "at least one instance is needed"));
         }
         if models.len() != d.instances.len() {
-            return Err(self.invalid("instances", "instances", "internal: one model description per instance expected"));
+            return Err(self.invalid(
+                "instances",
+                "instances",
+                "internal: one model description per instance expected",
+            ));
         }
         if !(d.step.is_finite() && d.step > 0.0) {
-            return Err(self.invalid("step", "step", format!("must be a positive number, got {}", d.step)));
+            return Err(self.invalid(
+                "step",
+                "step",
+                format!("must be a positive number, got {}", d.step),
+            ));
         }
         if !(d.start_time.is_finite() && d.stop_time.is_finite() && d.stop_time > d.start_time) {
             return Err(self.invalid(
                 "stop_time",
                 "stop_time",
-                format!("must be greater than start_time ({}), got {}", d.start_time, d.stop_time),
+                format!(
+                    "must be greater than start_time ({}), got {}",
+                    d.start_time, d.stop_time
+                ),
             ));
         }
         let span = d.stop_time - d.start_time;
@@ -351,28 +384,57 @@ impl LoadedSystem {
             return Err(self.invalid(
                 "step",
                 "step",
-                format!("stop_time - start_time = {span} s is not an integer multiple of step = {} s", d.step),
+                format!(
+                    "stop_time - start_time = {span} s is not an integer multiple of step = {} s",
+                    d.step
+                ),
             ));
         }
         let mut instances = Vec::new();
         for (i, inst) in d.instances.iter().enumerate() {
             let f = format!("instances[{i}].name");
             if inst.name.is_empty() || inst.name.contains('.') || inst.name.contains('\0') {
-                return Err(self.invalid(f, &inst.name, format!("'{}' is not a valid instance name (non-empty, no '.')", inst.name)));
+                return Err(self.invalid(
+                    f,
+                    &inst.name,
+                    format!(
+                        "'{}' is not a valid instance name (non-empty, no '.')",
+                        inst.name
+                    ),
+                ));
             }
             if d.instances[..i].iter().any(|o| o.name == inst.name) {
-                return Err(self.invalid(f, &inst.name, format!("instance name '{}' is used twice", inst.name)));
+                return Err(self.invalid(
+                    f,
+                    &inst.name,
+                    format!("instance name '{}' is used twice", inst.name),
+                ));
             }
             if inst.step_multiple == 0 {
-                return Err(self.invalid(format!("instances[{i}].step_multiple"), "step_multiple", "must be >= 1"));
+                return Err(self.invalid(
+                    format!("instances[{i}].step_multiple"),
+                    "step_multiple",
+                    "must be >= 1",
+                ));
             }
             let md = models[i];
             let mut params = Vec::new();
+            let mut parameter_names = Vec::new();
             for (name, value) in &inst.parameters {
                 let field = format!("instances[{i}].parameters.{name}");
                 let Some((_, v)) = md.variable(name) else {
-                    let hint = md.suggest(name).map(|n| format!(" (did you mean '{n}'?)")).unwrap_or_default();
-                    return Err(self.invalid(field, name, format!("unknown variable '{name}' in model '{}'{hint}", md.model_name)));
+                    let hint = md
+                        .suggest(name)
+                        .map(|n| format!(" (did you mean '{n}'?)"))
+                        .unwrap_or_default();
+                    return Err(self.invalid(
+                        field,
+                        name,
+                        format!(
+                            "unknown variable '{name}' in model '{}'{hint}",
+                            md.model_name
+                        ),
+                    ));
                 };
                 if !v.is_settable() {
                     return Err(self.invalid(
@@ -382,15 +444,28 @@ impl LoadedSystem {
                     ));
                 }
                 let Some(ty) = type_of(v.var_type) else {
-                    return Err(self.invalid(field, name, format!("{} variables are not supported", v.var_type)));
+                    return Err(self.invalid(
+                        field,
+                        name,
+                        format!("{} variables are not supported", v.var_type),
+                    ));
                 };
-                let x = json_value_for(v.var_type, value).map_err(|r| self.invalid(field.clone(), name, r))?;
-                params.push((VarRef { vr: v.value_reference, ty }, x));
+                let x = json_value_for(v.var_type, value)
+                    .map_err(|r| self.invalid(field.clone(), name, r))?;
+                params.push((
+                    VarRef {
+                        vr: v.value_reference,
+                        ty,
+                    },
+                    x,
+                ));
+                parameter_names.push(name.clone());
             }
             instances.push(PlanInstance {
                 name: inst.name.clone(),
                 step_multiple: inst.step_multiple,
                 parameters: params,
+                parameter_names,
             });
         }
 
@@ -403,10 +478,24 @@ impl LoadedSystem {
             let (fi, fvi, fv) = self.resolve(&ff, &c.from, models)?;
             let (ti, tvi, tv) = self.resolve(&tf, &c.to, models)?;
             if fv.causality != Causality::Output {
-                return Err(self.invalid(ff, &c.from, format!("'{}' has causality '{}', only outputs can be connection sources", c.from, fv.causality)));
+                return Err(self.invalid(
+                    ff,
+                    &c.from,
+                    format!(
+                        "'{}' has causality '{}', only outputs can be connection sources",
+                        c.from, fv.causality
+                    ),
+                ));
             }
             if tv.causality != Causality::Input {
-                return Err(self.invalid(tf, &c.to, format!("'{}' has causality '{}', only inputs can be connection targets", c.to, tv.causality)));
+                return Err(self.invalid(
+                    tf,
+                    &c.to,
+                    format!(
+                        "'{}' has causality '{}', only inputs can be connection targets",
+                        c.to, tv.causality
+                    ),
+                ));
             }
             if fi == ti {
                 return Err(self.invalid(tf, &c.to, "connects an instance to itself"));
@@ -415,23 +504,37 @@ impl LoadedSystem {
                 return Err(self.invalid(
                     format!("connections[{ci}]"),
                     &c.to,
-                    format!("type mismatch: '{}' is {} but '{}' is {}", c.from, fv.var_type, c.to, tv.var_type),
+                    format!(
+                        "type mismatch: '{}' is {} but '{}' is {}",
+                        c.from, fv.var_type, c.to, tv.var_type
+                    ),
                 ));
             }
             let Some(ty) = type_of(fv.var_type) else {
-                return Err(self.invalid(format!("connections[{ci}]"), &c.from, format!("{} connections are not supported", fv.var_type)));
+                return Err(self.invalid(
+                    format!("connections[{ci}]"),
+                    &c.from,
+                    format!("{} connections are not supported", fv.var_type),
+                ));
             };
             if let (Some(uf), Some(ut)) = (&fv.unit, &tv.unit) {
                 if uf != ut {
                     return Err(self.invalid(
                         format!("connections[{ci}]"),
                         &c.to,
-                        format!("unit mismatch: '{}' is in [{uf}] but '{}' is in [{ut}]", c.from, c.to),
+                        format!(
+                            "unit mismatch: '{}' is in [{uf}] but '{}' is in [{ut}]",
+                            c.from, c.to
+                        ),
                     ));
                 }
             }
             if let Some(prev) = inputs_taken.insert((ti, tvi), ci) {
-                return Err(self.invalid(tf, &c.to, format!("input '{}' is already driven by connections[{prev}]", c.to)));
+                return Err(self.invalid(
+                    tf,
+                    &c.to,
+                    format!("input '{}' is already driven by connections[{prev}]", c.to),
+                ));
             }
             if models[ti].has_direct_feedthrough(tvi) {
                 feedthrough_edges.push((fi, ti));
@@ -439,9 +542,15 @@ impl LoadedSystem {
             let _ = fvi;
             connections.push(PlanConnection {
                 from_instance: fi,
-                from: VarRef { vr: fv.value_reference, ty },
+                from: VarRef {
+                    vr: fv.value_reference,
+                    ty,
+                },
                 to_instance: ti,
-                to: VarRef { vr: tv.value_reference, ty },
+                to: VarRef {
+                    vr: tv.value_reference,
+                    ty,
+                },
                 label: c.from.clone(),
             });
         }
@@ -451,10 +560,18 @@ impl LoadedSystem {
                 let mut order = Vec::new();
                 for (k, n) in names.iter().enumerate() {
                     let Some(i) = self.instance_index(n) else {
-                        return Err(self.invalid(format!("order[{k}]"), n, format!("unknown instance '{n}'")));
+                        return Err(self.invalid(
+                            format!("order[{k}]"),
+                            n,
+                            format!("unknown instance '{n}'"),
+                        ));
                     };
                     if order.contains(&i) {
-                        return Err(self.invalid(format!("order[{k}]"), n, format!("instance '{n}' appears twice")));
+                        return Err(self.invalid(
+                            format!("order[{k}]"),
+                            n,
+                            format!("instance '{n}' appears twice"),
+                        ));
                     }
                     order.push(i);
                 }
@@ -463,14 +580,21 @@ impl LoadedSystem {
                         .filter(|i| !order.contains(i))
                         .map(|i| d.instances[i].name.as_str())
                         .collect();
-                    return Err(self.invalid("order", "order", format!("must list every instance; missing: {}", missing.join(", "))));
+                    return Err(self.invalid(
+                        "order",
+                        "order",
+                        format!("must list every instance; missing: {}", missing.join(", ")),
+                    ));
                 }
                 order
             }
             None => {
                 let (order, broken) = topological_order(d.instances.len(), &feedthrough_edges);
                 if !broken.is_empty() && d.algorithm == Algorithm::GaussSeidel {
-                    let names: Vec<&str> = broken.iter().map(|&i| d.instances[i].name.as_str()).collect();
+                    let names: Vec<&str> = broken
+                        .iter()
+                        .map(|&i| d.instances[i].name.as_str())
+                        .collect();
                     log::warn!(target: "master", "{}: algebraic loop through direct feedthrough; Gauss-Seidel order breaks it at {}", self.file, names.join(", "));
                 }
                 order
@@ -487,18 +611,37 @@ impl LoadedSystem {
                 for (k, s) in list.iter().enumerate() {
                     let (i, _, v) = self.resolve(&format!("record[{k}]"), s, models)?;
                     let Some(ty) = type_of(v.var_type) else {
-                        return Err(self.invalid(format!("record[{k}]"), s, format!("{} variables cannot be recorded", v.var_type)));
+                        return Err(self.invalid(
+                            format!("record[{k}]"),
+                            s,
+                            format!("{} variables cannot be recorded", v.var_type),
+                        ));
                     };
-                    record.push(Recorded { instance: i, var: VarRef { vr: v.value_reference, ty }, label: label(i, v) });
+                    record.push(Recorded {
+                        instance: i,
+                        var: VarRef {
+                            vr: v.value_reference,
+                            ty,
+                        },
+                        label: label(i, v),
+                    });
                 }
             }
             None => {
                 for (i, md) in models.iter().enumerate() {
                     for (vi, v) in md.variables.iter().enumerate() {
-                        let connected_input = v.causality == Causality::Input && inputs_taken.contains_key(&(i, vi));
+                        let connected_input =
+                            v.causality == Causality::Input && inputs_taken.contains_key(&(i, vi));
                         if v.causality == Causality::Output || connected_input {
                             if let Some(ty) = type_of(v.var_type) {
-                                record.push(Recorded { instance: i, var: VarRef { vr: v.value_reference, ty }, label: label(i, v) });
+                                record.push(Recorded {
+                                    instance: i,
+                                    var: VarRef {
+                                        vr: v.value_reference,
+                                        ty,
+                                    },
+                                    label: label(i, v),
+                                });
                             }
                         }
                     }
@@ -530,7 +673,8 @@ impl LoadedSystem {
         for (a, inst) in archives.iter().zip(&self.desc.instances) {
             slaves.push(a.instantiate(&inst.name, inst.logging)?);
         }
-        let mut refs: Vec<&mut dyn Slave> = slaves.iter_mut().map(|s| s as &mut dyn Slave).collect();
+        let mut refs: Vec<&mut dyn Slave> =
+            slaves.iter_mut().map(|s| s as &mut dyn Slave).collect();
         let out = simulate(&plan, &mut refs, opts)?;
         Ok(out)
     }
@@ -577,7 +721,10 @@ mod tests {
 }"#;
 
     fn models() -> (ModelDescription, ModelDescription) {
-        (ModelDescription::parse(SDM).unwrap(), ModelDescription::parse(MASS_SPRING).unwrap())
+        (
+            ModelDescription::parse(SDM).unwrap(),
+            ModelDescription::parse(MASS_SPRING).unwrap(),
+        )
     }
 
     fn plan_of(text: &str) -> Result<CouplingPlan, SystemError> {
@@ -597,16 +744,39 @@ mod tests {
         assert_eq!(p.order, vec![1, 0]);
         assert_eq!(p.algorithm, Algorithm::GaussSeidel);
         assert_eq!(p.connections.len(), 3);
-        assert_eq!(p.instances[0].parameters, vec![
-            (VarRef { vr: 1, ty: ScalarType::Real }, 200.0),
-            (VarRef { vr: 8, ty: ScalarType::Integer }, 1.0),
-        ]);
+        assert_eq!(
+            p.instances[0].parameters,
+            vec![
+                (
+                    VarRef {
+                        vr: 1,
+                        ty: ScalarType::Real
+                    },
+                    200.0
+                ),
+                (
+                    VarRef {
+                        vr: 8,
+                        ty: ScalarType::Integer
+                    },
+                    1.0
+                ),
+            ]
+        );
         let labels: Vec<&str> = p.record.iter().map(|r| r.label.as_str()).collect();
-        assert_eq!(labels, vec![
-            "sdm.input_position [m]", "sdm.input_velocity [m/s]", "sdm.coupling_force [N]",
-            "sdm.position [m]", "sdm.velocity [m/s]",
-            "ms.force [N]", "ms.position [m]", "ms.velocity [m/s]",
-        ]);
+        assert_eq!(
+            labels,
+            vec![
+                "sdm.input_position [m]",
+                "sdm.input_velocity [m/s]",
+                "sdm.coupling_force [N]",
+                "sdm.position [m]",
+                "sdm.velocity [m/s]",
+                "ms.force [N]",
+                "ms.position [m]",
+                "ms.velocity [m/s]",
+            ]
+        );
     }
 
     #[test]
@@ -629,10 +799,16 @@ mod tests {
             "sys.json line 9: connections[2].from: unknown variable 'sdm.coupling_forse' in instance 'sdm' (model 'SpringDamperMass') (did you mean 'sdm.coupling_force'?)"
         );
         let t = SYS.replace("\"to\": \"ms.force\"", "\"to\": \"mss.force\"");
-        assert!(err_of(&t).contains("connections[2].to: unknown instance 'mss' (did you mean 'ms'?)"));
+        assert!(
+            err_of(&t).contains("connections[2].to: unknown instance 'mss' (did you mean 'ms'?)")
+        );
         let t = SYS.replace("\"k\": 100.0", "\"kk\": 100.0");
         let e = err_of(&t);
-        assert!(e.contains("instances[1].parameters.kk: unknown variable 'kk'") && e.contains("did you mean 'k'"), "{e}");
+        assert!(
+            e.contains("instances[1].parameters.kk: unknown variable 'kk'")
+                && e.contains("did you mean 'k'"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -642,7 +818,10 @@ mod tests {
         let t = SYS.replace("\"to\": \"ms.force\"", "\"to\": \"ms.velocity\"");
         assert!(err_of(&t).contains("only inputs can be connection targets"));
         // unit mismatch: position [m] -> input_velocity [m/s]
-        let t = SYS.replace("{\"from\": \"ms.velocity\", \"to\": \"sdm.input_velocity\"}", "{\"from\": \"ms.position\", \"to\": \"sdm.input_velocity\"}");
+        let t = SYS.replace(
+            "{\"from\": \"ms.velocity\", \"to\": \"sdm.input_velocity\"}",
+            "{\"from\": \"ms.position\", \"to\": \"sdm.input_velocity\"}",
+        );
         let e = err_of(&t);
         assert!(e.contains("connections[1]: unit mismatch: 'ms.position' is in [m] but 'sdm.input_velocity' is in [m/s]"), "{e}");
         // type mismatch needs an Integer output: make ms.velocity Integer
@@ -651,10 +830,18 @@ mod tests {
         let b = ModelDescription::parse(&ms_int).unwrap();
         let s = LoadedSystem::from_json_str(SYS, Path::new("/x"), "sys.json").unwrap();
         let e = s.plan(&[&a, &b]).unwrap_err().to_string();
-        assert!(e.contains("type mismatch: 'ms.velocity' is Integer but 'sdm.input_velocity' is Real"), "{e}");
+        assert!(
+            e.contains("type mismatch: 'ms.velocity' is Integer but 'sdm.input_velocity' is Real"),
+            "{e}"
+        );
         // the same input twice
-        let t = SYS.replace("{\"from\": \"ms.velocity\", \"to\": \"sdm.input_velocity\"}", "{\"from\": \"ms.position\", \"to\": \"sdm.input_position\"}");
-        assert!(err_of(&t).contains("connections[1].to: input 'sdm.input_position' is already driven by connections[0]"));
+        let t = SYS.replace(
+            "{\"from\": \"ms.velocity\", \"to\": \"sdm.input_velocity\"}",
+            "{\"from\": \"ms.position\", \"to\": \"sdm.input_position\"}",
+        );
+        assert!(err_of(&t).contains(
+            "connections[1].to: input 'sdm.input_position' is already driven by connections[0]"
+        ));
     }
 
     #[test]
@@ -675,9 +862,14 @@ mod tests {
         assert!(e.contains("unknown field `stpe`"), "{e}");
         assert!(err_of(&SYS.replace("0.001", "-1")).contains("step: must be a positive number"));
         assert!(err_of(&SYS.replace("0.001", "0.3")).contains("not an integer multiple"));
-        assert!(err_of(&SYS.replace("\"stop_time\": 1.0", "\"stop_time\": 0.0")).contains("stop_time"));
+        assert!(
+            err_of(&SYS.replace("\"stop_time\": 1.0", "\"stop_time\": 0.0")).contains("stop_time")
+        );
         let e = err_of(&SYS.replace("\"name\": \"ms\"", "\"name\": \"sdm\""));
-        assert!(e.contains("instances[1].name: instance name 'sdm' is used twice"), "{e}");
+        assert!(
+            e.contains("instances[1].name: instance name 'sdm' is used twice"),
+            "{e}"
+        );
         let e = err_of(&SYS.replace("\"name\": \"ms\"", "\"name\": \"m.s\""));
         assert!(e.contains("not a valid instance name"), "{e}");
     }
@@ -686,8 +878,14 @@ mod tests {
     fn missing_fmu_names_the_field() {
         let s = LoadedSystem::from_json_str(SYS, Path::new("/nonexistent"), "sys.json").unwrap();
         let e = s.open_fmus().unwrap_err().to_string();
-        assert!(e.contains("instances[0].fmu") && e.contains("/nonexistent/SpringDamperMass.fmu"), "{e}");
+        assert!(
+            e.contains("instances[0].fmu") && e.contains("/nonexistent/SpringDamperMass.fmu"),
+            "{e}"
+        );
         let r = s.resolved();
-        assert_eq!(r.instances[1].fmu, PathBuf::from("/nonexistent/MassSpring.fmu"));
+        assert_eq!(
+            r.instances[1].fmu,
+            PathBuf::from("/nonexistent/MassSpring.fmu")
+        );
     }
 }

@@ -1,6 +1,8 @@
 //! Bad input through the built binary: clear message naming the thing, non-zero exit, no
 //! result file. No real FMU is needed: validation happens before any binary is loaded.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
+
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -36,7 +38,8 @@ fn fake_fmu(dir: &Path, file: &str, id: &str, md: &str) -> PathBuf {
     let o = zip::write::SimpleFileOptions::default();
     z.start_file("modelDescription.xml", o).unwrap();
     z.write_all(md.as_bytes()).unwrap();
-    z.start_file(format!("binaries/linux64/{id}.so"), o).unwrap();
+    z.start_file(format!("binaries/linux64/{id}.so"), o)
+        .unwrap();
     z.write_all(b"not really a library").unwrap();
     z.finish().unwrap();
     p
@@ -100,17 +103,26 @@ fn missing_system_file() {
     let c = Case::new(SYSTEM);
     std::fs::remove_file(c.path("system.json")).unwrap();
     let e = c.run_fails();
-    assert!(e.contains("cannot read") && e.contains("system.json"), "{e}");
+    assert!(
+        e.contains("cannot read") && e.contains("system.json"),
+        "{e}"
+    );
 }
 
 #[test]
 fn malformed_json_names_line_and_column() {
     let c = Case::new(&SYSTEM.replace("\"step\": 0.001", "\"step\": 0.001,"));
     let e = c.run_fails();
-    assert!(e.contains("system.json: line 12, column 1: trailing comma"), "{e}");
+    assert!(
+        e.contains("system.json: line 12, column 1: trailing comma"),
+        "{e}"
+    );
     let c = Case::new(&SYSTEM.replace("\"stop_time\"", "\"stop_tiem\""));
     let e = c.run_fails();
-    assert!(e.contains("unknown field `stop_tiem`") && e.contains("line 10"), "{e}");
+    assert!(
+        e.contains("unknown field `stop_tiem`") && e.contains("line 10"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -118,7 +130,10 @@ fn missing_fmu() {
     let c = Case::new(SYSTEM);
     std::fs::remove_file(c.path("Damper.fmu")).unwrap();
     let e = c.run_fails();
-    assert!(e.contains("instances[1].fmu") && e.contains("Damper.fmu") && e.contains("not found"), "{e}");
+    assert!(
+        e.contains("instances[1].fmu") && e.contains("Damper.fmu") && e.contains("not found"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -126,15 +141,26 @@ fn corrupt_zip() {
     let c = Case::new(SYSTEM);
     std::fs::write(c.path("Damper.fmu"), b"garbage garbage garbage").unwrap();
     let e = c.run_fails();
-    assert!(e.contains("instances[1].fmu") && e.contains("not a valid zip"), "{e}");
+    assert!(
+        e.contains("instances[1].fmu") && e.contains("not a valid zip"),
+        "{e}"
+    );
 }
 
 #[test]
 fn unparsable_model_description() {
     let c = Case::new(SYSTEM);
-    fake_fmu(c.dir.path(), "Damper.fmu", "Damper", &DAMPER_MD.replace("</ModelVariables>", ""));
+    fake_fmu(
+        c.dir.path(),
+        "Damper.fmu",
+        "Damper",
+        &DAMPER_MD.replace("</ModelVariables>", ""),
+    );
     let e = c.run_fails();
-    assert!(e.contains("Damper.fmu") && e.contains("modelDescription.xml"), "{e}");
+    assert!(
+        e.contains("Damper.fmu") && e.contains("modelDescription.xml"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -142,8 +168,9 @@ fn unknown_variable_in_connection() {
     let c = Case::new(&SYSTEM.replace("\"damper.force\"", "\"damper.forse\""));
     let e = c.run_fails();
     assert!(
-        e.contains("line 8: connections[1].from: unknown variable 'damper.forse' in instance 'damper'")
-            && e.contains("did you mean 'damper.force'?"),
+        e.contains(
+            "line 8: connections[1].from: unknown variable 'damper.forse' in instance 'damper'"
+        ) && e.contains("did you mean 'damper.force'?"),
         "{e}"
     );
 }
@@ -155,7 +182,10 @@ fn unit_and_type_mismatch() {
     assert!(e.contains("connections[0]: unit mismatch: 'body.position' is in [m] but 'damper.velocity' is in [m/s]"), "{e}");
     let c = Case::new(&SYSTEM.replace("\"body.velocity\"", "\"body.count\""));
     let e = c.run_fails();
-    assert!(e.contains("type mismatch: 'body.count' is Integer but 'damper.velocity' is Real"), "{e}");
+    assert!(
+        e.contains("type mismatch: 'body.count' is Integer but 'damper.velocity' is Real"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -171,15 +201,29 @@ fn fake_binary_fails_to_load_cleanly() {
 fn inspect_reports_bad_fmus_and_help_works() {
     let c = Case::new(SYSTEM);
     std::fs::write(c.path("bad.fmu"), b"xx").unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_master")).arg("inspect").arg(c.path("bad.fmu")).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .arg("inspect")
+        .arg(c.path("bad.fmu"))
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("bad.fmu' is not a valid zip"));
-    let out = Command::new(env!("CARGO_BIN_EXE_master")).arg("inspect").arg(c.path("Damper.fmu")).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .arg("inspect")
+        .arg(c.path("Damper.fmu"))
+        .output()
+        .unwrap();
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("force") && text.contains("output") && text.contains("N"), "{text}");
+    assert!(
+        text.contains("force") && text.contains("output") && text.contains("N"),
+        "{text}"
+    );
     for sub in ["run", "sweep", "inspect"] {
-        let out = Command::new(env!("CARGO_BIN_EXE_master")).args([sub, "--help"]).output().unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_master"))
+            .args([sub, "--help"])
+            .output()
+            .unwrap();
         assert!(out.status.success(), "{sub} --help");
         assert!(String::from_utf8_lossy(&out.stdout).contains("Usage: master"));
     }
@@ -188,7 +232,11 @@ fn inspect_reports_bad_fmus_and_help_works() {
 #[test]
 fn sweep_with_bad_runset_fails_without_output() {
     let c = Case::new(SYSTEM);
-    std::fs::write(c.path("set.json"), r#"{"base": "system.json", "product": {"bodyy.mass": [1, 2]}}"#).unwrap();
+    std::fs::write(
+        c.path("set.json"),
+        r#"{"base": "system.json", "product": {"bodyy.mass": [1, 2]}}"#,
+    )
+    .unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_master"))
         .args(["--quiet", "sweep"])
         .arg(c.path("set.json"))
@@ -197,6 +245,7 @@ fn sweep_with_bad_runset_fails_without_output() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("product.bodyy.mass: unknown instance 'bodyy'"));
+    assert!(String::from_utf8_lossy(&out.stderr)
+        .contains("product.bodyy.mass: unknown instance 'bodyy'"));
     assert!(!c.path("out").exists());
 }

@@ -19,7 +19,8 @@ pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
     let a = FmuArchive::open(&args.fmu)?;
     let md = &a.model;
     if args.json {
-        let s = serde_json::to_string_pretty(md).map_err(|e| CommandError::Failed(e.to_string()))?;
+        let s =
+            serde_json::to_string_pretty(md).map_err(|e| CommandError::Failed(e.to_string()))?;
         println!("{s}");
         return Ok(());
     }
@@ -33,10 +34,16 @@ pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
         );
     }
     if let Some(d) = &md.default_experiment {
-        println!("default experiment: start {:?}, stop {:?}, step {:?}", d.start_time, d.stop_time, d.step_size);
+        println!(
+            "default experiment: start {:?}, stop {:?}, step {:?}",
+            d.start_time, d.stop_time, d.step_size
+        );
     }
     println!();
-    println!("{:<32} {:>5} {:<12} {:<11} {:<8} {:<8} {:>10}  description", "name", "vr", "causality", "variability", "type", "unit", "start");
+    println!(
+        "{:<32} {:>5} {:<12} {:<11} {:<8} {:<8} {:>10}  description",
+        "name", "vr", "causality", "variability", "type", "unit", "start"
+    );
     for v in &md.variables {
         println!(
             "{:<32} {:>5} {:<12} {:<11} {:<8} {:<8} {:>10}  {}",

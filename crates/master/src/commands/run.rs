@@ -31,7 +31,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         if k == 1 {
             bar.set_length(n);
         }
-        if k % 64 == 0 || k == n {
+        if k.is_multiple_of(64) || k == n {
             bar.set_position(k);
         }
     };

@@ -27,7 +27,11 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     let reports = run_all(&jobs, &args.output, threads, ctx.progress, |job| {
         run_job_fmu(job, cancel)
     })?;
-    let failed: Vec<&str> = reports.iter().filter(|r| !r.ok).map(|r| r.name.as_str()).collect();
+    let failed: Vec<&str> = reports
+        .iter()
+        .filter(|r| !r.ok)
+        .map(|r| r.name.as_str())
+        .collect();
     for r in &reports {
         match (&r.summary, &r.error) {
             (Some(s), _) => println!("{}: ok, {s}", r.name),
@@ -35,10 +39,19 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             _ => {}
         }
     }
-    println!("{} of {} runs ok; see {}", reports.len() - failed.len(), reports.len(), args.output.join("sweep.json").display());
+    println!(
+        "{} of {} runs ok; see {}",
+        reports.len() - failed.len(),
+        reports.len(),
+        args.output.join("sweep.json").display()
+    );
     if failed.is_empty() {
         Ok(())
     } else {
-        Err(CommandError::Failed(format!("{} run(s) failed: {}", failed.len(), failed.join(", "))))
+        Err(CommandError::Failed(format!(
+            "{} run(s) failed: {}",
+            failed.len(),
+            failed.join(", ")
+        )))
     }
 }

@@ -17,6 +17,7 @@ pub struct Hooks {
     pub can_state: bool,
     pub cancel_after: Option<(usize, Arc<AtomicBool>)>,
     pub step_times: Vec<(f64, f64)>,
+    pub fail_set_vr: Option<u32>,
 }
 
 /// Dynamics: state (x, v), values by value reference.
@@ -161,6 +162,13 @@ impl<M: Model + Clone> Slave for Mock<M> {
     }
     fn set(&mut self, vars: &[VarRef], values: &[f64]) -> Result<(), SlaveError> {
         for (v, x) in vars.iter().zip(values) {
+            if self.hooks.fail_set_vr == Some(v.vr) {
+                return Err(SlaveError {
+                    instance: self.name.clone(),
+                    call: "fmi2SetReal",
+                    status: crate::slave::FailStatus::Error,
+                });
+            }
             self.m.values()[v.vr as usize] = *x;
         }
         Ok(())
@@ -233,11 +241,13 @@ pub fn two_mass_plan(alg: Algorithm, order: Vec<usize>, h: f64, stop: f64) -> Co
                 name: "ms".into(),
                 step_multiple: 1,
                 parameters: vec![(r(0), 1.0), (r(1), 100.0), (r(2), 0.5), (r(4), 0.1)],
+                parameter_names: vec![],
             },
             PlanInstance {
                 name: "sdm".into(),
                 step_multiple: 1,
                 parameters: vec![(r(0), 0.5), (r(1), 200.0), (r(2), 1.0)],
+                parameter_names: vec!["m".into(), "k".into(), "d".into()],
             },
         ],
         connections: vec![
@@ -451,6 +461,23 @@ fn cancel_flag_stops_and_terminates_everything() {
     let l = log.borrow();
     assert_eq!(l.iter().filter(|s| s.ends_with(":terminate")).count(), 2);
     assert_eq!(a.hooks.step_times.len(), 10);
+}
+
+#[test]
+fn failure_during_initialisation_names_the_parameter_and_does_not_terminate() {
+    let plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.01);
+    let (mut a, mut b) = slaves();
+    let log = CallLog::default();
+    a.hooks.log = log.clone();
+    b.hooks.log = log.clone();
+    b.hooks.fail_set_vr = Some(1);
+    let e = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "instance 'sdm': setting start value 'k' = 200 failed: instance 'sdm': fmi2SetReal failed with fmi2Error"
+    );
+    // ms is in initialisation mode: fmi2Terminate is not allowed there, only freeing
+    assert_eq!(*log.borrow(), vec!["ms:setup", "ms:enter", "sdm:setup"]);
 }
 
 #[test]
