@@ -34,6 +34,14 @@ enum Command {
     Sweep(commands::sweep::Args),
     /// Check an FMU and print its variables.
     Inspect(commands::inspect::Args),
+    /// Characterise the yaw dampers: hysteresis loops, FRFs, equivalent stiffness and damping.
+    Characterise(commands::characterise::Args),
+    /// Eigenvalues of the linear bogie over speed: root locus, critical speed, hunting frequency.
+    RootLocus(commands::root_locus::Args),
+    /// Wheel/rail contact geometry from profiles: delta r, contact angles, equivalent conicity.
+    ContactGeometry(commands::contact_geometry::Args),
+    /// The stability study: passive, semi-active and full-active yaw dampers, EN 14363 report.
+    Study(commands::study::Args),
 }
 
 fn main() -> ExitCode {
@@ -56,6 +64,10 @@ fn main() -> ExitCode {
         Command::Run(a) => commands::run::execute(a, &ctx),
         Command::Sweep(a) => commands::sweep::execute(a, &ctx),
         Command::Inspect(a) => commands::inspect::execute(a, &ctx),
+        Command::Characterise(a) => commands::characterise::execute(a, &ctx),
+        Command::RootLocus(a) => commands::root_locus::execute(a, &ctx),
+        Command::ContactGeometry(a) => commands::contact_geometry::execute(a, &ctx),
+        Command::Study(a) => commands::study::execute(a, &ctx),
     };
     match res {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,8 +5,12 @@
 
 use std::sync::atomic::AtomicBool;
 
+pub mod characterise;
+pub mod contact_geometry;
 pub mod inspect;
+pub mod root_locus;
 pub mod run;
+pub mod study;
 pub mod sweep;
 
 /// Shared state of a command invocation.
