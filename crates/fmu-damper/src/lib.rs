@@ -9,6 +9,9 @@
 //! * [`Actuator`] with [`ActuatorParams`] (Table 3-2 defaults, model and rod mode);
 //! * [`characterise`] for loops, FRFs and [`characterise::equivalent_stiffness_damping`].
 //!
+//! FMUs (module [`fmu`], exported with feature `fmi-export`): `SemiActiveDamper`,
+//! `PassiveYawDamper`, `FullActiveActuator`.
+//!
 //! Sign convention of every `force_n`: positive in tension (opposing extension).
 //!
 //! # Calibration and measured numbers (semi-active, defaults)
@@ -34,6 +37,7 @@
 pub mod characterise;
 pub mod complex;
 pub mod error;
+pub mod fmu;
 pub mod full_active;
 pub mod ode;
 pub mod semi_active;

@@ -1,0 +1,140 @@
+//! FMI 2.0 co-simulation shells over the damper physics (thin: the physics lives in
+//! [`crate::semi_active`], [`crate::valve`], [`crate::full_active`]; the FMI machinery in
+//! `model-description`).
+//!
+//! * [`SemiActiveDamper`]: semi-active yaw damper (3.38)-(3.45) with the by-pass valve command;
+//! * [`PassiveYawDamper`]: the same damper with the valve fixed at 30 % (seed section 4.3);
+//! * [`FullActiveActuator`]: full-active hydraulic actuator (3.46)-(3.66), rod imposed by the
+//!   vehicle.
+//!
+//! Common behaviour (also in each FMU's documentation):
+//! * force outputs are positive in **tension** (opposing extension) for every model;
+//! * parameters are fixed; strictly positive quantities are declared with `min = 0` (FMI bounds
+//!   are inclusive): a negative value is rejected when it is set, zero (and every cross-parameter
+//!   condition) at `fmi2ExitInitializationMode` by the physics' validation, both naming the FMI
+//!   variable;
+//! * a step is computed on a copy of the physics and committed only on success: an integrator
+//!   failure returns `fmi2Discard` with the state unchanged;
+//! * NaN/inf inputs cannot arrive (the glue rejects them at set time); a non-finite result of the
+//!   physics is never returned as a number.
+
+mod actuator;
+mod semi;
+
+pub use actuator::FullActiveActuator;
+pub use semi::{PassiveYawDamper, SemiActiveDamper};
+
+use model_description::{ModelError, StepError};
+
+use crate::error::{ParamError, StepError as PhysicsStepError};
+
+/// Author string written to every modelDescription.xml of this crate.
+const AUTHOR: &str = "rail-fmu project (fmu-damper)";
+
+/// Name of the physics field carried by a parameter error.
+fn param_field(e: &ParamError) -> &'static str {
+    match e {
+        ParamError::NotFinite { name, .. }
+        | ParamError::NotPositive { name, .. }
+        | ParamError::Negative { name, .. }
+        | ParamError::OutOfRange { name, .. } => name,
+    }
+}
+
+/// Physics field name -> FMI variable name (unknown fields keep their physics name).
+fn fmi_name(field: &'static str, map: &[(&'static str, &'static str)]) -> &'static str {
+    map.iter()
+        .find(|(f, _)| *f == field)
+        .map_or(field, |(_, fmi)| *fmi)
+}
+
+/// `text` with every physics field name (a whole identifier token) replaced by its FMI name,
+/// so messages such as "must exceed area_b_m2 * half_stroke_m" speak the FMU's language.
+fn rename_fields(text: &str, map: &[(&'static str, &'static str)]) -> String {
+    let is_ident = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '.';
+    let mut out = String::with_capacity(text.len() + 16);
+    let mut rest = text;
+    while let Some(start) = rest.find(is_ident) {
+        out.push_str(&rest[..start]);
+        let tail = &rest[start..];
+        let len = tail.find(|c: char| !is_ident(c)).unwrap_or(tail.len());
+        // A sentence's full stop is not part of the name.
+        let token = tail[..len].trim_end_matches('.');
+        let token = if token.is_empty() {
+            &tail[..len]
+        } else {
+            token
+        };
+        out.push_str(
+            map.iter()
+                .find(|(f, _)| *f == token)
+                .map_or(token, |(_, fmi)| *fmi),
+        );
+        rest = &tail[token.len()..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// A physics parameter error, renamed to the FMI variable.
+fn param_error(e: &ParamError, map: &[(&'static str, &'static str)]) -> ModelError {
+    let name = fmi_name(param_field(e), map);
+    // The physics message names its fields; say which FMI variables those are.
+    ModelError::InvalidParameter {
+        name: name.to_string(),
+        reason: rename_fields(&e.to_string(), map),
+    }
+}
+
+/// A physics error outside a step (initialisation, output evaluation).
+fn model_error(e: &PhysicsStepError, map: &[(&'static str, &'static str)]) -> ModelError {
+    match e {
+        PhysicsStepError::BadInput { name, value } => ModelError::InvalidInput {
+            name: fmi_name(name, map).to_string(),
+            reason: format!("not finite ({value})"),
+        },
+        PhysicsStepError::Param(p) => param_error(p, map),
+        other => ModelError::Other(other.to_string()),
+    }
+}
+
+/// A failed physics step: an integrator failure or a non-finite state may go away with a
+/// smaller communication step (fmi2Discard, state unchanged); anything else ends the run.
+fn step_error(e: &PhysicsStepError, map: &[(&'static str, &'static str)]) -> StepError {
+    match e {
+        PhysicsStepError::Integration { .. } | PhysicsStepError::NonFinite { .. } => {
+            StepError::Discard(e.to_string())
+        }
+        other => StepError::Error(model_error(other, map)),
+    }
+}
+
+fn not_initialised() -> StepError {
+    StepError::Error(ModelError::Other(
+        "the physics is built in fmi2ExitInitializationMode; no step before it".into(),
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn field_names_are_renamed_as_whole_tokens() {
+        let map = [
+            ("area_b_m2", "cylinder.area_b"),
+            ("half_stroke_m", "cylinder.half_stroke"),
+        ];
+        assert_eq!(
+            rename_fields(
+                "`x` must be > area_b_m2 * half_stroke_m. area_b_m2x ...",
+                &map
+            ),
+            "`x` must be > cylinder.area_b * cylinder.half_stroke. area_b_m2x ..."
+        );
+        assert_eq!(rename_fields("", &map), "");
+    }
+}
+
+#[cfg(feature = "fmi-export")]
+model_description::export_fmus!(SemiActiveDamper, PassiveYawDamper, FullActiveActuator);
