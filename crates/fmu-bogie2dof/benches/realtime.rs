@@ -1,18 +1,17 @@
 //! Real-time factor of the non-linear model: one simulated second (1000 communication
-//! steps of 1 ms, internal RK4 sub-step 1e-4 s) with a Kelvin-Voigt damper in the loop,
-//! at 320 km/h in flange contact. Simulated seconds per wall second = 1 / (time per iter).
+//! steps of 1 ms, internal RK4 sub-step 1e-4 s) with the passive Maxwell damper in the
+//! loop, at 320 km/h (default table, flange-root limit cycle). Simulated seconds per wall second = 1 / (time per iter).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 use criterion::{criterion_group, criterion_main, Criterion};
 use fmu_bogie2dof::calibration::*;
-use fmu_bogie2dof::contact::ContactTable;
 use fmu_bogie2dof::sim::{run_closed_loop, LoopDamper};
 use fmu_bogie2dof::{Bogie, Params, PsdLevel, TrackSource};
 
 fn bench(c: &mut Criterion) {
-    let table = ContactTable::synthetic(CALIBRATED_CONICITY, 7e-3, 5e-4, 2.7).unwrap();
-    let damper = LoopDamper::KelvinVoigt {
-        k: PLACEHOLDER_DAMPER_K_N_PER_M,
-        c: PLACEHOLDER_DAMPER_C_NS_PER_M,
+    let table = fmu_bogie2dof::model::default_contact_table().unwrap();
+    let damper = LoopDamper::Maxwell {
+        k: PASSIVE_MAXWELL_K_N_PER_M,
+        c: PASSIVE_MAXWELL_C_NS_PER_M,
     };
     for (name, track) in [
         ("nonlinear_1s_sim_h1ms", TrackSource::None),

@@ -1,5 +1,5 @@
 //! Prints the calibration numbers: linear critical speed and hunting mode (R5, R6) with the
-//! placeholder damper, and the non-linear response to a 3 mm initial perturbation (R7) at
+//! passive (Maxwell-fitted) damper, and the non-linear response to a 3 mm initial perturbation (R7) at
 //! several speeds. Usage: `cargo run --release --example calibration_report [table.csv [k_ssx [conicity [k_grav]]]]`.
 use fmu_bogie2dof::calibration::*;
 use fmu_bogie2dof::contact::ContactTable;
@@ -22,16 +22,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(g) = std::env::args().nth(4) {
         p.gravity_stiffness_n_per_m = g.parse()?;
     }
-    let c = critical_speed(&p, &placeholder_damper(), 5.0, 199.0)?;
+    let c = critical_speed(&p, &passive_damper(), 5.0, 199.0)?;
     println!(
         "linear: V_cr {:.1} km/h, hunting {:.2} Hz (Im {:.2} rad/s)",
         c.speed_kmh, c.hunting.freq_hz, c.hunting.im
     );
-    let (lam, grav) = table.linearise(3e-3);
-    println!("table: equivalent conicity at 3 mm {lam:.3}, gravity stiffness/P {grav:.2} 1/m");
-    let damper = LoopDamper::KelvinVoigt {
-        k: PLACEHOLDER_DAMPER_K_N_PER_M,
-        c: PLACEHOLDER_DAMPER_C_NS_PER_M,
+    let (lam, grav) = table.linearise(LINEARISATION_AMPLITUDE_M);
+    println!("table: equivalent conicity at 1 mm {lam:.3}, gravity stiffness/P {grav:.2} 1/m");
+    let damper = LoopDamper::Maxwell {
+        k: PASSIVE_MAXWELL_K_N_PER_M,
+        c: PASSIVE_MAXWELL_C_NS_PER_M,
     };
     for kmh in [220.0, 250.0, 265.0, 275.0, 285.0, 300.0, 320.0] {
         let q = Params {

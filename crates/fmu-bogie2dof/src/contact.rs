@@ -216,6 +216,40 @@ impl ContactTable {
         Self::from_columns(y, dl, dr, tl, tr)
     }
 
+    /// Copy whose tread is replaced by a cone: for |y| <= `y_flange_m` the rolling-radius
+    /// difference is delta_r(0) +- `conicity` y; beyond, the table's own rise (flange) is
+    /// appended continuously: delta_r_R(y) = delta_r(0) + conicity y_f + (dr_R(y) - dr_R(y_f))
+    /// (left side mirrored the same way). Contact angles are kept. Used for the worn-profile
+    /// surrogate (see [`crate::calibration`]).
+    pub fn with_tread_cone(&self, conicity: f64, y_flange_m: f64) -> Self {
+        let c0 = self.lookup(0.0);
+        let yf = y_flange_m.abs();
+        let (at_pos, at_neg) = (self.lookup(yf), self.lookup(-yf));
+        let mut dr_l = Vec::with_capacity(self.y.len());
+        let mut dr_r = Vec::with_capacity(self.y.len());
+        for (i, &y) in self.y.iter().enumerate() {
+            let r = if y <= yf {
+                c0.delta_r_right_m + conicity * y
+            } else {
+                c0.delta_r_right_m + conicity * yf + (self.dr_r[i] - at_pos.delta_r_right_m)
+            };
+            let l = if y >= -yf {
+                c0.delta_r_left_m - conicity * y
+            } else {
+                c0.delta_r_left_m + conicity * yf + (self.dr_l[i] - at_neg.delta_r_left_m)
+            };
+            dr_r.push(r);
+            dr_l.push(l);
+        }
+        Self {
+            y: self.y.clone(),
+            dr_l,
+            dr_r,
+            tg_l: self.tg_l.clone(),
+            tg_r: self.tg_r.clone(),
+        }
+    }
+
     /// Number of rows.
     pub fn len(&self) -> usize {
         self.y.len()

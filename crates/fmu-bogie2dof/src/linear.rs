@@ -18,7 +18,8 @@ use crate::params::Params;
 pub fn matrices(p: &Params, speed_mps: f64) -> (Matrix2<f64>, Matrix2<f64>, Matrix2<f64>) {
     let v = speed_mps;
     let (s, pp, b) = (p.half_contact_gauge_m, p.half_wheelbase_m, p.damper_arm_m);
-    let (f11, f22) = (p.f11_n, p.f22_n);
+    // Kalker coefficients with the reduction factor kappa (see Params::creep_reduction)
+    let (f11, f22) = (p.creep_reduction * p.f11_n, p.creep_reduction * p.f22_n);
     let kg = p.gravity_stiffness_n_per_m;
     let m = Matrix2::new(p.bogie_mass_kg, 0.0, 0.0, p.bogie_yaw_inertia_kgm2);
     let c = Matrix2::new(
@@ -47,8 +48,9 @@ mod tests {
         let (m, c, k) = matrices(&p, v);
         assert_eq!(m[(0, 1)], 0.0);
         assert_eq!(c[(0, 1)], 0.0);
-        assert!((c[(0, 0)] - 4.0 * p.f22_n / v).abs() < 1e-6);
-        assert!((k[(0, 1)] - 4.0 * p.f22_n).abs() < 1e-6);
+        let f22 = p.creep_reduction * p.f22_n;
+        assert!((c[(0, 0)] - 4.0 * f22 / v).abs() < 1e-6);
+        assert!((k[(0, 1)] - 4.0 * f22).abs() < 1e-6);
         // kinematic coupling: yaw moment pushes a right-displaced bogie nose-left
         assert!(k[(1, 0)] < 0.0);
     }

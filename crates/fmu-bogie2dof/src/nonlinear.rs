@@ -5,7 +5,7 @@
 //! * creepages (5.8)-(5.11) with the ABSOLUTE wheelset lateral velocity and yaw, and rolling
 //!   radii r_{L,R} = r0 + delta_r_{L,R}(y_i - y_track,i) (5.19); wheel angular speed
 //!   Omega + beta_i' (5.26) with Omega = V/r0;
-//! * Kalker linear forces (5.2)-(5.3), saturated per wheel with Vermeulen-Johnson
+//! * Kalker linear forces (5.2)-(5.3) (coefficients times the reduction factor kappa), saturated per wheel with Vermeulen-Johnson
 //!   (5.21)-(5.25) using the static wheel load P;
 //! * normal-force lateral components (5.20): F_BL = +P tan g_L, F_BR = -P tan g_R (the table
 //!   holds positive tan g; signs so the net force restores, see [`crate::contact`]);
@@ -61,8 +61,8 @@ impl Consts {
             k_ssx: p.k_ssx_n_per_m,
             lambda: p.conicity,
             kg: p.gravity_stiffness_n_per_m,
-            f11: p.f11_n,
-            f22: p.f22_n,
+            f11: p.creep_reduction * p.f11_n,
+            f22: p.creep_reduction * p.f22_n,
             load: p.wheel_load_n,
             mu_p: p.friction_coefficient * p.wheel_load_n,
             nonlinear: p.model == ModelKind::NonLinear,
@@ -189,7 +189,11 @@ mod tests {
     /// At small amplitude on a cone the non-linear forces equal the linear ones.
     #[test]
     fn nonlinear_reduces_to_linear_at_small_amplitude() {
-        let mut p = Params::default();
+        // synthetic cone: no contact-angle change, so no gravitational stiffness
+        let mut p = Params {
+            gravity_stiffness_n_per_m: 0.0,
+            ..Params::default()
+        };
         let table = ContactTable::synthetic(p.conicity, 7e-3, 5e-4, 2.7).unwrap();
         p.model = ModelKind::NonLinear;
         let cn = Consts::new(&p);

@@ -14,7 +14,11 @@
 //!
 //! Calibrated (free) parameters, see [`crate::calibration`]: `k_ssx_n_per_m` (effective
 //! longitudinal secondary stiffness per side at arm b: air spring + mountings, WITHOUT the yaw
-//! damper, whose elastic part comes with the damper representation) and `conicity`.
+//! damper, whose elastic part comes with the damper representation), `creep_reduction`
+//! (Kalker reduction factor, Polach 2005), and the contact geometry: the default table is the
+//! worn-profile surrogate (A/A with doubled rolling-radius differences); `conicity` and
+//! `gravity_stiffness_n_per_m` of the linear model are its describing-function values at
+//! 1 mm amplitude, so both models see the same contact at small amplitude.
 
 use serde::{Deserialize, Serialize};
 
@@ -79,9 +83,14 @@ pub enum TrackSource {
 /// Which wheel/rail contact table the non-linear model uses.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum ContactSource {
+    /// DEFAULT: worn-profile surrogate, the A/A table with a 0.25 cone on the central
+    /// +-3.5 mm of the tread and the A/A rise beyond (equivalent conicity 0.25 up to 3.5 mm,
+    /// 0.38 at 6 mm), contact angles kept; `resources/wheel_rail_worn_surrogate.csv`. See
+    /// [`crate::calibration`] for why.
+    #[default]
+    WornSurrogate,
     /// Built-in table of EN 15302 profiles A/A (wheel A on rail A, 1435 mm gauge),
     /// `resources/wheel_rail_A_A.csv`, computed by the `wheel-rail` crate.
-    #[default]
     ProfilesAA,
     /// Synthetic cone of `conicity` with a steep flange at 7 mm (the profile with which R7
     /// is reproduced, see `calibration`).
@@ -91,11 +100,12 @@ pub enum ContactSource {
 }
 
 impl ContactSource {
-    /// Mapping of an FMU string parameter: "" or "AA" -> ProfilesAA, "synthetic" ->
-    /// SyntheticCone, anything else is a file path.
+    /// Mapping of an FMU string parameter: "" or "worn" -> WornSurrogate, "AA" ->
+    /// ProfilesAA, "synthetic" -> SyntheticCone, anything else is a file path.
     pub fn from_path_str(s: &str) -> Self {
         match s.trim() {
-            "" | "AA" => ContactSource::ProfilesAA,
+            "" | "worn" => ContactSource::WornSurrogate,
+            "AA" => ContactSource::ProfilesAA,
             "synthetic" => ContactSource::SyntheticCone,
             p => ContactSource::File(p.to_string()),
         }
@@ -132,13 +142,19 @@ pub struct Params {
     pub k_ssx_n_per_m: f64,
     /// lambda: equivalent conicity of the linear model [-]. CALIBRATED.
     pub conicity: f64,
-    /// Extra lateral gravitational stiffness per wheelset used by the LINEAR model [N/m]
-    /// (0 in the seed's (5.18); see [`crate::contact::ContactTable::linearise`]).
+    /// Lateral gravitational (contact-angle) stiffness per wheelset used by the LINEAR model
+    /// [N/m]: P d(tan g_R - tan g_L)/dy of the table (describing function at 1 mm, see
+    /// [`crate::contact::ContactTable::linearise`]). Not in the seed's (5.18); included here
+    /// because the non-linear model (5.20) has it through the contact angles.
     pub gravity_stiffness_n_per_m: f64,
     /// f11: Kalker longitudinal creep coefficient per wheel [N] (Hertz+Kalker: 11.5 MN).
     pub f11_n: f64,
     /// f22: Kalker lateral creep coefficient per wheel [N] (Hertz+Kalker: 10.4 MN).
     pub f22_n: f64,
+    /// kappa: reduction factor applied to f11 and f22 in both models (0, 1]. Measured initial
+    /// creep slopes are lower than Kalker's theory; Polach (2005, Wear 258) uses reduction
+    /// factors of about 0.3-1 (0.5-1 for dry rail). CALIBRATED: 0.6.
+    pub creep_reduction: f64,
     /// P: vertical load per wheel [N] (~140 kN per wheelset; Table 4-1's 27.52 kN is
     /// implausible, see REFERENCE.md).
     pub wheel_load_n: f64,
@@ -160,7 +176,7 @@ impl Default for Params {
             speed_mps: 250.0 / 3.6,
             model: ModelKind::NonLinear,
             bogie_mass_kg: 6100.0,
-            bogie_yaw_inertia_kgm2: 11_000.0,
+            bogie_yaw_inertia_kgm2: 11_000.0, // Manchester: 10 973, rounded
             wheelset_spin_inertia_kgm2: 112.0,
             half_wheelbase_m: 1.25,
             half_contact_gauge_m: 0.7465,
@@ -169,15 +185,16 @@ impl Default for Params {
             k_ssy_n_per_m: 160e3,
             k_ssx_n_per_m: crate::calibration::CALIBRATED_K_SSX_N_PER_M,
             conicity: crate::calibration::CALIBRATED_CONICITY,
-            gravity_stiffness_n_per_m: 0.0,
+            gravity_stiffness_n_per_m: crate::calibration::CALIBRATED_GRAVITY_STIFFNESS_N_PER_M,
             f11_n: 11.5e6,
             f22_n: 10.4e6,
+            creep_reduction: crate::calibration::CALIBRATED_CREEP_REDUCTION,
             wheel_load_n: 70e3,
             friction_coefficient: crate::calibration::CALIBRATED_FRICTION,
             initial_lateral_m: 0.0,
             initial_yaw_rad: 0.0,
             track: TrackSource::External,
-            contact: ContactSource::ProfilesAA,
+            contact: ContactSource::WornSurrogate,
         }
     }
 }
@@ -241,6 +258,13 @@ impl Params {
         non_negative("gravity_stiffness_n_per_m", self.gravity_stiffness_n_per_m)?;
         positive("f11_n", self.f11_n)?;
         positive("f22_n", self.f22_n)?;
+        positive("creep_reduction", self.creep_reduction)?;
+        if self.creep_reduction > 1.0 {
+            return Err(ParamError::new(
+                "creep_reduction",
+                format!("must be in (0, 1], got {}", self.creep_reduction),
+            ));
+        }
         positive("wheel_load_n", self.wheel_load_n)?;
         finite("friction_coefficient", self.friction_coefficient)?;
         if !(self.friction_coefficient > 0.0 && self.friction_coefficient <= 1.0) {
