@@ -79,3 +79,33 @@ fn mass_spring() {
 fn spring_damper_mass() {
     check::<fmu_examples::SpringDamperMass>();
 }
+
+#[test]
+fn semi_active_damper() {
+    check::<fmu_damper::fmu::SemiActiveDamper>();
+}
+
+#[test]
+fn passive_yaw_damper() {
+    check::<fmu_damper::fmu::PassiveYawDamper>();
+}
+
+#[test]
+fn full_active_actuator() {
+    check::<fmu_damper::fmu::FullActiveActuator>();
+}
+
+#[test]
+fn mppt_controller() {
+    check::<fmu_controller::fmu::MpptController>();
+}
+
+#[test]
+fn sky_hook_controller() {
+    check::<fmu_controller::fmu::SkyHookController>();
+}
+
+#[test]
+fn ideal_damper_force_controller() {
+    check::<fmu_controller::fmu::IdealDamperForceController>();
+}

@@ -16,7 +16,8 @@
 //! positive `z` feeds chamber A and `P_A A_A` pushes the rod in `+x`; if `x` is the elongation,
 //! chamber A pressure is a compression, the tension is `-(P_A - P_B) A` and the right value is
 //! `command_sign = -1`, which is exactly the seed's printed form `u = k_p (F_YD - F_ref)` (3.15).
-//! The default is +1; set it from the actuator's convention (open point, see the crate report).
+//! The default is -1: our `FullActiveActuator` FMU confirms it (a positive `spool.command` fills
+//! chamber A, pushes the rod out and lowers `damper.force`; its test closes this loop with -1).
 //!
 //! # Gain
 //! The seed tunes `k_p` "by trial and error". Around zero load the actuator of Table 3-2 turns
@@ -56,7 +57,7 @@ impl Default for IdfParams {
             sample_time_s: 1e-3,
             c_v_nspm: 330e3,
             k_p_m_per_n: 3e-7,
-            command_sign: 1.0,
+            command_sign: -1.0,
             u_max_m: 1e-3,
             nan_policy: NanPolicy::HoldAndWarn,
         }
@@ -193,7 +194,7 @@ mod tests {
     #[test]
     fn proportional_law_hand_cases() {
         let mut c = Idf::new(IdfParams::default()).unwrap();
-        // F_ref = 330e3 * 0.02 = 6600 N, F = 5000 N -> u = 3e-7 * 1600 = 4.8e-4 m
+        // F_ref = 330e3 * 0.02 = 6600 N, F = 5000 N -> u = -3e-7 * 1600 = -4.8e-4 m (sign -1)
         let o = c
             .step(
                 1e-3,
@@ -205,7 +206,7 @@ mod tests {
             .unwrap();
         assert_relative_eq!(o.force_ref_n, 6600.0, max_relative = 1e-12);
         assert_relative_eq!(o.force_error_n, 1600.0, max_relative = 1e-12);
-        assert_relative_eq!(o.spool_command_m, 4.8e-4, max_relative = 1e-12);
+        assert_relative_eq!(o.spool_command_m, -4.8e-4, max_relative = 1e-12);
         assert!(!o.saturated);
         // large error saturates at alpha
         let o = c
@@ -217,20 +218,20 @@ mod tests {
                 },
             )
             .unwrap();
-        assert_eq!(o.spool_command_m, 1e-3);
+        assert_eq!(o.spool_command_m, -1e-3);
         assert!(o.saturated);
-        // command_sign = -1 (the seed's printed form u = k_p (F - F_ref))
+        // command_sign = +1 (an actuator whose positive spool raises tension)
         let neg = Idf::new(IdfParams {
-            command_sign: -1.0,
+            command_sign: 1.0,
             ..Default::default()
         })
         .unwrap();
         assert_relative_eq!(
             neg.law(0.02, 5000.0).spool_command_m,
-            -4.8e-4,
+            4.8e-4,
             max_relative = 1e-12
         );
-        assert_eq!(neg.law(-0.1, 0.0).spool_command_m, 1e-3);
+        assert_eq!(neg.law(-0.1, 0.0).spool_command_m, -1e-3);
     }
 
     #[test]

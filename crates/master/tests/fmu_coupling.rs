@@ -1,7 +1,6 @@
 //! Tests against the example FMUs `MassSpring` and `SpringDamperMass` from dist/.
-//! They are #[ignore]d because dist/ is built separately
-//! (`cargo run --release -p model-description --bin package-fmus`); run them with
-//! `cargo test -p master --test fmu_coupling -- --ignored`.
+//! dist/ is built by the test command (scripts/test.sh) before `cargo test`; by hand:
+//! `cargo run --release -p model-description --bin package-fmus`.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
 
@@ -85,7 +84,6 @@ fn final_error(alg: &str, step: f64) -> f64 {
 }
 
 #[test]
-#[ignore = "needs dist/MassSpring.fmu and dist/SpringDamperMass.fmu (package-fmus)"]
 fn gauss_seidel_order_is_derived_from_feedthrough() {
     let sys = LoadedSystem::from_json_str(
         &system_json("gauss-seidel", 1e-3, 1.0),
@@ -101,7 +99,6 @@ fn gauss_seidel_order_is_derived_from_feedthrough() {
 }
 
 #[test]
-#[ignore = "needs dist/MassSpring.fmu and dist/SpringDamperMass.fmu (package-fmus)"]
 fn coupled_fmus_converge_to_the_monolithic_solution_and_gs_beats_jacobi() {
     let j1 = final_error("jacobi", 2e-3);
     let j2 = final_error("jacobi", 1e-3);
@@ -117,7 +114,6 @@ fn coupled_fmus_converge_to_the_monolithic_solution_and_gs_beats_jacobi() {
 }
 
 #[test]
-#[ignore = "needs dist/MassSpring.fmu (package-fmus)"]
 fn fmu_state_save_and_restore_round_trip() {
     let a = FmuArchive::open(&dist().join("MassSpring.fmu")).unwrap();
     let (_, pos) = a.model.variable("position").unwrap();
@@ -141,7 +137,6 @@ fn fmu_state_save_and_restore_round_trip() {
 }
 
 #[test]
-#[ignore = "needs dist/*.fmu (package-fmus)"]
 fn sweep_runs_in_parallel_and_keeps_failures() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(
@@ -200,7 +195,6 @@ fn sweep_runs_in_parallel_and_keeps_failures() {
 }
 
 #[test]
-#[ignore = "needs dist/*.fmu (package-fmus)"]
 fn ctrl_c_stops_cleanly_without_result_file() {
     let dir = tempfile::tempdir().unwrap();
     // long enough to be interrupted: 2000 s at 1 ms

@@ -255,8 +255,8 @@ demand in metres, saturated at <code>u_max</code> = alpha = 1 mm (Table 3-2; bey
 saturates anyway, (3.47)).</p>
 <h2>Sign (<code>command_sign</code>)</h2>
 <p>The loop is stable only if a positive <code>command_sign</code> x u <em>increases</em> the measured
-tension. Default +1 (the physics crate's default). The seed's printed form u = k_p (F_YD - F_ref)
-corresponds to -1. The project's full-active actuator (fmu-damper, as documented at the time of
+tension. Default -1, which our FullActiveActuator needs (its test closes the loop with -1;
++1 runs away). The seed's printed form u = k_p (F_YD - F_ref) also corresponds to -1. The project's full-active actuator (fmu-damper, as documented at the time of
 writing: a positive spool position feeds chamber A, whose pressure pushes the rod towards
 extension, and its force output is tension positive = minus the push force) is of the kind that
 needs <b>command_sign = -1</b>; check the actuator's documentation before coupling, a wrong sign
