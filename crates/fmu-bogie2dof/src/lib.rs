@@ -11,10 +11,11 @@
 //! (right-hand sides), [`contact`] (table, saturation, Kalker, Hertz), [`eigen`] (root
 //! locus, critical speed, damper representations), [`track`] (ERRI B176 generator),
 //! [`model`] (time-domain [`Bogie`] for the FMU), [`sim`] (closed loop with a simple
-//! damper), [`calibration`].
+//! damper), [`calibration`], [`fmu`] (FMU shell `Bogie2Dof`, exported with feature `fmi-export`).
 pub mod calibration;
 pub mod contact;
 pub mod eigen;
+pub mod fmu;
 pub mod linear;
 pub mod model;
 pub mod nonlinear;

@@ -79,13 +79,27 @@ pub enum StepError {
         /// Step [s].
         h: f64,
     },
-    /// The state became NaN/inf or left the physical range (derailment).
+    /// The state became NaN/inf (a smaller step may help).
     #[error("state diverged at t = {time_s} s: {what}")]
     Diverged {
         /// Time [s].
         time_s: f64,
         /// Description.
         what: String,
+    },
+    /// A wheelset left the rail (|displacement relative to the track| > 50 mm): the model has
+    /// no meaning any more (a smaller step does not help).
+    #[error(
+        "derailment at t = {time_s} s: wheelset displacement relative to the track \
+         {front_m:.4} m (front) / {rear_m:.4} m (rear), limit 0.05 m"
+    )]
+    Derailed {
+        /// Time [s].
+        time_s: f64,
+        /// Front wheelset relative displacement [m].
+        front_m: f64,
+        /// Rear wheelset relative displacement [m].
+        rear_m: f64,
     },
 }
 
@@ -129,6 +143,10 @@ pub struct Outputs {
     pub damper_left_velocity_mps: f64,
     /// Right damper elongation velocity [m/s].
     pub damper_right_velocity_mps: f64,
+    /// Yaw acceleration sigma'' [rad/s^2]. Direct feedthrough.
+    pub yaw_acc_radps2: f64,
+    /// Bogie centre lateral acceleration y'' [m/s^2]. Direct feedthrough.
+    pub bogie_lateral_acc_mps2: f64,
     /// Bogie frame lateral acceleration above the front wheelset, y'' - p sigma'' [m/s^2]
     /// (EN 14363 stability quantity). Direct feedthrough.
     pub frame_acc_front_mps2: f64,
@@ -333,6 +351,8 @@ impl Bogie {
             damper_right_elongation_m: -c.b * x[1],
             damper_left_velocity_mps: c.b * x[3],
             damper_right_velocity_mps: -c.b * x[3],
+            yaw_acc_radps2: sdd,
+            bogie_lateral_acc_mps2: ydd,
             frame_acc_front_mps2: acc_f,
             frame_acc_rear_mps2: acc_r,
             wheelset_front_lateral_m: yf,
@@ -366,15 +386,29 @@ impl Bogie {
     }
 
     /// Advances over one communication step h with the inputs held constant; returns the
-    /// outputs at the end of the step (evaluated with the same held inputs).
+    /// outputs at the end of the step (evaluated with the same held inputs). On error the
+    /// model is left exactly as it was (a host may retry with a smaller step).
     pub fn step(&mut self, h: f64, inputs: &Inputs) -> Result<Outputs, StepError> {
         if !(h.is_finite() && h > 0.0 && h <= 1.0) {
             return Err(StepError::InvalidStep { h });
         }
         inputs.check()?;
-        if self.params.track == TrackSource::External {
-            self.delay.push(self.position_m, inputs.track_lateral_m);
+        let undo = if self.params.track == TrackSource::External {
+            Some(
+                self.delay
+                    .push_undoable(self.position_m, inputs.track_lateral_m),
+            )
+        } else {
+            None
+        };
+        let r = self.step_inner(h, inputs);
+        if let (Err(_), Some(u)) = (&r, undo) {
+            self.delay.undo(u);
         }
+        r
+    }
+
+    fn step_inner(&mut self, h: f64, inputs: &Inputs) -> Result<Outputs, StepError> {
         let c = self.consts;
         let yt0 = self.track_at_start(inputs);
         let x_end = self.position_m + c.v * h;
@@ -414,9 +448,10 @@ impl Bogie {
         // Beyond 50 mm the wheel has left the rail: the model has no meaning any more.
         let (yf, yr) = (x[0] - c.p * x[1], x[0] + c.p * x[1]);
         if (yf - yt1[0]).abs() > 0.05 || (yr - yt1[1]).abs() > 0.05 {
-            return Err(StepError::Diverged {
+            return Err(StepError::Derailed {
                 time_s: self.time_s + h,
-                what: format!("wheelset displacement {yf:.4} / {yr:.4} m (derailment)"),
+                front_m: yf - yt1[0],
+                rear_m: yr - yt1[1],
             });
         }
         self.state = x;

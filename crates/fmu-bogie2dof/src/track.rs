@@ -112,6 +112,16 @@ impl TrackGenerator {
     }
 }
 
+/// What [`DelayLine::undo`] needs to take back one push.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DelayUndo {
+    head: usize,
+    len: usize,
+    slot: usize,
+    x: f64,
+    v: f64,
+}
+
 /// Spatial delay line: records the external alignment input at the front wheelset against
 /// travelled distance, so the rear wheelset (2p behind) sees the same track. Samples are
 /// stored every `spacing` metres at most (bounded memory for any speed/step).
@@ -135,6 +145,34 @@ impl DelayLine {
             len: 0,
             spacing: (delay_m.abs() / (cap as f64 / 2.0)).max(1e-9),
         }
+    }
+
+    /// As [`Self::push`], returning what [`Self::undo`] needs to take it back (so a failed
+    /// step leaves the line unchanged).
+    pub fn push_undoable(&mut self, x: f64, value: f64) -> DelayUndo {
+        let cap = self.x.len();
+        let slot = if self.len >= 2 && x - self.x[(self.head + cap - 2) % cap] < self.spacing {
+            (self.head + cap - 1) % cap
+        } else {
+            self.head
+        };
+        let u = DelayUndo {
+            head: self.head,
+            len: self.len,
+            slot,
+            x: self.x[slot],
+            v: self.v[slot],
+        };
+        self.push(x, value);
+        u
+    }
+
+    /// Takes back the push that returned `u` (must be the last change).
+    pub fn undo(&mut self, u: DelayUndo) {
+        self.head = u.head;
+        self.len = u.len;
+        self.x[u.slot] = u.x;
+        self.v[u.slot] = u.v;
     }
 
     /// Records the value at position x (x non-decreasing).

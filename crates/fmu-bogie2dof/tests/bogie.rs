@@ -602,7 +602,51 @@ fn bad_params_and_inputs_rejected() {
             break;
         }
     }
-    assert!(matches!(res, Err(StepError::Diverged { .. })), "{res:?}");
+    assert!(
+        matches!(
+            res,
+            Err(StepError::Diverged { .. }) | Err(StepError::Derailed { .. })
+        ),
+        "{res:?}"
+    );
+    // a failed step leaves the model unchanged
+    let before = b.clone();
+    assert!(b.step(1e-3, &huge).is_err());
+    assert_eq!(b, before);
+}
+
+/// A failed step with an external track input leaves the delay line unchanged too.
+#[test]
+fn failed_step_is_transactional_with_external_track() {
+    let p = Params {
+        speed_mps: 50.0,
+        ..Params::default()
+    };
+    let mut b = Bogie::new(p).unwrap();
+    let i = Inputs {
+        track_lateral_m: 1e-3,
+        ..Inputs::default()
+    };
+    for _ in 0..20 {
+        b.step(1e-3, &i).unwrap();
+    }
+    let huge = Inputs {
+        damper_left_force_n: 1e13,
+        track_lateral_m: 2e-3,
+        ..Inputs::default()
+    };
+    let mut n = 0;
+    loop {
+        let before = b.clone();
+        match b.step(1e-2, &huge) {
+            Ok(_) => n += 1,
+            Err(_) => {
+                assert_eq!(b, before);
+                break;
+            }
+        }
+        assert!(n < 1000);
+    }
 }
 
 #[test]
