@@ -43,8 +43,8 @@
 //!   lowers the hunting frequency towards R6.
 //! * k_ssx = 0.390 MN/m per side ([`CALIBRATED_K_SSX_N_PER_M`]) fitted for 270 km/h by
 //!   [`calibrate_k_ssx`]. The total effective yaw stiffness per side at arm b is then
-//!   k_ssx + k_eq(damper, 4.4 Hz) ~ 0.39 + 0.42 = 0.81 MN/m, plus the gravitational stiffness's
-//!   share 2 k_g p^2 / (2 b^2) = 1.7 MN/m: 2.5 MN/m, a little under REFERENCE's 3-5 MN/m
+//!   k_ssx + k_eq(damper, 4.4 Hz) ~ 0.39 + 0.47 = 0.86 MN/m, plus the gravitational stiffness's
+//!   share 2 k_g p^2 / (2 b^2) = 1.73 MN/m: 2.6 MN/m, a little under REFERENCE's 3-5 MN/m
 //!   window, which was derived WITHOUT the gravitational stiffness.
 //! * k_ssy = 160 kN/m (Manchester), J = 11 000 kg m^2 (Manchester), kept.
 //! * Result: V_cr = 270 km/h, hunting frequency 4.41 Hz (Im 27.7 rad/s). KNOWN GAP to R6's

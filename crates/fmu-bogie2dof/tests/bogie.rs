@@ -176,7 +176,7 @@ fn calibration_function_reproduces_constant() {
     assert!((c.speed_kmh - 270.0).abs() < 0.01);
     assert!((k - CALIBRATED_K_SSX_N_PER_M).abs() / k < 0.01, "k_ssx {k}");
     // effective yaw stiffness per side: k_ssx + damper k_eq + gravitational share.
-    // KNOWN GAP: about 2.5 MN/m, under REFERENCE's 3-5 MN/m (derived without gravity).
+    // KNOWN GAP: about 2.6 MN/m, under REFERENCE's 3-5 MN/m (derived without gravity).
     let (ke, _) = maxwell_equivalent(
         PASSIVE_MAXWELL_K_N_PER_M,
         PASSIVE_MAXWELL_C_NS_PER_M,
