@@ -109,3 +109,8 @@ fn sky_hook_controller() {
 fn ideal_damper_force_controller() {
     check::<fmu_controller::fmu::IdealDamperForceController>();
 }
+
+#[test]
+fn bogie_2dof() {
+    check::<fmu_bogie2dof::fmu::Bogie2Dof>();
+}
