@@ -1,10 +1,101 @@
-//! `master characterise` (being written).
+//! `master characterise [damper|actuator|all]`: hysteresis loops, FRFs and equivalent
+//! stiffness/damping of the semi-active yaw damper, FRFs of the full-active actuator
+//! (seed 3.3.4, 3.4.4; computation in [`crate::analysis::damper`]).
+
+use std::path::PathBuf;
+
+use fmu_damper::{ActuatorParams, SemiActiveParams};
 
 use super::{CommandError, Context};
+use crate::analysis::damper::{
+    characterise_actuator, characterise_damper, ActuatorOptions, DamperOptions,
+};
+use crate::analysis::{AnalysisError, Artefacts};
 
+/// Which model to characterise.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Target {
+    /// Semi-active damper (default parameters): loops at 4 Hz, 1 and 3 mm, openings 0/20/50/100 %;
+    /// force/displacement FRF at 1 mm, openings 0/20/30/50/100 %.
+    Damper,
+    /// Full-active actuator (Table 3-2): FRF u -> rod velocity, rod free, full-order,
+    /// reduced-order and linearised models at |u| = alpha and 0.3 alpha.
+    Actuator,
+    /// Both.
+    All,
+}
+
+/// Characterise the yaw dampers. Writes CSVs and SVG figures into --out and prints the R1
+/// peak-force table and the R3 eigenfrequency next to the seed's values.
+///
+/// Files (damper): damper_hysteresis.csv, damper_hysteresis_<A>mm_force_displacement.svg,
+/// damper_hysteresis_<A>mm_force_velocity.svg, damper_peak_forces.csv, damper_frf.csv,
+/// damper_frf_{modulus,phase,k_eq,c_eq}.svg.
+/// Files (actuator): actuator_frf.csv, actuator_frf_{modulus,phase}_alpha.svg.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// What to characterise.
+    #[arg(value_enum, default_value_t = Target::All)]
+    pub target: Target,
+    /// Output folder (created if needed; files are written only once everything is computed).
+    #[arg(long, default_value = "results/characterise")]
+    pub out: PathBuf,
+    /// Number of log-spaced frequencies of the damper FRF.
+    #[arg(long, default_value_t = 25)]
+    pub damper_freqs: usize,
+    /// Lowest damper FRF frequency [Hz].
+    #[arg(long, default_value_t = 0.5)]
+    pub damper_f_min: f64,
+    /// Highest damper FRF frequency [Hz].
+    #[arg(long, default_value_t = 20.0)]
+    pub damper_f_max: f64,
+    /// Number of log-spaced frequencies of the actuator FRF.
+    #[arg(long, default_value_t = 30)]
+    pub actuator_freqs: usize,
+    /// Lowest actuator FRF frequency [Hz].
+    #[arg(long, default_value_t = 1.0)]
+    pub actuator_f_min: f64,
+    /// Highest actuator FRF frequency [Hz].
+    #[arg(long, default_value_t = 320.0)]
+    pub actuator_f_max: f64,
+}
 
-pub fn execute(_args: &Args, _ctx: &Context) -> Result<(), CommandError> {
-    Err(CommandError::Failed("not implemented yet".into()))
+fn failed(e: AnalysisError) -> CommandError {
+    CommandError::Failed(e.to_string())
+}
+
+pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
+    let mut files = Artefacts::default();
+    let mut summary = String::new();
+    if matches!(args.target, Target::Damper | Target::All) {
+        let opts = DamperOptions {
+            frf_points: args.damper_freqs,
+            frf_band_hz: (args.damper_f_min, args.damper_f_max),
+            ..DamperOptions::default()
+        };
+        let r =
+            characterise_damper(&SemiActiveParams::default(), &opts, ctx.cancel).map_err(failed)?;
+        r.add_artefacts(&mut files).map_err(failed)?;
+        summary.push_str(&r.summary());
+    }
+    if matches!(args.target, Target::Actuator | Target::All) {
+        let opts = ActuatorOptions {
+            points: args.actuator_freqs,
+            band_hz: (args.actuator_f_min, args.actuator_f_max),
+            ..ActuatorOptions::default()
+        };
+        let r =
+            characterise_actuator(&ActuatorParams::default(), &opts, ctx.cancel).map_err(failed)?;
+        r.add_artefacts(&mut files).map_err(failed)?;
+        summary.push_str(&r.summary());
+    }
+    files.write_all(&args.out)?;
+    print!("{summary}");
+    println!(
+        "wrote {} files to {}: {}",
+        files.files.len(),
+        args.out.display(),
+        files.names().join(", ")
+    );
+    Ok(())
 }

@@ -1,0 +1,360 @@
+//! Figures the linear charts of [`crate::plot`] cannot draw: line charts with logarithmic
+//! axes (FRF moduli) and scatter plots whose points are coloured by a third variable (root
+//! locus coloured by speed). Both render to an SVG string.
+
+use std::ops::Range;
+
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::prelude::*;
+
+use crate::plot::{Chart, PlotError};
+
+/// Axis scale.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scale {
+    Linear,
+    /// Base-10 logarithmic; points with a non-positive coordinate on this axis are skipped.
+    Log,
+}
+
+fn data_err(title: &str, reason: &str) -> PlotError {
+    PlotError::Data {
+        title: title.to_string(),
+        reason: reason.to_string(),
+    }
+}
+
+fn draw_err(title: &str, e: &dyn std::fmt::Display) -> PlotError {
+    PlotError::Draw {
+        title: title.to_string(),
+        reason: e.to_string(),
+    }
+}
+
+fn usable(p: (f64, f64), x: Scale, y: Scale) -> bool {
+    p.0.is_finite()
+        && p.1.is_finite()
+        && (x == Scale::Linear || p.0 > 0.0)
+        && (y == Scale::Linear || p.1 > 0.0)
+}
+
+/// Axis range from data extremes: 5 % padding on a linear axis, a factor 1.25 on a log axis
+/// for y (x keeps the data span, e.g. the frequency band).
+fn axis_range(lo: f64, hi: f64, scale: Scale, pad: bool) -> Range<f64> {
+    match scale {
+        Scale::Linear => {
+            let d = if hi > lo {
+                (hi - lo) * 0.05
+            } else {
+                lo.abs().max(1.0) * 0.05
+            };
+            if pad || hi <= lo {
+                (lo - d)..(hi + d)
+            } else {
+                lo..hi
+            }
+        }
+        Scale::Log => {
+            if pad || hi <= lo {
+                (lo / 1.25)..(hi * 1.25)
+            } else {
+                lo..hi
+            }
+        }
+    }
+}
+
+/// Line chart with the given axis scales (linear/linear falls back to [`Chart::to_svg`]).
+pub fn lines_svg(chart: &Chart, x: Scale, y: Scale) -> Result<String, PlotError> {
+    if x == Scale::Linear && y == Scale::Linear {
+        return chart.to_svg(false);
+    }
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &p in chart.series.iter().flat_map(|s| s.points.iter()) {
+        if usable(p, x, y) {
+            x0 = x0.min(p.0);
+            x1 = x1.max(p.0);
+            y0 = y0.min(p.1);
+            y1 = y1.max(p.1);
+        }
+    }
+    if x0 > x1 {
+        return Err(data_err(
+            &chart.title,
+            "no finite points (positive on the logarithmic axes)",
+        ));
+    }
+    if let Some((v, _)) = &chart.limit {
+        if y == Scale::Linear || *v > 0.0 {
+            y0 = y0.min(*v);
+            y1 = y1.max(*v);
+        }
+    }
+    let xr = axis_range(x0, x1, x, false);
+    let yr = axis_range(y0, y1, y, true);
+    let span = (xr.start, xr.end);
+    match (x, y) {
+        (Scale::Log, Scale::Log) => render(chart, xr.log_scale(), yr.log_scale(), span, x, y),
+        (Scale::Log, Scale::Linear) => render(chart, xr.log_scale(), yr, span, x, y),
+        _ => render(chart, xr, yr.log_scale(), span, x, y),
+    }
+}
+
+fn render<X, Y>(
+    chart: &Chart,
+    xr: X,
+    yr: Y,
+    x_span: (f64, f64),
+    xs: Scale,
+    ys: Scale,
+) -> Result<String, PlotError>
+where
+    X: AsRangedCoord<Value = f64>,
+    Y: AsRangedCoord<Value = f64>,
+    X::CoordDescType: ValueFormatter<f64>,
+    Y::CoordDescType: ValueFormatter<f64>,
+{
+    let t = chart.title.as_str();
+    let mut svg = String::new();
+    {
+        let root =
+            SVGBackend::with_string(&mut svg, (chart.width, chart.height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| draw_err(t, &e))?;
+        let mut ctx = ChartBuilder::on(&root)
+            .caption(t, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(xr, yr)
+            .map_err(|e| draw_err(t, &e))?;
+        ctx.configure_mesh()
+            .x_desc(&chart.x_label)
+            .y_desc(&chart.y_label)
+            .draw()
+            .map_err(|e| draw_err(t, &e))?;
+        for (i, s) in chart.series.iter().enumerate() {
+            let color = Palette99::pick(i).to_rgba();
+            let pts: Vec<(f64, f64)> = s
+                .points
+                .iter()
+                .copied()
+                .filter(|&p| usable(p, xs, ys))
+                .collect();
+            ctx.draw_series(LineSeries::new(pts, color.stroke_width(2)))
+                .map_err(|e| draw_err(t, &e))?
+                .label(&s.name)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                });
+        }
+        if let Some((v, label)) = &chart.limit {
+            if ys == Scale::Linear || *v > 0.0 {
+                let style = RED.stroke_width(1);
+                ctx.draw_series(DashedLineSeries::new(
+                    vec![(x_span.0, *v), (x_span.1, *v)],
+                    8,
+                    5,
+                    style,
+                ))
+                .map_err(|e| draw_err(t, &e))?
+                .label(label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            }
+        }
+        ctx.configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| draw_err(t, &e))?;
+        root.present().map_err(|e| draw_err(t, &e))?;
+    }
+    Ok(svg)
+}
+
+/// Viridis-like colour ramp, `u` in 0..1 (dark blue -> teal -> green -> yellow).
+pub fn ramp(u: f64) -> RGBColor {
+    const STOPS: [(f64, f64, f64); 5] = [
+        (68.0, 1.0, 84.0),
+        (59.0, 82.0, 139.0),
+        (33.0, 145.0, 140.0),
+        (94.0, 201.0, 98.0),
+        (253.0, 231.0, 37.0),
+    ];
+    let u = if u.is_finite() {
+        u.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let f = u * (STOPS.len() - 1) as f64;
+    let i = (f.floor() as usize).min(STOPS.len() - 2);
+    let w = f - i as f64;
+    let (a, b) = (STOPS[i], STOPS[i + 1]);
+    let mix = |p: f64, q: f64| (p + (q - p) * w).round().clamp(0.0, 255.0) as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+/// Scatter plot with points coloured by a third variable `c` (e.g. speed), an optional
+/// highlighted subset (drawn as larger red rings) and an optional dashed vertical line at
+/// `x = 0` (stability boundary of a root locus).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ColourScatter {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    /// Name and unit of the colour variable, e.g. "km/h".
+    pub c_unit: String,
+    /// (x, y, c)
+    pub points: Vec<(f64, f64, f64)>,
+    /// (legend label, points)
+    pub highlight: Option<(String, Vec<(f64, f64)>)>,
+    pub zero_line_x: bool,
+    /// Number of colour stops shown in the legend.
+    pub legend_stops: usize,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl ColourScatter {
+    pub fn new(title: &str, x_label: &str, y_label: &str, c_unit: &str) -> Self {
+        ColourScatter {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            c_unit: c_unit.into(),
+            points: Vec::new(),
+            highlight: None,
+            zero_line_x: false,
+            legend_stops: 5,
+            width: 900,
+            height: 640,
+        }
+    }
+
+    pub fn to_svg(&self) -> Result<String, PlotError> {
+        let t = self.title.as_str();
+        let pts: Vec<(f64, f64, f64)> = self
+            .points
+            .iter()
+            .copied()
+            .filter(|p| p.0.is_finite() && p.1.is_finite() && p.2.is_finite())
+            .collect();
+        if pts.is_empty() {
+            return Err(data_err(t, "no finite points"));
+        }
+        let fold = |f: fn(&(f64, f64, f64)) -> f64| {
+            pts.iter()
+                .map(f)
+                .fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)))
+        };
+        let (mut x0, mut x1) = fold(|p| p.0);
+        let (y0, y1) = fold(|p| p.1);
+        let (c0, c1) = fold(|p| p.2);
+        if self.zero_line_x {
+            x0 = x0.min(0.0);
+            x1 = x1.max(0.0);
+        }
+        let xr = axis_range(x0, x1, Scale::Linear, true);
+        let yr = axis_range(y0, y1, Scale::Linear, true);
+        let cu = |c: f64| if c1 > c0 { (c - c0) / (c1 - c0) } else { 0.5 };
+        let mut svg = String::new();
+        {
+            let root =
+                SVGBackend::with_string(&mut svg, (self.width, self.height)).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| draw_err(t, &e))?;
+            let mut ctx = ChartBuilder::on(&root)
+                .caption(t, ("sans-serif", 20))
+                .margin(12)
+                .x_label_area_size(45)
+                .y_label_area_size(70)
+                .build_cartesian_2d(xr.clone(), yr.clone())
+                .map_err(|e| draw_err(t, &e))?;
+            ctx.configure_mesh()
+                .x_desc(&self.x_label)
+                .y_desc(&self.y_label)
+                .draw()
+                .map_err(|e| draw_err(t, &e))?;
+            if self.zero_line_x {
+                let style = BLACK.mix(0.6).stroke_width(1);
+                ctx.draw_series(DashedLineSeries::new(
+                    vec![(0.0, yr.start), (0.0, yr.end)],
+                    6,
+                    4,
+                    style,
+                ))
+                .map_err(|e| draw_err(t, &e))?;
+            }
+            ctx.draw_series(
+                pts.iter()
+                    .map(|&(x, y, c)| Circle::new((x, y), 3, ramp(cu(c)).filled())),
+            )
+            .map_err(|e| draw_err(t, &e))?;
+            if let Some((label, hp)) = &self.highlight {
+                let hp: Vec<(f64, f64)> = hp
+                    .iter()
+                    .copied()
+                    .filter(|p| p.0.is_finite() && p.1.is_finite())
+                    .collect();
+                ctx.draw_series(
+                    hp.into_iter()
+                        .map(|p| Circle::new(p, 6, RED.stroke_width(2))),
+                )
+                .map_err(|e| draw_err(t, &e))?
+                .label(label)
+                .legend(|(x, y)| Circle::new((x + 10, y), 6, RED.stroke_width(2)));
+            }
+            let n = self.legend_stops.max(2);
+            for k in 0..n {
+                let u = k as f64 / (n - 1) as f64;
+                let c = c0 + u * (c1 - c0);
+                let color = ramp(u);
+                ctx.draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+                    .map_err(|e| draw_err(t, &e))?
+                    .label(format!("{c:.0} {}", self.c_unit))
+                    .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled()));
+            }
+            ctx.configure_series_labels()
+                .position(SeriesLabelPosition::UpperLeft)
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .draw()
+                .map_err(|e| draw_err(t, &e))?;
+            root.present().map_err(|e| draw_err(t, &e))?;
+        }
+        Ok(svg)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log_log_chart_skips_non_positive_points() {
+        let c = Chart::new("FRF", "frequency [Hz]", "|H| [1/s]")
+            .with_series("full", vec![(1.0, 10.0), (10.0, 5.0), (100.0, 0.0)])
+            .with_series("reduced", vec![(1.0, 9.0), (100.0, 1.0)]);
+        let svg = lines_svg(&c, Scale::Log, Scale::Log).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("full") && svg.contains("reduced"));
+        let zeros = Chart::new("zeros", "f", "m").with_series("z", vec![(1.0, 0.0), (2.0, 0.0)]);
+        let e = lines_svg(&zeros, Scale::Log, Scale::Log).unwrap_err();
+        assert!(e.to_string().contains("zeros"), "{e}");
+        // log x, linear y (phase plot)
+        let ph = Chart::new("phase", "f", "deg").with_series("p", vec![(1.0, -10.0), (5.0, -90.0)]);
+        assert!(lines_svg(&ph, Scale::Log, Scale::Linear).is_ok());
+    }
+
+    #[test]
+    fn ramp_ends_and_coloured_scatter() {
+        assert_eq!(ramp(0.0), RGBColor(68, 1, 84));
+        assert_eq!(ramp(1.0), RGBColor(253, 231, 37));
+        assert_eq!(ramp(f64::NAN), RGBColor(68, 1, 84));
+        let mut s = ColourScatter::new("locus", "Re [1/s]", "Im [rad/s]", "km/h");
+        s.points = vec![(-1.0, 20.0, 100.0), (0.5, 21.0, 300.0)];
+        s.highlight = Some(("hunting".into(), vec![(0.5, 21.0)]));
+        s.zero_line_x = true;
+        let svg = s.to_svg().unwrap();
+        assert!(svg.contains("hunting") && svg.contains("300 km/h") && svg.contains("circle"));
+        s.points.clear();
+        assert!(s.to_svg().is_err());
+    }
+}

@@ -1,0 +1,1 @@
+//! Root locus of the linear bogie (being written).

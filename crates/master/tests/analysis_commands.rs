@@ -1,0 +1,272 @@
+//! The analysis subcommands through the built binary: characterise, contact-geometry,
+//! root-locus. Each writes its CSVs and SVGs into a temporary folder; the printed numbers are
+//! checked against the seed's ranges where the physics crates assert them (R1, E1 conicity,
+//! R5/R6), and bad input must fail cleanly without writing anything.
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
+
+use std::path::Path;
+use std::process::Command;
+
+struct Run {
+    ok: bool,
+    stdout: String,
+    stderr: String,
+}
+
+fn master(args: &[&str]) -> Run {
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .arg("--quiet")
+        .args(args)
+        .output()
+        .unwrap();
+    Run {
+        ok: out.status.success(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+fn check_files(dir: &Path, names: &[&str]) {
+    for n in names {
+        let p = dir.join(n);
+        let text = std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{n}: {e}"));
+        assert!(!text.trim().is_empty(), "{n} is empty");
+        if n.ends_with(".svg") {
+            assert!(
+                text.starts_with("<svg") || text.starts_with("<?xml"),
+                "{n} is not an SVG: {}",
+                &text[..text.len().min(60)]
+            );
+            assert!(text.trim_end().ends_with("</svg>"), "{n} is truncated");
+        } else {
+            assert!(text.lines().count() >= 2, "{n} has no data rows");
+        }
+    }
+}
+
+/// Numbers after the `|` separators of the summary row starting with `label`.
+fn table_row(stdout: &str, label: &str) -> Vec<f64> {
+    let line = stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with(label))
+        .unwrap_or_else(|| panic!("no row '{label}' in:\n{stdout}"));
+    line.split('|')
+        .skip(1)
+        .filter_map(|c| c.trim().parse().ok())
+        .collect()
+}
+
+/// The number right after `prefix` in the output.
+fn number_after(stdout: &str, prefix: &str) -> f64 {
+    let i = stdout
+        .find(prefix)
+        .unwrap_or_else(|| panic!("'{prefix}' not in:\n{stdout}"));
+    let rest = &stdout[i + prefix.len()..];
+    let s: String = rest
+        .trim_start()
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || *c == '.' || *c == '-')
+        .collect();
+    s.parse()
+        .unwrap_or_else(|_| panic!("no number after '{prefix}' in:\n{stdout}"))
+}
+
+#[test]
+fn characterise_damper_writes_loops_frfs_and_r1_table() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("ch");
+    let r = master(&[
+        "characterise",
+        "damper",
+        "--damper-freqs",
+        "3",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}\n{}", r.stdout, r.stderr);
+    check_files(
+        &out,
+        &[
+            "damper_hysteresis.csv",
+            "damper_hysteresis_1mm_force_displacement.svg",
+            "damper_hysteresis_1mm_force_velocity.svg",
+            "damper_hysteresis_3mm_force_displacement.svg",
+            "damper_hysteresis_3mm_force_velocity.svg",
+            "damper_peak_forces.csv",
+            "damper_frf.csv",
+            "damper_frf_modulus.svg",
+            "damper_frf_phase.svg",
+            "damper_frf_k_eq.svg",
+            "damper_frf_c_eq.svg",
+        ],
+    );
+    // R1: 12-20 kN at 0 %, 0.5-1 kN at 100 % (both amplitudes)
+    let closed = table_row(&r.stdout, "0 %");
+    let open = table_row(&r.stdout, "100 %");
+    assert_eq!(closed.len(), 2, "{}", r.stdout);
+    for f in &closed {
+        assert!((12.0..=20.0).contains(f), "R1 0 %: {f} kN\n{}", r.stdout);
+    }
+    for f in &open {
+        assert!((0.5..=1.0).contains(f), "R1 100 %: {f} kN\n{}", r.stdout);
+    }
+    // every loop has one full period per (opening, amplitude): 4 openings x 2 amplitudes
+    let csv = std::fs::read_to_string(out.join("damper_peak_forces.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 8);
+    // FRF: 5 openings x 3 frequencies
+    let csv = std::fs::read_to_string(out.join("damper_frf.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 15);
+}
+
+#[test]
+fn characterise_actuator_reports_r3_and_the_dead_zone() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("act");
+    let r = master(&[
+        "characterise",
+        "actuator",
+        "--actuator-freqs",
+        "4",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}\n{}", r.stdout, r.stderr);
+    check_files(
+        &out,
+        &[
+            "actuator_frf.csv",
+            "actuator_frf_modulus_alpha.svg",
+            "actuator_frf_phase_alpha.svg",
+        ],
+    );
+    // R3: 319.7 rad/s from (3.68) with Table 3-2
+    let w = number_after(&r.stdout, "R3 cylinder eigenfrequency (3.68):");
+    assert!((315.0..=325.0).contains(&w), "R3 {w} rad/s");
+    // 0.3 alpha sits in the dead zone: reported as zero, not plotted on a log axis
+    assert!(r.stdout.contains("0.3 alpha: all zero"), "{}", r.stdout);
+    assert!(!out.join("actuator_frf_modulus_0.3alpha.svg").exists());
+    let csv = std::fs::read_to_string(out.join("actuator_frf.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 2 * 4);
+    // no damper files for the actuator target
+    assert!(!out.join("damper_frf.csv").exists());
+}
+
+const E1_FILES: [&str; 6] = [
+    "wheel_rail_table.csv",
+    "contact_detail.csv",
+    "conicity.csv",
+    "delta_r.svg",
+    "tan_gamma.svg",
+    "conicity.svg",
+];
+
+#[test]
+fn contact_geometry_defaults_to_e1() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("cg");
+    let r = master(&["contact-geometry", "--out", out.to_str().unwrap()]);
+    assert!(r.ok, "{}\n{}", r.stdout, r.stderr);
+    check_files(&out, &E1_FILES);
+    let table = std::fs::read_to_string(out.join("wheel_rail_table.csv")).unwrap();
+    assert_eq!(table.lines().next().unwrap(), wheel_rail::BOGIE_CSV_HEADER);
+    assert_eq!(table.lines().count(), 1 + 401); // -10..10 mm every 0.05 mm
+    for a in [1, 3, 5, 7] {
+        let c = number_after(&r.stdout, &format!("tan gamma_e at {a} mm:"));
+        assert!(c > 0.0 && c < 1.0, "{a} mm: {c}");
+    }
+    let c3 = number_after(&r.stdout, "tan gamma_e at 3 mm:");
+    assert!((0.15..=0.25).contains(&c3), "conicity at 3 mm: {c3}");
+}
+
+#[test]
+fn contact_geometry_from_files_matches_the_built_in_case() {
+    let d = tempfile::tempdir().unwrap();
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../wheel-rail/data");
+    let wheel = data.join("RUIC519A.dat");
+    let rail = data.join("SUIC519A.dat");
+    let out = d.path().join("cg");
+    let r = master(&[
+        "contact-geometry",
+        "--wheel",
+        wheel.to_str().unwrap(),
+        "--rail",
+        rail.to_str().unwrap(),
+        "--wheel-right",
+        wheel.to_str().unwrap(),
+        "--rail-right",
+        rail.to_str().unwrap(),
+        "--gauge",
+        "1435.16",
+        "--inclination",
+        "0",
+        "--radius",
+        "460",
+        "--radius-right",
+        "460",
+        "--y-max",
+        "8",
+        "--step",
+        "0.1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}\n{}", r.stdout, r.stderr);
+    check_files(&out, &E1_FILES);
+    assert!(r.stdout.contains("RUIC519A.dat"));
+    let c3 = number_after(&r.stdout, "tan gamma_e at 3 mm:");
+    assert!((0.15..=0.25).contains(&c3), "conicity at 3 mm: {c3}");
+}
+
+#[test]
+fn malformed_profile_fails_with_file_and_line_and_writes_nothing() {
+    let d = tempfile::tempdir().unwrap();
+    let good = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../wheel-rail/data/SUIC519A.dat"),
+    )
+    .unwrap();
+    let mut lines: Vec<&str> = good.lines().collect();
+    lines[4] = "-32.2 oops";
+    let bad = d.path().join("bad_rail.dat");
+    std::fs::write(&bad, lines.join("\n")).unwrap();
+    let out = d.path().join("cg");
+    let r = master(&[
+        "contact-geometry",
+        "--rail",
+        bad.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!r.ok, "{}", r.stdout);
+    let want = format!("{}:5:", bad.display());
+    assert!(
+        r.stderr.contains(&want),
+        "expected '{want}' in: {}",
+        r.stderr
+    );
+    assert!(!out.exists(), "output folder created despite the error");
+    // an existing output folder stays empty
+    std::fs::create_dir(&out).unwrap();
+    let r = master(&[
+        "contact-geometry",
+        "--wheel-right",
+        bad.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!r.ok && r.stderr.contains(&want), "{}", r.stderr);
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 0);
+    // a missing file is named too
+    let missing = d.path().join("nope.dat");
+    let r = master(&[
+        "contact-geometry",
+        "--wheel",
+        missing.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!r.ok && r.stderr.contains("nope.dat"), "{}", r.stderr);
+    // a bad inclination is rejected by the argument parser
+    let r = master(&["contact-geometry", "--inclination", "steep"]);
+    assert!(!r.ok && r.stderr.contains("steep"), "{}", r.stderr);
+}
