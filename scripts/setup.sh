@@ -23,6 +23,13 @@ if [ ! -x "$VENV/bin/fmpy" ]; then
   "$VENV/bin/pip" install -q "fmpy==0.3.32" >/dev/null
 fi
 
+# pythonfmu packages a Python class as an FMU: tests/fmpy/make_pythonfmu.py builds a test FMU
+# whose binary this project did not write (tests/tests/foreign_fmus.rs, master_vs_fmpy.rs).
+if ! "$VENV/bin/python" -c "import pythonfmu" 2>/dev/null; then
+  step "installing pythonfmu into $VENV"
+  "$VENV/bin/pip" install -q "pythonfmu==0.7.0" >/dev/null
+fi
+
 package_fmus() {
   cargo run --release -q -p model-description --bin package-fmus
 }

@@ -20,8 +20,20 @@ step "fmpy: validate and simulate every FMU in dist/"
 rm -rf target/fmpy
 "$VENV/bin/python" tests/fmpy/check_fmus.py dist target/fmpy
 
+step "foreign FMUs into target/foreign: fmpy's container FMU around ours, a pythonfmu FMU"
+# Each comes with a one-instance system for the master and fmpy's results of it
+# (tests/tests/foreign_fmus.rs). The pythonfmu binary needs libpython's symbols loaded globally
+# in a non-Python host (it is not linked against libpython; LD_LIBRARY_PATH would not help):
+# the tests start a child process with LD_PRELOAD and PYTHONHOME from target/foreign/python_env.txt.
+rm -rf target/foreign
+"$VENV/bin/python" tests/fmpy/make_container.py dist target/foreign
+"$VENV/bin/python" tests/fmpy/make_pythonfmu.py target/foreign
+
 step "Rust tests (release)"
 export RAIL_FMPY_RESULTS="$PWD/target/fmpy"
+export RAIL_FOREIGN_FMUS="$PWD/target/foreign"
+# the venv's python with fmpy: tests/tests/master_vs_fmpy.rs replays master runs in fmpy
+export RAIL_PYTHON="$VENV/bin/python"
 cargo test --release --workspace
 # The glue's no-allocation test calls the exported C functions in-process (feature fmi-export).
 cargo test --release -p fmu-examples --features fmi-export
