@@ -270,3 +270,93 @@ fn malformed_profile_fails_with_file_and_line_and_writes_nothing() {
     let r = master(&["contact-geometry", "--inclination", "steep"]);
     assert!(!r.ok && r.stderr.contains("steep"), "{}", r.stderr);
 }
+
+#[test]
+fn root_locus_passive_gives_r5_r6() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("rl");
+    let r = master(&[
+        "root-locus",
+        "--from",
+        "150",
+        "--to",
+        "350",
+        "--step",
+        "10",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}\n{}", r.stdout, r.stderr);
+    check_files(
+        &out,
+        &[
+            "root_locus_eigenvalues.csv",
+            "root_locus_hunting.csv",
+            "root_locus.svg",
+            "root_locus_zoom.svg",
+            "damping_ratio.svg",
+            "hunting_frequency.svg",
+        ],
+    );
+    // same tolerances as fmu-bogie2dof's calibration test: R5 270 +- 10 km/h, R6 3-4.5 Hz
+    // (the crate documents its gap to the seed's 21 rad/s)
+    let v = number_after(&r.stdout, "linear critical speed:");
+    assert!((260.0..=280.0).contains(&v), "V_cr {v} km/h");
+    let im = number_after(&r.stdout, "hunting at onset: Im");
+    let f = number_after(&r.stdout, "rad/s, frequency");
+    assert!((3.0..=4.5).contains(&f), "hunting frequency {f} Hz");
+    assert!((im / (2.0 * std::f64::consts::PI) - f).abs() < 0.01);
+    // every speed has all its eigenvalues (5 with the Maxwell damper), 21 speeds
+    let csv = std::fs::read_to_string(out.join("root_locus_eigenvalues.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 21 * 5);
+    // the hunting mode changes sign of its real part across the critical speed
+    let hunting_re = |speed: f64| {
+        rows.iter()
+            .find(|r| r[0] == speed && r[6] == 1.0)
+            .map(|r| r[2])
+            .unwrap()
+    };
+    assert!(hunting_re(250.0) < 0.0 && hunting_re(290.0) > 0.0);
+}
+
+#[test]
+fn root_locus_damper_options() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("rl");
+    let run = |damper: &str| {
+        master(&[
+            "root-locus",
+            "--from",
+            "100",
+            "--to",
+            "300",
+            "--step",
+            "50",
+            "--damper",
+            damper,
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    let none = run("none");
+    assert!(none.ok, "{}", none.stderr);
+    let viscous = run("viscous:120k");
+    assert!(viscous.ok, "{}", viscous.stderr);
+    // yaw damping raises the critical speed
+    let v_none = number_after(&none.stdout, "linear critical speed:");
+    let v_visc = number_after(&viscous.stdout, "linear critical speed:");
+    assert!(v_visc > v_none + 20.0, "{v_none} vs {v_visc}");
+    let bad = run("hydraulic");
+    assert!(
+        !bad.ok && bad.stderr.contains("hydraulic"),
+        "{}",
+        bad.stderr
+    );
+    let r = master(&["root-locus", "--from", "300", "--to", "200"]);
+    assert!(!r.ok && r.stderr.contains("--to"), "{}", r.stderr);
+}

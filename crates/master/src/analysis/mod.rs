@@ -51,6 +51,21 @@ pub enum AnalysisError {
     Plot(#[from] PlotError),
 }
 
+/// Prints a command's summary and the list of written files to stdout. A closed stdout
+/// (`master ... | head`) is not an error: the files are already written.
+pub fn print_report(summary: &str, files: &Artefacts, dir: &Path) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let _ = write!(out, "{summary}");
+    let _ = writeln!(
+        out,
+        "wrote {} files to {}: {}",
+        files.files.len(),
+        dir.display(),
+        files.names().join(", ")
+    );
+}
+
 /// Returns [`AnalysisError::Cancelled`] once `cancel` is set (Ctrl-C).
 pub fn check_cancel(cancel: &std::sync::atomic::AtomicBool) -> Result<(), AnalysisError> {
     if cancel.load(std::sync::atomic::Ordering::SeqCst) {

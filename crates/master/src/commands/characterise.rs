@@ -10,7 +10,7 @@ use super::{CommandError, Context};
 use crate::analysis::damper::{
     characterise_actuator, characterise_damper, ActuatorOptions, DamperOptions,
 };
-use crate::analysis::{AnalysisError, Artefacts};
+use crate::analysis::{print_report, AnalysisError, Artefacts};
 
 /// Which model to characterise.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -25,20 +25,17 @@ pub enum Target {
     All,
 }
 
-/// Characterise the yaw dampers. Writes CSVs and SVG figures into --out and prints the R1
-/// peak-force table and the R3 eigenfrequency next to the seed's values.
-///
-/// Files (damper): damper_hysteresis.csv, damper_hysteresis_<A>mm_force_displacement.svg,
-/// damper_hysteresis_<A>mm_force_velocity.svg, damper_peak_forces.csv, damper_frf.csv,
-/// damper_frf_{modulus,phase,k_eq,c_eq}.svg.
-/// Files (actuator): actuator_frf.csv, actuator_frf_{modulus,phase}_alpha.svg.
+/// Options of `master characterise` (the description shown by `--help` is the `after_help`).
 #[derive(Debug, clap::Args)]
+#[command(
+    after_help = "Characterise the yaw dampers. Writes CSVs and SVG figures into --out and prints the R1 peak-force table and the R3 eigenfrequency next to the seed's values.\n\nFiles (damper): damper_hysteresis.csv, damper_hysteresis_<A>mm_force_displacement.svg, damper_hysteresis_<A>mm_force_velocity.svg, damper_peak_forces.csv, damper_frf.csv, damper_frf_{modulus,phase,k_eq,c_eq}.svg. Files (actuator): actuator_frf.csv, actuator_frf_{modulus,phase}_alpha.svg."
+)]
 pub struct Args {
     /// What to characterise.
     #[arg(value_enum, default_value_t = Target::All)]
     pub target: Target,
     /// Output folder (created if needed; files are written only once everything is computed).
-    #[arg(long, default_value = "results/characterise")]
+    #[arg(long, value_name = "DIR", default_value = "results/characterise")]
     pub out: PathBuf,
     /// Number of log-spaced frequencies of the damper FRF.
     #[arg(long, default_value_t = 25)]
@@ -90,12 +87,6 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         summary.push_str(&r.summary());
     }
     files.write_all(&args.out)?;
-    print!("{summary}");
-    println!(
-        "wrote {} files to {}: {}",
-        files.files.len(),
-        args.out.display(),
-        files.names().join(", ")
-    );
+    print_report(&summary, &files, &args.out);
     Ok(())
 }

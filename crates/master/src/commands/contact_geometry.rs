@@ -7,19 +7,13 @@ use super::{CommandError, Context};
 use crate::analysis::geometry::{
     contact_geometry, parse_inclination, GeometryInputs, ProfileSource,
 };
-use crate::analysis::{check_cancel, Artefacts};
+use crate::analysis::{check_cancel, print_report, Artefacts};
 
-/// Wheel/rail contact geometry from profiles. Without options: EN 15302 case E1 (wheel A,
-/// rail A, 920 mm wheels, gauge 1435.16 mm) with the built-in benchmark profiles.
-///
-/// Profile files: two numbers per line, lateral and vertical in mm (whitespace, comma or
-/// semicolon separated), '#' comments, optional header line; lateral positive towards the
-/// field side (flange at negative values), vertical up, wheel origin on the nominal rolling
-/// circle. A bad file stops the command with file:line and writes nothing.
-///
-/// Files: wheel_rail_table.csv (the bogie model's contact table format), contact_detail.csv,
-/// conicity.csv (1-7 mm), delta_r.svg, tan_gamma.svg, conicity.svg.
+/// Options of `master contact-geometry` (the description shown by `--help` is the `after_help`).
 #[derive(Debug, clap::Args)]
+#[command(
+    after_help = "Wheel/rail contact geometry from profiles. Without options: EN 15302 case E1 (wheel A, rail A, 920 mm wheels, gauge 1435.16 mm) with the built-in benchmark profiles.\n\nProfile files: two numbers per line, lateral and vertical in mm (whitespace, comma or semicolon separated), '#' comments, optional header line; lateral positive towards the field side (flange at negative values), vertical up, wheel origin on the nominal rolling circle. A bad file stops the command with file:line and writes nothing.\n\nFiles: wheel_rail_table.csv (the bogie model's contact table format), contact_detail.csv, conicity.csv (1-7 mm), delta_r.svg, tan_gamma.svg, conicity.svg."
+)]
 pub struct Args {
     /// Wheel profile (both sides unless --wheel-right) [default: built-in EN 15302 wheel A].
     #[arg(long, value_name = "FILE")]
@@ -53,7 +47,7 @@ pub struct Args {
     #[arg(long, value_name = "MM", default_value_t = 0.05)]
     pub step: f64,
     /// Output folder (created if needed; files are written only once everything is computed).
-    #[arg(long, default_value = "results/contact-geometry")]
+    #[arg(long, value_name = "DIR", default_value = "results/contact-geometry")]
     pub out: PathBuf,
 }
 
@@ -81,12 +75,6 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     let mut files = Artefacts::default();
     r.add_artefacts(&mut files).map_err(failed)?;
     files.write_all(&args.out)?;
-    print!("{}", r.summary());
-    println!(
-        "wrote {} files to {}: {}",
-        files.files.len(),
-        args.out.display(),
-        files.names().join(", ")
-    );
+    print_report(&r.summary(), &files, &args.out);
     Ok(())
 }
