@@ -4,7 +4,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use fmu_examples::{MassSpring, __fmi2_exports as fmi};
+use fmu_examples::{__fmi2_exports as fmi, MassSpring};
 use model_description::capi::ffi;
 use model_description::{Diagnostics, FmuModel, InstanceContext};
 

@@ -51,7 +51,8 @@ fn communication_step_path_does_not_allocate() {
         assert_eq!(fmi::fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), 0);
         assert_eq!(fmi::fmi2EnterInitializationMode(c), 0);
         assert_eq!(fmi::fmi2ExitInitializationMode(c), 0);
-        let force_vr = [model_description::value_reference::<fmu_examples::MassSpring>("force").unwrap()];
+        let force_vr =
+            [model_description::value_reference::<fmu_examples::MassSpring>("force").unwrap()];
         let out_vr = [
             model_description::value_reference::<fmu_examples::MassSpring>("position").unwrap(),
             model_description::value_reference::<fmu_examples::MassSpring>("velocity").unwrap(),
