@@ -29,4 +29,5 @@ pub mod plot;
 pub mod runset;
 pub mod signal;
 pub mod slave;
+pub mod study;
 pub mod system;

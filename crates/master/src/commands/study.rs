@@ -1,10 +1,105 @@
-//! `master study` (being written).
+//! `master study [--fmus DIR] [--out DIR] [--quick] [--jobs N]`: the stability study
+//! (see [`crate::study`]): speed sweep per configuration, critical speeds, perturbation runs,
+//! c_v sensitivity, time histories; REPORT.md, SVG plots and CSVs under `--out`.
+
+use std::path::PathBuf;
+use std::time::Instant;
 
 use super::{CommandError, Context};
+use crate::study::{
+    run_study, write_outputs, Sources, StudyError, StudyOptions, StudySettings, Timing,
+};
 
+/// Run the stability study and write REPORT.md, plots and CSVs.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Folder with the FMUs (Bogie2Dof.fmu, SemiActiveDamper.fmu, ...).
+    #[arg(long)]
+    pub fmus: Option<PathBuf>,
+    /// Output folder.
+    #[arg(long, default_value = "results")]
+    pub out: PathBuf,
+    /// Reduced study for CI: 5 speeds, 1 seed, shorter runs, bisection to 10 km/h only.
+    #[arg(long)]
+    pub quick: bool,
+    /// Number of parallel runs (default: all cores).
+    #[arg(short, long)]
+    pub jobs: Option<usize>,
+    /// Folder with <configuration>.json system descriptions to use instead of the built-in
+    /// copies of systems/*.json.
+    #[arg(long)]
+    pub systems: Option<PathBuf>,
+}
 
-pub fn execute(_args: &Args, _ctx: &Context) -> Result<(), CommandError> {
-    Err(CommandError::Failed("not implemented yet".into()))
+impl From<StudyError> for CommandError {
+    fn from(e: StudyError) -> Self {
+        match e {
+            StudyError::System(e) => CommandError::System(e),
+            StudyError::Sweep(e) => CommandError::Sweep(e),
+            StudyError::Output(e) => CommandError::Output(e),
+            StudyError::Plot(e) => CommandError::Plot(e),
+            other => CommandError::Failed(other.to_string()),
+        }
+    }
+}
+
+pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
+    let start = Instant::now();
+    // Hundreds of runs: FMU warnings (e.g. an IDF spool command at its clamp) would drown the
+    // progress bar. At the default level (info) only errors are shown; --log-level warn or
+    // lower keeps them.
+    if log::max_level() == log::LevelFilter::Info {
+        log::set_max_level(log::LevelFilter::Error);
+    }
+    let settings = if args.quick {
+        StudySettings::quick()
+    } else {
+        StudySettings::full()
+    };
+    let threads = args
+        .jobs
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+        .max(1);
+    let opts = StudyOptions {
+        sources: Sources {
+            fmus: args
+                .fmus
+                .clone()
+                .unwrap_or_else(crate::study::run::default_fmu_dir),
+            systems: args.systems.clone(),
+        },
+        out: args.out.clone(),
+        threads,
+        progress: ctx.progress,
+        cancel: ctx.cancel,
+    };
+    eprintln!(
+        "study ({}): {} runs before bisection on {threads} threads, output in {}",
+        if args.quick { "quick" } else { "full" },
+        settings.planned_runs(),
+        args.out.display()
+    );
+    let results = run_study(&settings, &opts)?;
+    let timing = Timing {
+        wall_s: start.elapsed().as_secs_f64(),
+        threads,
+    };
+    write_outputs(&results, &args.out, &timing)?;
+    for c in &results.configs {
+        println!(
+            "{:<36} critical speed {}",
+            c.label,
+            c.critical.map_or("n/a".into(), |k| k.describe())
+        );
+    }
+    println!(
+        "{} runs ({} failed), {:.0} s simulated in {:.1} s wall time: {:.1} simulated s per wall s; report: {}",
+        results.runs,
+        results.failures.len(),
+        results.simulated_s,
+        timing.wall_s,
+        timing.sim_per_wall(&results),
+        args.out.join("REPORT.md").display()
+    );
+    Ok(())
 }

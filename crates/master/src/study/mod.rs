@@ -1,0 +1,25 @@
+//! The stability study of the seed's chapter 4 (issue 7): passive, semi-active (MPPT1/2,
+//! sky-hook on/off and continuous, each with an ideal and a slow valve) and full-active (IDF)
+//! yaw dampers on the non-linear 2-dof bogie, assessed by the EN 14363 rms criterion.
+//!
+//! * [`config`]: the configurations (system descriptions in `systems/*.json`) and run requests.
+//! * [`settings`]: the full and the `--quick` study.
+//! * [`metrics`]: numbers of one run (EN 14363 rms, oscillation amplitude, peak force...).
+//! * [`critical`]: critical speed from an rms curve, bisection.
+//! * [`run`]: runs the batches through [`crate::runset`] (parallel, one folder per run).
+//! * [`report`]: CSVs, SVG charts and REPORT.md.
+//!
+//! From a test: `run_study(&StudySettings::quick(), &opts)` gives [`run::StudyResults`].
+
+pub mod config;
+pub mod critical;
+pub mod metrics;
+pub mod report;
+pub mod run;
+pub mod settings;
+
+pub use config::{Configuration, Sources, CONFIGURATIONS};
+pub use critical::Critical;
+pub use report::{write_outputs, Timing};
+pub use run::{run_study, StudyError, StudyOptions, StudyResults};
+pub use settings::StudySettings;

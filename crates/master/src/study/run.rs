@@ -1,0 +1,561 @@
+//! Running the study: every batch of runs goes through the master's run sets
+//! ([`crate::runset::execute`]: parallel on a rayon pool, one folder per run with
+//! system.json / results.csv / summary.json, failures kept), the numbers of each run are
+//! computed from its full-rate output inside the worker, and the stored results.csv is
+//! decimated to [`StudySettings::stored_rate_hz`].
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
+
+use serde_json::Value;
+
+use crate::coupling::SimOutput;
+use crate::en14363::acceleration_limit;
+use crate::runset::{execute, run_job_fmu, Job, SweepError};
+use crate::study::config::{
+    configuration, required_fmus, var, Configuration, Family, RunRequest, Sources,
+};
+use crate::study::critical::{Critical, CurvePoint};
+use crate::study::metrics::{decimate, run_metrics, MetricSpec, RunMetrics, BOGIE_MASS_T};
+use crate::study::settings::StudySettings;
+use crate::system::SystemError;
+
+/// Why the study stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    #[error("unknown configuration '{0}'")]
+    UnknownConfiguration(String),
+    #[error("FMU '{path}' not found: {hint}")]
+    MissingFmu { path: PathBuf, hint: String },
+    #[error(transparent)]
+    System(#[from] SystemError),
+    #[error(transparent)]
+    Sweep(#[from] SweepError),
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    #[error(transparent)]
+    Plot(#[from] crate::plot::PlotError),
+    #[error("cancelled")]
+    Cancelled,
+}
+
+/// How to run.
+pub struct StudyOptions<'a> {
+    pub sources: Sources,
+    /// Output folder (runs go to `<out>/runs/<batch>/<run>/`).
+    pub out: PathBuf,
+    pub threads: usize,
+    pub progress: bool,
+    pub cancel: &'a AtomicBool,
+}
+
+/// rms of one speed of one configuration.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SpeedPoint {
+    pub speed_kmh: f64,
+    /// EN 14363 rms per seed (max over the wheelsets), `None` for a failed run.
+    pub per_seed: Vec<Option<f64>>,
+}
+
+impl SpeedPoint {
+    /// Max over seeds; `None` if any run failed.
+    pub fn rms(&self) -> Option<f64> {
+        self.per_seed
+            .iter()
+            .try_fold(0.0f64, |m, r| r.map(|r| m.max(r)))
+    }
+}
+
+/// The sweep result of one configuration.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ConfigResult {
+    pub id: &'static str,
+    pub label: &'static str,
+    pub seed_value: &'static str,
+    pub reference: &'static str,
+    /// Sweep points (sorted by speed).
+    pub sweep: Vec<SpeedPoint>,
+    /// Bisection points in the order run.
+    pub bisection: Vec<SpeedPoint>,
+    pub critical: Option<Critical>,
+}
+
+impl ConfigResult {
+    pub fn curve(&self) -> Vec<CurvePoint> {
+        let mut v: Vec<CurvePoint> = self
+            .sweep
+            .iter()
+            .chain(&self.bisection)
+            .map(|p| CurvePoint {
+                speed_kmh: p.speed_kmh,
+                rms: p.rms(),
+            })
+            .collect();
+        v.sort_by(|a, b| a.speed_kmh.total_cmp(&b.speed_kmh));
+        v
+    }
+    /// rms at a sweep speed (max over seeds).
+    pub fn rms_at(&self, speed_kmh: f64) -> Option<f64> {
+        self.sweep
+            .iter()
+            .chain(&self.bisection)
+            .find(|p| (p.speed_kmh - speed_kmh).abs() < 1e-6)
+            .and_then(SpeedPoint::rms)
+    }
+}
+
+/// One named single run (perturbation, c_v, scenario).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct NamedRun {
+    pub name: String,
+    pub config: &'static str,
+    pub speed_kmh: f64,
+    /// c_v [N s/m] for the sensitivity runs.
+    pub c_v_nspm: Option<f64>,
+    pub metrics: Option<RunMetrics>,
+    pub error: Option<String>,
+}
+
+/// Everything the report and the tests need.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct StudyResults {
+    pub settings: StudySettings,
+    pub limit_mps2: f64,
+    pub configs: Vec<ConfigResult>,
+    pub perturbation: Vec<NamedRun>,
+    pub cv: Vec<NamedRun>,
+    /// history-*, mpptlow-*, hil-* runs by name.
+    pub scenarios: Vec<NamedRun>,
+    /// (run, error) of every failed run.
+    pub failures: Vec<(String, String)>,
+    pub runs: usize,
+    pub simulated_s: f64,
+    /// Sum of the runs' own wall times (CPU-side effort) [s].
+    pub run_wall_s: f64,
+    /// Stored (decimated) outputs of the runs the plots need, by run name.
+    #[serde(skip)]
+    pub kept: BTreeMap<String, SimOutput>,
+}
+
+impl StudyResults {
+    pub fn config(&self, id: &str) -> Option<&ConfigResult> {
+        self.configs.iter().find(|c| c.id == id)
+    }
+    pub fn scenario(&self, name: &str) -> Option<&NamedRun> {
+        self.scenarios.iter().find(|r| r.name == name)
+    }
+}
+
+/// What one request is for.
+#[derive(Debug, Clone)]
+struct Planned {
+    request: RunRequest,
+    keep: bool,
+}
+
+/// Per-run outcome collected from the workers.
+#[derive(Debug, Default)]
+struct Collected {
+    metrics: BTreeMap<String, Result<RunMetrics, String>>,
+    kept: BTreeMap<String, SimOutput>,
+    simulated_s: f64,
+    run_wall_s: f64,
+    runs: usize,
+}
+
+struct Executor<'a> {
+    settings: &'a StudySettings,
+    opts: &'a StudyOptions<'a>,
+    collected: Collected,
+}
+
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+impl Executor<'_> {
+    /// Runs one batch in `<out>/runs/<batch>` and collects its numbers.
+    fn run_batch(&mut self, batch: &str, planned: Vec<Planned>) -> Result<(), StudyError> {
+        if planned.is_empty() {
+            return Ok(());
+        }
+        let mut jobs: Vec<Job> = Vec::with_capacity(planned.len());
+        let mut specs: HashMap<String, (MetricSpec, bool)> = HashMap::new();
+        for p in &planned {
+            jobs.push(p.request.job(&self.opts.sources)?);
+            specs.insert(
+                p.request.name.clone(),
+                (
+                    MetricSpec {
+                        skip_s: self.settings.skip_s,
+                        tail_s: self.settings.tail_s,
+                        speed_kmh: p.request.speed_kmh,
+                    },
+                    p.keep,
+                ),
+            );
+        }
+        // longest runs first: the pool's tail is then short
+        jobs.sort_by(|a, b| {
+            let cost = |j: &Job| {
+                (j.system.stop_time - j.system.start_time) * j.system.instances.len() as f64
+            };
+            cost(b).total_cmp(&cost(a))
+        });
+        let metrics: Mutex<BTreeMap<String, Result<RunMetrics, String>>> =
+            Mutex::new(BTreeMap::new());
+        let kept: Mutex<BTreeMap<String, SimOutput>> = Mutex::new(BTreeMap::new());
+        let cancel = self.opts.cancel;
+        let rate = self.settings.stored_rate_hz;
+        let runner = |job: &Job| -> Result<SimOutput, String> {
+            let out = run_job_fmu(job, cancel)?;
+            let Some((spec, keep)) = specs.get(&job.name) else {
+                return Err(format!("internal: no metric spec for run '{}'", job.name));
+            };
+            let m = run_metrics(&out, spec).map_err(|e| e.to_string());
+            lock(&metrics).insert(job.name.clone(), m);
+            let factor = crate::study::metrics::sample_rate(&out)
+                .map_or(1, |fs| (fs / rate).round().max(1.0) as usize);
+            let small = decimate(&out, factor);
+            if *keep {
+                lock(&kept).insert(job.name.clone(), small.clone());
+            }
+            Ok(small)
+        };
+        let dir = self.opts.out.join("runs").join(batch);
+        let reports = execute(&jobs, &dir, self.opts.threads, self.opts.progress, runner)?;
+        if cancel.load(Ordering::SeqCst) {
+            return Err(StudyError::Cancelled);
+        }
+        let mut metrics = metrics
+            .into_inner()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        for r in reports {
+            self.collected.runs += 1;
+            if let Some(s) = &r.summary {
+                self.collected.simulated_s += s.simulated_time_s;
+                self.collected.run_wall_s += s.wall_time_s;
+            }
+            let m = match (r.ok, metrics.remove(&r.name)) {
+                (true, Some(m)) => m,
+                (true, None) => Err("internal: run gave no metrics".to_string()),
+                (false, Some(Err(e))) => Err(e),
+                (false, _) => Err(r.error.unwrap_or_else(|| "run failed".to_string())),
+            };
+            self.collected.metrics.insert(r.name, m);
+        }
+        self.collected.kept.extend(
+            kept.into_inner()
+                .unwrap_or_else(std::sync::PoisonError::into_inner),
+        );
+        Ok(())
+    }
+
+    fn metric(&self, name: &str) -> Option<&Result<RunMetrics, String>> {
+        self.collected.metrics.get(name)
+    }
+
+    fn named(&self, req: &RunRequest, c_v: Option<f64>) -> NamedRun {
+        let (metrics, error) = match self.metric(&req.name) {
+            Some(Ok(m)) => (Some(m.clone()), None),
+            Some(Err(e)) => (None, Some(e.clone())),
+            None => (None, Some("not run".to_string())),
+        };
+        NamedRun {
+            name: req.name.clone(),
+            config: req.config.id,
+            speed_kmh: req.speed_kmh,
+            c_v_nspm: c_v,
+            metrics,
+            error,
+        }
+    }
+
+    fn speed_point(&self, c: &'static Configuration, speed: f64, prefix: &str) -> SpeedPoint {
+        let per_seed = self
+            .settings
+            .seeds
+            .iter()
+            .map(|&s| {
+                let name = sweep_request(prefix, c, speed, s, self.settings).name;
+                self.metric(&name)
+                    .and_then(|m| m.as_ref().ok())
+                    .map(RunMetrics::rms)
+            })
+            .collect();
+        SpeedPoint {
+            speed_kmh: speed,
+            per_seed,
+        }
+    }
+}
+
+fn sweep_request(
+    prefix: &str,
+    c: &'static Configuration,
+    speed: f64,
+    seed: u32,
+    s: &StudySettings,
+) -> RunRequest {
+    RunRequest::new(prefix, c, speed, Some(seed), s.sweep_stop_s)
+}
+
+fn config_or_err(id: &str) -> Result<&'static Configuration, StudyError> {
+    configuration(id).ok_or_else(|| StudyError::UnknownConfiguration(id.to_string()))
+}
+
+/// Names of the scenario runs (also used by the report and the tests).
+pub mod scenario {
+    /// Time histories at the history speed (Figs. 4.18, 4.21, 4.25).
+    pub fn history(id: &str) -> String {
+        format!("history-{id}")
+    }
+    /// MPPT from a closed valve at a low speed (Fig. 4.16, R10).
+    pub fn mppt_low(id: &str) -> String {
+        format!("mpptlow-{id}")
+    }
+    /// HIL-like runs at 260 km/h, ideal track, initial perturbation (Figs. 5.19-5.24, R12).
+    pub fn hil(id: &str) -> String {
+        format!("hil-{id}")
+    }
+}
+
+/// Configurations of the time-history comparison (Figs. 4.18/4.21/4.25).
+pub const HISTORY_CONFIGS: &[&str] = &["passive", "mppt2", "skyhook_onoff", "full_active"];
+/// Configurations of the HIL-like runs.
+pub const HIL_CONFIGS: &[&str] = &[
+    "mppt1_slow",
+    "mppt2_slow",
+    "skyhook_onoff_slow",
+    "skyhook_continuous_slow",
+    "skyhook_onoff",
+];
+
+fn is_mppt(c: &Configuration) -> bool {
+    matches!(c.family, Family::Mppt1 | Family::Mppt2)
+}
+
+fn with_initial_command(r: RunRequest, c: &Configuration, v: f64) -> RunRequest {
+    if is_mppt(c) {
+        r.with(var::MPPT_INITIAL_LEFT, Value::from(v))
+            .with(var::MPPT_INITIAL_RIGHT, Value::from(v))
+    } else {
+        r
+    }
+}
+
+/// Checks that every FMU the configurations need is there; names the first missing one.
+pub fn check_fmus(sources: &Sources, configs: &[&Configuration]) -> Result<(), StudyError> {
+    for name in required_fmus(configs) {
+        let p = sources.fmus.join(&name);
+        if !p.is_file() {
+            return Err(StudyError::MissingFmu {
+                path: p,
+                hint: "build the FMUs first: cargo run --release -p model-description --bin package-fmus (writes dist/), or pass --fmus DIR".into(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Runs the whole study (sweep, bisection, perturbation, c_v, scenarios).
+pub fn run_study(
+    settings: &StudySettings,
+    opts: &StudyOptions<'_>,
+) -> Result<StudyResults, StudyError> {
+    let configs: Vec<&'static Configuration> = settings
+        .configurations
+        .iter()
+        .map(|id| config_or_err(id))
+        .collect::<Result<_, _>>()?;
+    let mut needed = configs.clone();
+    for id in ["passive", "full_active", "mppt1", "mppt2"]
+        .iter()
+        .chain(HISTORY_CONFIGS)
+        .chain(HIL_CONFIGS)
+    {
+        let c = config_or_err(id)?;
+        if !needed.contains(&c) {
+            needed.push(c);
+        }
+    }
+    check_fmus(&opts.sources, &needed)?;
+    let s = settings;
+    let first_seed = s.seeds.first().copied().unwrap_or(1);
+    let mut ex = Executor {
+        settings,
+        opts,
+        collected: Collected::default(),
+    };
+
+    // ---- main batch: sweep, perturbation, c_v, scenarios
+    let mut planned = Vec::new();
+    for c in &configs {
+        for &v in &s.speeds_kmh {
+            for &seed in &s.seeds {
+                planned.push(Planned {
+                    request: sweep_request("sweep-", c, v, seed, s),
+                    keep: false,
+                });
+            }
+        }
+    }
+    let passive = config_or_err("passive")?;
+    let perturbation: Vec<RunRequest> = s
+        .perturbation_speeds_kmh
+        .iter()
+        .map(|&v| {
+            RunRequest::new("perturbation-", passive, v, None, s.perturbation_stop_s)
+                .with(var::INITIAL_LATERAL, Value::from(s.perturbation_lateral_m))
+        })
+        .collect();
+    let full = config_or_err("full_active")?;
+    let cv: Vec<(RunRequest, f64)> = s
+        .cv_values_nspm
+        .iter()
+        .map(|&c_v| {
+            let r = RunRequest::new("cv-", full, s.cv_speed_kmh, Some(first_seed), s.cv_stop_s)
+                .named(&format!("cv-{:.0}", c_v / 1e3))
+                .with(var::CV_LEFT, Value::from(c_v))
+                .with(var::CV_RIGHT, Value::from(c_v));
+            (r, c_v)
+        })
+        .collect();
+    let mut scenarios: Vec<RunRequest> = Vec::new();
+    for id in HISTORY_CONFIGS {
+        let c = config_or_err(id)?;
+        let r = RunRequest::new(
+            "",
+            c,
+            s.history_speed_kmh,
+            Some(first_seed),
+            s.scenario_stop_s,
+        )
+        .named(&scenario::history(id));
+        // Fig. 4.18 starts the MPPT from the maximum command (fully open)
+        scenarios.push(with_initial_command(r, c, 10.0));
+    }
+    for id in ["mppt1", "mppt2"] {
+        let c = config_or_err(id)?;
+        let r = RunRequest::new(
+            "",
+            c,
+            s.mppt_low_speed_kmh,
+            Some(first_seed),
+            s.scenario_stop_s,
+        )
+        .named(&scenario::mppt_low(id));
+        scenarios.push(with_initial_command(r, c, 0.0));
+    }
+    for id in HIL_CONFIGS {
+        // ideal track + initial perturbation: the final amplitude is then the hunting motion
+        // alone (on the irregular track a stable bogie still moves 3-4 mm relative to the rails)
+        let c = config_or_err(id)?;
+        let r = RunRequest::new("", c, s.hil_speed_kmh, None, s.scenario_stop_s)
+            .named(&scenario::hil(id))
+            .with(var::INITIAL_LATERAL, Value::from(s.perturbation_lateral_m));
+        scenarios.push(with_initial_command(r, c, s.hil_initial_command_v));
+    }
+    for r in perturbation
+        .iter()
+        .chain(cv.iter().map(|(r, _)| r))
+        .chain(&scenarios)
+    {
+        planned.push(Planned {
+            request: r.clone(),
+            keep: true,
+        });
+    }
+    ex.run_batch("main", planned)?;
+
+    let limit = acceleration_limit(BOGIE_MASS_T);
+    let mut results: Vec<ConfigResult> = configs
+        .iter()
+        .map(|c| {
+            let sweep: Vec<SpeedPoint> = s
+                .speeds_kmh
+                .iter()
+                .map(|&v| ex.speed_point(c, v, "sweep-"))
+                .collect();
+            let mut r = ConfigResult {
+                id: c.id,
+                label: c.label,
+                seed_value: c.seed_value,
+                reference: c.reference,
+                sweep,
+                bisection: Vec::new(),
+                critical: None,
+            };
+            r.critical = Critical::from_curve(&r.curve(), limit);
+            r
+        })
+        .collect();
+
+    // ---- bisection rounds (all configurations of a round in one parallel batch)
+    if let Some(tol) = s.bisection_tol_kmh {
+        for round in 1.. {
+            let mut todo: Vec<(usize, f64)> = Vec::new();
+            for (i, r) in results.iter().enumerate() {
+                if let Some(m) = r.critical.and_then(|k| k.midpoint(tol)) {
+                    todo.push((i, m));
+                }
+            }
+            if todo.is_empty() {
+                break;
+            }
+            let prefix = format!("bisect{round}-");
+            let mut planned = Vec::new();
+            for &(i, v) in &todo {
+                for &seed in &s.seeds {
+                    planned.push(Planned {
+                        request: sweep_request(&prefix, configs[i], v, seed, s),
+                        keep: false,
+                    });
+                }
+            }
+            ex.run_batch(&format!("bisect-{round}"), planned)?;
+            for (i, v) in todo {
+                let p = ex.speed_point(configs[i], v, &prefix);
+                let unstable = !matches!(p.rms(), Some(v) if v <= limit);
+                let r = &mut results[i];
+                r.critical = r.critical.map(|k| k.refine(v, unstable));
+                r.bisection.push(p);
+            }
+        }
+    }
+
+    let perturbation = perturbation.iter().map(|r| ex.named(r, None)).collect();
+    let cv = cv.iter().map(|(r, c)| ex.named(r, Some(*c))).collect();
+    let scenarios = scenarios.iter().map(|r| ex.named(r, None)).collect();
+    let failures = ex
+        .collected
+        .metrics
+        .iter()
+        .filter_map(|(n, m)| m.as_ref().err().map(|e| (n.clone(), e.clone())))
+        .collect();
+    Ok(StudyResults {
+        settings: s.clone(),
+        limit_mps2: limit,
+        configs: results,
+        perturbation,
+        cv,
+        scenarios,
+        failures,
+        runs: ex.collected.runs,
+        simulated_s: ex.collected.simulated_s,
+        run_wall_s: ex.collected.run_wall_s,
+        kept: std::mem::take(&mut ex.collected.kept),
+    })
+}
+
+/// Default FMU folder: `dist/` next to the current folder's workspace, else `dist`.
+pub fn default_fmu_dir() -> PathBuf {
+    let ws = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../dist");
+    if Path::new("dist").is_dir() || !ws.is_dir() {
+        PathBuf::from("dist")
+    } else {
+        ws
+    }
+}

@@ -1,0 +1,122 @@
+//! What the study runs: the full default study and the reduced `--quick` one.
+
+use crate::study::config::CONFIGURATIONS;
+
+/// Everything that sizes the study.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct StudySettings {
+    /// Configuration ids (see [`crate::study::config::CONFIGURATIONS`]).
+    pub configurations: Vec<&'static str>,
+    /// Speeds of the rms sweep [km/h].
+    pub speeds_kmh: Vec<f64>,
+    /// Track seeds of the internal ERRI B176 low-level generator.
+    pub seeds: Vec<u32>,
+    /// Length of a sweep run [s].
+    pub sweep_stop_s: f64,
+    /// Start-up transient excluded from every number [s].
+    pub skip_s: f64,
+    /// Final part used for oscillation amplitudes and mean valve commands [s].
+    pub tail_s: f64,
+    /// Bisection of the critical speed down to this bracket width [km/h]; `None` = no bisection.
+    pub bisection_tol_kmh: Option<f64>,
+    /// Initial-perturbation runs of the passive vehicle (seed Figs. 5.11-5.13, R7) [km/h].
+    pub perturbation_speeds_kmh: Vec<f64>,
+    /// Initial lateral displacement of the bogie for those runs [m].
+    pub perturbation_lateral_m: f64,
+    pub perturbation_stop_s: f64,
+    /// Full-active c_v sensitivity (Table 4-3, R14): gains [N s/m], speed, run length.
+    pub cv_values_nspm: Vec<f64>,
+    pub cv_speed_kmh: f64,
+    pub cv_stop_s: f64,
+    /// Speed of the time-history comparison passive / MPPT2 / sky-hook (Figs. 4.18, 4.21).
+    pub history_speed_kmh: f64,
+    /// Speed of the MPPT1 vs MPPT2 valve-command comparison from a closed valve (Fig. 4.16).
+    pub mppt_low_speed_kmh: f64,
+    /// Speed of the slow-valve runs of the HIL chapter (Figs. 5.19-5.24, R12); ideal track,
+    /// initial lateral displacement `perturbation_lateral_m`.
+    pub hil_speed_kmh: f64,
+    /// Initial MPPT command of the HIL runs (seed: fully open valve, 80 %) [V].
+    pub hil_initial_command_v: f64,
+    /// Length of the scenario runs (histories, MPPT, HIL) [s].
+    pub scenario_stop_s: f64,
+    /// Sampling rate of the stored results.csv of every run [Hz] (the numbers are computed
+    /// from the full-rate signals before decimation).
+    pub stored_rate_hz: f64,
+}
+
+fn range(from: f64, to: f64, step: f64) -> Vec<f64> {
+    let n = ((to - from) / step).round() as usize;
+    (0..=n).map(|k| from + k as f64 * step).collect()
+}
+
+impl StudySettings {
+    /// The full study: 200-400 km/h in 10 km/h steps, 2 seeds, bisection to 2 km/h.
+    pub fn full() -> Self {
+        StudySettings {
+            configurations: CONFIGURATIONS.iter().map(|c| c.id).collect(),
+            speeds_kmh: range(200.0, 400.0, 10.0),
+            seeds: vec![1, 2],
+            // 5 s start-up + 10 s assessed: 556 m (46 windows of 100 m) at 200 km/h
+            sweep_stop_s: 15.0,
+            skip_s: 5.0,
+            tail_s: 3.0,
+            bisection_tol_kmh: Some(2.0),
+            perturbation_speeds_kmh: vec![220.0, 285.0, 320.0],
+            perturbation_lateral_m: 3e-3,
+            perturbation_stop_s: 10.0,
+            cv_values_nspm: vec![210e3, 270e3, 330e3, 390e3],
+            cv_speed_kmh: 380.0,
+            cv_stop_s: 15.0,
+            history_speed_kmh: 300.0,
+            mppt_low_speed_kmh: 220.0,
+            hil_speed_kmh: 260.0,
+            hil_initial_command_v: 8.0,
+            scenario_stop_s: 40.0,
+            stored_rate_hz: 100.0,
+        }
+    }
+
+    /// The reduced study for CI: 5 speeds (40 km/h apart), 1 seed, shorter runs, and a coarse
+    /// bisection to 10 km/h (two rounds of one run per configuration) so that the tests can
+    /// check critical speeds to +-10 km/h rather than +-40 km/h.
+    pub fn quick() -> Self {
+        StudySettings {
+            speeds_kmh: vec![240.0, 280.0, 320.0, 360.0, 400.0],
+            seeds: vec![1],
+            sweep_stop_s: 12.0,
+            bisection_tol_kmh: Some(10.0),
+            perturbation_stop_s: 8.0,
+            cv_stop_s: 12.0,
+            ..Self::full()
+        }
+    }
+
+    /// Number of runs before bisection (for the start message).
+    pub fn planned_runs(&self) -> usize {
+        self.configurations.len() * self.speeds_kmh.len() * self.seeds.len()
+            + self.perturbation_speeds_kmh.len()
+            + self.cv_values_nspm.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn full_and_quick_sizes() {
+        let f = StudySettings::full();
+        assert_eq!(f.speeds_kmh.len(), 21);
+        assert_eq!(f.speeds_kmh[0], 200.0);
+        assert_eq!(f.speeds_kmh[20], 400.0);
+        assert_eq!(f.configurations.len(), CONFIGURATIONS.len());
+        // several 100 m windows after the skip at the lowest speed
+        let assessed_m = (f.sweep_stop_s - f.skip_s) * f.speeds_kmh[0] / 3.6;
+        assert!(assessed_m >= 500.0, "{assessed_m}");
+        let q = StudySettings::quick();
+        assert!(q.planned_runs() < f.planned_runs() / 4);
+        assert!(q.bisection_tol_kmh.unwrap() > f.bisection_tol_kmh.unwrap());
+        let assessed_m = (q.sweep_stop_s - q.skip_s) * q.speeds_kmh[0] / 3.6;
+        assert!(assessed_m >= 300.0, "{assessed_m}");
+    }
+}
