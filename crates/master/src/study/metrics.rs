@@ -54,10 +54,10 @@ pub struct RunMetrics {
     pub max_displacement_m: f64,
     /// Max |damper force| after the skip, both sides [N].
     pub peak_force_n: f64,
-    /// rms of the mechanical power F v of both actuators together (the seed's "dissipated
-    /// power" of Table 4-3) [W], if recorded.
+    /// rms of the mechanical power F v per actuator (mean of both sides; the seed's
+    /// "dissipated power" of Table 4-3) [W], if recorded.
     pub rms_power_w: Option<f64>,
-    /// rms of the hydraulic supply power of both actuators together [W], if recorded.
+    /// rms of the hydraulic supply power per actuator (mean of both sides) [W], if recorded.
     pub rms_hydraulic_power_w: Option<f64>,
     /// Mean valve command over the tail (both sides) [V], if recorded.
     pub tail_command_v: Option<f64>,
@@ -151,14 +151,10 @@ pub fn run_metrics(out: &SimOutput, spec: &MetricSpec) -> Result<RunMetrics, Met
             peak_force_n = peak_force_n.max(max_abs(&f[skip..]));
         }
     }
+    // per actuator (the seed's Table 4-3 is per damper): mean of the two sides' rms
     let rms_sum = |left: &str, right: &str| match (out.column(left), out.column(right)) {
         (Some(l), Some(r)) => {
-            let s: Vec<f64> = l[skip..]
-                .iter()
-                .zip(&r[skip..])
-                .map(|(a, b)| a + b)
-                .collect();
-            Some(crate::signal::rms(&s))
+            Some((crate::signal::rms(&l[skip..]) + crate::signal::rms(&r[skip..])) / 2.0)
         }
         (Some(l), None) => Some(crate::signal::rms(&l[skip..])),
         _ => None,
