@@ -8,6 +8,9 @@
 //! Where our physics cannot reach the seed's number the measured value is pinned with a
 //! comment and the qualitative ordering is asserted instead (see REPORT.md).
 
+// test helpers outside #[test] fns: allowed like the other end-to-end test files
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::sync::OnceLock;
@@ -145,7 +148,10 @@ fn r10_mppt1_stays_closed_mppt2_reopens() {
     let c2 = scenario_metrics(&scenario::mppt_low("mppt2"))
         .tail_command_v
         .unwrap_or(f64::NAN);
-    assert!(c1 <= 1.5, "MPPT1 final command {c1} V, expected nearly closed (<= 1.5 V)");
+    assert!(
+        c1 <= 1.5,
+        "MPPT1 final command {c1} V, expected nearly closed (<= 1.5 V)"
+    );
     assert!(
         c2 >= c1 + 1.0 && c2 < 9.0,
         "MPPT2 final command {c2} V should re-open part way, above MPPT1's {c1} V"
@@ -153,7 +159,10 @@ fn r10_mppt1_stays_closed_mppt2_reopens() {
     for id in ["mppt1_slow", "mppt2_slow"] {
         let m = scenario_metrics(&scenario::hil(id));
         let c = m.tail_command_v.unwrap_or(f64::NAN);
-        assert!(c <= 2.0, "{id}: from 8 V the valve should be closed (<= 2 V), got {c} V");
+        assert!(
+            c <= 2.0,
+            "{id}: from 8 V the valve should be closed (<= 2 V), got {c} V"
+        );
     }
 }
 
@@ -189,7 +198,11 @@ fn r12_slow_valve_mppt_stabilises() {
     }
     // and the slow-valve MPPT stays above the passive vehicle in the sweep
     for id in ["mppt1_slow", "mppt2_slow"] {
-        assert!(vcr(id) > vcr("passive") + 50.0, "{id}: {}", critical(id).describe());
+        assert!(
+            vcr(id) > vcr("passive") + 50.0,
+            "{id}: {}",
+            critical(id).describe()
+        );
     }
 }
 
@@ -262,17 +275,19 @@ fn r13_full_active_stable_at_380_and_ordering() {
 #[test]
 fn r14_cv_trends() {
     let r = results();
-    let rows: Vec<(f64, f64, f64)> = r
-        .cv
-        .iter()
-        .map(|c| {
-            let m = c.metrics.as_ref().expect("c_v run failed");
-            (c.c_v_nspm.unwrap_or(0.0), m.rms(), m.peak_force_n)
-        })
-        .collect();
+    let rows: Vec<(f64, f64, f64)> =
+        r.cv.iter()
+            .map(|c| {
+                let m = c.metrics.as_ref().expect("c_v run failed");
+                (c.c_v_nspm.unwrap_or(0.0), m.rms(), m.peak_force_n)
+            })
+            .collect();
     assert_eq!(rows.len(), 4);
     let (first, last) = (rows[0], rows[3]);
-    assert!(last.1 < first.1, "rms acceleration should fall with c_v: {rows:?}");
+    assert!(
+        last.1 < first.1,
+        "rms acceleration should fall with c_v: {rows:?}"
+    );
     // mostly monotone: at most one inversion between neighbours
     let inversions = rows.windows(2).filter(|w| w[1].1 > w[0].1).count();
     assert!(inversions <= 1, "rms vs c_v: {rows:?}");
@@ -302,7 +317,10 @@ fn r7_perturbation_runs() {
     };
     let (a220, a285, a320) = (amp(220.0), amp(285.0), amp(320.0));
     assert!(a220 < 0.5e-3, "220 km/h should decay: {a220}");
-    assert!((5e-3..=7.5e-3).contains(&a320), "320 km/h: {a320} (seed +-6 mm)");
+    assert!(
+        (5e-3..=7.5e-3).contains(&a320),
+        "320 km/h: {a320} (seed +-6 mm)"
+    );
     // pinned (seed: small, no flange contact)
     assert!(
         (5.5e-3..=7.5e-3).contains(&a285),
