@@ -56,6 +56,14 @@ where
         fill(&mut w)?;
         w.flush().map_err(io_err(path))?;
     }
+    // Temporary files are created 0600; results are ordinary files others may read.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        tmp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(0o644))
+            .map_err(io_err(path))?;
+    }
     tmp.as_file().sync_all().map_err(io_err(path))?;
     tmp.persist(path).map_err(|e| OutputError::Io {
         path: path.to_path_buf(),
