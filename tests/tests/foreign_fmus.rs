@@ -160,9 +160,9 @@ fn step_not_dividing_the_stop_time_is_refused() {
 
 /// FMI 2.0 allows `canHandleMultipleSetPerTimeInstant` on any ScalarVariable (fmpy writes it on
 /// every variable of the container FMUs it builds; make_container.py leaves it out). The `fmi`
-/// crate the master loads FMUs with rejects it ("unknown field"), so such FMUs do not load.
+/// crate's parser (fmi-schema 0.8) rejects it ("unknown field"); the master strips it before
+/// handing the description over, so such FMUs load.
 #[test]
-#[ignore = "known limitation of the master's FMU loader (fmi-schema 0.8): remove the ignore when fixed"]
 fn fmu_with_can_handle_multiple_set_per_time_instant_loads() {
     let Some(dir) = foreign_dir() else { return };
     let src = dir.join("Container.fmu");

@@ -184,8 +184,7 @@ impl FmuArchive {
             instance: instance_name.to_string(),
             reason,
         };
-        let import: Fmi2Import =
-            fmi::import::from_path(&self.path).map_err(|e| load_err(e.to_string()))?;
+        let import = import_fmi2(&self.path).map_err(load_err)?;
         let instance = import
             .instantiate_cs(instance_name, false, logging_on)
             .map_err(|e| load_err(e.to_string()))?;
@@ -476,5 +475,56 @@ mod tests {
         assert!(matches!(e, FmuError::Load { .. }), "{e}");
         let e = a.instantiate("bad\0name", false).unwrap_err();
         assert!(matches!(e, FmuError::InstanceName { .. }));
+    }
+}
+
+/// Attributes that FMI 2.0 allows but fmi-schema 0.8 (behind the `fmi` crate) rejects as
+/// "unknown field"; fmpy writes the first on every variable of its container FMUs. They carry
+/// nothing the master uses, so they are removed before the `fmi` crate parses the description.
+const ATTRIBUTES_UNKNOWN_TO_FMI_SCHEMA: &[&str] = &["canHandleMultipleSetPerTimeInstant"];
+
+fn strip_attributes(xml: &str, names: &[&str]) -> String {
+    let mut out = xml.to_string();
+    for name in names {
+        let key = format!(" {name}=\"");
+        while let Some(start) = out.find(&key) {
+            let value_start = start + key.len();
+            let Some(len) = out[value_start..].find('"') else {
+                break;
+            };
+            out.replace_range(start..value_start + len + 1, "");
+        }
+    }
+    out
+}
+
+/// `fmi::import::from_path`, but with the description cleaned of attributes fmi-schema 0.8
+/// does not know (see [`ATTRIBUTES_UNKNOWN_TO_FMI_SCHEMA`]).
+fn import_fmi2(path: &Path) -> Result<Fmi2Import, String> {
+    use fmi::traits::FmiImport;
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let mut archive = zip::ZipArchive::new(file).map_err(|e| e.to_string())?;
+    let dir = tempfile::Builder::new()
+        .prefix("fmi-rs")
+        .tempdir()
+        .map_err(|e| e.to_string())?;
+    archive.extract(dir.path()).map_err(|e| e.to_string())?;
+    let xml = std::fs::read_to_string(dir.path().join("modelDescription.xml"))
+        .map_err(|e| e.to_string())?;
+    let xml = strip_attributes(&xml, ATTRIBUTES_UNKNOWN_TO_FMI_SCHEMA);
+    Fmi2Import::new(dir, &xml).map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod strip_tests {
+    use super::strip_attributes;
+
+    #[test]
+    fn removes_only_the_named_attribute() {
+        let xml = r#"<ScalarVariable canHandleMultipleSetPerTimeInstant="true" name="a" valueReference="0"/>"#;
+        assert_eq!(
+            strip_attributes(xml, &["canHandleMultipleSetPerTimeInstant"]),
+            r#"<ScalarVariable name="a" valueReference="0"/>"#
+        );
     }
 }
