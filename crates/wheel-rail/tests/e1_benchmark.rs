@@ -29,50 +29,76 @@ fn reference() -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Δr agreement with the reference for |y| <= 6 mm.
-///
-/// Both functions are staircases (the contact point jumps across nearly conformal zones of the
-/// profiles: rail R300/R80 crown vs wheel tread, rail R13 corner vs wheel flange root), and the
-/// jumps fall at slightly different y, so the pointwise error has a sawtooth. Measured: RMS
-/// 0.058 mm, 111 of 121 points within 0.1 mm, max 0.20 mm at |y| = 5.9 mm (flange-root zone).
-/// The brief asked for 0.1 mm everywhere; that is met for |y| <= 3 mm only (asserted below).
-#[test]
-fn e1_delta_r_matches_reference() {
-    let setup = e1_setup();
-    let mut errs = Vec::new();
-    for (y, dr_ref) in reference() {
-        if y.abs() > 6.0e-3 + 1e-12 {
-            continue;
-        }
-        let row = solve_contact(&setup, y).unwrap();
-        assert!(!row.beyond_flange_limit, "y = {y}");
-        errs.push((y, row.delta_r_m - dr_ref));
-    }
-    assert_eq!(errs.len(), 121);
-    let rms = (errs.iter().map(|e| e.1 * e.1).sum::<f64>() / errs.len() as f64).sqrt();
-    let within = errs.iter().filter(|e| e.1.abs() <= 0.1e-3).count();
-    let worst = errs.iter().copied().fold((0.0_f64, 0.0_f64), |a, e| {
+/// Pointwise Δr error against the reference for |y| <= 6 mm: (y, error) for each reference point.
+fn errors_up_to_6mm(setup: &ContactSetup) -> Vec<(f64, f64)> {
+    reference()
+        .into_iter()
+        .filter(|(y, _)| y.abs() <= 6.0e-3 + 1e-12)
+        .map(|(y, dr_ref)| {
+            let row = solve_contact(setup, y).unwrap();
+            assert!(!row.beyond_flange_limit, "y = {y}");
+            (y, row.delta_r_m - dr_ref)
+        })
+        .collect()
+}
+
+fn worst(errs: &[(f64, f64)]) -> (f64, f64) {
+    errs.iter().copied().fold((0.0_f64, 0.0_f64), |a, e| {
         if e.1.abs() > a.1.abs() {
             e
         } else {
             a
         }
-    });
+    })
+}
+
+/// Issue 8 criterion: every reference point with |y| <= 6 mm within 0.1 mm of the reference.
+/// Measured: RMS 0.038 mm, max 0.076 mm at |y| = 5.6 mm.
+#[test]
+fn e1_delta_r_matches_reference() {
+    let errs = errors_up_to_6mm(&e1_setup());
+    assert_eq!(errs.len(), 121);
+    let rms = (errs.iter().map(|e| e.1 * e.1).sum::<f64>() / errs.len() as f64).sqrt();
+    let within = errs.iter().filter(|e| e.1.abs() <= 0.1e-3).count();
+    let w = worst(&errs);
     println!(
         "E1 |y|<=6 mm: rms {:.4} mm, {within}/{} within 0.1 mm, max {:.4} mm at y = {:.1} mm",
         rms * 1e3,
         errs.len(),
-        worst.1 * 1e3,
-        worst.0 * 1e3
+        w.1 * 1e3,
+        w.0 * 1e3
     );
-    assert!(rms < 0.07e-3, "rms {rms}");
-    assert!(within * 10 >= errs.len() * 9, "only {within} within 0.1 mm");
-    assert!(worst.1.abs() < 0.25e-3, "max error {worst:?}");
-    // |y| <= 3 mm (tread only): every point within 0.1 mm
-    assert!(errs
-        .iter()
-        .filter(|e| e.0.abs() <= 3.0e-3 + 1e-12)
-        .all(|e| e.1.abs() <= 0.1e-3));
+    assert_eq!(within, errs.len(), "worst {w:?}");
+    assert!(rms < 0.05e-3, "rms {rms}");
+}
+
+/// The criterion does not hinge on the exact contact-zone depth: it holds from 5 to 10 µm. The
+/// bare minimum-distance point (depth 0) misses it, because the profile tables' curvature ripple
+/// makes the minimum jump across the nearly conformal zones (crate docs).
+#[test]
+fn e1_contact_zone_depth_sensitivity() {
+    for depth in [5e-6, 10e-6] {
+        let mut setup = e1_setup();
+        setup.contact_zone_depth_m = depth;
+        let w = worst(&errors_up_to_6mm(&setup));
+        println!(
+            "depth {depth:e} m: max error {:.4} mm at {:.1} mm",
+            w.1 * 1e3,
+            w.0 * 1e3
+        );
+        assert!(w.1.abs() <= 0.1e-3, "depth {depth}: {w:?}");
+    }
+    let mut setup = e1_setup();
+    setup.contact_zone_depth_m = 0.0;
+    let errs = errors_up_to_6mm(&setup);
+    let w = worst(&errs);
+    let within = errs.iter().filter(|e| e.1.abs() <= 0.1e-3).count();
+    println!(
+        "depth 0: {within}/121 within 0.1 mm, max {:.4} mm at {:.1} mm",
+        w.1 * 1e3,
+        w.0 * 1e3
+    );
+    assert!(w.1.abs() > 0.15e-3 && within < 115, "{within} {w:?}");
 }
 
 /// Sign convention: y > 0 moves the right wheel towards its flange, so Δr = r_R - r_L > 0, and
@@ -176,5 +202,16 @@ fn conicity_of_reference_delta_r() {
         let c = d.equivalent_conicity(a_mm * 1e-3).unwrap().tan_gamma_e;
         println!("reference Δr, {a_mm} mm: {c:.4} (Annex E {reference})");
         assert!((c - reference).abs() < 0.01, "{a_mm} mm: {c}");
+    }
+}
+
+/// A negative or non-finite contact-zone depth is rejected, naming the parameter.
+#[test]
+fn bad_contact_zone_depth_is_rejected() {
+    for bad in [-1e-6, f64::NAN, 1e-3] {
+        let mut setup = e1_setup();
+        setup.contact_zone_depth_m = bad;
+        let err = solve_contact(&setup, 1e-3).unwrap_err().to_string();
+        assert!(err.contains("contact_zone_depth_m"), "{err}");
     }
 }
