@@ -553,7 +553,20 @@ impl Actuator {
     }
 
     /// Advances the model by `h` seconds with inputs held constant.
+    ///
+    /// Atomic: on error (bad input, integrator failure such as
+    /// `solver.max_internal_steps` reached, non-finite state or output) the model is left
+    /// exactly as it was, so [`Self::outputs`] still returns the last (finite) outputs and
+    /// the caller may retry with a smaller step or other inputs.
     pub fn step(&mut self, h: f64, inputs: &ActuatorInputs) -> Result<ActuatorOutputs, StepError> {
+        // Plain data: the copy is a memcpy, no allocation.
+        let mut next = self.clone();
+        let out = next.advance(h, inputs)?;
+        *self = next;
+        Ok(out)
+    }
+
+    fn advance(&mut self, h: f64, inputs: &ActuatorInputs) -> Result<ActuatorOutputs, StepError> {
         if !(h.is_finite() && h > 0.0) {
             return Err(StepError::BadStepSize { h });
         }

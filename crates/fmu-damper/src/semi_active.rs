@@ -168,7 +168,17 @@ impl SemiActiveParams {
     /// Velocity function `f(v)` of (3.43), m^3/s (cubic-root shaped).
     pub fn velocity_flow(&self, v: f64) -> f64 {
         let vl = self.velocity_linear_mps;
-        self.velocity_flow_ref_m3ps * v / (self.velocity_ref_mps.cbrt() * (v * v + vl * vl).cbrt())
+        let m = v.abs().max(vl);
+        if m < SQUARE_SAFE {
+            self.velocity_flow_ref_m3ps * v
+                / (self.velocity_ref_mps.cbrt() * (v * v + vl * vl).cbrt())
+        } else {
+            // v^2 would overflow (and give f = 0): scale by m, (v^2 + vl^2)^(1/3) = m^(2/3) (..)^(1/3).
+            let (a, b) = (v / m, vl / m);
+            let c = m.cbrt();
+            self.velocity_flow_ref_m3ps
+                * (v / (c * c * self.velocity_ref_mps.cbrt() * (a * a + b * b).cbrt()))
+        }
     }
 
     /// Total orifice coefficient at opening `x` (piston + by-pass), m^3/(s Pa^0.5).
@@ -179,8 +189,20 @@ impl SemiActiveParams {
 
 /// `g(dP) = dP / (dP^2 + dP_t^2)^(1/4)`: signed square root with a laminar core.
 pub fn orifice_law(dp: f64, dp_t: f64) -> f64 {
-    dp / (dp * dp + dp_t * dp_t).sqrt().sqrt()
+    let m = dp.abs().max(dp_t.abs());
+    if m < SQUARE_SAFE {
+        dp / (dp * dp + dp_t * dp_t).sqrt().sqrt()
+    } else {
+        // dp^2 would overflow (and give g = 0): scale by m.
+        let (a, b) = (dp / m, dp_t / m);
+        dp / (m.sqrt() * (a * a + b * b).sqrt().sqrt())
+    }
 }
+
+/// Below this magnitude a square cannot overflow (the plain formulas are used, bit for bit);
+/// above it the regularised laws are evaluated in scaled form instead of silently returning 0
+/// for absurd but finite inputs.
+const SQUARE_SAFE: f64 = 1e150;
 
 /// Inputs of one communication step (held constant over the step).
 #[derive(Clone, Copy, Debug, PartialEq, Default, Serialize, Deserialize)]
@@ -329,7 +351,24 @@ impl SemiActiveDamper {
     }
 
     /// Advances the model by `h` seconds with inputs held constant.
+    ///
+    /// Atomic: on error (bad input, integrator failure such as
+    /// `solver.max_internal_steps` reached, non-finite state or output) the model is left
+    /// exactly as it was, so [`Self::outputs`] still returns the last (finite) outputs and
+    /// the caller may retry with a smaller step or other inputs.
     pub fn step(
+        &mut self,
+        h: f64,
+        inputs: &SemiActiveInputs,
+    ) -> Result<SemiActiveOutputs, StepError> {
+        // Plain data: the copy is a memcpy, no allocation.
+        let mut next = self.clone();
+        let out = next.advance(h, inputs)?;
+        *self = next;
+        Ok(out)
+    }
+
+    fn advance(
         &mut self,
         h: f64,
         inputs: &SemiActiveInputs,

@@ -7,7 +7,10 @@ use model_description::{
 };
 use serde::{Deserialize, Serialize};
 
-use super::{model_error, not_initialised, param_error, step_error, AUTHOR};
+use super::{
+    model_error, not_initialised, param_error, step_error, steps_from_fmi, steps_to_fmi, AUTHOR,
+    MAX_STEPS_DESCRIPTION, MAX_STEPS_NAME, MAX_STEPS_RANGE,
+};
 use crate::full_active::{
     Actuator, ActuatorInputs, ActuatorModel, ActuatorOutputs, ActuatorParams, RodMode,
     LEAKAGE_LITRE_READING_M3PS_PER_PA,
@@ -411,6 +414,14 @@ impl FmuModel for FullActiveActuator {
         )
         .unit("W")
         .display_unit("kW");
+        // Declared last so the other value references stay put.
+        v.integer_parameter(
+            MAX_STEPS_NAME,
+            MAX_STEPS_DESCRIPTION,
+            |m| steps_to_fmi(m.params.solver.max_internal_steps),
+            |m, x| m.params.solver.max_internal_steps = steps_from_fmi(x),
+        )
+        .range(MAX_STEPS_RANGE.0, MAX_STEPS_RANGE.1);
         v.into_vec()
     }
 
@@ -563,6 +574,17 @@ Shampine and Reichelt (1997, MATLAB's ode23s), second order with a third-order e
 relative tolerance 1e-6 (absolute 10 Pa on pressures, 1e-9 m on the spool), allocation-free, the
 internal step chosen by error control. Inputs are held over a communication step (zero-order
 hold).</p>
+
+<h2>Failed steps</h2>
+<p>A communication step that cannot be completed returns <b>fmi2Discard</b> with a logged
+message (category logStatusDiscard) and leaves the model exactly as before the step: outputs
+stay the last finite values, never NaN or inf. Two causes exist: the integrator's work bound
+<code>solver.max_internal_steps</code> is reached (set it to bound the time of one fmi2DoStep on a
+real-time host; the default 20000 is far above need), or an absurd but finite input makes a
+state or output overflow (e.g. an elongation velocity of 1e300 m/s). The instance is then in
+FMI's stepFailed state: restore an FMU state saved before the step (fmi2SetFMUstate) and retry,
+with a smaller communication step or corrected inputs. Bad parameters or inputs detected by the
+physics end the run with fmi2Error instead.</p>
 
 <h2>Initialisation</h2>
 <p>Spool centred and at rest, P_A = P_B = (P_S + P_T)/2, rod at the imposed elongation.</p>

@@ -109,6 +109,26 @@ fn step_error(e: &PhysicsStepError, map: &[(&'static str, &'static str)]) -> Ste
     }
 }
 
+/// Name, description and range of the integer parameter bounding the integrator's work.
+const MAX_STEPS_NAME: &str = "solver.max_internal_steps";
+const MAX_STEPS_DESCRIPTION: &str =
+    "Maximum number of internal integrator steps (accepted + rejected) per communication step: \
+     bounds the work of one fmi2DoStep (real-time/HIL hosts). Reaching it returns fmi2Discard \
+     with a logged message and the state unchanged (restore an FMU state and retry with a \
+     smaller communication step). Default 20000, far above need (1-50 per 1 ms step)";
+const MAX_STEPS_RANGE: (f64, f64) = (1.0, i32::MAX as f64);
+
+/// The physics' step limit as an FMI Integer (saturating).
+fn steps_to_fmi(n: u32) -> i32 {
+    i32::try_from(n).unwrap_or(i32::MAX)
+}
+
+/// An FMI Integer as the physics' step limit (the declared range keeps it >= 1; anything
+/// else becomes 0, which the physics' validation rejects by name).
+fn steps_from_fmi(x: i32) -> u32 {
+    u32::try_from(x).unwrap_or(0)
+}
+
 fn not_initialised() -> StepError {
     StepError::Error(ModelError::Other(
         "the physics is built in fmi2ExitInitializationMode; no step before it".into(),

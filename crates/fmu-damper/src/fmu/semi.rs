@@ -7,7 +7,10 @@ use model_description::{
 };
 use serde::{Deserialize, Serialize};
 
-use super::{model_error, not_initialised, param_error, step_error, AUTHOR};
+use super::{
+    model_error, not_initialised, param_error, step_error, steps_from_fmi, steps_to_fmi, AUTHOR,
+    MAX_STEPS_DESCRIPTION, MAX_STEPS_NAME, MAX_STEPS_RANGE,
+};
 use crate::semi_active::{
     SemiActiveDamper as Physics, SemiActiveInputs, SemiActiveOutputs, SemiActiveParams,
 };
@@ -229,6 +232,17 @@ fn declare_damper_parameters<M: HasShell>(v: &mut VariableList<M>) {
     .min(0.0);
 }
 
+/// The integrator's work bound, declared last so the other value references stay put.
+fn declare_solver_parameter<M: HasShell>(v: &mut VariableList<M>) {
+    v.integer_parameter(
+        MAX_STEPS_NAME,
+        MAX_STEPS_DESCRIPTION,
+        |m| steps_to_fmi(m.shell().params.solver.max_internal_steps),
+        |m, x| m.shell_mut().params.solver.max_internal_steps = steps_from_fmi(x),
+    )
+    .range(MAX_STEPS_RANGE.0, MAX_STEPS_RANGE.1);
+}
+
 fn declare_motion_inputs<M: HasShell>(v: &mut VariableList<M>) {
     v.input(
         "damper.elongation",
@@ -406,6 +420,7 @@ impl FmuModel for SemiActiveDamper {
         )
         .unit("W")
         .display_unit("kW");
+        declare_solver_parameter(&mut v);
         v.into_vec()
     }
 
@@ -490,6 +505,7 @@ impl FmuModel for PassiveYawDamper {
         )
         .unit("W")
         .display_unit("kW");
+        declare_solver_parameter(&mut v);
         v.into_vec()
     }
 
@@ -592,6 +608,17 @@ constant over a communication step (zero-order hold). Step-size study (4 Hz, +-3
 communication steps of 1e-4, 1e-3 and 5e-3 s the force agrees within 0.5 % of its peak when the
 host samples the input at mid-step, and the steady peak force agrees within 0.5 % with a plain
 zero-order hold (which delays the input by h/2).</p>
+
+<h2>Failed steps</h2>
+<p>A communication step that cannot be completed returns <b>fmi2Discard</b> with a logged
+message (category logStatusDiscard) and leaves the model exactly as before the step: outputs
+stay the last finite values, never NaN or inf. Two causes exist: the integrator's work bound
+<code>solver.max_internal_steps</code> is reached (set it to bound the time of one fmi2DoStep on a
+real-time host; the default 20000 is far above need), or an absurd but finite input makes a
+state or output overflow (e.g. an elongation velocity of 1e300 m/s). The instance is then in
+FMI's stepFailed state: restore an FMU state saved before the step (fmi2SetFMUstate) and retry,
+with a smaller communication step or corrected inputs. Bad parameters or inputs detected by the
+physics end the run with fmi2Error instead.</p>
 
 <h2>Initialisation</h2>
 <p>dP = 0 at the start time (damper at rest). Outputs at the start time are consistent with the
