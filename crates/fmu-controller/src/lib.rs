@@ -255,7 +255,7 @@ mod tests {
             s.step(
                 1e-3,
                 &SkyHookInputs {
-                    end_accel_mps2: a,
+                    sensor_accel_mps2: a,
                     abs_velocity_mps: 0.0,
                     elongation_velocity_mps: 0.01 * a,
                 },
@@ -282,7 +282,7 @@ mod tests {
             };
             assert_eq!(m.step(1e-3, &mi).unwrap(), m2.step(1e-3, &mi).unwrap());
             let si = SkyHookInputs {
-                end_accel_mps2: a,
+                sensor_accel_mps2: a,
                 abs_velocity_mps: 0.0,
                 elongation_velocity_mps: 0.01 * a,
             };

@@ -1,31 +1,38 @@
 //! Sky-hook control of the semi-active damper, seed section 3.2.1.2, (3.6)-(3.13), with the
 //! practical absolute-velocity estimate of section 2.3.2.
 //!
-//! # Mapping onto our damper
-//! Seed: `x` is the bogie-side coordinate, `x0` the other damper end ("ground"/car body); the
-//! damper force is `F_YD = c_YD (x' - x0')` and the sky-hook wants `F_sky = c_sky x'` (3.6).
-//! Our damper: elongation velocity `v_e` (positive = extension) and force `F` tension positive,
-//! `F ~ +c v_e`. Measuring the absolute velocity `x'` of the bogie-side damper end ALONG THE DAMPER
-//! AXIS, positive in the direction that extends the damper, gives `x' - x0' = v_e` exactly, the
-//! tension `c_sky x'` is the sky-hook force on the bogie end, and the condition function is
-//! `x' (x' - x0') = x' v_e`. If the host's sensor axis points the other way set
-//! `absolute_sign = -1`.
-//!
+//! # The law
+//! Seed: `x'` is "the velocity response of the bogie" (3.6), `x' - x0'` the relative velocity
+//! across the damper; the damper force is `F_YD = c_YD (x' - x0')` (3.9) and the sky-hook wants
+//! `F_sky = c_sky x'`. Our damper: elongation velocity `v_e` (positive = extension) and force
+//! tension positive, `F ~ +c v_e`, so `x' - x0' = v_e` and the condition function is `x' v_e`.
 //! * continuous (3.11): `c = clamp(c_sky x'/v_e, c_min, c_max)` if `x' v_e >= 0`, else `c_min`;
 //! * on/off (3.13): `c = c_max` if `x' v_e >= 0`, else `c_min`;
 //! * `c` is turned into a valve opening by inverting the damper's equivalent damping-vs-opening
 //!   table (piecewise-linear, `c` decreasing with opening); command `V = 10 V x opening`.
 //!   Damping above the table's closed value gives 0 V, below its open value 10 V.
 //!
-//! # Absolute velocity
-//! In the bogie model the car body does not move, so the ideal absolute velocity equals `v_e`
-//! and the condition function is `v_e^2 >= 0`: the damper would never switch off
-//! (REFERENCE.md). The practical scheme (2.3.2) integrates an accelerometer with a high-pass
-//! against drift; its phase lead at the hunting frequency (`2 atan(fc/f)`, 8.6 deg at
-//! fc = 0.3 Hz, f = 4 Hz) is what makes the condition change sign. Default corner 0.3 Hz: a
-//! decade below the 3-4 Hz hunting frequency (R6), so amplitude and phase are within 1 % / 9 deg,
-//! while a constant accelerometer offset is removed with a 0.5 s time constant.
-//! [`VelocitySource::Ideal`] takes the absolute velocity from an input instead.
+//! # Which velocity is `x'` (interpretation)
+//! The controller integrates one accelerometer signal (`sensor_accel_mps2`, times
+//! `absolute_sign`); the host decides where that sensor sits. Two choices:
+//! * the seed's co-simulation (section 4.4): Simpack hands Simulink only "the piston velocity
+//!   of the yaw dampers and the lateral acceleration of the wheelsets", so its sky-hook can only
+//!   have used the integrated lateral acceleration as `x'`. Lateral and yaw motion of a hunting
+//!   bogie are roughly in quadrature, so `x' v_e` changes sign twice per cycle and the valve
+//!   switches "frequently between fully open and fully closed" (seed Figs. 4.19-4.20). This is
+//!   what the study uses (systems/skyhook*.json); the sign (`absolute_sign`) is a mounting
+//!   convention the seed does not give, chosen there so that both dampers switch together.
+//! * the textbook sky-hook: the absolute velocity of the bogie-side damper end along the damper
+//!   axis. With a car body that does not move (our bogie model, the HIL rig) this equals `v_e`,
+//!   the condition is `v_e^2 >= 0` and the damper never switches off except for the phase lead of
+//!   the estimate (REFERENCE.md): the controller is then a closed passive damper.
+//!
+//! # Absolute velocity estimate
+//! The practical scheme (2.3.2) integrates the accelerometer with a high-pass against drift:
+//! G(s) = s/(s + w_c)^2, default corner 0.3 Hz, a decade below the 3-6 Hz hunting frequency
+//! (R6), so amplitude and phase are within 1 % / 9 deg of a true integral, while a constant
+//! accelerometer offset is removed with a 0.5 s time constant. [`VelocitySource::Ideal`] takes
+//! the velocity from an input instead.
 //!
 //! Defaults not in the seed: `c_sky = 330 kNs/m` (same magnitude as the full-active ideal damper
 //! c_v of (3.14)); `c_min`, `c_max` = the ends of the damping table; board at 1 kHz ("very short
@@ -155,10 +162,10 @@ pub enum SkyHookMode {
     OnOff,
 }
 
-/// Where the absolute velocity of the bogie-side damper end comes from.
+/// Where the sky-hook velocity `x'` comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum VelocitySource {
-    /// High-pass + leaky integration of `end_accel_mps2` (practical scheme, 2.3.2).
+    /// High-pass + leaky integration of `sensor_accel_mps2` (practical scheme, 2.3.2).
     #[default]
     EstimatedFromAcceleration,
     /// Ideal absolute velocity input `abs_velocity_mps`.
@@ -241,9 +248,9 @@ impl SkyHookParams {
 
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct SkyHookInputs {
-    /// Absolute acceleration of the bogie-side damper end along the damper axis (m/s^2).
-    pub end_accel_mps2: f64,
-    /// Ideal absolute velocity of the same point (m/s); used only with `VelocitySource::Ideal`.
+    /// Acceleration whose integral is the sky-hook velocity `x'` (m/s^2), before `absolute_sign`.
+    pub sensor_accel_mps2: f64,
+    /// Ideal velocity `x'` of the same sensor (m/s); used only with `VelocitySource::Ideal`.
     pub abs_velocity_mps: f64,
     /// Damper elongation velocity (m/s), positive = extension.
     pub elongation_velocity_mps: f64,
@@ -343,7 +350,9 @@ impl SkyHook {
             return Err(StepError::InvalidStep(h));
         }
         let abs_in = match self.params.velocity_source {
-            VelocitySource::EstimatedFromAcceleration => ("end_accel_mps2", inputs.end_accel_mps2),
+            VelocitySource::EstimatedFromAcceleration => {
+                ("sensor_accel_mps2", inputs.sensor_accel_mps2)
+            }
             VelocitySource::Ideal => ("abs_velocity_mps", inputs.abs_velocity_mps),
         };
         let bad = [
@@ -367,7 +376,7 @@ impl SkyHook {
             let abs_vel = self.params.absolute_sign
                 * match self.params.velocity_source {
                     VelocitySource::EstimatedFromAcceleration => {
-                        self.estimator.process(inputs.end_accel_mps2)
+                        self.estimator.process(inputs.sensor_accel_mps2)
                     }
                     VelocitySource::Ideal => inputs.abs_velocity_mps,
                 };
@@ -415,7 +424,7 @@ mod tests {
 
     fn inp(xa: f64, ve: f64) -> SkyHookInputs {
         SkyHookInputs {
-            end_accel_mps2: 0.0,
+            sensor_accel_mps2: 0.0,
             abs_velocity_mps: xa,
             elongation_velocity_mps: ve,
         }
@@ -515,7 +524,7 @@ mod tests {
                 .step(
                     dt,
                     &SkyHookInputs {
-                        end_accel_mps2: a,
+                        sensor_accel_mps2: a,
                         abs_velocity_mps: 0.0,
                         elongation_velocity_mps: ve,
                     },
@@ -560,7 +569,7 @@ mod tests {
                     .step(
                         1e-3,
                         &SkyHookInputs {
-                            end_accel_mps2: acc,
+                            sensor_accel_mps2: acc,
                             abs_velocity_mps: 0.0,
                             elongation_velocity_mps: ve,
                         },
@@ -573,7 +582,7 @@ mod tests {
                         .step(
                             1e-4,
                             &SkyHookInputs {
-                                end_accel_mps2: acc,
+                                sensor_accel_mps2: acc,
                                 abs_velocity_mps: 0.0,
                                 elongation_velocity_mps: ve,
                             },
@@ -600,7 +609,7 @@ mod tests {
             .step(
                 1e-3,
                 &SkyHookInputs {
-                    end_accel_mps2: f64::NAN,
+                    sensor_accel_mps2: f64::NAN,
                     abs_velocity_mps: 0.01,
                     elongation_velocity_mps: 0.01,
                 },
@@ -617,12 +626,12 @@ mod tests {
             e.step(
                 1e-3,
                 &SkyHookInputs {
-                    end_accel_mps2: f64::INFINITY,
+                    sensor_accel_mps2: f64::INFINITY,
                     ..Default::default()
                 }
             ),
             Err(StepError::NonFiniteInput {
-                name: "end_accel_mps2",
+                name: "sensor_accel_mps2",
                 ..
             })
         ));

@@ -355,7 +355,7 @@ fn skyhook_stabilises_stand_in_with_ideal_valve() {
                 ctrl.step(
                     h,
                     &SkyHookInputs {
-                        end_accel_mps2: a,
+                        sensor_accel_mps2: a,
                         abs_velocity_mps: plant.xd,
                         elongation_velocity_mps: plant.xd,
                     },

@@ -220,8 +220,8 @@ fn skyhook_fmu_equals_physics() {
         })
         .unwrap();
         let ins = [
-            vr::<M>("damper_end.absolute_acceleration"),
-            vr::<M>("damper_end.absolute_velocity"),
+            vr::<M>("sensor.acceleration"),
+            vr::<M>("sensor.velocity"),
             vr::<M>("damper.elongation_velocity"),
         ];
         let h = 1e-3;
@@ -235,7 +235,7 @@ fn skyhook_fmu_equals_physics() {
                 .step(
                     h,
                     &SkyHookInputs {
-                        end_accel_mps2: a,
+                        sensor_accel_mps2: a,
                         abs_velocity_mps: xa,
                         elongation_velocity_mps: ve,
                     },
@@ -447,7 +447,7 @@ fn a_changed_table_is_used() {
     assert_eq!(set_r::<S>(&mut c, "c_min", 10e3), Status::Ok);
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
     let ins = [
-        vr::<S>("damper_end.absolute_velocity"),
+        vr::<S>("sensor.velocity"),
         vr::<S>("damper.elongation_velocity"),
     ];
     assert_eq!(c.set_real(&ins, &[0.05, 0.05]), Status::Ok);
@@ -543,8 +543,8 @@ fn step_size_independence_through_the_fmu() {
         vec![a, xa, ve]
     };
     let ins = [
-        "damper_end.absolute_acceleration",
-        "damper_end.absolute_velocity",
+        "sensor.acceleration",
+        "sensor.velocity",
         "damper.elongation_velocity",
     ];
     for mode in [0, 1] {
@@ -614,8 +614,8 @@ fn outputs_have_no_direct_feedthrough() {
     );
     check_no_feedthrough::<SkyHookController>(
         &[
-            "damper_end.absolute_acceleration",
-            "damper_end.absolute_velocity",
+            "sensor.acceleration",
+            "sensor.velocity",
             "damper.elongation_velocity",
         ],
         &[1.0, 0.0, 0.01],
@@ -734,8 +734,8 @@ fn warnings_and_events_only_on_change() {
     let (mut c, log) = init::<S>();
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
     let ins = [
-        vr::<S>("damper_end.absolute_acceleration"),
-        vr::<S>("damper_end.absolute_velocity"),
+        vr::<S>("sensor.acceleration"),
+        vr::<S>("sensor.velocity"),
         vr::<S>("damper.elongation_velocity"),
     ];
     let mut switches = 0;
@@ -798,8 +798,8 @@ fn fmu_state_save_restore_and_serialise() {
     });
     state_round_trip::<SkyHookController>(
         &[
-            "damper_end.absolute_acceleration",
-            "damper_end.absolute_velocity",
+            "sensor.acceleration",
+            "sensor.velocity",
             "damper.elongation_velocity",
         ],
         &|t| {

@@ -13,7 +13,7 @@ use crate::skyhook::{
     VelocitySource, DAMPING_TABLE_4HZ,
 };
 
-/// Number of points of the damping table parameters (that of the placeholder table).
+/// Number of points of the damping table parameters (that of the measured default table).
 pub const TABLE_LEN: usize = DAMPING_TABLE_4HZ.len();
 
 const NAMES: &[(&str, &str)] = &[
@@ -28,8 +28,8 @@ const NAMES: &[(&str, &str)] = &[
 ];
 
 const INPUT_NAMES: &[(&str, &str)] = &[
-    ("end_accel_mps2", "damper_end.absolute_acceleration"),
-    ("abs_velocity_mps", "damper_end.absolute_velocity"),
+    ("sensor_accel_mps2", "sensor.acceleration"),
+    ("abs_velocity_mps", "sensor.velocity"),
     ("elongation_velocity_mps", "damper.elongation_velocity"),
 ];
 
@@ -80,7 +80,7 @@ macro_rules! table_access {
     };
 }
 
-/// Accessors of `table.opening[i+1]`, `table.damping[i+1]` (fails to compile if the placeholder
+/// Accessors of `table.opening[i+1]`, `table.damping[i+1]` (fails to compile if the default
 /// table changes length: add or remove entries here).
 const TABLE_ACCESS: [(Get, Set, Get, Set); TABLE_LEN] = table_access!(0, 1, 2, 3, 4, 5, 6, 7, 8);
 
@@ -201,8 +201,8 @@ impl FmuModel for SkyHookController {
         .range(0.0, 1.0);
         v.integer_parameter(
             "velocity_source",
-            "Absolute velocity x': 0 = estimated from damper_end.absolute_acceleration \
-             (high-pass + leaky integrator, seed 2.3.2), 1 = ideal input damper_end.absolute_velocity",
+            "Absolute velocity x': 0 = estimated from sensor.acceleration \
+             (high-pass + leaky integrator, seed 2.3.2), 1 = ideal input sensor.velocity",
             |m| match m.params.velocity_source {
                 VelocitySource::EstimatedFromAcceleration => 0,
                 VelocitySource::Ideal => 1,
@@ -218,7 +218,8 @@ impl FmuModel for SkyHookController {
         .range(0.0, 1.0);
         v.integer_parameter(
             "absolute_sign",
-            "+1 if the absolute sensor axis points in the damper's extension direction, else -1",
+            "Sign applied to sensor.acceleration / sensor.velocity to give x' of (3.6): a mounting \
+             convention (the study uses -1 left, +1 right with the lateral frame acceleration)",
             |m| sign_to_int(m.params.absolute_sign),
             |m, x| m.params.absolute_sign = f64::from(x),
         )
@@ -289,7 +290,7 @@ impl FmuModel for SkyHookController {
             v.parameter(
                 &format!("table.damping[{}]", i + 1),
                 "Equivalent damping of the damper at table.opening[i] (strictly decreasing; \
-                 PLACEHOLDER values, not measured)",
+                 default: measured on SemiActiveDamper at 4 Hz, 1 mm)",
                 *gd,
                 *sd,
             )
@@ -299,16 +300,17 @@ impl FmuModel for SkyHookController {
         }
 
         v.input(
-            "damper_end.absolute_acceleration",
-            "Absolute acceleration of the bogie-side damper end along the damper axis \
-             (extension direction x absolute_sign); used with velocity_source = 0",
-            |m| m.inputs.end_accel_mps2,
-            |m, x| m.inputs.end_accel_mps2 = x,
+            "sensor.acceleration",
+            "Accelerometer whose integral (x absolute_sign) is the sky-hook velocity x' of (3.6): \
+             the bogie's lateral acceleration as in the seed's co-simulation (4.4), or the \
+             damper end's along its axis; used with velocity_source = 0",
+            |m| m.inputs.sensor_accel_mps2,
+            |m, x| m.inputs.sensor_accel_mps2 = x,
         )
         .unit("m/s2");
         v.input(
-            "damper_end.absolute_velocity",
-            "Absolute velocity of the same point; used with velocity_source = 1",
+            "sensor.velocity",
+            "Velocity of the same sensor (ideal x'); used with velocity_source = 1",
             |m| m.inputs.abs_velocity_mps,
             |m, x| m.inputs.abs_velocity_mps = x,
         )
@@ -453,25 +455,34 @@ mode = 0, on/off (3.13):      c = c_max  if x' (x' - x0') &gt;= 0,  c_min otherw
 <code>valve.command</code> = 10 V x opening, 0 V = closed = maximum damping.</p>
 <h2>Sign conventions</h2>
 <p>Damper elongation positive = extension, x' - x0' = <code>damper.elongation_velocity</code>,
-damper force tension positive (F = +c v_e). The absolute acceleration/velocity inputs are measured
-along the damper axis, positive in the direction that extends the damper; if the host's sensor
-axis points the other way set <code>absolute_sign = -1</code>.</p>
-<h2>Absolute velocity (seed 2.3.2)</h2>
+damper force tension positive (F = +c v_e). x' = <code>absolute_sign</code> times the integrated
+<code>sensor.acceleration</code> (or <code>sensor.velocity</code>).</p>
+<h2>Which velocity is x' (interpretation)</h2>
+<p>The seed's co-simulation (section 4.4) gives the controller only the damper's piston velocity
+and the lateral acceleration of the bogie, so its sky-hook integrates the <b>lateral</b>
+acceleration: lateral and yaw motion of a hunting bogie are roughly in quadrature, the condition
+x' (x' - x0') changes sign twice per cycle, and the valve switches frequently between open and
+closed as in the seed's Figs. 4.19-4.20. Connect the bogie's lateral frame acceleration to
+<code>sensor.acceleration</code> for that behaviour (the project's study does, with
+<code>absolute_sign</code> = -1 on the left damper and +1 on the right so both switch together).
+The textbook alternative, the absolute acceleration of the bogie-side damper end along the damper
+axis, gives x' = x' - x0' when the car body does not move: the condition is then always &gt;= 0 and
+the damper stays closed except for the phase lead of the estimate.</p>
+<h2>Velocity estimate (seed 2.3.2)</h2>
 <p><code>velocity_source = 0</code> (default): x' is estimated from
-<code>damper_end.absolute_acceleration</code> by a first-order high-pass and a leaky integrator with
+<code>sensor.acceleration</code> by a first-order high-pass and a leaky integrator with
 the same corner <code>filter_corner</code> (0.3 Hz), G(s) = s/(s + w_c)^2: at 4 Hz the gain is
 within 1 % of an integrator and the phase lead 8.6 deg; an accelerometer offset gives no velocity.
-In a bogie model whose car body does not move, the ideal x' equals v_e and the condition is always
-&gt;= 0 (the damper never switches off); the estimate's phase lead is what lets the on/off law
-switch. <code>velocity_source = 1</code> uses <code>damper_end.absolute_velocity</code>.</p>
-<h2>Damping table (PLACEHOLDER)</h2>
+<code>velocity_source = 1</code> uses <code>sensor.velocity</code>.</p>
+<h2>Damping table</h2>
 <p><code>table.opening[i]</code> / <code>table.damping[i]</code>, i = 1..9: openings strictly
 increasing in [0, 1], damping strictly decreasing; checked at fmi2ExitInitializationMode (the
-offending element is named). The default values are NOT measured: a geometric law from 400 kN.s/m
-(closed) to 10 kN.s/m (open) consistent with R1 (12-20 kN peak closed, 0.5-1 kN open at 4 Hz,
-&plusmn;1..3 mm); to be replaced by the equivalent damping measured on the calibrated damper model.
-<code>c_min</code> and <code>c_max</code> default to the table's ends but do not follow a changed
-table. <code>c_sky</code> = 330 kN.s/m is not in the seed (same magnitude as c_v of (3.14)).</p>
+offending element is named). The defaults are the equivalent damping c_eq = Im(F/x)/omega of the
+project's SemiActiveDamper at 4 Hz and 1 mm amplitude, measured on its calibrated model
+(325.7 kN.s/m closed ... 24.3 kN.s/m open; an end-to-end test re-measures them). Replace them by
+your damper's table when you use another damper. <code>c_min</code> and <code>c_max</code> default
+to the table's ends but do not follow a changed table. <code>c_sky</code> = 330 kN.s/m is not in
+the seed (same magnitude as c_v of (3.14)).</p>
 <h2>Timing and co-simulation</h2>
 <p>Samples at <code>start_time + k sample_time</code>; the command computed from the inputs sampled at
 t_k is output from t_(k+1) on (one sample of computational delay), so no output depends on the

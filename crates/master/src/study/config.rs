@@ -14,7 +14,7 @@
 //! System-level choices (the seed leaves them open):
 //! * each controller takes the signals of its own side: the left MPPT board the frame
 //!   acceleration over the front axle box, the right one over the rear axle box; sky-hook the
-//!   end acceleration / velocity and elongation velocity of its own damper; IDF the elongation
+//!   same accelerations and the elongation velocity of its own damper; IDF the elongation
 //!   velocity and force of its own actuator. IDF `command_sign = -1` (a positive spool command
 //!   pushes the rod out, i.e. compression in the tension-positive convention).
 //! * MPPT band-pass 2-8 Hz instead of the controller's default 2-6 Hz: our bogie hunts at
@@ -22,8 +22,11 @@
 //! * MPPT instability threshold (3.5) = 2.7 m/s^2 = a_lim / 2 (the seed gives no number): the
 //!   board's 1 s rms of a fully developed limit cycle is about a_lim in our bogie, so with
 //!   threshold = a_lim the emergency closing stopped half way (4 V) and the limit cycle stayed.
-//! * Sky-hook: the controller's defaults (absolute velocity estimated from the end
-//!   acceleration, corner 0.3 Hz; c_sky = 330 kNs/m; damping table of our damper at 4 Hz).
+//! * Sky-hook: x' of (3.6) is estimated from the frame lateral acceleration over the axle box
+//!   of the controller's side (the signal the seed's co-simulation gives the controllers, 4.4),
+//!   `absolute_sign` -1 left / +1 right so both dampers switch together; otherwise the
+//!   controller's defaults (corner 0.3 Hz; c_sky = 330 kNs/m; damping table of our damper at
+//!   4 Hz). See fmu-controller's skyhook module for why not the damper end's velocity.
 //! * The bogie starts centred (initial displacement 0) on the irregular track; the
 //!   perturbation and HIL-like runs set 3 mm on an ideal track.
 
