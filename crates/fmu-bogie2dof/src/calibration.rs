@@ -37,6 +37,11 @@
 //! from a 3 mm perturbation already at 220 km/h, against R7. A/A stays selectable
 //! (`ContactSource::ProfilesAA`, FMU `contact.table = "AA"`). Shipped as
 //! `resources/wheel_rail_worn_surrogate.csv` (`examples/write_surrogate.rs`).
+//! The A/A table under both is the wheel-rail crate's E1 output with the closest-point contact
+//! of session 1; wheel-rail now reports the centroid of the contact zone (E1 delta r within
+//! 0.1 mm to 6 mm), which would change this table by up to 0.24 mm / 0.046 in tan gamma near the
+//! flange root and the gravitational stiffness at 1 mm by -8 %. The calibration below rests on
+//! the shipped table; regenerating it means re-running this calibration.
 //!
 //! # Knobs and result
 //! * kappa = 0.6 ([`CALIBRATED_CREEP_REDUCTION`]): Kalker reduction factor (Polach 2005);

@@ -13,8 +13,9 @@
 //! std::fs::write("wheel_rail.csv", table.to_bogie_csv())?;
 //! # Ok(()) }
 //! ```
-//! `cargo run -p wheel-rail --release --example bogie_table` regenerates
-//! `crates/fmu-bogie2dof/resources/wheel_rail_A_A.csv` (E1 case).
+//! `cargo run -p wheel-rail --release --example bogie_table [out.csv]` writes the E1 table in
+//! the bogie's format (the bogie's shipped table is a calibration input and predates the
+//! contact-zone centroid: see the example's docs).
 //!
 //! # Coordinate conventions (established from the EN 15302 benchmark data, `data/`)
 //! * **Profile files**: lateral coordinate positive towards the FIELD side (away from the track
