@@ -10,8 +10,10 @@
 //! One benchmark iteration is one whole 4 Hz period (250 steps), so both paths do exactly the
 //! same work per iteration whatever the cost of the individual steps along the cycle; the models
 //! are created once and first run for 1 s (four periods) to reach the periodic state.
-//! Time per step = reported time / 250. Report the ratio of the two times of each model from
-//! one run.
+//! Time per step = reported time / 250. After each model's two criterion benchmarks, a paired
+//! measurement alternates one period direct / one period through the FMU and prints the median
+//! ratio (robust to a change of machine load between the two criterion runs). Report the
+//! ratios of each model from one run.
 //! Run: cargo bench -p fmu-damper --features fmi-export --bench fmu_vs_direct
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -87,8 +89,54 @@ fn period(k: &mut u64, mut step: impl FnMut(u64) -> f64) -> f64 {
     f
 }
 
+/// Load-robust ratio: alternate one period direct / one period through the FMU (order
+/// swapped every round) and print the medians. Criterion measures the two paths one after
+/// the other, so a change of machine load between them biases its ratio; paired rounds see
+/// the same load.
+fn paired(
+    name: &str,
+    kd: &mut u64,
+    direct: &mut impl FnMut(u64) -> f64,
+    kf: &mut u64,
+    fmu: &mut impl FnMut(u64) -> f64,
+) {
+    const ROUNDS: usize = 201;
+    let mut ratios = Vec::with_capacity(ROUNDS);
+    let (mut td, mut tf) = (Vec::with_capacity(ROUNDS), Vec::with_capacity(ROUNDS));
+    for r in 0..ROUNDS {
+        let time = |k: &mut u64, f: &mut dyn FnMut(u64) -> f64| {
+            let t0 = std::time::Instant::now();
+            black_box(period(k, f));
+            t0.elapsed().as_secs_f64()
+        };
+        let (d, f) = if r % 2 == 0 {
+            let d = time(kd, direct);
+            (d, time(kf, fmu))
+        } else {
+            let f = time(kf, fmu);
+            (time(kd, direct), f)
+        };
+        ratios.push(f / d);
+        td.push(d);
+        tf.push(f);
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let per_step = 1e6 / PERIOD as f64;
+    println!(
+        "{name}: paired medians over {ROUNDS} periods: direct {:.3} us/step, FMU {:.3} us/step, \
+         ratio FMU/direct {:.3}",
+        median(&mut td) * per_step,
+        median(&mut tf) * per_step,
+        median(&mut ratios)
+    );
+}
+
 fn bench_semi(c: &mut Criterion) {
-    let mut group = c.benchmark_group("semi-active damper, 250 steps of 1 ms (3 mm at 4 Hz)");
+    let name = "semi-active damper, 250 steps of 1 ms (3 mm at 4 Hz)".to_string();
+    let mut group = c.benchmark_group(&name);
     group.throughput(Throughput::Elements(PERIOD));
     let mut d = SemiActiveDamper::new(SemiActiveParams::default()).unwrap();
     let mut direct = |k: u64| {
@@ -100,12 +148,12 @@ fn bench_semi(c: &mut Criterion) {
         };
         d.step(H, &inputs).unwrap().force_n
     };
-    let mut k = 0u64;
+    let mut kd = 0u64;
     for _ in 0..WARM_PERIODS {
-        period(&mut k, &mut direct);
+        period(&mut kd, &mut direct);
     }
     group.bench_function("direct Rust", |b| {
-        b.iter(|| black_box(period(&mut k, &mut direct)))
+        b.iter(|| black_box(period(&mut kd, &mut direct)))
     });
     unsafe {
         let comp = instantiate::<SemiFmu>(&[]);
@@ -130,15 +178,15 @@ fn bench_semi(c: &mut Criterion) {
         group.bench_function("through the FMI C ABI", |b| {
             b.iter(|| black_box(period(&mut k, &mut fmu)))
         });
+        paired(&name, &mut kd, &mut direct, &mut k, &mut fmu);
         fmi::fmi2FreeInstance(comp);
     }
     group.finish();
 }
 
 fn bench_actuator(c: &mut Criterion, model: ActuatorModel, fmi_model: i32, label: &str) {
-    let mut group = c.benchmark_group(format!(
-        "actuator {label}, 250 steps of 1 ms (3 mm at 4 Hz, spool 0.6 mm)"
-    ));
+    let name = format!("actuator {label}, 250 steps of 1 ms (3 mm at 4 Hz, spool 0.6 mm)");
+    let mut group = c.benchmark_group(&name);
     group.throughput(Throughput::Elements(PERIOD));
     let mut a = Actuator::new(fmu_damper::ActuatorParams {
         model,
@@ -155,12 +203,12 @@ fn bench_actuator(c: &mut Criterion, model: ActuatorModel, fmi_model: i32, label
         };
         a.step(H, &inputs).unwrap().force_n
     };
-    let mut k = 0u64;
+    let mut kd = 0u64;
     for _ in 0..WARM_PERIODS {
-        period(&mut k, &mut direct);
+        period(&mut kd, &mut direct);
     }
     group.bench_function("direct Rust", |b| {
-        b.iter(|| black_box(period(&mut k, &mut direct)))
+        b.iter(|| black_box(period(&mut kd, &mut direct)))
     });
     unsafe {
         let comp = instantiate::<ActFmu>(&[("actuator.model", fmi_model)]);
@@ -186,6 +234,7 @@ fn bench_actuator(c: &mut Criterion, model: ActuatorModel, fmi_model: i32, label
         group.bench_function("through the FMI C ABI", |b| {
             b.iter(|| black_box(period(&mut k, &mut fmu)))
         });
+        paired(&name, &mut kd, &mut direct, &mut k, &mut fmu);
         fmi::fmi2FreeInstance(comp);
     }
     group.finish();
