@@ -591,11 +591,16 @@ actuator FMU uses the same convention, so both plug into the vehicle the same wa
 <tr><td>peak force, 0 % opening, +-1 / +-3 mm</td><td>12-20 kN</td><td>12.2 / 19.9 kN</td></tr>
 <tr><td>peak force, 100 % opening, +-1 / +-3 mm</td><td>0.5-1 kN</td><td>0.54 / 0.86 kN</td></tr>
 <tr><td>phase of F/x at 0, 20, 50, 100 % (1 mm)</td><td>rises toward 90 deg</td><td>42, 75, 85, 88 deg</td></tr>
-<tr><td>30 % opening, 1 mm: k_eq, c_eq</td><td>(passive reference, R5)</td><td>386 kN/m, 95.6 kN s/m</td></tr>
+<tr><td>30 % opening, 1 mm, 4 Hz: k_eq, c_eq</td><td>(passive reference, R5)</td><td>386 kN/m, 95.6 kN s/m</td></tr>
 </table>
-<p>R1 (both amplitudes within 12-20 kN at 0 %) caps the 0 % k_eq peak at about 4.7 Hz, so
-"k_eq rises with frequency" (R2) holds up to 4.5 Hz at 0 % and beyond 8 Hz at the other
-openings.</p>
+<p>At 0 % opening only K Q_ref/V0 and K C_f/V0 matter, and across that plane the 1 mm k_eq peak
+frequency is tied one-to-one to the force ratio F(3 mm)/F(1 mm) at 4 Hz (4.76 Hz at 1.632,
+5.66 Hz at 1.670, 6.73 Hz at 1.711; <code>examples/r2_peak.rs</code>). R1's 20/12 = 1.667 caps the
+peak at about 5.6 Hz with both forces on R1's edges; these defaults (12.2 / 19.9 kN) put it at
+4.76 Hz, so "k_eq rises with frequency" (R2) holds up to 4.5 Hz at 0 % and beyond 8 Hz at the
+other openings. A 6 Hz peak inside R1 needs nearly laminar orifices (a laminar core of 20-300 bar,
+departing from (3.42)/(3.44)) and would cut the 30 % k_eq by about 40 %
+(<code>examples/r2_candidate.rs</code>).</p>
 
 <h2>Integrator</h2>
 <p>The pressure state is stiff: its own eigenvalue (K/V0) dQ/ddP reaches 1e5-1e7 1/s near dP = 0
