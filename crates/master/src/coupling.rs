@@ -13,7 +13,10 @@
 //! * Step rejection: when a slave returns fmi2Discard and `max_step_halvings > 0` and every
 //!   slave can get/set its FMU state, all slaves are reset to the state saved before the macro
 //!   step and the step is redone as 2, 4, ... sub-steps (each active slave's step split into
-//!   equal parts, data exchanged after every part), up to `max_step_halvings` times.
+//!   equal parts, data exchanged after every part), up to `max_step_halvings` times; not when a
+//!   slave lacks canHandleVariableCommunicationStepSize (its step must stay constant).
+//! * A slave without canHandleVariableCommunicationStepSize is only accepted when its
+//!   `step_multiple` divides the number of steps (no shortened last window).
 //! * Every exit path (success, error, cancellation) calls fmi2Terminate on each slave that
 //!   reached step mode (exitInitializationMode) and did not report fmi2Fatal; freeing
 //!   (fmi2FreeInstance, allowed in every state) is the slaves' `Drop`.
@@ -424,7 +427,9 @@ impl Engine<'_, '_, '_, '_> {
         let h = self.t(k + 1) - t;
         let retry = self.plan.max_step_halvings > 0;
         let lacking = self.slaves.iter().position(|s| !s.can_save_state());
-        let can_retry = retry && lacking.is_none();
+        // sub-steps change every active slave's step size
+        let fixed = self.slaves.iter().position(|s| !s.can_vary_step());
+        let can_retry = retry && lacking.is_none() && fixed.is_none();
         if can_retry {
             for i in 0..self.slaves.len() {
                 self.slaves[i]
@@ -454,6 +459,18 @@ impl Engine<'_, '_, '_, '_> {
                     step: h / parts as f64,
                     reason: format!(
                         "cannot retry: instance '{}' does not support canGetAndSetFMUstate",
+                        self.slaves[l].name()
+                    ),
+                });
+            }
+            if let Some(l) = fixed {
+                return Err(SimError::Discarded {
+                    time: t,
+                    instance: name,
+                    step: h / parts as f64,
+                    reason: format!(
+                        "cannot retry with smaller steps: instance '{}' does not support \
+                         canHandleVariableCommunicationStepSize",
                         self.slaves[l].name()
                     ),
                 });
@@ -570,6 +587,28 @@ pub fn check_plan(plan: &CouplingPlan, n_slaves: usize) -> Result<u64, SimError>
     Ok(n as u64)
 }
 
+/// FMI 2.0 (4.3.1): a slave without canHandleVariableCommunicationStepSize must always be
+/// stepped with the same step. Its window is `step_multiple` steps, so the last window is
+/// shorter unless the multiple divides the number of steps: refused before any call.
+fn check_step_sizes(
+    plan: &CouplingPlan,
+    slaves: &[&mut dyn Slave],
+    n_steps: u64,
+) -> Result<(), SimError> {
+    for (inst, s) in plan.instances.iter().zip(slaves.iter()) {
+        let m = u64::from(inst.step_multiple.max(1));
+        if !s.can_vary_step() && !n_steps.is_multiple_of(m) {
+            return Err(SimError::Plan(format!(
+                "instance '{}' does not support canHandleVariableCommunicationStepSize, but its \
+                 step_multiple {m} does not divide the {n_steps} communication steps, so its last \
+                 step would be shorter; choose a step_multiple that divides {n_steps}",
+                s.name()
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Runs the plan on the given slaves (same order as `plan.instances`). The slaves are
 /// terminated on every path; freeing them is left to their owner (drop).
 pub fn simulate(
@@ -578,6 +617,7 @@ pub fn simulate(
     opts: &RunOptions,
 ) -> Result<SimOutput, SimError> {
     let n_steps = check_plan(plan, slaves.len())?;
+    check_step_sizes(plan, slaves, n_steps)?;
     let started = Instant::now();
     let n = slaves.len();
     let mut eng = Engine {

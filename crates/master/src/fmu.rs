@@ -193,10 +193,16 @@ impl FmuArchive {
             .co_simulation
             .as_ref()
             .is_some_and(|c| c.can_get_and_set_fmu_state);
+        let can_vary_step = self
+            .model
+            .co_simulation
+            .as_ref()
+            .is_some_and(|c| c.can_handle_variable_communication_step_size);
         Ok(FmuSlave {
             instance,
             saved: None,
             can_state,
+            can_vary_step,
             name: instance_name.to_string(),
             _import: import,
         })
@@ -210,6 +216,7 @@ pub struct FmuSlave {
     instance: InstanceCS,
     saved: Option<FmuState>,
     can_state: bool,
+    can_vary_step: bool,
     name: String,
     _import: Fmi2Import,
 }
@@ -314,6 +321,9 @@ impl Slave for FmuSlave {
     }
     fn can_save_state(&self) -> bool {
         self.can_state
+    }
+    fn can_vary_step(&self) -> bool {
+        self.can_vary_step
     }
     fn save_state(&mut self) -> Result<(), SlaveError> {
         match &self.saved {

@@ -83,6 +83,9 @@ pub trait Slave {
     fn do_step(&mut self, t: f64, h: f64) -> Result<StepStatus, SlaveError>;
     /// Whether [`Slave::save_state`] / [`Slave::restore_state`] work (canGetAndSetFMUstate).
     fn can_save_state(&self) -> bool;
+    /// canHandleVariableCommunicationStepSize: whether fmi2DoStep may be called with a step
+    /// other than the first one (shortened last windows, retried sub-steps).
+    fn can_vary_step(&self) -> bool;
     /// Saves the complete state into the slave's single save slot.
     fn save_state(&mut self) -> Result<(), SlaveError>;
     /// Restores the state saved last.

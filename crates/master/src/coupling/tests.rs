@@ -15,6 +15,8 @@ pub struct Hooks {
     pub log: CallLog,
     pub discard_above: Option<f64>,
     pub can_state: bool,
+    /// canHandleVariableCommunicationStepSize is false
+    pub fixed_step_only: bool,
     pub cancel_after: Option<(usize, Arc<AtomicBool>)>,
     pub step_times: Vec<(f64, f64)>,
     pub fail_set_vr: Option<u32>,
@@ -201,6 +203,9 @@ impl<M: Model + Clone> Slave for Mock<M> {
     }
     fn can_save_state(&self) -> bool {
         self.hooks.can_state
+    }
+    fn can_vary_step(&self) -> bool {
+        !self.hooks.fixed_step_only
     }
     fn save_state(&mut self) -> Result<(), SlaveError> {
         self.saved = Some(self.m.clone());
@@ -515,4 +520,57 @@ fn topological_order_is_stable_and_breaks_cycles() {
     assert_eq!(o, vec![0, 1, 2]);
     assert_eq!(b, vec![0]);
     let _ = ScalarType::Integer;
+}
+
+#[test]
+fn fixed_step_slave_refuses_a_shortened_last_window() {
+    // 11 steps: a step multiple of 4 would end with a 3-step window
+    let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.011);
+    plan.instances[1].step_multiple = 4;
+    let (mut a, mut b) = slaves();
+    let log = CallLog::default();
+    b.hooks.log = log.clone();
+    b.hooks.fixed_step_only = true;
+    let e = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        matches!(e, SimError::Plan(_))
+            && msg.contains("'sdm'")
+            && msg.contains("canHandleVariableCommunicationStepSize"),
+        "{msg}"
+    );
+    assert!(log.borrow().is_empty(), "no call before the check: {log:?}");
+    // a multiple that divides the steps is fine, and every step has the same size
+    plan.stop_time = 0.012;
+    let (mut a, mut b) = slaves();
+    b.hooks.fixed_step_only = true;
+    simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap();
+    assert_eq!(b.hooks.step_times.len(), 3);
+    assert!(b
+        .hooks
+        .step_times
+        .iter()
+        .all(|&(_, h)| (h - 4e-3).abs() < 1e-15));
+}
+
+#[test]
+fn fixed_step_slave_is_not_retried_with_smaller_steps() {
+    let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 4e-3, 0.2);
+    plan.max_step_halvings = 3;
+    let (mut a, mut b) = slaves();
+    a.hooks.fixed_step_only = true;
+    b.hooks.discard_above = Some(1.1e-3);
+    let e = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        matches!(e, SimError::Discarded { ref instance, .. } if instance == "sdm")
+            && msg.contains("'ms' does not support canHandleVariableCommunicationStepSize"),
+        "{msg}"
+    );
+    // every step ms was given has the plan's size (no sub-steps were tried)
+    assert!(a
+        .hooks
+        .step_times
+        .iter()
+        .all(|&(_, h)| (h - 4e-3).abs() < 1e-15));
 }
