@@ -133,6 +133,42 @@ trait HasShell {
     fn shell_mut(&mut self) -> &mut SemiShell;
 }
 
+/// `HasShell` for a model whose shell is its field `s`.
+macro_rules! impl_has_shell {
+    ($model:ty) => {
+        impl HasShell for $model {
+            fn shell(&self) -> &SemiShell {
+                &self.s
+            }
+            fn shell_mut(&mut self) -> &mut SemiShell {
+                &mut self.s
+            }
+        }
+    };
+}
+
+/// The FMI life cycle of both models: all of it is the shell's.
+macro_rules! delegate_to_shell {
+    () => {
+        fn exit_initialization(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError> {
+            self.s.exit_initialization(diag)
+        }
+
+        fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
+            self.s.update_outputs()
+        }
+
+        fn do_step(
+            &mut self,
+            _time: f64,
+            step: f64,
+            diag: &mut Diagnostics,
+        ) -> Result<(), StepError> {
+            self.s.do_step(step, diag)
+        }
+    };
+}
+
 /// Parameters of (3.38)-(3.45) common to both shells.
 fn declare_damper_parameters<M: HasShell>(v: &mut VariableList<M>) {
     v.parameter(
@@ -282,6 +318,31 @@ fn declare_force_outputs<M: HasShell>(v: &mut VariableList<M>) {
     .display_unit("bar");
 }
 
+/// The two powers, declared after the valve outputs; only the loss power's description and
+/// feedthrough (the valve command moves the opening at once, or not at all) differ per model.
+fn declare_power_outputs<M: HasShell>(
+    v: &mut VariableList<M>,
+    dissipated_description: &str,
+    dissipated_feedthrough: &[&'static str],
+) {
+    v.output(
+        "damper.dissipated_power",
+        dissipated_description,
+        dissipated_feedthrough,
+        |m| m.shell().out.dissipated_power_w,
+    )
+    .unit("W")
+    .display_unit("kW");
+    v.output(
+        "damper.power",
+        "Mechanical power taken from the vehicle, damper.force x damper.elongation_velocity",
+        &["damper.elongation_velocity"],
+        |m| m.shell().out.mechanical_power_w,
+    )
+    .unit("W")
+    .display_unit("kW");
+}
+
 /// Default inputs of the default experiment: a constant extension at 0.05 m/s.
 fn demo_inputs() -> SemiActiveInputs {
     SemiActiveInputs {
@@ -297,14 +358,7 @@ pub struct SemiActiveDamper {
     s: SemiShell,
 }
 
-impl HasShell for SemiActiveDamper {
-    fn shell(&self) -> &SemiShell {
-        &self.s
-    }
-    fn shell_mut(&mut self) -> &mut SemiShell {
-        &mut self.s
-    }
-}
+impl_has_shell!(SemiActiveDamper);
 
 impl FmuModel for SemiActiveDamper {
     const INFO: ModelInfo = ModelInfo {
@@ -404,22 +458,11 @@ impl FmuModel for SemiActiveDamper {
             &["valve.command"],
             |m| m.s.out.command_clamped,
         );
-        v.output(
-            "damper.dissipated_power",
+        declare_power_outputs(
+            &mut v,
             "Orifice loss power dP (Q_f + Q_v) >= 0",
             &["valve.command"],
-            |m| m.s.out.dissipated_power_w,
-        )
-        .unit("W")
-        .display_unit("kW");
-        v.output(
-            "damper.power",
-            "Mechanical power taken from the vehicle, damper.force x damper.elongation_velocity",
-            &["damper.elongation_velocity"],
-            |m| m.s.out.mechanical_power_w,
-        )
-        .unit("W")
-        .display_unit("kW");
+        );
         declare_solver_parameter(&mut v);
         v.into_vec()
     }
@@ -430,17 +473,7 @@ impl FmuModel for SemiActiveDamper {
         })
     }
 
-    fn exit_initialization(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError> {
-        self.s.exit_initialization(diag)
-    }
-
-    fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-        self.s.update_outputs()
-    }
-
-    fn do_step(&mut self, _time: f64, step: f64, diag: &mut Diagnostics) -> Result<(), StepError> {
-        self.s.do_step(step, diag)
-    }
+    delegate_to_shell!();
 }
 
 /// Passive reference yaw damper FMU: the semi-active damper at a fixed opening (seed 4.3).
@@ -449,14 +482,7 @@ pub struct PassiveYawDamper {
     s: SemiShell,
 }
 
-impl HasShell for PassiveYawDamper {
-    fn shell(&self) -> &SemiShell {
-        &self.s
-    }
-    fn shell_mut(&mut self) -> &mut SemiShell {
-        &mut self.s
-    }
-}
+impl_has_shell!(PassiveYawDamper);
 
 impl FmuModel for PassiveYawDamper {
     const INFO: ModelInfo = ModelInfo {
@@ -489,22 +515,11 @@ impl FmuModel for PassiveYawDamper {
         .range(0.0, 1.0);
         declare_motion_inputs(&mut v);
         declare_force_outputs(&mut v);
-        v.output(
-            "damper.dissipated_power",
+        declare_power_outputs(
+            &mut v,
             "Orifice loss power dP (Q_f + Q_v) >= 0 (from the state: no feedthrough)",
             &[],
-            |m| m.s.out.dissipated_power_w,
-        )
-        .unit("W")
-        .display_unit("kW");
-        v.output(
-            "damper.power",
-            "Mechanical power taken from the vehicle, damper.force x damper.elongation_velocity",
-            &["damper.elongation_velocity"],
-            |m| m.s.out.mechanical_power_w,
-        )
-        .unit("W")
-        .display_unit("kW");
+        );
         declare_solver_parameter(&mut v);
         v.into_vec()
     }
@@ -515,17 +530,7 @@ impl FmuModel for PassiveYawDamper {
         })
     }
 
-    fn exit_initialization(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError> {
-        self.s.exit_initialization(diag)
-    }
-
-    fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-        self.s.update_outputs()
-    }
-
-    fn do_step(&mut self, _time: f64, step: f64, diag: &mut Diagnostics) -> Result<(), StepError> {
-        self.s.do_step(step, diag)
-    }
+    delegate_to_shell!();
 }
 
 /// Equations, interpretations, calibration and numerics shared by both documentations.
