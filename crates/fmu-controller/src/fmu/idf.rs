@@ -6,7 +6,7 @@ use model_description::{
 };
 use serde::{Deserialize, Serialize};
 
-use super::{param_error, sign_to_int, step_error, AUTHOR};
+use super::{param_error, report_input_fault, sign_to_int, AUTHOR};
 use crate::idf::{Idf, IdfInputs, IdfOutputs, IdfParams};
 
 const NAMES: &[(&str, &str)] = &[
@@ -46,6 +46,10 @@ impl IdealDamperForceController {
         Ok(())
     }
 
+    fn reported_after_init(&self) -> Reported {
+        Reported::default()
+    }
+
     fn report(&mut self, t_end: f64, o: &IdfOutputs, diag: &mut Diagnostics) {
         let r = &mut self.reported;
         if o.saturated != r.saturated {
@@ -62,18 +66,13 @@ impl IdealDamperForceController {
             }
             r.saturated = o.saturated;
         }
-        if o.input_fault != r.input_fault {
-            if o.input_fault {
-                diag.warn(format!(
-                    "t = {t_end:.6} s: non-finite input, samples dropped and command held \
-                     ({} dropped so far)",
-                    o.dropped_samples
-                ));
-            } else {
-                diag.event(format!("t = {t_end:.6} s: inputs finite again"));
-            }
-            r.input_fault = o.input_fault;
-        }
+        report_input_fault(
+            t_end,
+            o.input_fault,
+            o.dropped_samples,
+            &mut r.input_fault,
+            diag,
+        );
     }
 }
 
@@ -214,30 +213,7 @@ impl FmuModel for IdealDamperForceController {
         })
     }
 
-    fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-        self.build()?;
-        self.reported = Reported::default();
-        self.initialized = true;
-        Ok(())
-    }
-
-    fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-        // No direct feedthrough; in initialization mode preview the parameters set so far.
-        if !self.initialized {
-            let _ = self.build();
-        }
-        Ok(())
-    }
-
-    fn do_step(&mut self, time: f64, step: f64, diag: &mut Diagnostics) -> Result<(), StepError> {
-        let out = self
-            .ctrl
-            .step(step, &self.inputs)
-            .map_err(|e| step_error(e, INPUT_NAMES))?;
-        self.report(time + step, &out, diag);
-        self.out = out;
-        Ok(())
-    }
+    board_life_cycle!(INPUT_NAMES);
 }
 
 const DOC: &str = r#"

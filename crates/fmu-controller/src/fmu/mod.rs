@@ -18,6 +18,48 @@
 //! * logging is on change only: controller updates, overrides, saturation and switching are
 //!   reported when they start or stop, never once per sample.
 
+/// `exit_initialization`, `update_outputs` and `do_step` of a board FMU, the same for the three
+/// controllers (inside `impl FmuModel`). The model provides the fields `ctrl` (with
+/// `step(h, &inputs)`), `inputs`, `out`, `initialized`, `reported` and the methods `build()`
+/// (controller and outputs from the parameters), `reported_after_init()` (what the log counts as
+/// already reported at the start) and `report(t_end, &out, diag)` (log changes);
+/// `$input_names` maps the physics' input fields to the FMI names for step errors.
+macro_rules! board_life_cycle {
+    ($input_names:expr) => {
+        fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
+            self.build()?;
+            self.reported = self.reported_after_init();
+            self.initialized = true;
+            Ok(())
+        }
+
+        fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
+            // No output depends on the current inputs (one-sample board delay). In
+            // initialization mode, preview the initial outputs of the parameters set so far;
+            // invalid values are reported by exit_initialization.
+            if !self.initialized {
+                let _ = self.build();
+            }
+            Ok(())
+        }
+
+        fn do_step(
+            &mut self,
+            time: f64,
+            step: f64,
+            diag: &mut Diagnostics,
+        ) -> Result<(), StepError> {
+            let out = self
+                .ctrl
+                .step(step, &self.inputs)
+                .map_err(|e| $crate::fmu::step_error(e, $input_names))?;
+            self.report(time + step, &out, diag);
+            self.out = out;
+            Ok(())
+        }
+    };
+}
+
 mod idf;
 mod mppt;
 mod skyhook;
@@ -26,7 +68,7 @@ pub use idf::IdealDamperForceController;
 pub use mppt::MpptController;
 pub use skyhook::SkyHookController;
 
-use model_description::{ModelError, StepError};
+use model_description::{Diagnostics, ModelError, StepError};
 
 use crate::{ParamError, StepError as PhysicsStepError};
 
@@ -69,6 +111,28 @@ fn step_error(e: PhysicsStepError, inputs: &[(&str, &str)]) -> StepError {
             })
         }
         other => StepError::Error(ModelError::Other(other.to_string())),
+    }
+}
+
+/// Log the start (warning) and the end (event) of the physics' hold path for non-finite
+/// samples; `reported` is the state last logged.
+fn report_input_fault(
+    t_end: f64,
+    input_fault: bool,
+    dropped_samples: u64,
+    reported: &mut bool,
+    diag: &mut Diagnostics,
+) {
+    if input_fault != *reported {
+        if input_fault {
+            diag.warn(format!(
+                "t = {t_end:.6} s: non-finite input, samples dropped and command held \
+                 ({dropped_samples} dropped so far)"
+            ));
+        } else {
+            diag.event(format!("t = {t_end:.6} s: inputs finite again"));
+        }
+        *reported = input_fault;
     }
 }
 

@@ -6,7 +6,7 @@ use model_description::{
 };
 use serde::{Deserialize, Serialize};
 
-use super::{param_error, sign_to_int, step_error, AUTHOR};
+use super::{param_error, report_input_fault, sign_to_int, AUTHOR};
 use crate::mppt::{ForceNormaliser, Mppt, MpptInputs, MpptOutputs, MpptParams};
 
 /// Physics field -> FMI variable name (for error messages).
@@ -67,6 +67,14 @@ impl MpptController {
         o.command_v <= self.params.command_min_v || o.command_v >= self.params.command_max_v
     }
 
+    /// A command starting at its limit is not news.
+    fn reported_after_init(&self) -> Reported {
+        Reported {
+            at_limit: self.at_limit(&self.out),
+            ..Reported::default()
+        }
+    }
+
     /// Log what changed in this step (never once per sample).
     fn report(&mut self, t_end: f64, o: &MpptOutputs, diag: &mut Diagnostics) {
         let r = &mut self.reported;
@@ -92,18 +100,13 @@ impl MpptController {
             }
             r.override_active = o.override_active;
         }
-        if o.input_fault != r.input_fault {
-            if o.input_fault {
-                diag.warn(format!(
-                    "t = {t_end:.6} s: non-finite input, samples dropped and command held \
-                     ({} dropped so far)",
-                    o.dropped_samples
-                ));
-            } else {
-                diag.event(format!("t = {t_end:.6} s: inputs finite again"));
-            }
-            r.input_fault = o.input_fault;
-        }
+        report_input_fault(
+            t_end,
+            o.input_fault,
+            o.dropped_samples,
+            &mut r.input_fault,
+            diag,
+        );
         let at_limit = self.at_limit(o);
         if at_limit != self.reported.at_limit {
             diag.event(if at_limit {
@@ -398,35 +401,7 @@ impl FmuModel for MpptController {
         })
     }
 
-    fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-        self.build()?;
-        self.reported = Reported {
-            at_limit: self.at_limit(&self.out),
-            ..Reported::default()
-        };
-        self.initialized = true;
-        Ok(())
-    }
-
-    fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-        // No output depends on the current inputs (one-sample board delay). In initialization
-        // mode, preview the initial outputs of the parameters set so far; invalid values are
-        // reported by exit_initialization.
-        if !self.initialized {
-            let _ = self.build();
-        }
-        Ok(())
-    }
-
-    fn do_step(&mut self, time: f64, step: f64, diag: &mut Diagnostics) -> Result<(), StepError> {
-        let out = self
-            .ctrl
-            .step(step, &self.inputs)
-            .map_err(|e| step_error(e, INPUT_NAMES))?;
-        self.report(time + step, &out, diag);
-        self.out = out;
-        Ok(())
-    }
+    board_life_cycle!(INPUT_NAMES);
 }
 
 const DOC: &str = r#"

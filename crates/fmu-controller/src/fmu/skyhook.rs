@@ -7,7 +7,7 @@ use model_description::{
 };
 use serde::{Deserialize, Serialize};
 
-use super::{invalid, param_error, sign_to_int, step_error, AUTHOR};
+use super::{invalid, param_error, report_input_fault, sign_to_int, AUTHOR};
 use crate::skyhook::{
     DampingTable, SkyHook, SkyHookInputs, SkyHookMode, SkyHookOutputs, SkyHookParams,
     VelocitySource, DAMPING_TABLE_4HZ,
@@ -136,6 +136,14 @@ impl SkyHookController {
         Ok(())
     }
 
+    /// The switching state at the start is not news.
+    fn reported_after_init(&self) -> Reported {
+        Reported {
+            on_state: self.out.on_state,
+            input_fault: false,
+        }
+    }
+
     fn report(&mut self, t_end: f64, o: &SkyHookOutputs, diag: &mut Diagnostics) {
         let r = &mut self.reported;
         if o.on_state != r.on_state {
@@ -149,18 +157,13 @@ impl SkyHookController {
             ));
             r.on_state = o.on_state;
         }
-        if o.input_fault != r.input_fault {
-            if o.input_fault {
-                diag.warn(format!(
-                    "t = {t_end:.6} s: non-finite input, samples dropped and command held \
-                     ({} dropped so far)",
-                    o.dropped_samples
-                ));
-            } else {
-                diag.event(format!("t = {t_end:.6} s: inputs finite again"));
-            }
-            r.input_fault = o.input_fault;
-        }
+        report_input_fault(
+            t_end,
+            o.input_fault,
+            o.dropped_samples,
+            &mut r.input_fault,
+            diag,
+        );
     }
 }
 
@@ -410,33 +413,7 @@ impl FmuModel for SkyHookController {
         })
     }
 
-    fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-        self.build()?;
-        self.reported = Reported {
-            on_state: self.out.on_state,
-            input_fault: false,
-        };
-        self.initialized = true;
-        Ok(())
-    }
-
-    fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-        // No direct feedthrough; in initialization mode preview the parameters set so far.
-        if !self.initialized {
-            let _ = self.build();
-        }
-        Ok(())
-    }
-
-    fn do_step(&mut self, time: f64, step: f64, diag: &mut Diagnostics) -> Result<(), StepError> {
-        let out = self
-            .ctrl
-            .step(step, &self.inputs)
-            .map_err(|e| step_error(e, INPUT_NAMES))?;
-        self.report(time + step, &out, diag);
-        self.out = out;
-        Ok(())
-    }
+    board_life_cycle!(INPUT_NAMES);
 }
 
 const DOC: &str = r#"
