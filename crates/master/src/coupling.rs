@@ -444,43 +444,30 @@ impl Engine<'_, '_, '_, '_> {
                 return Ok(());
             };
             let name = self.slaves[i].name().to_string();
-            if !retry {
+            let refusal = if !retry {
+                Some("step retry is off (max_step_halvings = 0)".to_string())
+            } else if let Some(l) = lacking {
+                Some(format!(
+                    "cannot retry: instance '{}' does not support canGetAndSetFMUstate",
+                    self.slaves[l].name()
+                ))
+            } else if let Some(l) = fixed {
+                Some(format!(
+                    "cannot retry with smaller steps: instance '{}' does not support \
+                     canHandleVariableCommunicationStepSize",
+                    self.slaves[l].name()
+                ))
+            } else if halvings >= self.plan.max_step_halvings {
+                Some(format!("still discarded after {halvings} halvings"))
+            } else {
+                None
+            };
+            if let Some(reason) = refusal {
                 return Err(SimError::Discarded {
                     time: t,
                     instance: name,
                     step: h / parts as f64,
-                    reason: "step retry is off (max_step_halvings = 0)".into(),
-                });
-            }
-            if let Some(l) = lacking {
-                return Err(SimError::Discarded {
-                    time: t,
-                    instance: name,
-                    step: h / parts as f64,
-                    reason: format!(
-                        "cannot retry: instance '{}' does not support canGetAndSetFMUstate",
-                        self.slaves[l].name()
-                    ),
-                });
-            }
-            if let Some(l) = fixed {
-                return Err(SimError::Discarded {
-                    time: t,
-                    instance: name,
-                    step: h / parts as f64,
-                    reason: format!(
-                        "cannot retry with smaller steps: instance '{}' does not support \
-                         canHandleVariableCommunicationStepSize",
-                        self.slaves[l].name()
-                    ),
-                });
-            }
-            if halvings >= self.plan.max_step_halvings {
-                return Err(SimError::Discarded {
-                    time: t,
-                    instance: name,
-                    step: h / parts as f64,
-                    reason: format!("still discarded after {halvings} halvings"),
+                    reason,
                 });
             }
             for j in 0..self.slaves.len() {
