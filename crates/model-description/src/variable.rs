@@ -181,24 +181,33 @@ impl<M> Clone for Variable<M> {
 }
 
 impl<M> Variable<M> {
-    fn new(name: &str, description: &str, access: Access<M>) -> Self {
+    /// The one constructor behind the typed ones: parameters (also calculated ones) are fixed,
+    /// other Real variables continuous, other types discrete; `feedthrough` is for outputs only.
+    fn new(
+        name: &str,
+        description: &str,
+        causality: Causality,
+        feedthrough: &[&'static str],
+        access: Access<M>,
+    ) -> Self {
         let var_type = access.var_type();
+        let variability = match causality {
+            Causality::Parameter | Causality::CalculatedParameter => Variability::Fixed,
+            _ if var_type == VarType::Real => Variability::Continuous,
+            _ => Variability::Discrete,
+        };
         Variable {
             meta: VarMeta {
                 name: name.to_string(),
                 description: description.to_string(),
                 var_type,
-                causality: Causality::Local,
-                variability: if var_type == VarType::Real {
-                    Variability::Continuous
-                } else {
-                    Variability::Discrete
-                },
+                causality,
+                variability,
                 unit: None,
                 display_unit: None,
                 min: None,
                 max: None,
-                feedthrough: Vec::new(),
+                feedthrough: feedthrough.to_vec(),
             },
             access,
         }
@@ -211,17 +220,11 @@ impl<M> Variable<M> {
         get: fn(&M) -> f64,
         set: fn(&mut M, f64),
     ) -> Self {
-        let mut v = Self::new(
-            name,
-            description,
-            Access::Real {
-                get,
-                set: Some(set),
-            },
-        );
-        v.meta.causality = Causality::Parameter;
-        v.meta.variability = Variability::Fixed;
-        v
+        let access = Access::Real {
+            get,
+            set: Some(set),
+        };
+        Self::new(name, description, Causality::Parameter, &[], access)
     }
 
     /// A fixed Integer parameter (enumerations are declared as Integer with min/max).
@@ -231,17 +234,11 @@ impl<M> Variable<M> {
         get: fn(&M) -> i32,
         set: fn(&mut M, i32),
     ) -> Self {
-        let mut v = Self::new(
-            name,
-            description,
-            Access::Integer {
-                get,
-                set: Some(set),
-            },
-        );
-        v.meta.causality = Causality::Parameter;
-        v.meta.variability = Variability::Fixed;
-        v
+        let access = Access::Integer {
+            get,
+            set: Some(set),
+        };
+        Self::new(name, description, Causality::Parameter, &[], access)
     }
 
     /// A fixed Boolean parameter.
@@ -251,17 +248,11 @@ impl<M> Variable<M> {
         get: fn(&M) -> bool,
         set: fn(&mut M, bool),
     ) -> Self {
-        let mut v = Self::new(
-            name,
-            description,
-            Access::Boolean {
-                get,
-                set: Some(set),
-            },
-        );
-        v.meta.causality = Causality::Parameter;
-        v.meta.variability = Variability::Fixed;
-        v
+        let access = Access::Boolean {
+            get,
+            set: Some(set),
+        };
+        Self::new(name, description, Causality::Parameter, &[], access)
     }
 
     /// A fixed String parameter (e.g. a file path).
@@ -271,31 +262,20 @@ impl<M> Variable<M> {
         get: fn(&M) -> String,
         set: fn(&mut M, &str),
     ) -> Self {
-        let mut v = Self::new(
-            name,
-            description,
-            Access::String {
-                get,
-                set: Some(set),
-            },
-        );
-        v.meta.causality = Causality::Parameter;
-        v.meta.variability = Variability::Fixed;
-        v
+        let access = Access::String {
+            get,
+            set: Some(set),
+        };
+        Self::new(name, description, Causality::Parameter, &[], access)
     }
 
     /// A continuous Real input.
     pub fn input(name: &str, description: &str, get: fn(&M) -> f64, set: fn(&mut M, f64)) -> Self {
-        let mut v = Self::new(
-            name,
-            description,
-            Access::Real {
-                get,
-                set: Some(set),
-            },
-        );
-        v.meta.causality = Causality::Input;
-        v
+        let access = Access::Real {
+            get,
+            set: Some(set),
+        };
+        Self::new(name, description, Causality::Input, &[], access)
     }
 
     /// A continuous Real output. `feedthrough` lists the inputs it depends on at the same
@@ -307,10 +287,8 @@ impl<M> Variable<M> {
         feedthrough: &[&'static str],
         get: fn(&M) -> f64,
     ) -> Self {
-        let mut v = Self::new(name, description, Access::Real { get, set: None });
-        v.meta.causality = Causality::Output;
-        v.meta.feedthrough = feedthrough.to_vec();
-        v
+        let access = Access::Real { get, set: None };
+        Self::new(name, description, Causality::Output, feedthrough, access)
     }
 
     /// A discrete Integer output.
@@ -320,10 +298,8 @@ impl<M> Variable<M> {
         feedthrough: &[&'static str],
         get: fn(&M) -> i32,
     ) -> Self {
-        let mut v = Self::new(name, description, Access::Integer { get, set: None });
-        v.meta.causality = Causality::Output;
-        v.meta.feedthrough = feedthrough.to_vec();
-        v
+        let access = Access::Integer { get, set: None };
+        Self::new(name, description, Causality::Output, feedthrough, access)
     }
 
     /// A discrete Boolean output.
@@ -333,23 +309,26 @@ impl<M> Variable<M> {
         feedthrough: &[&'static str],
         get: fn(&M) -> bool,
     ) -> Self {
-        let mut v = Self::new(name, description, Access::Boolean { get, set: None });
-        v.meta.causality = Causality::Output;
-        v.meta.feedthrough = feedthrough.to_vec();
-        v
+        let access = Access::Boolean { get, set: None };
+        Self::new(name, description, Causality::Output, feedthrough, access)
     }
 
     /// A Real parameter computed from others at initialisation (read-only).
     pub fn calculated_parameter(name: &str, description: &str, get: fn(&M) -> f64) -> Self {
-        let mut v = Self::new(name, description, Access::Real { get, set: None });
-        v.meta.causality = Causality::CalculatedParameter;
-        v.meta.variability = Variability::Fixed;
-        v
+        let access = Access::Real { get, set: None };
+        Self::new(
+            name,
+            description,
+            Causality::CalculatedParameter,
+            &[],
+            access,
+        )
     }
 
     /// A Real local variable (observable, not settable).
     pub fn local(name: &str, description: &str, get: fn(&M) -> f64) -> Self {
-        Self::new(name, description, Access::Real { get, set: None })
+        let access = Access::Real { get, set: None };
+        Self::new(name, description, Causality::Local, &[], access)
     }
 
     /// Unit (must be one of [`crate::units::UNITS`]).
