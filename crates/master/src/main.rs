@@ -42,6 +42,8 @@ enum Command {
     ContactGeometry(commands::contact_geometry::Args),
     /// The stability study: passive, semi-active and full-active yaw dampers, EN 14363 report.
     Study(commands::study::Args),
+    /// EN 14363 stability assessment of recorded signals (ours or a host's export).
+    Assess(commands::assess::Args),
 }
 
 fn main() -> ExitCode {
@@ -68,6 +70,7 @@ fn main() -> ExitCode {
         Command::RootLocus(a) => commands::root_locus::execute(a, &ctx),
         Command::ContactGeometry(a) => commands::contact_geometry::execute(a, &ctx),
         Command::Study(a) => commands::study::execute(a, &ctx),
+        Command::Assess(a) => commands::assess::execute(a, &ctx),
     };
     match res {
         Ok(()) => ExitCode::SUCCESS,

@@ -360,3 +360,85 @@ fn root_locus_damper_options() {
     let r = master(&["root-locus", "--from", "300", "--to", "200"]);
     assert!(!r.ok && r.stderr.contains("--to"), "{}", r.stderr);
 }
+
+/// `master assess` on a synthetic record (two signals, one over the limit) and on bad input.
+#[test]
+fn assess_reports_the_en14363_verdict_and_refuses_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("record.csv");
+    // 12 s at 500 Hz, 4 Hz sines: rms 4.24 (within 5.39) and 5.66 m/s2 (over)
+    let mut text = String::from("time [s],front [m/s2],rear [m/s2]\n");
+    for k in 0..6000 {
+        let t = k as f64 / 500.0;
+        let s = (2.0 * std::f64::consts::PI * 4.0 * t).sin();
+        text.push_str(&format!("{t},{},{}\n", 6.0 * s, 8.0 * s));
+    }
+    std::fs::write(&csv, &text).unwrap();
+    let out = dir.path().join("a");
+    let csv_s = csv.to_str().unwrap();
+    let out_s = out.to_str().unwrap();
+    let r = master(&[
+        "assess", csv_s, "--signal", "front", "--speed", "300", "--out", out_s,
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(r.stdout.contains("verdict: stable"), "{}", r.stdout);
+    assert!(
+        (number_after(&r.stdout, "max rms") - 4.243).abs() < 0.08,
+        "{}",
+        r.stdout
+    );
+    check_files(&out, &["assess.csv", "assess.svg", "assess_summary.csv"]);
+    let r = master(&[
+        "assess",
+        csv_s,
+        "--signal",
+        "front",
+        "--signal",
+        "rear [m/s2]",
+        "--speed",
+        "300",
+        "--out",
+        out_s,
+    ]);
+    assert!(
+        r.ok && r.stdout.contains("verdict: unstable"),
+        "{}",
+        r.stdout
+    );
+    assert!(r.stdout.contains("LIMIT EXCEEDED"), "{}", r.stdout);
+
+    // unknown signal, wrong unit, non-uniform time: exit 1, message, nothing written
+    let none = dir.path().join("none");
+    let none_s = none.to_str().unwrap();
+    let r = master(&[
+        "assess", csv_s, "--signal", "middle", "--speed", "300", "--out", none_s,
+    ]);
+    assert!(!r.ok && r.stderr.contains("no signal 'middle'") && r.stderr.contains("front"));
+    let r = master(&[
+        "assess",
+        csv_s,
+        "--signal",
+        "front",
+        "--quantity",
+        "guiding-force",
+        "--speed",
+        "300",
+        "--out",
+        none_s,
+    ]);
+    assert!(!r.ok && r.stderr.contains("wrong unit"), "{}", r.stderr);
+    let bad = dir.path().join("bad.csv");
+    std::fs::write(&bad, "time,a\n0,1\n0.1,2\n0.3,3\n0.4,x\n").unwrap();
+    let r = master(&[
+        "assess",
+        bad.to_str().unwrap(),
+        "--signal",
+        "a",
+        "--speed",
+        "300",
+        "--out",
+        none_s,
+    ]);
+    assert!(!r.ok && r.stderr.contains("bad.csv:5"), "{}", r.stderr);
+    assert!(!none.exists(), "nothing may be written on error");
+}

@@ -1,4 +1,4 @@
-//! Offline analyses behind the `characterise`, `contact-geometry` and `root-locus`
+//! Offline analyses behind the `characterise`, `contact-geometry`, `root-locus` and `assess`
 //! subcommands: plain functions that compute data from the physics crates and turn it into
 //! in-memory result files ([`Artefacts`]: CSV text and SVG figures). The commands only parse
 //! options, call these, print a summary and write the artefacts, so a failure anywhere before
@@ -9,12 +9,14 @@
 //! * [`damper`]: hysteresis loops, damper FRFs, actuator FRFs (crate `fmu-damper`).
 //! * [`geometry`]: wheel/rail contact tables and equivalent conicity (crate `wheel-rail`).
 //! * [`locus`]: eigenvalues of the linear bogie over speed (crate `fmu-bogie2dof`).
+//! * [`assess`]: EN 14363 assessment of recorded signals (ours or a host's export).
 
 use std::path::{Path, PathBuf};
 
 use crate::output::{csv_field, write_bytes_atomic, OutputError};
 use crate::plot::{Chart, PlotError};
 
+pub mod assess;
 pub mod damper;
 pub mod figures;
 pub mod geometry;
@@ -37,6 +39,9 @@ pub enum AnalysisError {
     Geometry(String),
     #[error("bogie model: {0}")]
     Bogie(String),
+    /// A results table or signal that cannot be assessed (message names file, line, column).
+    #[error("{0}")]
+    Input(String),
     #[error("invalid option {option} = {value}: {reason}")]
     Option {
         option: &'static str,

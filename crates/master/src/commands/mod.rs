@@ -5,6 +5,7 @@
 
 use std::sync::atomic::AtomicBool;
 
+pub mod assess;
 pub mod characterise;
 pub mod contact_geometry;
 pub mod inspect;

@@ -1,0 +1,521 @@
+//! EN 14363 running-stability assessment of recorded signals (`master assess`): reads a results
+//! table (ours from `master run`/`study`, or a host's export such as Simpack's), picks the
+//! signals, and applies [`crate::en14363`] (band-pass +-2 Hz around the dominant frequency, rms
+//! over 100 m windows in 10 m steps) with the lateral-acceleration limit `(12 - m_bogie/5)/2`
+//! or the sum-of-guiding-forces limit `(10 + 2 Q0/3)/2`.
+//!
+//! Input format: one header line of column names, the first column the time in seconds; then
+//! one row of numbers per sample, uniformly sampled. Separators: comma (our CSV, with optional
+//! double quotes around names), semicolon, or whitespace. Lines starting with `#` are
+//! comments. A column is selected by its full name or by the name without a trailing
+//! ` [unit]`; a unit in brackets is checked against the criterion (m/s2 for accelerations; N or
+//! kN for forces, kN converted).
+
+use std::path::{Path, PathBuf};
+
+use super::{AnalysisError, Artefacts, Table};
+use crate::en14363::{
+    assess_guiding_forces, assess_lateral_acceleration, AssessError, Assessment, StabilitySettings,
+};
+use crate::plot::Chart;
+
+/// Which EN 14363 quantity the signals are.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Criterion {
+    /// Lateral acceleration [m/s^2]; limit from the bogie mass [t].
+    LateralAcceleration { bogie_mass_t: f64 },
+    /// Sum of guiding forces of a wheelset [N]; limit from the static wheel load [N].
+    GuidingForces { static_wheel_load_n: f64 },
+}
+
+/// A parsed results table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResultsTable {
+    pub path: PathBuf,
+    /// Column names as written (the first is the time).
+    pub names: Vec<String>,
+    /// Column-major values.
+    pub columns: Vec<Vec<f64>>,
+}
+
+fn bad_file(path: &Path, line: usize, reason: String) -> AnalysisError {
+    AnalysisError::Input(format!("{}:{line}: {reason}", path.display()))
+}
+
+fn split_fields(line: &str, sep: Option<char>) -> Vec<String> {
+    let fields: Vec<&str> = match sep {
+        Some(c) => line.split(c).collect(),
+        None => line.split_whitespace().collect(),
+    };
+    fields
+        .iter()
+        .map(|f| f.trim().trim_matches('"').trim().to_string())
+        .collect()
+}
+
+/// `name [unit]` -> (`name`, `Some(unit)`).
+fn split_unit(name: &str) -> (&str, Option<&str>) {
+    match (name.rfind(" ["), name.ends_with(']')) {
+        (Some(i), true) => (&name[..i], Some(&name[i + 2..name.len() - 1])),
+        _ => (name, None),
+    }
+}
+
+impl ResultsTable {
+    /// Parses `text` (the content of `path`, named in errors with the line number).
+    pub fn parse(text: &str, path: &Path) -> Result<Self, AnalysisError> {
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| (i + 1, l.trim()))
+            .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+        let Some((_, header)) = lines.next() else {
+            return Err(bad_file(path, 1, "no header line".into()));
+        };
+        let sep = if header.contains(',') {
+            Some(',')
+        } else if header.contains(';') {
+            Some(';')
+        } else {
+            None
+        };
+        // names may contain commas inside quotes (our writer quotes them)
+        let names = if sep == Some(',') && header.contains('"') {
+            parse_quoted_header(header)
+        } else {
+            split_fields(header, sep)
+        };
+        if names.len() < 2 {
+            return Err(bad_file(
+                path,
+                1,
+                "the header needs a time column and at least one signal".into(),
+            ));
+        }
+        let mut columns = vec![Vec::new(); names.len()];
+        for (no, line) in lines {
+            let fields = split_fields(line, sep);
+            if fields.len() != names.len() {
+                return Err(bad_file(
+                    path,
+                    no,
+                    format!("{} fields, the header has {}", fields.len(), names.len()),
+                ));
+            }
+            for (k, f) in fields.iter().enumerate() {
+                let v: f64 = f.parse().map_err(|_| {
+                    bad_file(
+                        path,
+                        no,
+                        format!("'{f}' in column '{}' is not a number", names[k]),
+                    )
+                })?;
+                if !v.is_finite() {
+                    return Err(bad_file(
+                        path,
+                        no,
+                        format!("{v} in column '{}' is not finite", names[k]),
+                    ));
+                }
+                columns[k].push(v);
+            }
+        }
+        Ok(ResultsTable {
+            path: path.to_path_buf(),
+            names,
+            columns,
+        })
+    }
+
+    /// Reads and parses a file.
+    pub fn load(path: &Path) -> Result<Self, AnalysisError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| AnalysisError::Input(format!("{}: {e}", path.display())))?;
+        Self::parse(&text, path)
+    }
+
+    /// Index of a column by full name or by name without its ` [unit]`.
+    pub fn find(&self, name: &str) -> Result<usize, AnalysisError> {
+        let hits: Vec<usize> = (1..self.names.len())
+            .filter(|&i| self.names[i] == name || split_unit(&self.names[i]).0 == name)
+            .collect();
+        match hits.as_slice() {
+            [i] => Ok(*i),
+            [] => {
+                let list: Vec<&str> = self.names[1..].iter().map(|n| split_unit(n).0).collect();
+                Err(AnalysisError::Input(format!(
+                    "{}: no signal '{name}'; the signals are: {}",
+                    self.path.display(),
+                    list.join(", ")
+                )))
+            }
+            _ => Err(AnalysisError::Input(format!(
+                "{}: '{name}' matches several columns; give the full name with its unit",
+                self.path.display()
+            ))),
+        }
+    }
+
+    /// Sampling rate from the time column [Hz]; the sampling must be uniform.
+    pub fn sampling_rate_hz(&self) -> Result<f64, AnalysisError> {
+        let t = &self.columns[0];
+        if t.len() < 3 {
+            return Err(AnalysisError::Input(format!(
+                "{}: {} samples, too few to assess",
+                self.path.display(),
+                t.len()
+            )));
+        }
+        let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
+        if dt.is_nan() || dt <= 0.0 {
+            return Err(AnalysisError::Input(format!(
+                "{}: the time column (first column) does not increase",
+                self.path.display()
+            )));
+        }
+        for w in t.windows(2) {
+            if ((w[1] - w[0]) - dt).abs() > 1e-6 * dt + 1e-12 {
+                return Err(AnalysisError::Input(format!(
+                    "{}: the time column is not uniformly sampled (step {} s after t = {} s, \
+                     mean step {dt} s): resample the signals first",
+                    self.path.display(),
+                    w[1] - w[0],
+                    w[0]
+                )));
+            }
+        }
+        Ok(1.0 / dt)
+    }
+}
+
+/// Header fields split on commas outside double quotes.
+fn parse_quoted_header(line: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut cur = String::new();
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' if quoted && chars.peek() == Some(&'"') => {
+                cur.push('"');
+                chars.next();
+            }
+            '"' => quoted = !quoted,
+            ',' if !quoted => out.push(std::mem::take(&mut cur).trim().to_string()),
+            _ => cur.push(c),
+        }
+    }
+    out.push(cur.trim().to_string());
+    out
+}
+
+/// The assessment of each selected signal and the overall verdict.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AssessReport {
+    pub criterion: Criterion,
+    pub speed_kmh: f64,
+    /// (signal name as given, its assessment)
+    pub signals: Vec<(String, Assessment)>,
+}
+
+impl AssessReport {
+    pub fn max_rms(&self) -> f64 {
+        self.signals
+            .iter()
+            .map(|(_, a)| a.max_rms)
+            .fold(0.0, f64::max)
+    }
+
+    pub fn limit(&self) -> f64 {
+        self.signals.first().map_or(f64::NAN, |(_, a)| a.limit)
+    }
+
+    pub fn stable(&self) -> bool {
+        self.signals.iter().all(|(_, a)| a.stable)
+    }
+
+    fn unit(&self) -> &'static str {
+        match self.criterion {
+            Criterion::LateralAcceleration { .. } => "m/s2",
+            Criterion::GuidingForces { .. } => "kN",
+        }
+    }
+
+    /// Text printed by the command.
+    pub fn summary(&self) -> String {
+        let u = self.unit();
+        let mut s = format!(
+            "EN 14363 rms criterion at {:.1} km/h, limit {:.3} {u}\n",
+            self.speed_kmh,
+            self.limit()
+        );
+        for (name, a) in &self.signals {
+            s.push_str(&format!(
+                "  {name}: dominant {:.2} Hz, band {:.2}-{:.2} Hz, max rms {:.3} {u} over {} windows: {}\n",
+                a.dominant_frequency_hz,
+                a.band_hz.0,
+                a.band_hz.1,
+                a.max_rms,
+                a.rms.len(),
+                if a.stable { "within the limit" } else { "LIMIT EXCEEDED" }
+            ));
+        }
+        s.push_str(&format!(
+            "verdict: {} (max rms {:.3} {u}, {:.0} % of the limit)\n",
+            if self.stable() { "stable" } else { "unstable" },
+            self.max_rms(),
+            100.0 * self.max_rms() / self.limit()
+        ));
+        s
+    }
+
+    /// assess.csv (rms along the track per signal) and assess.svg.
+    pub fn add_artefacts(&self, files: &mut Artefacts) -> Result<(), AnalysisError> {
+        let u = self.unit();
+        let mut t = Table::new(&["signal index", "window centre [m]", &format!("rms [{u}]")]);
+        let mut chart = Chart::new(
+            &format!("EN 14363 rms at {:.1} km/h", self.speed_kmh),
+            "position along the track [m]",
+            &format!("rms [{u}]"),
+        );
+        for (k, (name, a)) in self.signals.iter().enumerate() {
+            for &(x, r) in &a.rms {
+                t.rows.push(vec![k as f64, x, r]);
+            }
+            chart = chart.with_series(name, a.rms.clone());
+        }
+        chart = chart.with_limit(self.limit(), "limit");
+        files.add_table("assess.csv", &t)?;
+        files.add_lines("assess.svg", &chart)?;
+        let mut legend =
+            String::from("signal index,signal,dominant frequency [Hz],max rms,limit,stable\n");
+        for (k, (name, a)) in self.signals.iter().enumerate() {
+            legend.push_str(&format!(
+                "{k},{},{},{},{},{}\n",
+                crate::output::csv_field(name),
+                a.dominant_frequency_hz,
+                a.max_rms,
+                a.limit,
+                a.stable
+            ));
+        }
+        files.add_text("assess_summary.csv", legend);
+        Ok(())
+    }
+}
+
+fn check_unit(
+    table: &ResultsTable,
+    col: usize,
+    criterion: Criterion,
+) -> Result<f64, AnalysisError> {
+    let (_, unit) = split_unit(&table.names[col]);
+    let scale = match (criterion, unit) {
+        (_, None) => Some(1.0),
+        (Criterion::LateralAcceleration { .. }, Some(u)) => {
+            matches!(u, "m/s2" | "m/s^2" | "m s-2").then_some(1.0)
+        }
+        (Criterion::GuidingForces { .. }, Some("N")) => Some(1.0),
+        (Criterion::GuidingForces { .. }, Some("kN")) => Some(1e3),
+        (Criterion::GuidingForces { .. }, Some(_)) => None,
+    };
+    scale.ok_or_else(|| {
+        AnalysisError::Input(format!(
+            "{}: column '{}' has the wrong unit for the {} criterion",
+            table.path.display(),
+            table.names[col],
+            match criterion {
+                Criterion::LateralAcceleration { .. } => "lateral-acceleration (m/s2)",
+                Criterion::GuidingForces { .. } => "guiding-force (N or kN)",
+            }
+        ))
+    })
+}
+
+/// Assesses each named signal of `table` at a constant `speed_kmh`.
+pub fn assess_table(
+    table: &ResultsTable,
+    signals: &[String],
+    speed_kmh: f64,
+    criterion: Criterion,
+    settings: &StabilitySettings,
+) -> Result<AssessReport, AnalysisError> {
+    if signals.is_empty() {
+        return Err(AnalysisError::Input("no --signal given".into()));
+    }
+    if !(speed_kmh.is_finite() && speed_kmh > 0.0) {
+        return Err(AnalysisError::Option {
+            option: "--speed",
+            value: speed_kmh.to_string(),
+            reason: "must be a speed > 0 km/h".into(),
+        });
+    }
+    let fs = table.sampling_rate_hz()?;
+    let duration = table.columns[0].len() as f64 / fs;
+    let assessed_m = (duration - settings.skip_s) * speed_kmh / 3.6;
+    if assessed_m < settings.window_m {
+        return Err(AnalysisError::Input(format!(
+            "{}: {duration:.2} s at {speed_kmh} km/h minus {} s skipped covers {assessed_m:.0} m, \
+             less than one {} m window",
+            table.path.display(),
+            settings.skip_s,
+            settings.window_m
+        )));
+    }
+    let mut out = Vec::with_capacity(signals.len());
+    for name in signals {
+        let col = table.find(name)?;
+        let scale = check_unit(table, col, criterion)?;
+        let x: Vec<f64> = table.columns[col].iter().map(|v| v * scale).collect();
+        let a = match criterion {
+            Criterion::LateralAcceleration { bogie_mass_t } => {
+                assess_lateral_acceleration(&x, fs, speed_kmh / 3.6, bogie_mass_t, settings)
+            }
+            Criterion::GuidingForces {
+                static_wheel_load_n,
+            } => assess_guiding_forces(&x, fs, speed_kmh / 3.6, static_wheel_load_n, settings),
+        }
+        .map_err(|e: AssessError| AnalysisError::Input(format!("signal '{name}': {e}")))?;
+        out.push((name.clone(), a));
+    }
+    Ok(AssessReport {
+        criterion,
+        speed_kmh,
+        signals: out,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    fn sine_table(amp: f64, f: f64, fs: f64, secs: f64, unit: &str) -> String {
+        let n = (secs * fs) as usize;
+        let mut s = format!("time [s],\"a, quoted [{unit}]\",other [m]\n");
+        for k in 0..n {
+            let t = k as f64 / fs;
+            s.push_str(&format!("{t},{},{}\n", amp * (2.0 * PI * f * t).sin(), 0.0));
+        }
+        s
+    }
+
+    #[test]
+    fn sine_of_known_rms_is_assessed_against_the_limit() {
+        // amplitude 6 m/s2 -> rms 4.24 < 5.39; amplitude 8 -> 5.66 > 5.39
+        for (amp, stable) in [(6.0, true), (8.0, false)] {
+            let table = ResultsTable::parse(
+                &sine_table(amp, 4.0, 500.0, 10.0, "m/s2"),
+                Path::new("x.csv"),
+            )
+            .unwrap();
+            let r = assess_table(
+                &table,
+                &["a, quoted".to_string()],
+                300.0,
+                Criterion::LateralAcceleration { bogie_mass_t: 6.1 },
+                &StabilitySettings::default(),
+            )
+            .unwrap();
+            let a = &r.signals[0].1;
+            assert!((a.dominant_frequency_hz - 4.0).abs() < 0.1, "{a:?}");
+            assert!((r.limit() - 5.39).abs() < 1e-12);
+            assert!(
+                (a.max_rms - amp / 2f64.sqrt()).abs() < 0.02 * amp,
+                "{} vs {}",
+                a.max_rms,
+                amp / 2f64.sqrt()
+            );
+            assert_eq!(r.stable(), stable);
+            let mut files = Artefacts::default();
+            r.add_artefacts(&mut files).unwrap();
+            assert_eq!(
+                files.names(),
+                vec!["assess.csv", "assess.svg", "assess_summary.csv"]
+            );
+            assert!(r.summary().contains(if stable {
+                "verdict: stable"
+            } else {
+                "verdict: unstable"
+            }));
+        }
+    }
+
+    #[test]
+    fn forces_in_kn_are_converted_and_wrong_units_refused() {
+        let text = sine_table(20.0, 5.0, 500.0, 10.0, "kN");
+        let table = ResultsTable::parse(&text, Path::new("f.csv")).unwrap();
+        let r = assess_table(
+            &table,
+            &["a, quoted".to_string()],
+            300.0,
+            Criterion::GuidingForces {
+                static_wheel_load_n: 70e3,
+            },
+            &StabilitySettings::default(),
+        )
+        .unwrap();
+        // reported in kN: 20 kN amplitude -> 14.1 kN rms against (10 + 2*70/3)/2 = 28.3 kN
+        assert!(
+            (r.signals[0].1.max_rms - 14.14).abs() < 0.3,
+            "{:?}",
+            r.signals[0].1.max_rms
+        );
+        assert!(r.stable());
+        let e = assess_table(
+            &table,
+            &["a, quoted".to_string()],
+            300.0,
+            Criterion::LateralAcceleration { bogie_mass_t: 6.1 },
+            &StabilitySettings::default(),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("wrong unit"), "{e}");
+    }
+
+    #[test]
+    fn bad_tables_name_the_file_and_line() {
+        let p = Path::new("bad.csv");
+        let e = ResultsTable::parse("time,a\n0,1\n0.1,x\n", p).unwrap_err();
+        assert!(
+            e.to_string().contains("bad.csv:3") && e.to_string().contains("'x'"),
+            "{e}"
+        );
+        let e = ResultsTable::parse("time,a\n0,1,2\n", p).unwrap_err();
+        assert!(e.to_string().contains("bad.csv:2"), "{e}");
+        let e = ResultsTable::parse("time,a\n0,NaN\n", p).unwrap_err();
+        assert!(e.to_string().contains("not finite"), "{e}");
+        let e = ResultsTable::parse("# only a comment\n", p).unwrap_err();
+        assert!(e.to_string().contains("no header"), "{e}");
+        // whitespace and semicolons, comments
+        let t = ResultsTable::parse("# c\ntime a b\n0 1 2\n1 3 4\n", p).unwrap();
+        assert_eq!(t.columns[2], vec![2.0, 4.0]);
+        let t = ResultsTable::parse("time;a\n0;1\n", p).unwrap();
+        assert_eq!(t.names, vec!["time", "a"]);
+        // unknown signal lists the available ones
+        let e = t.find("b").unwrap_err();
+        assert!(e.to_string().contains("the signals are: a"), "{e}");
+        // non-uniform time
+        let t = ResultsTable::parse("time,a\n0,1\n0.1,1\n0.3,1\n0.4,1\n", p).unwrap();
+        let e = t.sampling_rate_hz().unwrap_err();
+        assert!(e.to_string().contains("not uniformly sampled"), "{e}");
+    }
+
+    #[test]
+    fn too_short_records_are_refused() {
+        let table = ResultsTable::parse(
+            &sine_table(1.0, 4.0, 200.0, 1.0, "m/s2"),
+            Path::new("s.csv"),
+        )
+        .unwrap();
+        let e = assess_table(
+            &table,
+            &["other".to_string()],
+            200.0,
+            Criterion::LateralAcceleration { bogie_mass_t: 6.1 },
+            &StabilitySettings::default(),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("less than one 100 m window"), "{e}");
+    }
+}

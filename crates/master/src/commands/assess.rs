@@ -1,0 +1,78 @@
+//! `master assess`: EN 14363 running-stability assessment of recorded signals (computation in
+//! [`crate::analysis::assess`]).
+
+use std::path::PathBuf;
+
+use super::{CommandError, Context};
+use crate::analysis::assess::{assess_table, Criterion, ResultsTable};
+use crate::analysis::{print_report, Artefacts};
+use crate::en14363::StabilitySettings;
+
+/// EN 14363 quantity of the signals.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Quantity {
+    /// Lateral acceleration of the bogie frame / wheelset [m/s2]; limit (12 - m_bogie/5)/2.
+    Acceleration,
+    /// Sum of guiding forces of a wheelset [N or kN]; limit (10 + 2 Q0/3)/2 kN.
+    GuidingForce,
+}
+
+/// Options of `master assess`.
+#[derive(Debug, clap::Args)]
+#[command(
+    after_help = "Applies the EN 14363 rms stability criterion as the seed does (section 4.2): band-pass +-2 Hz around the dominant frequency of each signal, rms over 100 m of track in 10 m steps at the given constant speed, maximum compared with the limit. Works on our results CSV (`master run`, the study's runs) or on a host's export (Simpack, ...): first column the time in seconds, uniformly sampled; separators comma, semicolon or whitespace; '#' comment lines.\n\nFiles: assess.csv (rms per window), assess_summary.csv (per signal), assess.svg (rms along the track with the limit). Exit status 0 whether or not the limit is exceeded (read the verdict line); 1 when the input cannot be assessed (nothing is written then)."
+)]
+pub struct Args {
+    /// Results table (CSV or whitespace separated).
+    pub table: PathBuf,
+    /// Signal to assess: column name, with or without its " [unit]"; repeat for several
+    /// (e.g. front and rear wheelset), the verdict takes the largest rms.
+    #[arg(long = "signal", required = true, value_name = "COLUMN")]
+    pub signals: Vec<String>,
+    /// Vehicle speed over the record [km/h] (constant).
+    #[arg(long, value_name = "KMH")]
+    pub speed: f64,
+    /// EN 14363 quantity of the signals.
+    #[arg(long, value_enum, default_value = "acceleration")]
+    pub quantity: Quantity,
+    /// Bogie mass for the acceleration limit [t] (the seed's 6.1 t gives 5.39 m/s2).
+    #[arg(long, value_name = "T", default_value_t = 6.1)]
+    pub bogie_mass: f64,
+    /// Static wheel load Q0 for the guiding-force limit [kN].
+    #[arg(long, value_name = "KN", default_value_t = 70.0)]
+    pub wheel_load: f64,
+    /// Start-up time excluded from the assessment [s].
+    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    pub skip: f64,
+    /// Dominant frequency [Hz] instead of the spectrum's peak (searched in 0.5-20 Hz).
+    #[arg(long, value_name = "HZ")]
+    pub f0: Option<f64>,
+    /// Output folder (created if needed; files are written only once everything is computed).
+    #[arg(long, value_name = "DIR", default_value = "results/assess")]
+    pub out: PathBuf,
+}
+
+pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
+    let failed = |e| CommandError::Failed(format!("{e}"));
+    let criterion = match args.quantity {
+        Quantity::Acceleration => Criterion::LateralAcceleration {
+            bogie_mass_t: args.bogie_mass,
+        },
+        Quantity::GuidingForce => Criterion::GuidingForces {
+            static_wheel_load_n: args.wheel_load * 1e3,
+        },
+    };
+    let settings = StabilitySettings {
+        skip_s: args.skip,
+        dominant_frequency_hz: args.f0,
+        ..StabilitySettings::default()
+    };
+    let table = ResultsTable::load(&args.table).map_err(failed)?;
+    let report =
+        assess_table(&table, &args.signals, args.speed, criterion, &settings).map_err(failed)?;
+    let mut files = Artefacts::default();
+    report.add_artefacts(&mut files).map_err(failed)?;
+    files.write_all(&args.out)?;
+    print_report(&report.summary(), &files, &args.out);
+    Ok(())
+}
