@@ -7,7 +7,9 @@ use crate::output::{write_bytes_atomic, write_csv_atomic, write_json_atomic};
 use crate::plot::Chart;
 use crate::study::config::{configuration, var};
 use crate::study::critical::Critical;
-use crate::study::run::{scenario, StudyError, StudyResults, HIL_CONFIGS, HISTORY_CONFIGS};
+use crate::study::run::{
+    scenario, ConfigResult, StudyError, StudyResults, HIL_CONFIGS, HISTORY_CONFIGS,
+};
 
 /// Timing of the whole study, measured by the caller.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -385,6 +387,44 @@ fn crit_text(c: Option<Critical>) -> String {
     c.map_or("n/a".into(), |k| k.describe())
 }
 
+/// Sweep speeds above the critical speed at which the limit is met again, as ranges of
+/// consecutive sweep speeds ("320-370, 390"), or "-". Makes a first exceedance caused by a
+/// burst (MPPT2) visible next to the critical speed.
+pub fn within_limit_above(c: &ConfigResult, limit: f64) -> String {
+    let Some(vcr) = c.critical.and_then(|k| k.speed_kmh()) else {
+        return "-".into();
+    };
+    let speeds: Vec<f64> = c.sweep.iter().map(|p| p.speed_kmh).collect();
+    let ok: Vec<bool> = c
+        .sweep
+        .iter()
+        .map(|p| p.speed_kmh > vcr && p.rms().is_some_and(|r| r <= limit))
+        .collect();
+    let mut ranges: Vec<String> = Vec::new();
+    let mut i = 0;
+    while i < speeds.len() {
+        if !ok[i] {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i + 1 < speeds.len() && ok[i + 1] {
+            i += 1;
+        }
+        ranges.push(if i == start {
+            format!("{:.0}", speeds[start])
+        } else {
+            format!("{:.0}-{:.0}", speeds[start], speeds[i])
+        });
+        i += 1;
+    }
+    if ranges.is_empty() {
+        "-".into()
+    } else {
+        ranges.join(", ")
+    }
+}
+
 /// Difference of a configuration's critical speed to the passive one [km/h], if both defined.
 pub fn gain_over_passive(r: &StudyResults, id: &str) -> Option<f64> {
     let p = r.config("passive")?.critical?.speed_kmh()?;
@@ -438,9 +478,9 @@ pub fn report_markdown(r: &StudyResults, timing: &Timing, figures: &[(String, &s
     let _ = writeln!(m, "## Critical speeds (EN 14363 rms criterion)\n");
     let _ = writeln!(
         m,
-        "| configuration | ours [km/h] | gain over passive [km/h] | seed | ref |"
+        "| configuration | ours [km/h] | within the limit again at [km/h] | gain over passive [km/h] | seed | ref |"
     );
-    let _ = writeln!(m, "|---|---|---|---|---|");
+    let _ = writeln!(m, "|---|---|---|---|---|---|");
     for c in &r.configs {
         let gain = if c.id == "passive" {
             "-".to_string()
@@ -452,9 +492,10 @@ pub fn report_markdown(r: &StudyResults, timing: &Timing, figures: &[(String, &s
         };
         let _ = writeln!(
             m,
-            "| {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} |",
             c.label,
             crit_text(c.critical),
+            within_limit_above(c, r.limit_mps2),
             gain,
             c.seed_value,
             c.reference
@@ -761,8 +802,8 @@ mod tests {
         assert_eq!(gain_over_passive(&r, "mppt2"), Some(110.0));
         let md = report_markdown(&r, &t, &[("rms_vs_speed".into(), "caption")]);
         for s in [
-            "| passive (30 %) | 290.0 (stable at 280.0) | - | 280-300 km/h | R8 |",
-            "| MPPT2, ideal valve | > 400 | >= +110 |",
+            "| passive (30 %) | 290.0 (stable at 280.0) | - | - | 280-300 km/h | R8 |",
+            "| MPPT2, ideal valve | > 400 | - | >= +110 |",
             "**10.0 simulated seconds per wall-clock second**",
             "| 210 | 7.00 | 20.0 | 0.250 | 8.00 | 7.08 | 20.4 | 0.357 |",
             "| 270 | failed | failed | failed | failed | 5.98 |",
@@ -772,6 +813,36 @@ mod tests {
         ] {
             assert!(md.contains(s), "missing {s:?} in\n{md}");
         }
+    }
+
+    #[test]
+    fn speeds_within_the_limit_above_a_burst_are_listed_as_ranges() {
+        let point = |v: f64, rms: Option<f64>| SpeedPoint {
+            speed_kmh: v,
+            per_seed: vec![rms],
+        };
+        let mut c = results().configs.remove(0);
+        c.sweep = vec![
+            point(290.0, Some(3.0)),
+            point(300.0, Some(6.0)), // burst: first exceedance
+            point(310.0, Some(4.0)),
+            point(320.0, Some(5.0)),
+            point(330.0, Some(5.5)),
+            point(340.0, Some(2.0)),
+            point(350.0, None), // failed run: not counted as within the limit
+        ];
+        c.critical = Some(Critical::Between {
+            stable_kmh: 295.0,
+            unstable_kmh: 297.5,
+        });
+        assert_eq!(within_limit_above(&c, 5.39), "310-320, 340");
+        c.critical = Some(Critical::Above { max_kmh: 350.0 });
+        assert_eq!(within_limit_above(&c, 5.39), "-");
+        c.critical = Some(Critical::Between {
+            stable_kmh: 335.0,
+            unstable_kmh: 345.0,
+        });
+        assert_eq!(within_limit_above(&c, 5.39), "-");
     }
 
     #[test]
