@@ -362,7 +362,7 @@ impl FmuModel for SkyHookController {
         .discrete();
         v.output(
             "absolute_velocity",
-            "Absolute velocity x' used by the law (estimated or ideal), extension direction",
+            "Sky-hook velocity x' used by the law (estimated or ideal, times absolute_sign)",
             &[],
             |m| m.out.abs_velocity_mps,
         )
