@@ -123,25 +123,35 @@ fn container_fmu_agrees_with_fmpy() {
     assert!((f0 + 30.0).abs() < 1e-12, "{f0}");
 }
 
-/// Host-call robustness with a foreign FMU: the container steps only every third communication
-/// point, so its windows are 3 ms long and the last one is cut to 2 ms to end at the stop time.
-/// Inside, it takes 1 ms fixed steps with no inputs from outside, so at each of its points it
-/// must equal fmpy's 1 ms run exactly (the held values in between are not compared).
+/// Host-call robustness with a foreign FMU. fmpy's container declares no
+/// canHandleVariableCommunicationStepSize (FMI 2.0 default: false), so it must always be stepped
+/// with the same step. With a step multiple of 4 (dividing the 2000 steps) its windows are all
+/// 4 ms; inside it takes 1 ms fixed steps with no inputs from outside, so at each of its points
+/// it must equal fmpy's 1 ms run exactly (the held values in between are not compared). With a
+/// multiple of 3 its last window would be cut to 2 ms: refused before any call, naming the flag.
 #[test]
-fn container_with_step_multiple_and_short_last_window() {
+fn container_with_step_multiple_keeps_a_constant_step() {
     let Some(dir) = foreign_dir() else { return };
     let out = run_system(&dir.join("Container.system.json"), |s| {
-        s.desc.instances[0].step_multiple = 3;
+        s.desc.instances[0].step_multiple = 4;
     });
     let last = out.column("time").unwrap().len() - 1;
     assert_eq!(last, 2000);
     let n = compare(
-        "Container (step multiple 3)",
+        "Container (step multiple 4)",
         &out,
         &dir.join("Container.fmpy.csv"),
-        |k| k % 3 == 0 || k == last,
+        |k| k % 4 == 0,
     );
-    assert!(n > 4 * 600);
+    assert!(n >= 4 * 500, "{n}");
+
+    let mut sys = LoadedSystem::load(need(&dir.join("Container.system.json"))).unwrap();
+    sys.desc.instances[0].step_multiple = 3;
+    let e = sys.run(&RunOptions::default()).unwrap_err().to_string();
+    assert!(
+        e.contains("canHandleVariableCommunicationStepSize") && e.contains("step_multiple 3"),
+        "{e}"
+    );
 }
 
 /// A step that does not divide the stop time is refused before any FMU is loaded, naming the
