@@ -335,6 +335,40 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         ));
     }
 
+    // Fig. 5.25: zoom on the on/off sky-hook's command and the valve's actual opening
+    let slow = scenario::hil("skyhook_onoff_slow");
+    if let (Some(cmd), Some(open)) = (
+        series(r, &slow, var::COMMAND_LEFT, 0.1),
+        series(r, &slow, var::OPENING_LEFT, 1.0),
+    ) {
+        let t_end = cmd.last().map_or(0.0, |p| p.0);
+        let zoom = |s: &[(f64, f64)]| -> Vec<(f64, f64)> {
+            s.iter().filter(|p| p.0 >= t_end - 1.0).copied().collect()
+        };
+        write_series_csv(
+            &out.join("skyhook_valve_zoom.csv"),
+            &[
+                ("slow valve: command / 10 V [-]".into(), cmd.clone()),
+                ("slow valve: actual opening [-]".into(), open.clone()),
+            ],
+        )?;
+        Chart::new(
+            &format!(
+                "on/off sky-hook, slow valve, {v_hil:.0} km/h: command and actual opening, last 1 s ({:.0} Hz samples)",
+                r.settings.stored_rate_hz
+            ),
+            "time [s]",
+            "opening [-]",
+        )
+        .with_series("slow valve: command", zoom(&cmd))
+        .with_series("slow valve: actual opening", zoom(&open))
+        .write_lines(&out.join("skyhook_valve_zoom.svg"))?;
+        figures.push((
+            "skyhook_valve_zoom".into(),
+            "on/off sky-hook: the slow valve cannot follow the switching command (Fig. 5.25, R12)",
+        ));
+    }
+
     // ---- c_v sensitivity (Table 4-3)
     let cv_header: Vec<String> = [
         "c_v [kNs/m]",
