@@ -467,7 +467,8 @@ impl FmuModel for FullActiveActuator {
     }
 }
 
-const ACTUATOR_DOC: &str = r#"
+const ACTUATOR_DOC: &str = concat!(
+    r#"
 <h1>FullActiveActuator</h1>
 <p>Full-active hydraulic yaw actuator (Ruderman's model, seed section 3.4): a servo (directional
 control) valve feeding a double-acting cylinder. The rod motion is imposed by the vehicle
@@ -575,17 +576,10 @@ relative tolerance 1e-6 (absolute 10 Pa on pressures, 1e-9 m on the spool), allo
 internal step chosen by error control. Inputs are held over a communication step (zero-order
 hold).</p>
 
-<h2>Failed steps</h2>
-<p>A communication step that cannot be completed returns <b>fmi2Discard</b> with a logged
-message (category logStatusDiscard) and leaves the model exactly as before the step: outputs
-stay the last finite values, never NaN or inf. Two causes exist: the integrator's work bound
-<code>solver.max_internal_steps</code> is reached (set it to bound the time of one fmi2DoStep on a
-real-time host; the default 20000 is far above need), or an absurd but finite input makes a
-state or output overflow (e.g. an elongation velocity of 1e300 m/s). The instance is then in
-FMI's stepFailed state: restore an FMU state saved before the step (fmi2SetFMUstate) and retry,
-with a smaller communication step or corrected inputs. Bad parameters or inputs detected by the
-physics end the run with fmi2Error instead.</p>
-
+"#,
+    super::failed_steps_doc!(),
+    r#"
 <h2>Initialisation</h2>
 <p>Spool centred and at rest, P_A = P_B = (P_S + P_T)/2, rod at the imposed elongation.</p>
-"#;
+"#
+);

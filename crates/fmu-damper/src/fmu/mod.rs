@@ -18,6 +18,25 @@
 //! * NaN/inf inputs cannot arrive (the glue rejects them at set time); a non-finite result of the
 //!   physics is never returned as a number.
 
+/// The "Failed steps" section of the damper FMUs' documentation (the same behaviour for both:
+/// the glue's fmi2Discard path over the physics' atomic steps).
+macro_rules! failed_steps_doc {
+    () => {
+        r#"<h2>Failed steps</h2>
+<p>A communication step that cannot be completed returns <b>fmi2Discard</b> with a logged
+message (category logStatusDiscard) and leaves the model exactly as before the step: outputs
+stay the last finite values, never NaN or inf. Two causes exist: the integrator's work bound
+<code>solver.max_internal_steps</code> is reached (set it to bound the time of one fmi2DoStep on a
+real-time host; the default 20000 is far above need), or an absurd but finite input makes a
+state or output overflow (e.g. an elongation velocity of 1e300 m/s). The instance is then in
+FMI's stepFailed state: restore an FMU state saved before the step (fmi2SetFMUstate) and retry,
+with a smaller communication step or corrected inputs. Bad parameters or inputs detected by the
+physics end the run with fmi2Error instead.</p>
+"#
+    };
+}
+pub(crate) use failed_steps_doc;
+
 mod actuator;
 mod semi;
 

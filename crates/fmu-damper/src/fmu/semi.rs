@@ -536,7 +536,8 @@ impl FmuModel for PassiveYawDamper {
 /// Equations, interpretations, calibration and numerics shared by both documentations.
 macro_rules! semi_common_doc {
     () => {
-        r#"
+        concat!(
+            r#"
 <h2>Equations (seed 3.3.2-3.3.3)</h2>
 <p>One hydraulic state, the pressure difference dP = P_A - P_B (rebound minus compression
 chamber), plus the valve opening x_v when the valve is not ideal:</p>
@@ -619,21 +620,14 @@ communication steps of 1e-4, 1e-3 and 5e-3 s the force agrees within 0.5 % of it
 host samples the input at mid-step, and the steady peak force agrees within 0.5 % with a plain
 zero-order hold (which delays the input by h/2).</p>
 
-<h2>Failed steps</h2>
-<p>A communication step that cannot be completed returns <b>fmi2Discard</b> with a logged
-message (category logStatusDiscard) and leaves the model exactly as before the step: outputs
-stay the last finite values, never NaN or inf. Two causes exist: the integrator's work bound
-<code>solver.max_internal_steps</code> is reached (set it to bound the time of one fmi2DoStep on a
-real-time host; the default 20000 is far above need), or an absurd but finite input makes a
-state or output overflow (e.g. an elongation velocity of 1e300 m/s). The instance is then in
-FMI's stepFailed state: restore an FMU state saved before the step (fmi2SetFMUstate) and retry,
-with a smaller communication step or corrected inputs. Bad parameters or inputs detected by the
-physics end the run with fmi2Error instead.</p>
-
+"#,
+            $crate::fmu::failed_steps_doc!(),
+            r#"
 <h2>Initialisation</h2>
 <p>dP = 0 at the start time (damper at rest). Outputs at the start time are consistent with the
 inputs set during initialisation.</p>
 "#
+        )
     };
 }
 

@@ -204,9 +204,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         series(r, &fa, var::FORCE_REFERENCE_LEFT, 1e-3),
     ) {
         let t_end = f.last().map_or(0.0, |p| p.0);
-        let zoom = |s: &[(f64, f64)]| -> Vec<(f64, f64)> {
-            s.iter().filter(|p| p.0 >= t_end - 2.0).copied().collect()
-        };
+        let zoom = |s: &[(f64, f64)]| from_time(s, t_end - 2.0);
         write_series_csv(
             &out.join("full_active_force.csv"),
             &[
@@ -342,9 +340,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         series(r, &slow, var::OPENING_LEFT, 1.0),
     ) {
         let t_end = cmd.last().map_or(0.0, |p| p.0);
-        let zoom = |s: &[(f64, f64)]| -> Vec<(f64, f64)> {
-            s.iter().filter(|p| p.0 >= t_end - 1.0).copied().collect()
-        };
+        let zoom = |s: &[(f64, f64)]| from_time(s, t_end - 1.0);
         write_series_csv(
             &out.join("skyhook_valve_zoom.csv"),
             &[
@@ -415,6 +411,11 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     let text = report_markdown(r, timing, &figures);
     write_bytes_atomic(&out.join("REPORT.md"), text.as_bytes())?;
     Ok(text)
+}
+
+/// The points of a time series from `t0` on (zoomed figures).
+fn from_time(s: &[(f64, f64)], t0: f64) -> Vec<(f64, f64)> {
+    s.iter().filter(|p| p.0 >= t0).copied().collect()
 }
 
 fn crit_text(c: Option<Critical>) -> String {
