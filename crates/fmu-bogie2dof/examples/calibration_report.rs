@@ -2,14 +2,14 @@
 //! passive (Maxwell-fitted) damper, and the non-linear response to a 3 mm initial perturbation (R7) at
 //! several speeds. Usage: `cargo run --release --example calibration_report [table.csv [k_ssx [conicity [k_grav]]]]`.
 use fmu_bogie2dof::calibration::*;
-use fmu_bogie2dof::contact::ContactTable;
 use fmu_bogie2dof::eigen::critical_speed;
 use fmu_bogie2dof::sim::{run_closed_loop, LoopDamper};
 use fmu_bogie2dof::{Bogie, Params};
+use wheel_rail::GeometryTable;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let table = match std::env::args().nth(1) {
-        Some(path) => ContactTable::load(&path)?,
+        Some(path) => GeometryTable::load(&path)?,
         None => fmu_bogie2dof::model::default_contact_table()?,
     };
     let mut p = Params::default();

@@ -9,7 +9,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                   fmu-bogie2dof (examples/write_surrogate.rs).";
     std::fs::write(
         "resources/wheel_rail_worn_surrogate.csv",
-        format!("{header}\n{}", t.to_csv()),
+        format!("{header}\n{}", t.to_csv(wheel_rail::CsvNumbers::Scientific)),
     )?;
     Ok(())
 }

@@ -18,7 +18,7 @@
 //! (gravitational) stiffness P d(tan g_R - tan g_L)/dy, about 2 MN/m per wheelset for the
 //! EN 15302 A/A table. It is INCLUDED IN BOTH models: the linear model gets it as
 //! `gravity_stiffness_n_per_m`, and its conicity, from the describing function of the table
-//! at 1 mm ([`crate::contact::ContactTable::linearise`]). Leaving it out of the linear model
+//! at 1 mm ([`wheel_rail::GeometryTable::linearise`]). Leaving it out of the linear model
 //! would make the two models disagree by tens of km/h at small amplitude.
 //!
 //! With the A/A table itself (equivalent conicity 0.13 at 1 mm, 0.19 at 3 mm) no choice of
@@ -26,7 +26,7 @@
 //! J 8000-14000 kg m^2) brings the linear critical speed below 338 km/h: a new profile
 //! cannot reproduce R5. The seed used a WORN S1002 (200 000 km), whose equivalent conicity
 //! is higher. The default table is therefore a documented WORN-PROFILE SURROGATE built from
-//! the A/A table ([`crate::contact::ContactTable::with_tread_cone`]): within
+//! the A/A table ([`wheel_rail::GeometryTable::with_tread_cone`]): within
 //! +-3.5 mm the rolling-radius difference is that of a cone of conicity 0.25; beyond, the
 //! A/A rise towards the flange root and flange is appended continuously; the contact angles
 //! (tan gamma, hence the gravitational stiffness and the flange at 6.6-7.45 mm) are the A/A

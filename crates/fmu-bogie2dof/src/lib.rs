@@ -8,12 +8,13 @@
 //! e_R = -b sigma, tension positive, yaw moment -b F_L + b F_R (see [`eigen`]).
 //!
 //! Modules: [`params`] (Params, validation), [`linear`] (5.16) matrices, [`nonlinear`]
-//! (right-hand sides), [`contact`] (table, saturation, Kalker, Hertz), [`eigen`] (root
+//! (right-hand sides), [`eigen`] (root
 //! locus, critical speed, damper representations), [`track`] (ERRI B176 generator),
 //! [`model`] (time-domain [`Bogie`] for the FMU), [`sim`] (closed loop with a simple
 //! damper), [`calibration`], [`fmu`] (FMU shell `Bogie2Dof`, exported with feature `fmi-export`).
+//! The contact-geometry table and the creep laws come from the `wheel-rail` crate
+//! ([`wheel_rail::GeometryTable`], [`wheel_rail::creep`]).
 pub mod calibration;
-pub mod contact;
 pub mod eigen;
 pub mod fmu;
 pub mod linear;

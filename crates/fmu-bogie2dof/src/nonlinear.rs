@@ -8,14 +8,15 @@
 //! * Kalker linear forces (5.2)-(5.3) (coefficients times the reduction factor kappa), saturated per wheel with Vermeulen-Johnson
 //!   (5.21)-(5.25) using the static wheel load P;
 //! * normal-force lateral components (5.20): F_BL = +P tan g_L, F_BR = -P tan g_R (the table
-//!   holds positive tan g; signs so the net force restores, see [`crate::contact`]);
+//!   holds positive tan g; signs so the net force restores, see [`wheel_rail::table`]);
 //! * equations (5.27) with the damper moment -b F_L + b F_R (see [`crate::eigen`]).
 //!
 //! Linear model: the same structure with unsaturated forces, rolling radii r0 +- lambda
 //! (y_i - y_track,i), no normal-force term except the optional gravitational stiffness, and
 //! no spin dofs; it equals (5.16) exactly (checked against the state matrix in tests).
 
-use crate::contact::{saturation_factor, ContactTable};
+use wheel_rail::{saturation_factor, GeometryTable};
+
 use crate::params::{ModelKind, Params};
 
 /// State indices: y, sigma, y', sigma', beta1', beta2'.
@@ -83,7 +84,7 @@ pub struct Eval {
 #[inline]
 pub fn rhs(
     c: &Consts,
-    table: &ContactTable,
+    table: &GeometryTable,
     x: &[f64; N_STATES],
     yt: [f64; 2],
     f_left: f64,
@@ -154,7 +155,7 @@ mod tests {
             ..Params::default()
         };
         let c = Consts::new(&p);
-        let table = ContactTable::synthetic(0.15, 7e-3, 5e-4, 2.7).unwrap();
+        let table = GeometryTable::synthetic(0.15, 7e-3, 5e-4, 2.7).unwrap();
         let (kd, cd) = (2e6, 1.2e5);
         let a = state_matrix(
             &p,
@@ -194,7 +195,7 @@ mod tests {
             gravity_stiffness_n_per_m: 0.0,
             ..Params::default()
         };
-        let table = ContactTable::synthetic(p.conicity, 7e-3, 5e-4, 2.7).unwrap();
+        let table = GeometryTable::synthetic(p.conicity, 7e-3, 5e-4, 2.7).unwrap();
         p.model = ModelKind::NonLinear;
         let cn = Consts::new(&p);
         p.model = ModelKind::Linear;
@@ -215,7 +216,7 @@ mod tests {
     #[test]
     fn flange_force_restores() {
         let p = Params::default();
-        let table = ContactTable::synthetic(0.15, 7e-3, 5e-4, 2.7).unwrap();
+        let table = GeometryTable::synthetic(0.15, 7e-3, 5e-4, 2.7).unwrap();
         let c = Consts::new(&p);
         // wheelsets 8 mm right, no motion: strong force to the left
         let x = [8e-3, 0.0, 0.0, 0.0, 0.0, 0.0];

@@ -9,7 +9,7 @@
 //! * Mathematical Problems in Engineering 2019 ("Numerical investigation into the critical
 //!   speed and frequency of the hunting motion ...", Table 2): half contact gauge 0.7465 m,
 //!   half wheelbase 1.25 m, yaw damper lateral arm 1.35 m;
-//! * Hertz + Kalker (see [`crate::contact::hertz_kalker`]) at 70 kN per wheel on a 0.46 m wheel
+//! * Hertz + Kalker (see [`wheel_rail::creep::hertz_kalker`]) at 70 kN per wheel on a 0.46 m wheel
 //!   and a 0.30 m rail crown: f11 = 11.5 MN, f22 = 10.4 MN.
 //!
 //! Calibrated (free) parameters, see [`crate::calibration`]: `k_ssx_n_per_m` (effective
@@ -95,7 +95,7 @@ pub enum ContactSource {
     /// Synthetic cone of `conicity` with a steep flange at 7 mm (the profile with which R7
     /// is reproduced, see `calibration`).
     SyntheticCone,
-    /// CSV file at run time (format in [`crate::contact`]).
+    /// CSV file at run time (format in [`wheel_rail::table`]).
     File(String),
 }
 
@@ -144,7 +144,7 @@ pub struct Params {
     pub conicity: f64,
     /// Lateral gravitational (contact-angle) stiffness per wheelset used by the LINEAR model
     /// [N/m]: P d(tan g_R - tan g_L)/dy of the table (describing function at 1 mm, see
-    /// [`crate::contact::ContactTable::linearise`]). Not in the seed's (5.18); included here
+    /// [`wheel_rail::GeometryTable::linearise`]). Not in the seed's (5.18); included here
     /// because the non-linear model (5.20) has it through the contact angles.
     pub gravity_stiffness_n_per_m: f64,
     /// f11: Kalker longitudinal creep coefficient per wheel [N] (Hertz+Kalker: 11.5 MN).
@@ -293,5 +293,19 @@ impl Params {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The default creep coefficients are the Hertz + Kalker values of the module docs.
+    #[test]
+    fn default_creep_coefficients_come_from_hertz_kalker() {
+        let p = Params::default();
+        let hk = wheel_rail::hertz_kalker(p.wheel_load_n, p.wheel_radius_m, 0.3, 210e9, 0.28);
+        assert!((p.f11_n - hk.f11_n).abs() / hk.f11_n < 0.02, "{hk:?}");
+        assert!((p.f22_n - hk.f22_n).abs() / hk.f22_n < 0.02, "{hk:?}");
     }
 }

@@ -6,10 +6,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use fmu_bogie2dof::calibration::*;
-use fmu_bogie2dof::contact::ContactTable;
 use fmu_bogie2dof::eigen::*;
 use fmu_bogie2dof::sim::{run_closed_loop, LoopDamper};
 use fmu_bogie2dof::*;
+use wheel_rail::GeometryTable;
 
 fn passive_loop() -> LoopDamper {
     LoopDamper::Maxwell {
@@ -19,11 +19,11 @@ fn passive_loop() -> LoopDamper {
 }
 
 /// Synthetic cone + steep flange at 7 mm (no gravitational stiffness): integrator checks.
-fn synthetic_table() -> ContactTable {
-    ContactTable::synthetic(CALIBRATED_CONICITY, 7e-3, 5e-4, 2.7).unwrap()
+fn synthetic_table() -> GeometryTable {
+    GeometryTable::synthetic(CALIBRATED_CONICITY, 7e-3, 5e-4, 2.7).unwrap()
 }
 
-fn default_table() -> ContactTable {
+fn default_table() -> GeometryTable {
     fmu_bogie2dof::model::default_contact_table().unwrap()
 }
 
@@ -46,7 +46,7 @@ fn run_with(
     h: f64,
     t_end: f64,
     damper: LoopDamper,
-    table: ContactTable,
+    table: GeometryTable,
 ) -> Vec<(f64, f64, f64)> {
     let p = Params {
         speed_mps: kmh / 3.6,
@@ -100,6 +100,21 @@ fn maxwell_fit_of_passive_damper() {
     }
 }
 
+/// The shipped tables are exactly what the one CSV writer of `wheel-rail` produces: the A/A
+/// table in fixed decimals (written by the profile contact search), the surrogate in
+/// exponent form after its comment line (written by `examples/write_surrogate.rs`).
+#[test]
+fn shipped_tables_are_the_wheel_rail_writers_output() {
+    let aa = include_str!("../resources/wheel_rail_A_A.csv");
+    let table = model::default_aa_table().unwrap();
+    assert_eq!(table.to_csv(wheel_rail::CsvNumbers::Fixed), aa);
+    let worn = include_str!("../resources/wheel_rail_worn_surrogate.csv");
+    let (comment, body) = worn.split_once('\n').unwrap();
+    assert!(comment.starts_with("# Worn-profile surrogate"), "{comment}");
+    let surrogate = model::worn_surrogate_table().unwrap();
+    assert_eq!(surrogate.to_csv(wheel_rail::CsvNumbers::Scientific), body);
+}
+
 #[test]
 fn linear_model_uses_the_default_tables_contact_at_1mm() {
     let (lam, g) = default_table().linearise(LINEARISATION_AMPLITUDE_M);
@@ -112,7 +127,7 @@ fn linear_model_uses_the_default_tables_contact_at_1mm() {
     );
     // the shipped CSV equals the built-in surrogate
     let text = include_str!("../resources/wheel_rail_worn_surrogate.csv");
-    let shipped = ContactTable::parse_csv(text).unwrap();
+    let shipped = GeometryTable::parse_csv(text, "wheel_rail_worn_surrogate.csv").unwrap();
     for y in [-8e-3, -5e-3, -1e-3, 0.0, 2e-3, 4.2e-3, 6.7e-3] {
         let (a, b) = (shipped.lookup(y), default_table().lookup(y));
         // the CSV carries 7 significant digits

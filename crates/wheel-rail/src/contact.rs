@@ -22,6 +22,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::profile::{Profile, ProfileError};
+use crate::table::{write_csv, CsvNumbers, CsvRow, GeometryTable, TableError};
 
 /// Half width of the central difference used for the contact-angle slope [m].
 const SLOPE_HALF_WINDOW_M: f64 = 0.25e-3;
@@ -374,28 +375,37 @@ pub struct ContactTable {
     pub y_reachable_max_m: f64,
 }
 
-/// Exact header of [`ContactTable::to_bogie_csv`].
-pub const BOGIE_CSV_HEADER: &str =
-    "y_m,delta_r_left_m,delta_r_right_m,tan_gamma_left,tan_gamma_right";
-
 impl ContactTable {
-    /// The table as the bogie model's CSV (header [`BOGIE_CSV_HEADER`], SI units, one row per
-    /// grid point, rows beyond the flange limit repeat the last reachable values).
+    /// The table in the contact-table CSV format ([`crate::table`], header
+    /// [`crate::table::BOGIE_CSV_HEADER`], [`CsvNumbers::Fixed`]), one row per grid point; rows beyond the
+    /// flange limit repeat the last reachable values.
     pub fn to_bogie_csv(&self) -> String {
-        let mut out = String::with_capacity(64 * (self.rows.len() + 1));
-        out.push_str(BOGIE_CSV_HEADER);
-        out.push('\n');
-        for r in &self.rows {
-            out.push_str(&format!(
-                "{:.7},{:.9},{:.9},{:.6},{:.6}\n",
+        write_csv(self.csv_rows(), CsvNumbers::Fixed)
+    }
+
+    /// The table as the time-domain models' [`GeometryTable`] (full precision, no CSV round
+    /// trip).
+    pub fn geometry_table(&self) -> Result<GeometryTable, TableError> {
+        let mut cols: [Vec<f64>; 5] = Default::default();
+        for row in self.csv_rows() {
+            for (col, value) in cols.iter_mut().zip(row) {
+                col.push(value);
+            }
+        }
+        let [y, dr_l, dr_r, tg_l, tg_r] = cols;
+        GeometryTable::from_columns(y, dr_l, dr_r, tg_l, tg_r)
+    }
+
+    fn csv_rows(&self) -> impl Iterator<Item = CsvRow> + '_ {
+        self.rows.iter().map(|r| {
+            [
                 r.y_m,
                 r.left.delta_radius_m,
                 r.right.delta_radius_m,
                 r.left.tan_gamma,
-                r.right.tan_gamma
-            ));
-        }
-        out
+                r.right.tan_gamma,
+            ]
+        })
     }
 
     /// Rows within the reachable range.

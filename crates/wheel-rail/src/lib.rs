@@ -1,5 +1,8 @@
-//! Wheel/rail contact geometry from real profiles (issue 8): rigid contact search, rolling radius
-//! difference Δr(y), contact angles, roll angle and the EN 15302 equivalent conicity.
+//! Wheel/rail contact, the one home of it in the project: contact geometry from real profiles
+//! (rigid contact search, rolling radius difference Δr(y), contact angles, roll angle, EN 15302
+//! equivalent conicity), the contact-geometry table the time-domain models interpolate
+//! ([`table`]), and the creep-force laws of one wheel ([`creep`]: Hertz/Kalker coefficients,
+//! Vermeulen-Johnson saturation).
 //!
 //! # API (what the master's `contact-geometry` command calls)
 //! ```no_run
@@ -72,17 +75,28 @@
 //! tanγe = 0.123 / 0.182 / 0.258 / 0.523 at 1 / 3 / 5 / 7 mm (EN 15302 Annex E: 0.125 / 0.188 /
 //! 0.254 / 0.505).
 //!
-//! This crate is offline geometry (no time stepping), so it has no `Params`/`step` model; the
-//! bogie FMU reads the generated CSV.
+//! # For time-domain models (bogie, vehicle)
+//! This crate has no `Params`/`step` model of its own: the models hold a [`GeometryTable`]
+//! (read from the CSV with [`GeometryTable::load`], or converted from a profile search with
+//! [`ContactTable::geometry_table`]), share it between wheelsets (`Arc` or a borrow), and look it
+//! up per wheelset and evaluation ([`GeometryTable::lookup`], or
+//! [`GeometryTable::lookup_with_hint`] with one [`SegmentHint`] per wheelset); the creep forces
+//! use [`creep::saturation_factor`].
 
 pub mod conicity;
 pub mod contact;
+pub mod creep;
 pub mod profile;
+pub mod table;
 
 pub use conicity::{equivalent_conicity, harmonic_linearisation, Conicity, ConicityError, DeltaR};
 pub use contact::{
     compute_table, solve_contact, ContactError, ContactRow, ContactSetup, ContactTable,
-    LateralReference, RailPlacement, WheelContact, WheelPlacement, BOGIE_CSV_HEADER,
-    CONTACT_ZONE_DEPTH_M,
+    LateralReference, RailPlacement, WheelContact, WheelPlacement, CONTACT_ZONE_DEPTH_M,
 };
+pub use creep::{hertz_kalker, saturation_factor, HertzKalker};
 pub use profile::{Profile, ProfileError, MIN_POINTS};
+pub use table::{
+    write_csv, ContactGeometry, CsvNumbers, CsvRow, GeometryTable, SegmentHint, TableError,
+    BOGIE_CSV_HEADER,
+};
