@@ -9,11 +9,12 @@
 //!
 //! Modules: [`params`] (Params, validation), [`linear`] (5.16) matrices, [`nonlinear`]
 //! (right-hand sides), [`eigen`] (root
-//! locus, critical speed, damper representations), [`track`] (ERRI B176 generator),
+//! locus, critical speed, damper representations),
 //! [`model`] (time-domain [`Bogie`] for the FMU), [`sim`] (closed loop with a simple
 //! damper), [`calibration`], [`fmu`] (FMU shell `Bogie2Dof`, exported with feature `fmi-export`).
 //! The contact-geometry table and the creep laws come from the `wheel-rail` crate
-//! ([`wheel_rail::GeometryTable`], [`wheel_rail::creep`]).
+//! ([`wheel_rail::GeometryTable`], [`wheel_rail::creep`]), the ERRI B176 track generator and
+//! the delay line from [`wheel_rail::track`].
 pub mod calibration;
 pub mod eigen;
 pub mod fmu;
@@ -22,7 +23,6 @@ pub mod model;
 pub mod nonlinear;
 pub mod params;
 pub mod sim;
-pub mod track;
 
 pub use model::{Bogie, Inputs, ModelError, Outputs, StepError};
 pub use params::{ContactSource, ModelKind, ParamError, Params, PsdLevel, TrackSource};

@@ -52,15 +52,7 @@ pub enum ModelKind {
     NonLinear,
 }
 
-/// Level of the ERRI B176 lateral alignment spectrum.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-pub enum PsdLevel {
-    /// A = 2.119e-7 m rad.
-    #[default]
-    Low,
-    /// A = 6.125e-7 m rad.
-    High,
-}
+pub use wheel_rail::track::PsdLevel;
 
 /// Where the lateral track alignment comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]

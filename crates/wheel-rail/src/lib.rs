@@ -2,7 +2,8 @@
 //! (rigid contact search, rolling radius difference Δr(y), contact angles, roll angle, EN 15302
 //! equivalent conicity), the contact-geometry table the time-domain models interpolate
 //! ([`table`]), and the creep-force laws of one wheel ([`creep`]: Hertz/Kalker coefficients,
-//! Vermeulen-Johnson saturation).
+//! Vermeulen-Johnson saturation) and the lateral track alignment they run on ([`track`]: ERRI
+//! B176 spectrum and generator, spatial delay line).
 //!
 //! # API (what the master's `contact-geometry` command calls)
 //! ```no_run
@@ -81,13 +82,15 @@
 //! [`ContactTable::geometry_table`]), share it between wheelsets (`Arc` or a borrow), and look it
 //! up per wheelset and evaluation ([`GeometryTable::lookup`], or
 //! [`GeometryTable::lookup_with_hint`] with one [`SegmentHint`] per wheelset); the creep forces
-//! use [`creep::saturation_factor`].
+//! use [`creep::saturation_factor`]; the track under each wheelset comes from
+//! [`track::TrackGenerator`] or a [`track::DelayLine`].
 
 pub mod conicity;
 pub mod contact;
 pub mod creep;
 pub mod profile;
 pub mod table;
+pub mod track;
 
 pub use conicity::{equivalent_conicity, harmonic_linearisation, Conicity, ConicityError, DeltaR};
 pub use contact::{

@@ -1,5 +1,8 @@
 //! Lateral track alignment: ERRI B176 spectrum, sum-of-cosines synthesis, and a spatial
-//! delay line for an external input.
+//! delay line for an external input. Shared by the time-domain models: a model with several
+//! wheelsets evaluates one generator at each wheelset's position
+//! ([`TrackGenerator::eval_behind`]), or records an external input at the leading wheelset in
+//! one [`DelayLine`] and reads it back at each following wheelset's distance.
 //!
 //! Spectrum (one-sided, m^2/(rad/m)):
 //! S(Omega) = A Omega_c^2 / ((Omega^2 + Omega_r^2)(Omega^2 + Omega_c^2)),
@@ -13,7 +16,15 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::params::PsdLevel;
+/// Level of the ERRI B176 lateral alignment spectrum.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum PsdLevel {
+    /// A = 2.119e-7 m rad.
+    #[default]
+    Low,
+    /// A = 6.125e-7 m rad.
+    High,
+}
 
 /// Omega_c [rad/m].
 pub const OMEGA_C: f64 = 0.8246;
@@ -106,6 +117,12 @@ impl TrackGenerator {
         s
     }
 
+    /// Alignment under several wheelsets: `behind_m[k]` is how far wheelset k runs behind the
+    /// track position x [m] (0 for the leading one); entry k is `eval(x - behind_m[k])`.
+    pub fn eval_behind<const N: usize>(&self, x: f64, behind_m: [f64; N]) -> [f64; N] {
+        behind_m.map(|d| self.eval(x - d))
+    }
+
     /// Theoretical variance of the synthesised signal, sum a_i^2/2 [m^2].
     pub fn variance(&self) -> f64 {
         self.amp.iter().map(|a| 0.5 * a * a).sum()
@@ -123,8 +140,9 @@ pub struct DelayUndo {
 }
 
 /// Spatial delay line: records the external alignment input at the front wheelset against
-/// travelled distance, so the rear wheelset (2p behind) sees the same track. Samples are
-/// stored every `spacing` metres at most (bounded memory for any speed/step).
+/// travelled distance, so the wheelsets behind it (e.g. the bogie's rear wheelset, 2p behind)
+/// see the same track. Samples are stored every `spacing` metres at most (bounded memory for
+/// any speed/step): 2048 samples over the delay it was made for.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DelayLine {
     x: Vec<f64>,
@@ -135,7 +153,8 @@ pub struct DelayLine {
 }
 
 impl DelayLine {
-    /// Line able to look back `delay_m` metres.
+    /// Line able to look back `delay_m` metres (the distance of the last wheelset behind the
+    /// first).
     pub fn new(delay_m: f64) -> Self {
         let cap = 4096;
         Self {
@@ -281,6 +300,17 @@ mod tests {
         let c = TrackGenerator::new(PsdLevel::Low, 43);
         assert_eq!(a.eval(123.4), b.eval(123.4));
         assert_ne!(a.eval(123.4), c.eval(123.4));
+    }
+
+    #[test]
+    fn eval_behind_is_eval_at_each_wheelset() {
+        let g = TrackGenerator::new(PsdLevel::High, 5);
+        let x = 37.25;
+        let ys = g.eval_behind(x, [0.0, 2.5, 17.5, 20.0]);
+        for (y, d) in ys.iter().zip([0.0, 2.5, 17.5, 20.0]) {
+            assert_eq!(y.to_bits(), g.eval(x - d).to_bits());
+        }
+        assert_ne!(ys[0], ys[1]);
     }
 
     #[test]
