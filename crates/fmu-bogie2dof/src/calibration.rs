@@ -65,6 +65,13 @@
 
 use crate::eigen::{critical_speed, CriticalSpeed, DamperRepresentation, EigenError};
 use crate::params::Params;
+// The calibrated values are the defaults of [`Params`] and live there; they are named here too,
+// beside the procedure and the reasoning that produced them.
+pub use crate::params::{
+    CALIBRATED_CONICITY, CALIBRATED_CREEP_REDUCTION, CALIBRATED_FRICTION,
+    CALIBRATED_GRAVITY_STIFFNESS_N_PER_M, CALIBRATED_K_SSX_N_PER_M, LINEARISATION_AMPLITUDE_M,
+    WORN_SURROGATE_CONICITY, WORN_SURROGATE_TREAD_HALF_WIDTH_M,
+};
 
 /// One point of the passive damper characterisation (per damper).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,22 +115,6 @@ pub const PASSIVE_MAXWELL_K_N_PER_M: f64 = 16.9e6;
 /// Maxwell series damping of the passive damper [N s/m].
 pub const PASSIVE_MAXWELL_C_NS_PER_M: f64 = 104e3;
 
-/// Tread conicity of the worn-profile surrogate [-].
-pub const WORN_SURROGATE_CONICITY: f64 = 0.25;
-/// Half-width of the coned tread of the surrogate; the A/A flange rise is kept beyond [m].
-pub const WORN_SURROGATE_TREAD_HALF_WIDTH_M: f64 = 3.5e-3;
-/// Amplitude at which the linear model's conicity and gravity stiffness are taken [m].
-pub const LINEARISATION_AMPLITUDE_M: f64 = 1e-3;
-/// Equivalent conicity of the default table at 1 mm (describing function) [-].
-pub const CALIBRATED_CONICITY: f64 = 0.25;
-/// Gravitational stiffness per wheelset of the default table at 1 mm, P = 70 kN [N/m].
-pub const CALIBRATED_GRAVITY_STIFFNESS_N_PER_M: f64 = 2.022e6;
-/// Kalker creep-coefficient reduction factor [-].
-pub const CALIBRATED_CREEP_REDUCTION: f64 = 0.6;
-/// k_ssx calibrated for 270 km/h with the Maxwell passive damper [N/m per side].
-pub const CALIBRATED_K_SSX_N_PER_M: f64 = 0.390e6;
-/// Wheel/rail friction coefficient [-] (dry rail 0.3-0.4).
-pub const CALIBRATED_FRICTION: f64 = 0.35;
 /// R5 target [km/h].
 pub const TARGET_CRITICAL_SPEED_KMH: f64 = 270.0;
 

@@ -18,7 +18,10 @@
 use serde::{Deserialize, Serialize};
 
 use crate::nonlinear::{rhs, Consts, N_STATES};
-use crate::params::{ContactSource, ParamError, Params, TrackSource};
+use crate::params::{
+    ContactSource, ParamError, Params, TrackSource, WORN_SURROGATE_CONICITY,
+    WORN_SURROGATE_TREAD_HALF_WIDTH_M,
+};
 use wheel_rail::track::{DelayLine, TrackGenerator};
 use wheel_rail::{GeometryTable, TableError};
 
@@ -36,14 +39,11 @@ pub fn default_contact_table() -> Result<GeometryTable, TableError> {
 }
 
 /// Default table: worn-profile surrogate built from the A/A table (tread replaced by a cone
-/// of [`crate::calibration::WORN_SURROGATE_CONICITY`] within
-/// +-[`crate::calibration::WORN_SURROGATE_TREAD_HALF_WIDTH_M`], A/A rise beyond, contact
+/// of [`WORN_SURROGATE_CONICITY`] within +-[`WORN_SURROGATE_TREAD_HALF_WIDTH_M`], A/A rise beyond, contact
 /// angles kept). The same numbers are shipped as `resources/wheel_rail_worn_surrogate.csv`.
 pub fn worn_surrogate_table() -> Result<GeometryTable, TableError> {
-    Ok(default_aa_table()?.with_tread_cone(
-        crate::calibration::WORN_SURROGATE_CONICITY,
-        crate::calibration::WORN_SURROGATE_TREAD_HALF_WIDTH_M,
-    ))
+    Ok(default_aa_table()?
+        .with_tread_cone(WORN_SURROGATE_CONICITY, WORN_SURROGATE_TREAD_HALF_WIDTH_M))
 }
 
 /// Synthetic cone of conicity `conicity` with a steep flange (tan 2.7) from 7 mm over 0.5 mm.

@@ -16,11 +16,33 @@
 //! longitudinal secondary stiffness per side at arm b: air spring + mountings, WITHOUT the yaw
 //! damper, whose elastic part comes with the damper representation), `creep_reduction`
 //! (Kalker reduction factor, Polach 2005), and the contact geometry: the default table is the
-//! worn-profile surrogate (A/A with doubled rolling-radius differences); `conicity` and
-//! `gravity_stiffness_n_per_m` of the linear model are its describing-function values at
-//! 1 mm amplitude, so both models see the same contact at small amplitude.
+//! worn-profile surrogate (the A/A table with a 0.25 cone on the central +-3.5 mm of the
+//! tread); `conicity` and `gravity_stiffness_n_per_m` of the linear model are its
+//! describing-function values at 1 mm amplitude, so both models see the same contact at small
+//! amplitude. The calibrated values are the `CALIBRATED_*` / `WORN_SURROGATE_*` constants
+//! below (this module imports no other module of the crate).
 
 use serde::{Deserialize, Serialize};
+
+// Calibrated values: the defaults below use them; the procedure that produced them and its
+// reasoning are in the calibration module.
+
+/// Tread conicity of the worn-profile surrogate [-] (see [`crate::calibration`]).
+pub const WORN_SURROGATE_CONICITY: f64 = 0.25;
+/// Half-width of the coned tread of the surrogate; the A/A flange rise is kept beyond [m].
+pub const WORN_SURROGATE_TREAD_HALF_WIDTH_M: f64 = 3.5e-3;
+/// Amplitude at which the linear model's conicity and gravity stiffness are taken [m].
+pub const LINEARISATION_AMPLITUDE_M: f64 = 1e-3;
+/// Equivalent conicity of the default table at 1 mm (describing function) [-].
+pub const CALIBRATED_CONICITY: f64 = 0.25;
+/// Gravitational stiffness per wheelset of the default table at 1 mm, P = 70 kN [N/m].
+pub const CALIBRATED_GRAVITY_STIFFNESS_N_PER_M: f64 = 2.022e6;
+/// Kalker creep-coefficient reduction factor [-].
+pub const CALIBRATED_CREEP_REDUCTION: f64 = 0.6;
+/// k_ssx calibrated for 270 km/h with the Maxwell passive damper [N/m per side].
+pub const CALIBRATED_K_SSX_N_PER_M: f64 = 0.390e6;
+/// Wheel/rail friction coefficient [-] (dry rail 0.3-0.4).
+pub const CALIBRATED_FRICTION: f64 = 0.35;
 
 /// A parameter is out of its admissible range; names the parameter and the reason.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -175,14 +197,14 @@ impl Default for Params {
             damper_arm_m: 1.35,
             wheel_radius_m: 0.46,
             k_ssy_n_per_m: 160e3,
-            k_ssx_n_per_m: crate::calibration::CALIBRATED_K_SSX_N_PER_M,
-            conicity: crate::calibration::CALIBRATED_CONICITY,
-            gravity_stiffness_n_per_m: crate::calibration::CALIBRATED_GRAVITY_STIFFNESS_N_PER_M,
+            k_ssx_n_per_m: CALIBRATED_K_SSX_N_PER_M,
+            conicity: CALIBRATED_CONICITY,
+            gravity_stiffness_n_per_m: CALIBRATED_GRAVITY_STIFFNESS_N_PER_M,
             f11_n: 11.5e6,
             f22_n: 10.4e6,
-            creep_reduction: crate::calibration::CALIBRATED_CREEP_REDUCTION,
+            creep_reduction: CALIBRATED_CREEP_REDUCTION,
             wheel_load_n: 70e3,
-            friction_coefficient: crate::calibration::CALIBRATED_FRICTION,
+            friction_coefficient: CALIBRATED_FRICTION,
             initial_lateral_m: 0.0,
             initial_yaw_rad: 0.0,
             track: TrackSource::External,
