@@ -30,6 +30,25 @@ if ! "$VENV/bin/python" -c "import pythonfmu" 2>/dev/null; then
   "$VENV/bin/pip" install -q "pythonfmu==0.7.0" >/dev/null
 fi
 
+# Portable Linux binaries: cargo-zigbuild builds the FMUs against glibc 2.17 (manylinux2014)
+# with zig as C compiler and linker. Both are pinned: cargo-zigbuild from crates.io into
+# target/tools/bin (where package-fmus looks first), zig from PyPI's ziglang package in the venv,
+# which cargo-zigbuild runs as `$CARGO_ZIGBUILD_PYTHON_PATH -m ziglang`.
+ZIGBUILD_VERSION=0.24.1
+ZIGLANG_VERSION=0.15.2
+TOOLS="$PWD/target/tools"
+if [ "$("$TOOLS/bin/cargo-zigbuild" --version 2>/dev/null)" != "cargo-zigbuild $ZIGBUILD_VERSION" ]; then
+  step "installing cargo-zigbuild $ZIGBUILD_VERSION into $TOOLS"
+  cargo install -q cargo-zigbuild --version "$ZIGBUILD_VERSION" --locked --root "$TOOLS"
+fi
+if [ "$("$VENV/bin/python" -m ziglang version 2>/dev/null)" != "$ZIGLANG_VERSION" ]; then
+  step "installing zig $ZIGLANG_VERSION (PyPI ziglang) into $VENV"
+  "$VENV/bin/pip" install -q "ziglang==$ZIGLANG_VERSION" >/dev/null
+fi
+export PATH="$TOOLS/bin:$PATH"
+export CARGO_ZIGBUILD_PYTHON_PATH="$VENV/bin/python"
+
+# Builds the FMU libraries with cargo-zigbuild (glibc 2.17) and writes dist/*.fmu.
 package_fmus() {
   cargo run --release -q -p model-description --bin package-fmus
 }

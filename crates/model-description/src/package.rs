@@ -1,9 +1,12 @@
-//! Packaging: read the models a built binary carries (its `rfmi_manifest`) and write one
-//! reproducible `.fmu` per model.
+//! Packaging: read the models a built binary carries (its `rfmi_manifest`), check binaries
+//! for their platform folders, and write one reproducible `.fmu` per model with the binaries
+//! of every platform at hand.
 
+use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+pub use fmu_binary::{Platform, Policy};
 use zip::write::SimpleFileOptions;
 
 use crate::capi::PackagedModel;
@@ -26,6 +29,162 @@ pub enum PackageError {
         path: PathBuf,
         source: zip::result::ZipError,
     },
+    #[error("{}", binary_problems(.0))]
+    Binaries(Vec<String>),
+}
+
+fn binary_problems(problems: &[String]) -> String {
+    let mut s = format!(
+        "{} problem(s) with the binaries, no FMU written:",
+        problems.len()
+    );
+    for p in problems {
+        s.push_str("\n  ");
+        s.push_str(p);
+    }
+    s
+}
+
+/// One model's binary for one platform folder.
+#[derive(Debug, Clone)]
+pub struct PlatformBinary {
+    pub platform: Platform,
+    pub bytes: Vec<u8>,
+    /// Where it was read from (for messages).
+    pub source: PathBuf,
+}
+
+/// The problems of `bytes` as `model`'s binary in `platform`'s folder: format, architecture,
+/// the FMI 2.0 functions its modelDescription.xml requires, and `policy`'s Linux rules. Each
+/// problem is one line naming `source`; an empty list means it fits.
+pub fn binary_problems_for(
+    source: &Path,
+    bytes: &[u8],
+    platform: Platform,
+    model: &PackagedModel,
+    policy: &Policy,
+) -> Vec<String> {
+    let name = source.display();
+    let required = match fmu_binary::required_functions(&model.model_description_xml) {
+        Ok(r) => r,
+        Err(e) => return vec![format!("{}: modelDescription.xml: {e}", model.identifier)],
+    };
+    let exports: &[&str] = required
+        .get(&model.identifier)
+        .map(Vec::as_slice)
+        .unwrap_or(&[]);
+    match fmu_binary::inspect(bytes) {
+        Ok(info) => fmu_binary::check_binary(&info, platform, exports, policy)
+            .into_iter()
+            .map(|p| format!("{name} (for {platform}): {p}"))
+            .collect(),
+        Err(e) => vec![format!("{name} (for {platform}): {e}")],
+    }
+}
+
+/// Read binaries built elsewhere from `dir`, laid out as `<platform>/<modelIdentifier>.<ext>`
+/// (the `binaries/` folder of an FMU; `dir/binaries/` is used when it exists), for the
+/// `models` being packaged. Every file must be a known model's binary in a known platform
+/// folder other than `own_platform` (built here), fit that folder and export the FMI 2.0
+/// functions; all problems are reported together and nothing is returned on any.
+pub fn read_binaries_dir(
+    dir: &Path,
+    models: &[&PackagedModel],
+    own_platform: Platform,
+    policy: &Policy,
+) -> Result<BTreeMap<String, Vec<PlatformBinary>>, PackageError> {
+    let root = if dir.join("binaries").is_dir() {
+        dir.join("binaries")
+    } else {
+        dir.to_path_buf()
+    };
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| PackageError::Io { path, source }
+    };
+    let mut problems = Vec::new();
+    let mut out: BTreeMap<String, Vec<PlatformBinary>> = BTreeMap::new();
+    let mut folders: Vec<PathBuf> = std::fs::read_dir(&root)
+        .map_err(io(&root))?
+        .map(|e| e.map(|e| e.path()))
+        .collect::<Result<_, _>>()
+        .map_err(io(&root))?;
+    folders.sort();
+    for folder in folders {
+        let folder_name = folder
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        if !folder.is_dir() {
+            problems.push(format!(
+                "{}: expected only platform folders in {}",
+                folder.display(),
+                root.display()
+            ));
+            continue;
+        }
+        let Some(platform) = Platform::from_folder(&folder_name) else {
+            let known: Vec<&str> = Platform::ALL.iter().map(|p| p.folder()).collect();
+            problems.push(format!(
+                "{}: '{folder_name}' is no platform folder ({})",
+                folder.display(),
+                known.join(", ")
+            ));
+            continue;
+        };
+        if platform == own_platform {
+            problems.push(format!(
+                "{}: {platform} is built here; remove the folder or package on another platform",
+                folder.display()
+            ));
+            continue;
+        }
+        let mut files: Vec<PathBuf> = std::fs::read_dir(&folder)
+            .map_err(io(&folder))?
+            .map(|e| e.map(|e| e.path()))
+            .collect::<Result<_, _>>()
+            .map_err(io(&folder))?;
+        files.sort();
+        for file in files {
+            let file_name = file
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let model = models
+                .iter()
+                .find(|m| platform.library_file_name(&m.identifier) == file_name);
+            let Some(model) = model else {
+                let expected: Vec<String> = models
+                    .iter()
+                    .map(|m| platform.library_file_name(&m.identifier))
+                    .collect();
+                problems.push(format!(
+                    "{}: not a binary of a model packaged here (expected one of {})",
+                    file.display(),
+                    expected.join(", ")
+                ));
+                continue;
+            };
+            let bytes = std::fs::read(&file).map_err(io(&file))?;
+            let found = binary_problems_for(&file, &bytes, platform, model, policy);
+            if found.is_empty() {
+                out.entry(model.identifier.clone())
+                    .or_default()
+                    .push(PlatformBinary {
+                        platform,
+                        bytes,
+                        source: file,
+                    });
+            } else {
+                problems.extend(found);
+            }
+        }
+    }
+    if problems.is_empty() {
+        Ok(out)
+    } else {
+        Err(PackageError::Binaries(problems))
+    }
 }
 
 /// The models carried by the library at `path`, or `Ok(None)` if it is not one of ours.
@@ -68,13 +227,14 @@ pub fn read_manifest(path: &Path) -> Result<Option<Vec<PackagedModel>>, PackageE
         .map(Some)
 }
 
-/// Write `<out_dir>/<identifier>.fmu`. Entries are sorted and time-stamped 1980-01-01 so the
-/// same build gives the same bytes; the file is written to a temporary name and renamed.
+/// Write `<out_dir>/<identifier>.fmu` with `binaries/<platform>/<identifier>.<ext>` for each
+/// of `binaries`. Entries are sorted and time-stamped 1980-01-01 so the same binaries give the
+/// same bytes; the file is written to a temporary name and renamed. The modelDescription.xml
+/// (and its GUID) is the same whatever the platforms.
 pub fn write_fmu(
     out_dir: &Path,
     model: &PackagedModel,
-    binary: &[u8],
-    platform: &str,
+    binaries: &[(Platform, &[u8])],
 ) -> Result<PathBuf, PackageError> {
     let target = out_dir.join(format!("{}.fmu", model.identifier));
     let tmp = out_dir.join(format!(".{}.fmu.tmp", model.identifier));
@@ -99,16 +259,21 @@ pub fn write_fmu(
             0o644,
         ),
         (
-            format!("binaries/{platform}/{}.so", model.identifier),
-            binary,
-            0o755,
-        ),
-        (
             "documentation/index.html".into(),
             model.documentation_html.as_bytes(),
             0o644,
         ),
     ];
+    for (platform, bytes) in binaries {
+        entries.push((
+            format!(
+                "binaries/{platform}/{}",
+                platform.library_file_name(&model.identifier)
+            ),
+            bytes,
+            0o755,
+        ));
+    }
     for (name, bytes) in &model.resources {
         entries.push((format!("resources/{name}"), bytes.as_slice(), 0o644));
     }

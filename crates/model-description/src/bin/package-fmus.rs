@@ -1,114 +1,382 @@
 //! Build every FMU crate of the workspace (release, feature `fmi-export`) and write
 //! `dist/<Model>.fmu` for every model the built libraries carry.
 //!
-//! Usage: `cargo run --release -p model-description --bin package-fmus [-- --out DIR] [--no-build]`
+//! On Linux the libraries are built with cargo-zigbuild against glibc 2.17 (manylinux2014), so
+//! the FMUs load on every distribution since 2014; `--native` builds with plain cargo for the
+//! build machine's own glibc. `--binaries DIR` merges binaries built on other platforms into the
+//! same FMUs; `--export-binaries DIR` writes this platform's binaries for such a merge.
+//!
+//! Usage: `cargo run --release -p model-description --bin package-fmus [-- OPTIONS]`
 
-use std::path::PathBuf;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
-use model_description::package;
+use fmu_binary::{LinuxPolicy, SymbolVersion, GLIBC_BASELINE};
+use model_description::capi::PackagedModel;
+use model_description::package::{self, Platform, Policy};
 
-fn main() -> ExitCode {
-    let mut out = None;
-    let mut build = true;
+const HELP: &str = "package-fmus [--out DIR] [--no-build] [--native | --glibc X.Y] [--binaries DIR] [--export-binaries DIR]
+
+Builds the FMU crates (release, feature fmi-export) and writes DIR/<Model>.fmu
+(default DIR: <workspace>/dist). Every binary is checked before anything is written.
+
+  --out DIR              where the .fmu files go (default <workspace>/dist)
+  --no-build             package what the last build left in target/
+  --glibc X.Y            Linux: build with cargo-zigbuild against this glibc (default 2.17) and
+                         refuse binaries that need a newer one
+  --native               build with plain cargo for this machine (on Linux the binaries then
+                         need this machine's glibc; for machines without zig)
+  --binaries DIR         also put binaries built elsewhere into the FMUs: DIR/<platform>/
+                         <modelIdentifier>.<dll|dylib|so> (platforms win32, win64, linux32,
+                         linux64, darwin64, aarch64-linux, aarch64-darwin; DIR/binaries/ is used
+                         if it exists); each is checked for its folder's format, architecture
+                         and the FMI 2.0 exports
+  --export-binaries DIR  write this platform's binaries as DIR/<platform>/<modelIdentifier>.<ext>
+                         (for --binaries on another machine) instead of FMUs
+
+cargo-zigbuild is looked up in <workspace>/target/tools/bin, then on PATH; zig as
+`python -m ziglang` with <workspace>/.venv/bin/python (scripts/setup.sh installs both).";
+
+struct Options {
+    out: Option<PathBuf>,
+    build: bool,
+    native: bool,
+    glibc: Option<SymbolVersion>,
+    binaries: Option<PathBuf>,
+    export_binaries: Option<PathBuf>,
+}
+
+fn parse_args() -> Result<Option<Options>, String> {
+    let mut o = Options {
+        out: None,
+        build: true,
+        native: false,
+        glibc: None,
+        binaries: None,
+        export_binaries: None,
+    };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
+        let mut value = |name: &str| args.next().ok_or(format!("{name} needs a value"));
         match a.as_str() {
-            "--out" => out = args.next().map(PathBuf::from),
-            "--no-build" => build = false,
+            "--out" => o.out = Some(value("--out")?.into()),
+            "--no-build" => o.build = false,
+            "--native" => o.native = true,
+            "--glibc" => {
+                let v = value("--glibc")?;
+                o.glibc = Some(v.parse().map_err(|e| format!("--glibc: {e}"))?);
+            }
+            "--binaries" => o.binaries = Some(value("--binaries")?.into()),
+            "--export-binaries" => o.export_binaries = Some(value("--export-binaries")?.into()),
             "-h" | "--help" => {
-                println!("package-fmus [--out DIR] [--no-build]\n\nBuilds the FMU crates in release mode with feature fmi-export and writes DIR/<Model>.fmu (default DIR: <workspace>/dist).");
-                return ExitCode::SUCCESS;
+                println!("{HELP}");
+                return Ok(None);
             }
-            other => {
-                eprintln!("package-fmus: unknown argument '{other}' (see --help)");
-                return ExitCode::from(2);
-            }
+            other => return Err(format!("unknown argument '{other}' (see --help)")),
         }
     }
+    if o.native && o.glibc.is_some() {
+        return Err("--glibc sets the baseline of the zig build; --native has none".into());
+    }
+    if o.export_binaries.is_some() && (o.binaries.is_some() || o.out.is_some()) {
+        return Err("--export-binaries writes binaries, not FMUs: no --out or --binaries".into());
+    }
+    Ok(Some(o))
+}
+
+fn main() -> ExitCode {
+    match parse_args() {
+        Ok(Some(o)) => match run(&o) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("package-fmus: {e}");
+                ExitCode::FAILURE
+            }
+        },
+        Ok(None) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("package-fmus: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// How the libraries are built and where they land.
+struct Build {
+    platform: Platform,
+    /// `Some(triple)` for the zig build (`x86_64-unknown-linux-gnu`), `None` for plain cargo.
+    zig_triple: Option<String>,
+    policy: Policy,
+}
+
+impl Build {
+    fn new(o: &Options) -> Result<Self, String> {
+        let host = Platform::host().ok_or("this host is no FMI platform")?;
+        if o.native {
+            return Ok(Self {
+                platform: host,
+                zig_triple: None,
+                policy: Policy::native(),
+            });
+        }
+        if std::env::consts::OS != "linux" {
+            return Err(format!(
+                "the glibc-baseline build is for Linux hosts; on {} pass --native",
+                std::env::consts::OS
+            ));
+        }
+        let triple = format!("{}-unknown-linux-gnu", std::env::consts::ARCH);
+        Ok(Self {
+            platform: host,
+            zig_triple: Some(triple),
+            policy: Policy {
+                linux: Some(LinuxPolicy::with_glibc(o.glibc.unwrap_or(GLIBC_BASELINE))),
+            },
+        })
+    }
+
+    fn lib_dir(&self, target: &Path) -> PathBuf {
+        match &self.zig_triple {
+            Some(t) => target.join(t).join("release"),
+            None => target.join("release"),
+        }
+    }
+}
+
+fn run(o: &Options) -> Result<(), String> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let out = out.unwrap_or_else(|| root.join("dist"));
     let target = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| root.join("target"));
-    if build {
-        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-        let status = Command::new(cargo)
-            .current_dir(&root)
-            .args([
-                "build",
-                "--release",
-                "--workspace",
-                "--lib",
-                "--features",
-                "fmi-export",
-            ])
-            .status();
-        match status {
-            Ok(s) if s.success() => {}
-            Ok(s) => {
-                eprintln!("package-fmus: cargo build failed ({s})");
-                return ExitCode::FAILURE;
-            }
-            Err(e) => {
-                eprintln!("package-fmus: cannot run cargo: {e}");
-                return ExitCode::FAILURE;
-            }
+    let build = Build::new(o)?;
+    let crates = fmu_crates(&root)?;
+    if o.build {
+        cargo_build(&root, &build, &crates)?;
+    }
+    let lib_dir = build.lib_dir(&target);
+
+    // Every model of every library, each library checked for this platform before any output.
+    let mut models: Vec<(PackagedModel, PathBuf)> = Vec::new();
+    let mut problems = Vec::new();
+    for name in &crates {
+        let file_name = format!(
+            "{}{}{}",
+            std::env::consts::DLL_PREFIX,
+            name.replace('-', "_"),
+            std::env::consts::DLL_SUFFIX
+        );
+        let lib = lib_dir.join(file_name);
+        if !lib.is_file() {
+            return Err(format!(
+                "{} missing: build first (without --no-build)",
+                lib.display()
+            ));
+        }
+        let Some(carried) = package::read_manifest(&lib).map_err(|e| e.to_string())? else {
+            continue;
+        };
+        let bytes = std::fs::read(&lib).map_err(|e| format!("{}: {e}", lib.display()))?;
+        for m in carried {
+            problems.extend(package::binary_problems_for(
+                &lib,
+                &bytes,
+                build.platform,
+                &m,
+                &build.policy,
+            ));
+            models.push((m, lib.clone()));
         }
     }
-    let release = target.join("release");
-    let mut libs: Vec<PathBuf> = match std::fs::read_dir(&release) {
-        Ok(rd) => rd
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| {
-                p.extension().is_some_and(|x| x == "so")
-                    && p.file_name()
-                        .and_then(|n| n.to_str())
-                        .is_some_and(|n| n.starts_with("lib"))
-            })
-            .collect(),
-        Err(e) => {
-            eprintln!("package-fmus: {}: {e}", release.display());
-            return ExitCode::FAILURE;
+    if !problems.is_empty() {
+        return Err(package::PackageError::Binaries(problems).to_string());
+    }
+    if models.is_empty() {
+        return Err(format!("no FMU library found in {}", lib_dir.display()));
+    }
+    if let Some(newest) = glibc_of(&models)? {
+        println!("{} binaries need glibc {newest} or newer", build.platform);
+    }
+
+    if let Some(dir) = &o.export_binaries {
+        return export_binaries(dir, build.platform, &models);
+    }
+
+    let foreign = match &o.binaries {
+        Some(dir) => {
+            let refs: Vec<&PackagedModel> = models.iter().map(|(m, _)| m).collect();
+            package::read_binaries_dir(dir, &refs, build.platform, &build.policy)
+                .map_err(|e| format!("{}: {e}", dir.display()))?
+        }
+        None => BTreeMap::new(),
+    };
+    let out = o.out.clone().unwrap_or_else(|| root.join("dist"));
+    let mut libs: BTreeMap<PathBuf, Vec<u8>> = BTreeMap::new();
+    for (m, lib) in &models {
+        if !libs.contains_key(lib) {
+            let bytes = std::fs::read(lib).map_err(|e| format!("{}: {e}", lib.display()))?;
+            libs.insert(lib.clone(), bytes);
+        }
+        let own = libs.get(lib).map(Vec::as_slice).unwrap_or(&[]);
+        let mut binaries: Vec<(Platform, &[u8])> = vec![(build.platform, own)];
+        for b in foreign.get(&m.identifier).into_iter().flatten() {
+            binaries.push((b.platform, b.bytes.as_slice()));
+        }
+        binaries.sort_by_key(|(p, _)| *p);
+        let path = package::write_fmu(&out, m, &binaries).map_err(|e| e.to_string())?;
+        let platforms: Vec<&str> = binaries.iter().map(|(p, _)| p.folder()).collect();
+        println!("wrote {} ({})", path.display(), platforms.join(", "));
+    }
+    Ok(())
+}
+
+/// The newest glibc the built libraries need (Linux only).
+fn glibc_of(models: &[(PackagedModel, PathBuf)]) -> Result<Option<SymbolVersion>, String> {
+    let mut newest = None;
+    let mut seen: Vec<&Path> = Vec::new();
+    for (_, lib) in models {
+        if seen.contains(&lib.as_path()) {
+            continue;
+        }
+        seen.push(lib);
+        let bytes = std::fs::read(lib).map_err(|e| format!("{}: {e}", lib.display()))?;
+        let info = fmu_binary::inspect(&bytes).map_err(|e| format!("{}: {e}", lib.display()))?;
+        newest = newest.max(info.newest_glibc());
+    }
+    Ok(newest)
+}
+
+/// Write `dir/<platform>/<identifier>.<ext>` for every model (temporary name, then rename).
+fn export_binaries(
+    dir: &Path,
+    platform: Platform,
+    models: &[(PackagedModel, PathBuf)],
+) -> Result<(), String> {
+    let folder = dir.join(platform.folder());
+    std::fs::create_dir_all(&folder).map_err(|e| format!("{}: {e}", folder.display()))?;
+    for (m, lib) in models {
+        let target = folder.join(platform.library_file_name(&m.identifier));
+        let tmp = folder.join(format!(".{}.tmp", m.identifier));
+        std::fs::copy(lib, &tmp)
+            .and_then(|_| std::fs::rename(&tmp, &target))
+            .map_err(|e| format!("{}: {e}", target.display()))?;
+        println!("wrote {}", target.display());
+    }
+    Ok(())
+}
+
+/// Workspace members with a cdylib target and a feature `fmi-export`: the FMU crates.
+fn fmu_crates(root: &Path) -> Result<Vec<String>, String> {
+    #[derive(serde::Deserialize)]
+    struct Metadata {
+        packages: Vec<MetaPackage>,
+    }
+    #[derive(serde::Deserialize)]
+    struct MetaPackage {
+        name: String,
+        targets: Vec<MetaTarget>,
+        features: BTreeMap<String, Vec<String>>,
+    }
+    #[derive(serde::Deserialize)]
+    struct MetaTarget {
+        crate_types: Vec<String>,
+    }
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let out = Command::new(cargo)
+        .current_dir(root)
+        .args([
+            "metadata",
+            "--no-deps",
+            "--format-version",
+            "1",
+            "--offline",
+        ])
+        .output()
+        .map_err(|e| format!("cannot run cargo metadata: {e}"))?;
+    if !out.status.success() {
+        return Err(format!(
+            "cargo metadata failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
+    let meta: Metadata =
+        serde_json::from_slice(&out.stdout).map_err(|e| format!("cargo metadata output: {e}"))?;
+    let mut crates: Vec<String> = meta
+        .packages
+        .into_iter()
+        .filter(|p| {
+            p.features.contains_key("fmi-export")
+                && p.targets
+                    .iter()
+                    .any(|t| t.crate_types.iter().any(|c| c == "cdylib"))
+        })
+        .map(|p| p.name)
+        .collect();
+    crates.sort();
+    if crates.is_empty() {
+        return Err("no workspace crate has a cdylib target and a feature fmi-export".into());
+    }
+    Ok(crates)
+}
+
+fn cargo_build(root: &Path, build: &Build, crates: &[String]) -> Result<(), String> {
+    let mut cmd = match &build.zig_triple {
+        Some(triple) => {
+            let zigbuild = find_cargo_zigbuild(root)?;
+            let glibc = build
+                .policy
+                .linux
+                .as_ref()
+                .map(|l| l.glibc)
+                .unwrap_or(GLIBC_BASELINE);
+            let mut c = Command::new(zigbuild);
+            c.args(["zigbuild", "--target", &format!("{triple}.{glibc}")]);
+            let venv_python = root.join(".venv/bin/python");
+            if std::env::var_os("CARGO_ZIGBUILD_PYTHON_PATH").is_none() && venv_python.is_file() {
+                c.env("CARGO_ZIGBUILD_PYTHON_PATH", venv_python);
+            }
+            c
+        }
+        None => {
+            let mut c = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
+            c.arg("build");
+            c
         }
     };
-    libs.sort();
-    let mut written = 0;
-    for lib in libs {
-        let models = match package::read_manifest(&lib) {
-            Ok(Some(m)) => m,
-            Ok(None) => continue,
-            Err(e) => {
-                eprintln!("package-fmus: {e}");
-                return ExitCode::FAILURE;
-            }
-        };
-        let binary = match std::fs::read(&lib) {
-            Ok(b) => b,
-            Err(e) => {
-                eprintln!("package-fmus: {}: {e}", lib.display());
-                return ExitCode::FAILURE;
-            }
-        };
-        for m in &models {
-            match package::write_fmu(&out, m, &binary, "linux64") {
-                Ok(p) => {
-                    println!("wrote {}", p.display());
-                    written += 1;
-                }
-                Err(e) => {
-                    eprintln!("package-fmus: {e}");
-                    return ExitCode::FAILURE;
-                }
-            }
-        }
+    cmd.current_dir(root)
+        .args(["--release", "--lib", "--features", "fmi-export"]);
+    for c in crates {
+        cmd.args(["-p", c]);
     }
-    if written == 0 {
-        eprintln!(
-            "package-fmus: no FMU library found in {}",
-            release.display()
-        );
-        return ExitCode::FAILURE;
+    let status = cmd
+        .status()
+        .map_err(|e| format!("cannot run the build: {e}"))?;
+    if !status.success() {
+        let hint = if build.zig_triple.is_some() {
+            " (zig missing? run `bash scripts/setup.sh`, or pass --native to build for this machine's glibc)"
+        } else {
+            ""
+        };
+        return Err(format!("cargo build failed ({status}){hint}"));
     }
-    ExitCode::SUCCESS
+    Ok(())
+}
+
+/// `<workspace>/target/tools/bin/cargo-zigbuild` (where scripts/setup.sh installs it), else
+/// `cargo-zigbuild` on PATH.
+fn find_cargo_zigbuild(root: &Path) -> Result<PathBuf, String> {
+    let local = root.join("target/tools/bin/cargo-zigbuild");
+    if local.is_file() {
+        return Ok(local);
+    }
+    let on_path = std::env::var_os("PATH").and_then(|paths| {
+        std::env::split_paths(&paths)
+            .map(|p| p.join("cargo-zigbuild"))
+            .find(|p| p.is_file())
+    });
+    on_path.ok_or_else(|| {
+        "cargo-zigbuild not found (in target/tools/bin or on PATH): run `bash scripts/setup.sh`, \
+         or pass --native to build for this machine's glibc"
+            .to_string()
+    })
 }
