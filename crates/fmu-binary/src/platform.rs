@@ -12,24 +12,25 @@ use crate::inspect::{Architecture, BinaryFormat};
 /// a universal (both) Mach-O binary: FMI 2.0 hosts on Apple silicon load `darwin64` too.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Platform {
-    Win32,
-    Win64,
+    // In the alphabetical order of the folder names (the order of the entries in an FMU).
+    Aarch64Darwin,
+    Aarch64Linux,
+    Darwin64,
     Linux32,
     Linux64,
-    Darwin64,
-    Aarch64Linux,
-    Aarch64Darwin,
+    Win32,
+    Win64,
 }
 
 impl Platform {
     pub const ALL: [Platform; 7] = [
-        Platform::Win32,
-        Platform::Win64,
+        Platform::Aarch64Darwin,
+        Platform::Aarch64Linux,
+        Platform::Darwin64,
         Platform::Linux32,
         Platform::Linux64,
-        Platform::Darwin64,
-        Platform::Aarch64Linux,
-        Platform::Aarch64Darwin,
+        Platform::Win32,
+        Platform::Win64,
     ];
 
     /// The folder name under `binaries/`.
@@ -145,6 +146,9 @@ mod tests {
         for p in Platform::ALL {
             assert_eq!(Platform::from_folder(p.folder()), Some(p));
         }
+        let mut sorted = Platform::ALL;
+        sorted.sort_by_key(|p| p.folder());
+        assert_eq!(sorted, Platform::ALL, "Ord follows the folder names");
         assert_eq!(Platform::from_folder("linux"), None);
         let cases = [
             ("x86_64-unknown-linux-gnu.2.17", Some(Platform::Linux64)),

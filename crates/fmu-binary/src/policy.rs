@@ -146,6 +146,9 @@ impl fmt::Display for Problem {
                     allowed.join(" or ")
                 )
             }
+            Problem::MissingExports { missing, required } if missing.len() == *required => {
+                write!(f, "exports none of the {required} FMI 2.0 functions")
+            }
             Problem::MissingExports { missing, required } => write!(
                 f,
                 "does not export {} of the {required} FMI 2.0 functions: {}",
