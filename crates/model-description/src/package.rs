@@ -29,11 +29,11 @@ pub enum PackageError {
         path: PathBuf,
         source: zip::result::ZipError,
     },
-    #[error("{}", binary_problems(.0))]
+    #[error("{}", list_problems(.0))]
     Binaries(Vec<String>),
 }
 
-fn binary_problems(problems: &[String]) -> String {
+fn list_problems(problems: &[String]) -> String {
     let mut s = format!(
         "{} problem(s) with the binaries, no FMU written:",
         problems.len()

@@ -144,6 +144,13 @@ impl Build {
     }
 }
 
+/// A built library and the models it carries.
+struct Library {
+    path: PathBuf,
+    bytes: Vec<u8>,
+    models: Vec<PackagedModel>,
+}
+
 fn run(o: &Options) -> Result<(), String> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
     let root = root.canonicalize().unwrap_or(root);
@@ -155,113 +162,114 @@ fn run(o: &Options) -> Result<(), String> {
     if o.build {
         cargo_build(&root, &build, &crates)?;
     }
-    let lib_dir = build.lib_dir(&target);
+    let libs = read_libraries(&build.lib_dir(&target), &crates)?;
 
-    // Every model of every library, each library checked for this platform before any output.
-    let mut models: Vec<(PackagedModel, PathBuf)> = Vec::new();
+    // Every library is checked for this platform before anything is written.
     let mut problems = Vec::new();
-    for name in &crates {
+    let mut newest_glibc = None;
+    for lib in &libs {
+        for m in &lib.models {
+            problems.extend(package::binary_problems_for(
+                &lib.path,
+                &lib.bytes,
+                build.platform,
+                m,
+                &build.policy,
+            ));
+        }
+        if let Ok(info) = fmu_binary::inspect(&lib.bytes) {
+            newest_glibc = newest_glibc.max(info.newest_glibc());
+        }
+    }
+    if !problems.is_empty() {
+        return Err(package::PackageError::Binaries(problems).to_string());
+    }
+    if let Some(v) = newest_glibc {
+        match &build.policy.linux {
+            Some(l) => println!(
+                "{} binaries need glibc {v} or newer (baseline {})",
+                build.platform, l.glibc
+            ),
+            None => println!(
+                "{} binaries need glibc {v} or newer (--native: this machine's glibc)",
+                build.platform
+            ),
+        }
+    }
+
+    if let Some(dir) = &o.export_binaries {
+        return export_binaries(dir, build.platform, &libs);
+    }
+    let foreign = match &o.binaries {
+        Some(dir) => {
+            let models: Vec<&PackagedModel> = libs.iter().flat_map(|l| &l.models).collect();
+            package::read_binaries_dir(dir, &models, build.platform, &build.policy)
+                .map_err(|e| e.to_string())?
+        }
+        None => BTreeMap::new(),
+    };
+    let out = o.out.clone().unwrap_or_else(|| root.join("dist"));
+    for lib in &libs {
+        for m in &lib.models {
+            let mut binaries: Vec<(Platform, &[u8])> = vec![(build.platform, &lib.bytes)];
+            for b in foreign.get(&m.identifier).into_iter().flatten() {
+                binaries.push((b.platform, b.bytes.as_slice()));
+            }
+            binaries.sort_by_key(|(p, _)| *p);
+            let path = package::write_fmu(&out, m, &binaries).map_err(|e| e.to_string())?;
+            let platforms: Vec<&str> = binaries.iter().map(|(p, _)| p.folder()).collect();
+            println!("wrote {} ({})", path.display(), platforms.join(", "));
+        }
+    }
+    Ok(())
+}
+
+/// The library of each FMU crate in `lib_dir`, with the models its manifest lists.
+fn read_libraries(lib_dir: &Path, crates: &[String]) -> Result<Vec<Library>, String> {
+    let mut libs = Vec::new();
+    for name in crates {
         let file_name = format!(
             "{}{}{}",
             std::env::consts::DLL_PREFIX,
             name.replace('-', "_"),
             std::env::consts::DLL_SUFFIX
         );
-        let lib = lib_dir.join(file_name);
-        if !lib.is_file() {
+        let path = lib_dir.join(file_name);
+        if !path.is_file() {
             return Err(format!(
                 "{} missing: build first (without --no-build)",
-                lib.display()
+                path.display()
             ));
         }
-        let Some(carried) = package::read_manifest(&lib).map_err(|e| e.to_string())? else {
+        let Some(models) = package::read_manifest(&path).map_err(|e| e.to_string())? else {
             continue;
         };
-        let bytes = std::fs::read(&lib).map_err(|e| format!("{}: {e}", lib.display()))?;
-        for m in carried {
-            problems.extend(package::binary_problems_for(
-                &lib,
-                &bytes,
-                build.platform,
-                &m,
-                &build.policy,
-            ));
-            models.push((m, lib.clone()));
-        }
+        let bytes = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        libs.push(Library {
+            path,
+            bytes,
+            models,
+        });
     }
-    if !problems.is_empty() {
-        return Err(package::PackageError::Binaries(problems).to_string());
-    }
-    if models.is_empty() {
+    if libs.iter().all(|l| l.models.is_empty()) {
         return Err(format!("no FMU library found in {}", lib_dir.display()));
     }
-    if let Some(newest) = glibc_of(&models)? {
-        println!("{} binaries need glibc {newest} or newer", build.platform);
-    }
-
-    if let Some(dir) = &o.export_binaries {
-        return export_binaries(dir, build.platform, &models);
-    }
-
-    let foreign = match &o.binaries {
-        Some(dir) => {
-            let refs: Vec<&PackagedModel> = models.iter().map(|(m, _)| m).collect();
-            package::read_binaries_dir(dir, &refs, build.platform, &build.policy)
-                .map_err(|e| format!("{}: {e}", dir.display()))?
-        }
-        None => BTreeMap::new(),
-    };
-    let out = o.out.clone().unwrap_or_else(|| root.join("dist"));
-    let mut libs: BTreeMap<PathBuf, Vec<u8>> = BTreeMap::new();
-    for (m, lib) in &models {
-        if !libs.contains_key(lib) {
-            let bytes = std::fs::read(lib).map_err(|e| format!("{}: {e}", lib.display()))?;
-            libs.insert(lib.clone(), bytes);
-        }
-        let own = libs.get(lib).map(Vec::as_slice).unwrap_or(&[]);
-        let mut binaries: Vec<(Platform, &[u8])> = vec![(build.platform, own)];
-        for b in foreign.get(&m.identifier).into_iter().flatten() {
-            binaries.push((b.platform, b.bytes.as_slice()));
-        }
-        binaries.sort_by_key(|(p, _)| *p);
-        let path = package::write_fmu(&out, m, &binaries).map_err(|e| e.to_string())?;
-        let platforms: Vec<&str> = binaries.iter().map(|(p, _)| p.folder()).collect();
-        println!("wrote {} ({})", path.display(), platforms.join(", "));
-    }
-    Ok(())
-}
-
-/// The newest glibc the built libraries need (Linux only).
-fn glibc_of(models: &[(PackagedModel, PathBuf)]) -> Result<Option<SymbolVersion>, String> {
-    let mut newest = None;
-    let mut seen: Vec<&Path> = Vec::new();
-    for (_, lib) in models {
-        if seen.contains(&lib.as_path()) {
-            continue;
-        }
-        seen.push(lib);
-        let bytes = std::fs::read(lib).map_err(|e| format!("{}: {e}", lib.display()))?;
-        let info = fmu_binary::inspect(&bytes).map_err(|e| format!("{}: {e}", lib.display()))?;
-        newest = newest.max(info.newest_glibc());
-    }
-    Ok(newest)
+    Ok(libs)
 }
 
 /// Write `dir/<platform>/<identifier>.<ext>` for every model (temporary name, then rename).
-fn export_binaries(
-    dir: &Path,
-    platform: Platform,
-    models: &[(PackagedModel, PathBuf)],
-) -> Result<(), String> {
+fn export_binaries(dir: &Path, platform: Platform, libs: &[Library]) -> Result<(), String> {
     let folder = dir.join(platform.folder());
     std::fs::create_dir_all(&folder).map_err(|e| format!("{}: {e}", folder.display()))?;
-    for (m, lib) in models {
-        let target = folder.join(platform.library_file_name(&m.identifier));
-        let tmp = folder.join(format!(".{}.tmp", m.identifier));
-        std::fs::copy(lib, &tmp)
-            .and_then(|_| std::fs::rename(&tmp, &target))
-            .map_err(|e| format!("{}: {e}", target.display()))?;
-        println!("wrote {}", target.display());
+    for lib in libs {
+        for m in &lib.models {
+            let target = folder.join(platform.library_file_name(&m.identifier));
+            let tmp = folder.join(format!(".{}.tmp", m.identifier));
+            std::fs::write(&tmp, &lib.bytes)
+                .and_then(|_| std::fs::rename(&tmp, &target))
+                .map_err(|e| format!("{}: {e}", target.display()))?;
+            println!("wrote {}", target.display());
+        }
     }
     Ok(())
 }
