@@ -17,12 +17,26 @@
 //! zone around that minimum where the gap is below `min + contact_zone_depth_m` (integrated on a
 //! 0.01 mm lateral grid): in nearly conformal zones the bare minimum is ill-conditioned (see the
 //! crate docs), the centroid is not; where the gap is sharply curved it equals the minimum.
+//!
+//! Unequal nominal radii enter as [`ContactSetup::radius_convention`] says: the EN 15302 offset
+//! of Δr (search with equal radii) or the rigid wheelset's roll ([`RadiusConvention`]).
+//!
+//! The set-up types live in `setup`, the table over `y` (flange-climbing rows beyond the flange
+//! limit, contact-point jumps located by bisection) in `sweep`; both are re-exported here.
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::profile::{Profile, ProfileError};
-use crate::table::{write_csv, CsvNumbers, CsvRow, GeometryTable, TableError};
+
+mod setup;
+mod sweep;
+
+pub use setup::{
+    ContactSetup, LateralReference, RadiusConvention, RailPlacement, WheelPlacement,
+    CONTACT_ZONE_DEPTH_M,
+};
+pub use sweep::{compute_table, ContactJump, ContactTable};
 
 /// Half width of the central difference used for the contact-angle slope [m].
 const SLOPE_HALF_WINDOW_M: f64 = 0.25e-3;
@@ -78,246 +92,6 @@ pub enum ContactError {
     },
 }
 
-/// How the wheels are placed laterally on the axle.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum WheelPlacement {
-    /// Lateral distance between the origins of the two wheel profiles (nominal rolling circles),
-    /// e.g. 1.500 m for the EN 15302 benchmark profiles.
-    RollingCircleDistance {
-        /// Distance [m].
-        distance_m: f64,
-    },
-    /// Back-to-back distance of the wheels plus the lateral distance from each wheel's back face
-    /// to its profile origin (S1002: 70 mm): origin distance = B + 2 * offset.
-    BackToBack {
-        /// Back-to-back distance [m] (1.360 m nominal for standard gauge).
-        back_to_back_m: f64,
-        /// Back face to profile origin (taping line) [m].
-        back_face_to_origin_m: f64,
-    },
-    /// Distance between the active flange faces, each measured `measuring_depth_m` below the
-    /// profile origin (e.g. 10 mm below the tread datum).
-    FlangeFaces {
-        /// Distance [m].
-        distance_m: f64,
-        /// Measuring depth below the profile origin [m].
-        measuring_depth_m: f64,
-    },
-}
-
-/// How the rails are placed laterally.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum RailPlacement {
-    /// Track gauge between the gauge faces, measured `measuring_depth_m` (14 mm) below the highest
-    /// point of each (inclined) rail head. The gauge point is the first crossing of that level
-    /// coming from the gauge side of the rail profile.
-    Gauge {
-        /// Gauge [m].
-        gauge_m: f64,
-        /// Measuring depth below the top of rail [m].
-        measuring_depth_m: f64,
-    },
-    /// Lateral distance between the origins of the two rail profiles [m].
-    OriginDistance {
-        /// Distance [m].
-        distance_m: f64,
-    },
-}
-
-/// Where the wheelset lateral displacement `y` is measured (only differs by `h * sin(roll)`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum LateralReference {
-    /// Centre plane of the wheelset at the level of the nominal rolling circles (rail level).
-    /// This is the convention that reproduces the EN 15302 E1 reference.
-    RailLevel,
-    /// Axle centre.
-    AxleCentre,
-}
-
-/// Everything that defines a contact-geometry computation.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ContactSetup {
-    /// Left wheel profile (in its own frame: lateral towards the field side, vertical up).
-    pub wheel_left: Profile,
-    /// Right wheel profile.
-    pub wheel_right: Profile,
-    /// Left rail profile.
-    pub rail_left: Profile,
-    /// Right rail profile.
-    pub rail_right: Profile,
-    /// Nominal rolling radius of the left wheel at its profile origin [m] (diameter / 2).
-    pub nominal_radius_left_m: f64,
-    /// Nominal rolling radius of the right wheel [m].
-    pub nominal_radius_right_m: f64,
-    /// Lateral placement of the wheels on the axle.
-    pub wheel_placement: WheelPlacement,
-    /// Lateral placement of the rails.
-    pub rail_placement: RailPlacement,
-    /// Rail inclination to APPLY to the rail profiles as read, as a tangent (e.g. 1/40), positive
-    /// = rail head tilted towards the track centre. 0 for profiles already given in track
-    /// orientation, such as the EN 15302 rail A (which already contains its inclination).
-    pub rail_inclination: f64,
-    /// Where `y` is measured.
-    pub lateral_reference: LateralReference,
-    /// Depth of the contact zone [m] ("virtual penetration"): the contact point of each wheel is
-    /// the penetration-weighted centroid of the zone where the wheel/rail gap lies within this
-    /// depth of its minimum (see the module docs). 0 gives the bare minimum-distance point.
-    /// [`CONTACT_ZONE_DEPTH_M`] by default.
-    pub contact_zone_depth_m: f64,
-}
-
-/// Default [`ContactSetup::contact_zone_depth_m`]: 7.5 µm. Every depth from 5 to 10 µm puts all
-/// E1 points with |y| <= 6 mm within 0.1 mm of the EN 15302 reference (tests/e1_benchmark.rs);
-/// the default is the middle of that range. It is far below the elastic approach of a loaded
-/// wheel (~0.05-0.1 mm), so it only spreads the contact over zones that are conformal to within
-/// a few micrometres, where the bare minimum-distance point is ill-conditioned.
-pub const CONTACT_ZONE_DEPTH_M: f64 = 7.5e-6;
-
-impl ContactSetup {
-    /// Same wheel profile on both sides, same rail on both sides, EN 15302 benchmark placement:
-    /// profile origins 1.500 m apart, gauge measured 14 mm below the top of rail, no additional
-    /// rail inclination, `y` measured at rail level.
-    pub fn symmetric(wheel: Profile, rail: Profile, nominal_radius_m: f64, gauge_m: f64) -> Self {
-        Self {
-            wheel_left: wheel.clone(),
-            wheel_right: wheel,
-            rail_left: rail.clone(),
-            rail_right: rail,
-            nominal_radius_left_m: nominal_radius_m,
-            nominal_radius_right_m: nominal_radius_m,
-            wheel_placement: WheelPlacement::RollingCircleDistance { distance_m: 1.5 },
-            rail_placement: RailPlacement::Gauge {
-                gauge_m,
-                measuring_depth_m: 0.014,
-            },
-            rail_inclination: 0.0,
-            lateral_reference: LateralReference::RailLevel,
-            contact_zone_depth_m: CONTACT_ZONE_DEPTH_M,
-        }
-    }
-
-    /// Checks the numeric parameters; the error names the parameter.
-    pub fn validate(&self) -> Result<(), ContactError> {
-        let check = |name: &'static str, v: f64, lo: f64, hi: f64, reason: &'static str| {
-            if v.is_finite() && v > lo && v < hi {
-                Ok(())
-            } else {
-                Err(ContactError::Param {
-                    name,
-                    value: v,
-                    reason,
-                })
-            }
-        };
-        check(
-            "nominal_radius_left_m",
-            self.nominal_radius_left_m,
-            0.1,
-            2.0,
-            "must be a finite radius in (0.1, 2) m",
-        )?;
-        check(
-            "nominal_radius_right_m",
-            self.nominal_radius_right_m,
-            0.1,
-            2.0,
-            "must be a finite radius in (0.1, 2) m",
-        )?;
-        if !(self.contact_zone_depth_m.is_finite()
-            && (0.0..1e-3).contains(&self.contact_zone_depth_m))
-        {
-            return Err(ContactError::Param {
-                name: "contact_zone_depth_m",
-                value: self.contact_zone_depth_m,
-                reason: "must be a finite depth in [0, 1e-3) m",
-            });
-        }
-        check(
-            "rail_inclination",
-            self.rail_inclination,
-            -0.2,
-            0.2,
-            "must be a finite tangent in (-0.2, 0.2)",
-        )?;
-        match self.wheel_placement {
-            WheelPlacement::RollingCircleDistance { distance_m } => check(
-                "wheel_placement.distance_m",
-                distance_m,
-                0.3,
-                3.0,
-                "must be in (0.3, 3) m",
-            )?,
-            WheelPlacement::BackToBack {
-                back_to_back_m,
-                back_face_to_origin_m,
-            } => {
-                check(
-                    "wheel_placement.back_to_back_m",
-                    back_to_back_m,
-                    0.3,
-                    3.0,
-                    "must be in (0.3, 3) m",
-                )?;
-                check(
-                    "wheel_placement.back_face_to_origin_m",
-                    back_face_to_origin_m,
-                    0.0,
-                    0.3,
-                    "must be in (0, 0.3) m",
-                )?;
-            }
-            WheelPlacement::FlangeFaces {
-                distance_m,
-                measuring_depth_m,
-            } => {
-                check(
-                    "wheel_placement.distance_m",
-                    distance_m,
-                    0.3,
-                    3.0,
-                    "must be in (0.3, 3) m",
-                )?;
-                check(
-                    "wheel_placement.measuring_depth_m",
-                    measuring_depth_m,
-                    0.0,
-                    0.05,
-                    "must be in (0, 0.05) m",
-                )?;
-            }
-        }
-        match self.rail_placement {
-            RailPlacement::Gauge {
-                gauge_m,
-                measuring_depth_m,
-            } => {
-                check(
-                    "rail_placement.gauge_m",
-                    gauge_m,
-                    0.3,
-                    3.0,
-                    "must be in (0.3, 3) m",
-                )?;
-                check(
-                    "rail_placement.measuring_depth_m",
-                    measuring_depth_m,
-                    0.0,
-                    0.05,
-                    "must be in (0, 0.05) m",
-                )?;
-            }
-            RailPlacement::OriginDistance { distance_m } => check(
-                "rail_placement.distance_m",
-                distance_m,
-                0.3,
-                3.0,
-                "must be in (0.3, 3) m",
-            )?,
-        }
-        Ok(())
-    }
-}
-
 /// Contact point of one wheel.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct WheelContact {
@@ -358,92 +132,55 @@ pub struct ContactRow {
     pub beyond_flange_limit: bool,
 }
 
-/// Rolling-radius-difference table over a uniform grid of lateral displacements.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ContactTable {
-    /// Rows, increasing `y`.
-    pub rows: Vec<ContactRow>,
-    /// Nominal radius of the left wheel [m].
-    pub nominal_radius_left_m: f64,
-    /// Nominal radius of the right wheel [m].
-    pub nominal_radius_right_m: f64,
-    /// Half the lateral distance between the left and right contact points at y = 0 [m].
-    pub e0_m: f64,
-    /// Smallest reachable `y` of the table (rows below repeat this one) [m].
-    pub y_reachable_min_m: f64,
-    /// Largest reachable `y` [m].
-    pub y_reachable_max_m: f64,
-}
-
-impl ContactTable {
-    /// The table in the contact-table CSV format ([`crate::table`], header
-    /// [`crate::table::BOGIE_CSV_HEADER`], [`CsvNumbers::Fixed`]), one row per grid point; rows beyond the
-    /// flange limit repeat the last reachable values.
-    pub fn to_bogie_csv(&self) -> String {
-        write_csv(self.csv_rows(), CsvNumbers::Fixed)
-    }
-
-    /// The table as the time-domain models' [`GeometryTable`] (full precision, no CSV round
-    /// trip).
-    pub fn geometry_table(&self) -> Result<GeometryTable, TableError> {
-        let mut cols: [Vec<f64>; 5] = Default::default();
-        for row in self.csv_rows() {
-            for (col, value) in cols.iter_mut().zip(row) {
-                col.push(value);
-            }
-        }
-        let [y, dr_l, dr_r, tg_l, tg_r] = cols;
-        GeometryTable::from_columns(y, dr_l, dr_r, tg_l, tg_r)
-    }
-
-    fn csv_rows(&self) -> impl Iterator<Item = CsvRow> + '_ {
-        self.rows.iter().map(|r| {
-            [
-                r.y_m,
-                r.left.delta_radius_m,
-                r.right.delta_radius_m,
-                r.left.tan_gamma,
-                r.right.tan_gamma,
-            ]
-        })
-    }
-
-    /// Rows within the reachable range.
-    pub fn reachable_rows(&self) -> impl Iterator<Item = &ContactRow> {
-        self.rows.iter().filter(|r| !r.beyond_flange_limit)
-    }
-
-    /// Mean nominal radius [m].
-    pub fn nominal_radius_mean_m(&self) -> f64 {
-        0.5 * (self.nominal_radius_left_m + self.nominal_radius_right_m)
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Side {
+/// One wheel of the wheelset.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum WheelSide {
+    /// Left wheel (track lateral Y < 0).
     Left,
+    /// Right wheel (track lateral Y > 0).
     Right,
 }
 
-impl Side {
+impl WheelSide {
     fn sign(self) -> f64 {
         match self {
-            Side::Left => -1.0,
-            Side::Right => 1.0,
+            WheelSide::Left => -1.0,
+            WheelSide::Right => 1.0,
         }
     }
-    fn name(self) -> &'static str {
+    /// "left" or "right".
+    pub fn name(self) -> &'static str {
         match self {
-            Side::Left => "left",
-            Side::Right => "right",
+            WheelSide::Left => "left",
+            WheelSide::Right => "right",
         }
+    }
+}
+
+impl ContactRow {
+    /// The contact of one wheel.
+    pub fn wheel(&self, side: WheelSide) -> &WheelContact {
+        match side {
+            WheelSide::Left => &self.left,
+            WheelSide::Right => &self.right,
+        }
+    }
+
+    /// The same state with the wheels' nominal radii `r_left0`, `r_right0` applied as EN 15302
+    /// offsets ([`RadiusConvention::En15302Offset`]): each rolling radius becomes its own
+    /// nominal radius plus the deviation of this (equal-radius) row.
+    fn with_nominal_radii(mut self, r_left0: f64, r_right0: f64) -> Self {
+        self.left.rolling_radius_m = r_left0 + self.left.delta_radius_m;
+        self.right.rolling_radius_m = r_right0 + self.right.delta_radius_m;
+        self.delta_r_m = self.right.rolling_radius_m - self.left.rolling_radius_m;
+        self
     }
 }
 
 /// One side, prepared for the search.
 #[derive(Debug, Clone)]
 struct PreparedSide {
-    side: Side,
+    side: WheelSide,
     wheel: Profile,
     r0: f64,
     /// Half distance of the wheel profile origin from the wheelset centre plane.
@@ -455,11 +192,14 @@ struct PreparedSide {
 }
 
 #[derive(Debug, Clone)]
-struct Prepared {
+pub(crate) struct Prepared {
     left: PreparedSide,
     right: PreparedSide,
     pivot_depth: f64,
     zone_depth: f64,
+    /// (left, right) nominal radii to apply to each solved row as EN 15302 offsets, when the
+    /// search runs with their mean.
+    nominal_offsets: Option<(f64, f64)>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -512,21 +252,22 @@ fn flange_face_point(wheel: &Profile, depth: f64) -> Result<f64, ContactError> {
     })
 }
 
-fn prepare(setup: &ContactSetup) -> Result<Prepared, ContactError> {
+pub(crate) fn prepare(setup: &ContactSetup) -> Result<Prepared, ContactError> {
     setup.validate()?;
+    let (r_left0, r_right0) = (setup.nominal_radius_left_m, setup.nominal_radius_right_m);
+    // EN 15302 offset: search with the mean radius on both wheels, apply the real ones after.
+    let nominal_offsets = (setup.radius_convention == RadiusConvention::En15302Offset
+        && r_left0 != r_right0)
+        .then_some((r_left0, r_right0));
+    let (r_left, r_right) = match nominal_offsets {
+        Some(_) => (0.5 * (r_left0 + r_right0), 0.5 * (r_left0 + r_right0)),
+        None => (r_left0, r_right0),
+    };
     let incl = setup.rail_inclination.atan();
-    let mk = |side: Side| -> Result<PreparedSide, ContactError> {
+    let mk = |side: WheelSide| -> Result<PreparedSide, ContactError> {
         let (wheel, rail_file, r0) = match side {
-            Side::Left => (
-                &setup.wheel_left,
-                &setup.rail_left,
-                setup.nominal_radius_left_m,
-            ),
-            Side::Right => (
-                &setup.wheel_right,
-                &setup.rail_right,
-                setup.nominal_radius_right_m,
-            ),
+            WheelSide::Left => (&setup.wheel_left, &setup.rail_left, r_left),
+            WheelSide::Right => (&setup.wheel_right, &setup.rail_right, r_right),
         };
         let rail = if incl != 0.0 {
             rail_file.rotated(incl)?
@@ -560,7 +301,7 @@ fn prepare(setup: &ContactSetup) -> Result<Prepared, ContactError> {
             .zip(&rail.vertical_m)
             .map(|(&s, &z)| (sg * (offset + s), z, s * cs + z * sn))
             .collect();
-        if side == Side::Left {
+        if side == WheelSide::Left {
             pts.reverse();
         }
         let (fs, fm) = wheel.max_slope();
@@ -573,8 +314,8 @@ fn prepare(setup: &ContactSetup) -> Result<Prepared, ContactError> {
             flange_s: (fm > FLANGE_MIN_SLOPE).then_some(fs),
         })
     };
-    let left = mk(Side::Left)?;
-    let right = mk(Side::Right)?;
+    let left = mk(WheelSide::Left)?;
+    let right = mk(WheelSide::Right)?;
     let pivot_depth = match setup.lateral_reference {
         LateralReference::RailLevel => 0.5 * (left.r0 + right.r0),
         LateralReference::AxleCentre => 0.0,
@@ -584,6 +325,7 @@ fn prepare(setup: &ContactSetup) -> Result<Prepared, ContactError> {
         right,
         pivot_depth,
         zone_depth: setup.contact_zone_depth_m,
+        nominal_offsets,
     })
 }
 
@@ -762,12 +504,16 @@ impl PreparedSide {
     }
 }
 
-struct Solved {
-    row: ContactRow,
-    beyond: bool,
+/// One solved row and where it lies.
+pub(crate) struct Solved {
+    pub(crate) row: ContactRow,
+    /// Beyond the flange limit or at a profile end.
+    pub(crate) beyond: bool,
+    /// A contact at the end of a profile's overlap (the profiles are exhausted there).
+    pub(crate) at_end: bool,
 }
 
-fn solve_at(p: &Prepared, y: f64, phi_guess: f64) -> Result<Solved, ContactError> {
+pub(crate) fn solve_at(p: &Prepared, y: f64, phi_guess: f64) -> Result<Solved, ContactError> {
     let h = p.pivot_depth;
     let mut buf = Vec::with_capacity(p.left.wheel.len().max(p.right.wheel.len()));
     let mut f = |phi: f64| -> Result<(f64, SideGap, SideGap), ContactError> {
@@ -840,17 +586,23 @@ fn solve_at(p: &Prepared, y: f64, phi_guess: f64) -> Result<Solved, ContactError
     let left = p.left.contact(&gl, phi)?;
     let right = p.right.contact(&gr, phi)?;
     let beyond = p.left.beyond_limit(&gl) || p.right.beyond_limit(&gr);
+    let row = ContactRow {
+        y_m: y,
+        left,
+        right,
+        roll_rad: phi,
+        axle_centre_height_m: zc + h * phi.cos() - h,
+        delta_r_m: right.rolling_radius_m - left.rolling_radius_m,
+        beyond_flange_limit: beyond,
+    };
+    let row = match p.nominal_offsets {
+        Some((r_left0, r_right0)) => row.with_nominal_radii(r_left0, r_right0),
+        None => row,
+    };
     Ok(Solved {
-        row: ContactRow {
-            y_m: y,
-            left,
-            right,
-            roll_rad: phi,
-            axle_centre_height_m: zc + h * phi.cos() - h,
-            delta_r_m: right.rolling_radius_m - left.rolling_radius_m,
-            beyond_flange_limit: beyond,
-        },
+        row,
         beyond,
+        at_end: gl.at_end || gr.at_end,
     })
 }
 
@@ -866,89 +618,4 @@ pub fn solve_contact(setup: &ContactSetup, y_m: f64) -> Result<ContactRow, Conta
     }
     let p = prepare(setup)?;
     Ok(solve_at(&p, y_m, 0.0)?.row)
-}
-
-/// Contact table on the uniform grid `y_min_m, y_min_m + step_m, ..., y_max_m`.
-///
-/// The search marches outwards from the grid point nearest to y = 0. On each side, the first row
-/// whose contact lies beyond the flange limit (contact point past the steepest point of the
-/// flange, i.e. flange climbing) or at the end of a profile, or where no contact is found, ends
-/// the reachable range: it and all rows further out repeat the last reachable row (with their
-/// own `y_m` and `beyond_flange_limit = true`).
-pub fn compute_table(
-    setup: &ContactSetup,
-    y_min_m: f64,
-    y_max_m: f64,
-    step_m: f64,
-) -> Result<ContactTable, ContactError> {
-    let bad = |name, value, reason| ContactError::Param {
-        name,
-        value,
-        reason,
-    };
-    if !(step_m.is_finite() && step_m > 0.0) {
-        return Err(bad("step_m", step_m, "must be finite and > 0"));
-    }
-    if !(y_min_m.is_finite() && y_max_m.is_finite() && y_max_m >= y_min_m) {
-        return Err(bad("y_max_m", y_max_m, "must be finite and >= y_min_m"));
-    }
-    let nf = ((y_max_m - y_min_m) / step_m).round();
-    if nf > 1e6 {
-        return Err(bad("step_m", step_m, "gives more than 1e6 rows"));
-    }
-    let n = nf as usize + 1;
-    let p = prepare(setup)?;
-    let ys: Vec<f64> = (0..n).map(|i| y_min_m + i as f64 * step_m).collect();
-    let centre = ys
-        .iter()
-        .enumerate()
-        .min_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
-        .map(|(i, _)| i)
-        .unwrap_or(0);
-    let first = solve_at(&p, ys[centre], 0.0)?;
-    if first.beyond {
-        return Err(ContactError::NoContact {
-            side: "either",
-            y_m: ys[centre],
-            reason: "the central row already lies beyond the flange limit",
-        });
-    }
-    let mut rows: Vec<Option<ContactRow>> = vec![None; n];
-    rows[centre] = Some(first.row);
-    let mut reach = [ys[centre], ys[centre]];
-    for (dir, range) in [
-        (0usize, (centre + 1..n).collect::<Vec<_>>()),
-        (1usize, (0..centre).rev().collect::<Vec<_>>()),
-    ] {
-        let mut last = first.row;
-        let mut clamped = false;
-        for i in range {
-            if !clamped {
-                match solve_at(&p, ys[i], last.roll_rad) {
-                    Ok(s) if !s.beyond => {
-                        last = s.row;
-                        reach[dir] = ys[i];
-                        rows[i] = Some(s.row);
-                        continue;
-                    }
-                    _ => clamped = true,
-                }
-            }
-            rows[i] = Some(ContactRow {
-                y_m: ys[i],
-                beyond_flange_limit: true,
-                ..last
-            });
-        }
-    }
-    let rows: Vec<ContactRow> = rows.into_iter().flatten().collect();
-    let at0 = solve_at(&p, 0.0, 0.0)?.row;
-    Ok(ContactTable {
-        rows,
-        nominal_radius_left_m: setup.nominal_radius_left_m,
-        nominal_radius_right_m: setup.nominal_radius_right_m,
-        e0_m: 0.5 * (at0.right.track_lateral_m - at0.left.track_lateral_m),
-        y_reachable_min_m: reach[1],
-        y_reachable_max_m: reach[0],
-    })
 }

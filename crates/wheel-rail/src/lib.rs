@@ -94,8 +94,9 @@ pub mod track;
 
 pub use conicity::{equivalent_conicity, harmonic_linearisation, Conicity, ConicityError, DeltaR};
 pub use contact::{
-    compute_table, solve_contact, ContactError, ContactRow, ContactSetup, ContactTable,
-    LateralReference, RailPlacement, WheelContact, WheelPlacement, CONTACT_ZONE_DEPTH_M,
+    compute_table, solve_contact, ContactError, ContactJump, ContactRow, ContactSetup,
+    ContactTable, LateralReference, RadiusConvention, RailPlacement, WheelContact, WheelPlacement,
+    WheelSide, CONTACT_ZONE_DEPTH_M,
 };
 pub use creep::{hertz_kalker, saturation_factor, HertzKalker};
 pub use profile::{Profile, ProfileError, MIN_POINTS};

@@ -4,7 +4,7 @@
 
 use wheel_rail::{
     compute_table, equivalent_conicity, harmonic_linearisation, ContactSetup, LateralReference,
-    Profile, RailPlacement, WheelPlacement, CONTACT_ZONE_DEPTH_M,
+    Profile, RadiusConvention, RailPlacement, WheelPlacement, CONTACT_ZONE_DEPTH_M,
 };
 
 /// Cone: radius r0 - tanα s, i.e. vertical coordinate z = tanα s, s in [-40, 40] mm.
@@ -50,6 +50,7 @@ fn setup(tan_alpha: f64, r_left: f64, r_right: f64) -> ContactSetup {
         rail_inclination: 0.0,
         lateral_reference: LateralReference::RailLevel,
         contact_zone_depth_m: CONTACT_ZONE_DEPTH_M,
+        radius_convention: RadiusConvention::RigidRoll,
     }
 }
 
