@@ -1,5 +1,10 @@
 //! Equivalent conicity (EN 15302).
 //!
+//! EN 15302 is not public; what follows is our reading of it, with each interpretation marked.
+//! Its benchmark (Annex E reference values with the Annex F tolerance ±min(0.05, 0.5 tanγe),
+//! as tabulated in the public criogenox/B_ECC-Equivalent-Conicity-Calculation data) is what the
+//! tests check against.
+//!
 //! **Reference method (EN 15302 Annex B, integration of the non-linear kinematic equation).**
 //! A free wheelset rolling at constant speed without slip follows (Klingel, x = distance travelled)
 //!
@@ -14,9 +19,11 @@
 //!     (dy/dx)² = (S(y1) - S(y)) / (e0 r0)                               (K2)
 //! ```
 //!
-//! The turning points y1 < y2 of a kinematic oscillation of amplitude ŷ satisfy y2 - y1 = 2 ŷ and
-//! S(y1) = S(y2) (found by bisection; for a symmetric Δr, y1 = -ŷ). Half a wavelength is the
-//! travel from y1 to y2:
+//! S is the potential of the motion: the wheelset oscillates in the well of S around its
+//! equilibrium (the minimum of S, where Δr crosses zero upwards). The turning points y1 < y2 of
+//! an oscillation of amplitude ŷ satisfy y2 - y1 = 2 ŷ, S(y1) = S(y2), and S <= S(y1) between
+//! them, with the equilibrium between them (for a symmetric Δr, y1 = -ŷ). Half a wavelength is
+//! the travel from y1 to y2:
 //!
 //! ```text
 //!     λ = 2 sqrt(e0 r0) I,   I = ∫_{y1}^{y2} dy / sqrt(S(y1) - S(y))     (K3)
@@ -31,22 +38,49 @@
 //!
 //! so e0 and r0 cancel: the equivalent conicity depends only on the Δr(y) function. The reported
 //! wavelength uses e0 from the table (half distance between the contact points at y = 0) and the
-//! mean nominal radius. Δr between table rows is linearly interpolated and S(y) is its exact
-//! integral.
+//! mean nominal radius. Δr between states is linearly interpolated and S(y) is its exact
+//! integral. Interpretations where the standard's text is not available to us:
+//! * **Flat tread.** Where S(y) reaches the turning-point level inside the oscillation (Δr = 0
+//!   over the whole oscillation, as on a cylindrical or flat-worn tread at small amplitude, or a
+//!   separatrix), I diverges: the wavelength is infinite and (K4) gives tanγe = 0, which is what
+//!   we report (wavelength `f64::INFINITY`), not "no value".
+//! * **Amplitude range.** Δr is taken from every solved state of the table: the reachable rows,
+//!   the rows beyond the flange limit where the wheel climbs its flange (so the method gives a
+//!   value up to flange contact, as the Annex E values do: up to 7.5 mm for E1, whose flange
+//!   limit on our grid is 7.44 mm; and 7 mm for E5, whose turning point lies about 0.3 mm past
+//!   the steepest flange point), and the two states at each located contact-point jump (so a
+//!   two-point contact is a step of Δr at its own y, not a ramp across one grid step).
+//!   [`Conicity::beyond_flange_limit`] says when a turning point lies in the climbing range.
+//! * **Unequal radii.** The radius convention is the table's
+//!   ([`crate::contact::RadiusConvention`]; EN 15302's offset by default).
+//! * **No value.** Only when Δr has no equilibrium (it does not cross zero upwards), when the
+//!   oscillation would leave the range where the contact search found a contact, or when Δr does
+//!   not restore the wheelset between the turning points (S rises above their level in between:
+//!   a double-well Δr at an amplitude between the wells); the error says which.
+//!
+//! **Linear regression (EN 15302 Annex C, [`linear_regression`]).** Interpretation: the
+//! least-squares straight line Δr ≈ c + 2 tanγe (y - ym) over the range the wheelset sweeps,
+//! [y1, y2] = [ym - ŷ, ym + ŷ] from the reference method (for a symmetric Δr, -ŷ to +ŷ, the
+//! classical UIC 519 regression), uniformly weighted in y (the limit of a regression over
+//! equally spaced samples). For the piecewise-linear Δr the integrals are exact:
+//! tanγe = (3 / (4 ŷ³)) ∫_{-ŷ}^{ŷ} u Δr(ym + u) du. Centring on the turning points rather than
+//! on the equilibrium keeps the interval off a flange the oscillation never reaches when Δr is
+//! asymmetric (unequal radii: the E5 equilibrium lies at -2.7 mm, its 5 mm oscillation spans
+//! -6.6 to +3.4 mm).
 //!
 //! **Harmonic linearisation** ([`harmonic_linearisation`]): least-squares straight line
-//! Δr ≈ c + 2 tanγ (y - ym) over one period of a sinusoid y = ym + ŷ sin θ (i.e. a linear regression
-//! weighted by the time a sinusoidal oscillation spends at each y):
+//! Δr ≈ c + 2 tanγ (y - ym) over one period of a sinusoid y = ym + ŷ sin θ (a regression weighted
+//! by the time a sinusoidal oscillation spends at each y):
 //! tanγ = (1 / (2π ŷ)) ∫_0^{2π} Δr(ym + ŷ sin θ) sin θ dθ, with ym the centre found by the reference
-//! method. It is cheap and exact for linear Δr; EN 15302 Annex C describes a regression variant
-//! whose exact weighting is not reproduced here.
+//! method. It is cheap and exact for linear Δr.
+
+mod delta_r;
+
+pub use delta_r::DeltaR;
 
 use thiserror::Error;
 
 use crate::contact::ContactTable;
-
-/// Number of midpoint-rule panels for the integrals.
-const N_QUAD: usize = 4000;
 
 /// Errors of the conicity evaluation.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -60,20 +94,36 @@ pub enum ConicityError {
     /// Bad amplitude.
     #[error("invalid amplitude_m = {0}: must be finite and > 0")]
     Amplitude(f64),
-    /// The oscillation does not fit the reachable part of the table.
+    /// Δr does not cross zero upwards: nothing centres the wheelset.
     #[error(
-        "amplitude {amplitude_m} m: no kinematic oscillation within the reachable range \
-         [{y_min_m}, {y_max_m}] m of the table ({reason})"
+        "no equilibrium: Δr does not cross zero from negative to positive between y = {y_min_m} \
+         and {y_max_m} m (Δr there {delta_r_min_m} and {delta_r_max_m} m); the radius \
+         difference or the profile pair does not centre the wheelset"
+    )]
+    NoEquilibrium {
+        /// Range where Δr is known [m].
+        y_min_m: f64,
+        /// Range where Δr is known [m].
+        y_max_m: f64,
+        /// Δr at `y_min_m` [m].
+        delta_r_min_m: f64,
+        /// Δr at `y_max_m` [m].
+        delta_r_max_m: f64,
+    },
+    /// No kinematic oscillation of this amplitude exists on the known Δr.
+    #[error(
+        "amplitude {amplitude_m} m: no kinematic oscillation with Δr known for y in \
+         [{y_min_m}, {y_max_m}] m: {reason}"
     )]
     NoOscillation {
         /// Requested amplitude.
         amplitude_m: f64,
-        /// Reachable range.
+        /// Range where Δr is known.
         y_min_m: f64,
-        /// Reachable range.
+        /// Range where Δr is known.
         y_max_m: f64,
-        /// Reason.
-        reason: &'static str,
+        /// Why, with the numbers concerned.
+        reason: String,
     },
 }
 
@@ -82,9 +132,10 @@ pub enum ConicityError {
 pub struct Conicity {
     /// Amplitude ŷ [m].
     pub amplitude_m: f64,
-    /// Equivalent conicity tanγe [-].
+    /// Equivalent conicity tanγe [-]; 0 where Δr does not restore (flat tread).
     pub tan_gamma_e: f64,
-    /// Wavelength of the kinematic oscillation [m] (with `e0_m`, `r0_m`).
+    /// Wavelength of the kinematic oscillation [m] (with `e0_m`, `r0_m`); `f64::INFINITY` when
+    /// tanγe = 0.
     pub wavelength_m: f64,
     /// Left turning point y1 [m].
     pub y1_m: f64,
@@ -94,116 +145,25 @@ pub struct Conicity {
     pub e0_m: f64,
     /// Mean nominal rolling radius used for the wavelength [m].
     pub r0_m: f64,
+    /// A turning point lies beyond the table's flange limit (the wheel climbs its flange there).
+    pub beyond_flange_limit: bool,
 }
 
-/// Piecewise-linear Δr(y) = r_right - r_left and its exact integral.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DeltaR {
-    y: Vec<f64>,
-    dr: Vec<f64>,
-    s: Vec<f64>,
-    e0_m: f64,
-    r0_m: f64,
+/// Result of the linear-regression method (Annex C).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinearRegression {
+    /// Amplitude ŷ [m].
+    pub amplitude_m: f64,
+    /// Equivalent conicity tanγe = slope / 2 [-].
+    pub tan_gamma_e: f64,
+    /// Centre of the regression interval, ym = (y1 + y2) / 2 of the reference method [m].
+    pub centre_m: f64,
+    /// Δr of the regression line at the centre [m].
+    pub intercept_m: f64,
 }
 
-impl DeltaR {
-    /// From the reachable rows of a contact table.
-    pub fn from_table(table: &ContactTable) -> Self {
-        let (y, dr): (Vec<f64>, Vec<f64>) =
-            table.reachable_rows().map(|r| (r.y_m, r.delta_r_m)).unzip();
-        Self::build(y, dr, table.e0_m, table.nominal_radius_mean_m())
-    }
-
-    /// From sampled values (e.g. a reference Δr function): `y_m` strictly increasing, same length
-    /// as `delta_r_m`, at least 3 points; `e0_m`, `r0_m` only scale the reported wavelength.
-    pub fn from_samples(
-        y_m: &[f64],
-        delta_r_m: &[f64],
-        e0_m: f64,
-        r0_m: f64,
-    ) -> Result<Self, ConicityError> {
-        let ok = y_m.len() == delta_r_m.len()
-            && y_m.len() >= 3
-            && y_m.windows(2).all(|w| w[1] > w[0])
-            && y_m.iter().chain(delta_r_m).all(|v| v.is_finite())
-            && e0_m.is_finite()
-            && e0_m > 0.0
-            && r0_m.is_finite()
-            && r0_m > 0.0;
-        if !ok {
-            return Err(ConicityError::Samples);
-        }
-        Ok(Self::build(y_m.to_vec(), delta_r_m.to_vec(), e0_m, r0_m))
-    }
-
-    fn build(y: Vec<f64>, dr: Vec<f64>, e0_m: f64, r0_m: f64) -> Self {
-        let mut s = vec![0.0; y.len()];
-        for i in 1..y.len() {
-            s[i] = s[i - 1] + 0.5 * (dr[i] + dr[i - 1]) * (y[i] - y[i - 1]);
-        }
-        Self {
-            y,
-            dr,
-            s,
-            e0_m,
-            r0_m,
-        }
-    }
-    fn seg(&self, y: f64) -> usize {
-        self.y
-            .partition_point(|&v| v <= y)
-            .clamp(1, self.y.len() - 1)
-            - 1
-    }
-    fn dr_at(&self, y: f64) -> f64 {
-        let i = self.seg(y);
-        let t = (y - self.y[i]) / (self.y[i + 1] - self.y[i]);
-        self.dr[i] + t * (self.dr[i + 1] - self.dr[i])
-    }
-    fn s_at(&self, y: f64) -> f64 {
-        let i = self.seg(y);
-        let u = y - self.y[i];
-        let k = (self.dr[i + 1] - self.dr[i]) / (self.y[i + 1] - self.y[i]);
-        self.s[i] + self.dr[i] * u + 0.5 * k * u * u
-    }
-}
-
-fn turning_points(d: &DeltaR, a: f64) -> Result<(f64, f64), ConicityError> {
-    let no = |reason| ConicityError::NoOscillation {
-        amplitude_m: a,
-        y_min_m: d.y.first().copied().unwrap_or(f64::NAN),
-        y_max_m: d.y.last().copied().unwrap_or(f64::NAN),
-        reason,
-    };
-    if d.y.len() < 3 {
-        return Err(no("fewer than 3 reachable rows"));
-    }
-    let (ylo, yhi) = (d.y[0], d.y[d.y.len() - 1]);
-    if yhi - ylo < 2.0 * a {
-        return Err(no("range narrower than 2 * amplitude"));
-    }
-    // H(y1) = S(y1 + 2a) - S(y1), increasing for increasing Δr
-    let h = |y1: f64| d.s_at(y1 + 2.0 * a) - d.s_at(y1);
-    let (mut lo, mut hi) = (ylo, yhi - 2.0 * a);
-    if h(lo) > 0.0 || h(hi) < 0.0 {
-        return Err(no(
-            "energy balance S(y1) = S(y1 + 2 amplitude) has no solution",
-        ));
-    }
-    for _ in 0..200 {
-        let m = 0.5 * (lo + hi);
-        if h(m) < 0.0 {
-            lo = m;
-        } else {
-            hi = m;
-        }
-        if hi - lo < 1e-15 {
-            break;
-        }
-    }
-    let y1 = 0.5 * (lo + hi);
-    Ok((y1, y1 + 2.0 * a))
-}
+/// Number of midpoint-rule panels for the integrals.
+const N_QUAD: usize = 4000;
 
 /// Equivalent conicity for amplitude `amplitude_m` by the EN 15302 reference method (module docs,
 /// (K1)-(K4)).
@@ -223,61 +183,112 @@ pub fn harmonic_linearisation(
     DeltaR::from_table(table).harmonic_linearisation(amplitude_m)
 }
 
+/// Equivalent conicity by linear regression of Δr (EN 15302 Annex C as read in the module docs).
+pub fn linear_regression(
+    table: &ContactTable,
+    amplitude_m: f64,
+) -> Result<LinearRegression, ConicityError> {
+    DeltaR::from_table(table).linear_regression(amplitude_m)
+}
+
+fn check_amplitude(amplitude_m: f64) -> Result<(), ConicityError> {
+    if amplitude_m.is_finite() && amplitude_m > 0.0 {
+        Ok(())
+    } else {
+        Err(ConicityError::Amplitude(amplitude_m))
+    }
+}
+
 impl DeltaR {
     /// Reference method, see [`equivalent_conicity`].
     pub fn equivalent_conicity(&self, amplitude_m: f64) -> Result<Conicity, ConicityError> {
-        if !(amplitude_m.is_finite() && amplitude_m > 0.0) {
-            return Err(ConicityError::Amplitude(amplitude_m));
-        }
-        let d = self;
-        let (y1, y2) = turning_points(d, amplitude_m)?;
-        let ym = 0.5 * (y1 + y2);
-        let s1 = 0.5 * (d.s_at(y1) + d.s_at(y2));
+        check_amplitude(amplitude_m)?;
+        let a = amplitude_m;
+        let osc = self.oscillation(a)?;
+        let ym = 0.5 * (osc.y1 + osc.y2);
+        let depth = osc.level - osc.bottom;
+        // S reaching the turning-point level inside the oscillation: I diverges (flat tread)
+        let touch = 1e-12 * depth;
         let dth = std::f64::consts::PI / N_QUAD as f64;
         let mut integral = 0.0;
         for k in 0..N_QUAD {
             let th = (k as f64 + 0.5) * dth;
-            let y = ym - amplitude_m * th.cos();
-            let e = s1 - d.s_at(y);
-            if e <= 0.0 {
-                return Err(ConicityError::NoOscillation {
-                    amplitude_m,
-                    y_min_m: d.y[0],
-                    y_max_m: d.y[d.y.len() - 1],
-                    reason: "Δr does not restore the wheelset between the turning points",
-                });
+            let e = osc.level - self.s_at(ym - a * th.cos());
+            if e <= touch {
+                integral = f64::INFINITY;
+                break;
             }
-            integral += amplitude_m * th.sin() / e.sqrt() * dth;
+            integral += a * th.sin() / e.sqrt() * dth;
         }
-        let r0 = self.r0_m;
-        let e0 = self.e0_m;
         let pi = std::f64::consts::PI;
+        let beyond = self
+            .flange_limits_m()
+            .is_some_and(|(l, r)| osc.y1 < l - 1e-12 || osc.y2 > r + 1e-12);
         Ok(Conicity {
-            amplitude_m,
-            tan_gamma_e: (pi / integral).powi(2),
-            wavelength_m: 2.0 * (e0 * r0).sqrt() * integral,
-            y1_m: y1,
-            y2_m: y2,
-            e0_m: e0,
-            r0_m: r0,
+            amplitude_m: a,
+            tan_gamma_e: if integral.is_finite() {
+                (pi / integral).powi(2)
+            } else {
+                0.0
+            },
+            wavelength_m: 2.0 * (self.e0_m() * self.r0_m()).sqrt() * integral,
+            y1_m: osc.y1,
+            y2_m: osc.y2,
+            e0_m: self.e0_m(),
+            r0_m: self.r0_m(),
+            beyond_flange_limit: beyond,
         })
     }
 
     /// Harmonic linearisation, see [`harmonic_linearisation`].
     pub fn harmonic_linearisation(&self, amplitude_m: f64) -> Result<f64, ConicityError> {
-        if !(amplitude_m.is_finite() && amplitude_m > 0.0) {
-            return Err(ConicityError::Amplitude(amplitude_m));
-        }
-        let d = self;
-        let (y1, y2) = turning_points(d, amplitude_m)?;
-        let ym = 0.5 * (y1 + y2);
+        check_amplitude(amplitude_m)?;
+        let osc = self.oscillation(amplitude_m)?;
+        let ym = 0.5 * (osc.y1 + osc.y2);
         let n = 2 * N_QUAD;
         let dth = 2.0 * std::f64::consts::PI / n as f64;
         let mut acc = 0.0;
         for k in 0..n {
             let th = (k as f64 + 0.5) * dth;
-            acc += d.dr_at(ym + amplitude_m * th.sin()) * th.sin() * dth;
+            acc += self.delta_r_at(ym + amplitude_m * th.sin()) * th.sin() * dth;
         }
         Ok(acc / (2.0 * std::f64::consts::PI * amplitude_m))
+    }
+
+    /// Linear regression, see [`linear_regression`].
+    pub fn linear_regression(&self, amplitude_m: f64) -> Result<LinearRegression, ConicityError> {
+        check_amplitude(amplitude_m)?;
+        let a = amplitude_m;
+        let osc = self.oscillation(a)?;
+        let c = 0.5 * (osc.y1 + osc.y2);
+        // breakpoints of the piecewise-linear Δr inside (c - a, c + a), as offsets u
+        let mut us = vec![-a, a];
+        us.extend(
+            self.samples_y()
+                .iter()
+                .filter(|&&y| y > c - a && y < c + a)
+                .map(|&y| y - c),
+        );
+        us.sort_by(f64::total_cmp);
+        let (mut first, mut zeroth) = (0.0, 0.0);
+        for w in us.windows(2) {
+            let (u0, u1) = (w[0], w[1]);
+            if u1 <= u0 {
+                continue;
+            }
+            let d0 = self.delta_r_at(c + u0);
+            let d1 = self.delta_r_at(c + u1);
+            let k = (d1 - d0) / (u1 - u0);
+            first +=
+                (d0 - k * u0) * (u1 * u1 - u0 * u0) / 2.0 + k * (u1.powi(3) - u0.powi(3)) / 3.0;
+            zeroth += 0.5 * (d0 + d1) * (u1 - u0);
+        }
+        let slope = 3.0 * first / (2.0 * a.powi(3));
+        Ok(LinearRegression {
+            amplitude_m: a,
+            tan_gamma_e: 0.5 * slope,
+            centre_m: c,
+            intercept_m: zeroth / (2.0 * a),
+        })
     }
 }

@@ -92,7 +92,10 @@ pub mod profile;
 pub mod table;
 pub mod track;
 
-pub use conicity::{equivalent_conicity, harmonic_linearisation, Conicity, ConicityError, DeltaR};
+pub use conicity::{
+    equivalent_conicity, harmonic_linearisation, linear_regression, Conicity, ConicityError,
+    DeltaR, LinearRegression,
+};
 pub use contact::{
     compute_table, solve_contact, ContactError, ContactJump, ContactRow, ContactSetup,
     ContactTable, LateralReference, RadiusConvention, RailPlacement, WheelContact, WheelPlacement,
