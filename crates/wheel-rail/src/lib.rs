@@ -53,7 +53,16 @@
 //! # Method and limits
 //! Rigid, single-point contact per wheel, piecewise-linear profiles (see [`contact`]); the flange
 //! limit is the steepest point of the flange (E1: |y| = 7.40 mm on a 0.05 mm grid), beyond it the
-//! table repeats the last row. The equivalent conicity follows EN 15302 Annex B (see [`conicity`]).
+//! table's grid rows repeat the last reachable row (the time-domain models' table), while the
+//! search goes on up the flange ([`ContactTable::flange_climb_rows`]). A jump of a contact point
+//! between grid rows (two-point contact: tread to flange, or between the two bands of a
+//! hollow-worn tread) is located by bisection on y to 1e-8 m ([`ContactTable::jumps`]).
+//! Unequal nominal radii enter as [`ContactSetup::radius_convention`] says: EN 15302's offset of
+//! Δr (default of [`ContactSetup::symmetric`], the conicity's convention) or the rigid wheelset's
+//! roll (the bogie tables' convention, [`RadiusConvention`]). The equivalent conicity follows
+//! EN 15302 Annex B, with the Annex C regression and the harmonic linearisation beside it (see
+//! [`conicity`]): it is 0 where Δr does not restore (a flat tread), and an error only where the
+//! method gives no value.
 //!
 //! **Contact point in nearly conformal zones.** The benchmark profile tables carry a periodic
 //! curvature ripple (a resampling artefact: on the rail's R300 crown the curvature oscillates
@@ -73,8 +82,10 @@
 //! E1 results: Δr within 0.1 mm of the reference for all 121 points with |y| <= 6 mm (RMS 0.038 mm,
 //! max 0.076 mm at |y| = 5.6 mm; also met for zone depths 5-10 µm); flange contact (tanγ > 1) from
 //! 6.62 mm, largest Δr jump 9.2 -> 12.2 mm at 6.68-6.69 mm (issue: between 6.3 and 6.8 mm);
-//! tanγe = 0.123 / 0.182 / 0.258 / 0.523 at 1 / 3 / 5 / 7 mm (EN 15302 Annex E: 0.125 / 0.188 /
-//! 0.254 / 0.505).
+//! tanγe = 0.123 / 0.182 / 0.258 / 0.523 / 0.648 at 1 / 3 / 5 / 7 / 7.5 mm (EN 15302 Annex E:
+//! 0.125 / 0.188 / 0.254 / 0.505 / 0.640), every 0.5 mm within 0.019 of Annex E. Case E5 (920 /
+//! 918 mm) in the EN 15302 convention: within 0.012 of Annex E from 1 to 7.5 mm (rigid roll:
+//! 0.017), tests/en15302_e5.rs.
 //!
 //! # For time-domain models (bogie, vehicle)
 //! This crate has no `Params`/`step` model of its own: the models hold a [`GeometryTable`]
