@@ -96,9 +96,13 @@ pub enum ConicityError {
     Amplitude(f64),
     /// Δr does not cross zero upwards: nothing centres the wheelset.
     #[error(
-        "no equilibrium: Δr does not cross zero from negative to positive between y = {y_min_m} \
-         and {y_max_m} m (Δr there {delta_r_min_m} and {delta_r_max_m} m); the radius \
-         difference or the profile pair does not centre the wheelset"
+        "no equilibrium: Δr does not cross zero from negative to positive between y = {:.3} and \
+         {:.3} mm (Δr there {:.3} and {:.3} mm); the radius difference or the profile pair does \
+         not centre the wheelset",
+        .y_min_m * 1e3,
+        .y_max_m * 1e3,
+        .delta_r_min_m * 1e3,
+        .delta_r_max_m * 1e3
     )]
     NoEquilibrium {
         /// Range where Δr is known [m].
@@ -112,8 +116,11 @@ pub enum ConicityError {
     },
     /// No kinematic oscillation of this amplitude exists on the known Δr.
     #[error(
-        "amplitude {amplitude_m} m: no kinematic oscillation with Δr known for y in \
-         [{y_min_m}, {y_max_m}] m: {reason}"
+        "no kinematic oscillation of amplitude {:.2} mm (Δr known for y from {:.3} to {:.3} mm): \
+         {reason}",
+        .amplitude_m * 1e3,
+        .y_min_m * 1e3,
+        .y_max_m * 1e3
     )]
     NoOscillation {
         /// Requested amplitude.

@@ -368,8 +368,8 @@ impl DeltaR {
     fn limit_note(&self) -> String {
         match self.flange_limits_m {
             Some((l, r)) => format!(
-                " (flange limits {:.3} / {:.3} mm; a wider table range, e.g. --y-max, lets the \
-                 search follow the flange further)",
+                " (flange limits {:.3} / {:.3} mm; a table over a wider y range lets the search \
+                 follow the flange further)",
                 l * 1e3,
                 r * 1e3
             ),
