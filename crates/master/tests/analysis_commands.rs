@@ -271,6 +271,257 @@ fn malformed_profile_fails_with_file_and_line_and_writes_nothing() {
     assert!(!r.ok && r.stderr.contains("steep"), "{}", r.stderr);
 }
 
+/// Wheel A with a cylindrical tread (z = 0 from -15 mm outwards, its flange lowered to meet it),
+/// written as a profile file in mm.
+fn write_cylinder_wheel(path: &Path) {
+    let a = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../wheel-rail/data/RUIC519A.dat"),
+    )
+    .unwrap();
+    let pts: Vec<(f64, f64)> = a
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            let mut it = l.split_whitespace().map(|v| v.parse::<f64>().unwrap());
+            (it.next().unwrap(), it.next().unwrap())
+        })
+        .collect();
+    let z0 = pts
+        .windows(2)
+        .find(|w| w[0].0 <= -15.0 && w[1].0 >= -15.0)
+        .map(|w| w[0].1 + (w[1].1 - w[0].1) * (-15.0 - w[0].0) / (w[1].0 - w[0].0))
+        .unwrap();
+    let text: String = pts
+        .iter()
+        .map(|&(s, z)| {
+            let z = if s < -15.0 { (z - z0).min(0.0) } else { 0.0 };
+            format!("{s} {z}\n")
+        })
+        .collect();
+    std::fs::write(path, text).unwrap();
+}
+
+/// A flat tread has conicity 0 (a number, exit code 0), not "n/a".
+#[test]
+fn contact_geometry_flat_tread_gives_zero_conicity() {
+    let d = tempfile::tempdir().unwrap();
+    let wheel = d.path().join("cylinder.dat");
+    write_cylinder_wheel(&wheel);
+    let out = d.path().join("cg");
+    let r = master(&[
+        "contact-geometry",
+        "--wheel",
+        wheel.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}\n{}", r.stdout, r.stderr);
+    assert!(!r.stdout.contains("n/a"), "{}", r.stdout);
+    for a in [1, 3, 5] {
+        assert_eq!(
+            number_after(&r.stdout, &format!("tan gamma_e at {a} mm:")),
+            0.0
+        );
+    }
+    assert!(number_after(&r.stdout, "tan gamma_e at 7 mm:") > 0.0);
+    let csv = std::fs::read_to_string(out.join("conicity.csv")).unwrap();
+    let first: Vec<&str> = csv.lines().nth(1).unwrap().split(',').collect();
+    assert_eq!((first[0], first[1], first[2]), ("1", "0", "inf"), "{csv}");
+}
+
+/// Unequal radii (EN 15302 case E5, 918 / 920 mm): the conicity at 7 mm exists (its turning
+/// point lies on the climbing flange) and meets Annex E (0.492 ± 0.05); the CSV headers name the
+/// convention; the bogie-format table is the rigid-roll one whatever the option says.
+#[test]
+fn contact_geometry_unequal_radii_conventions() {
+    let d = tempfile::tempdir().unwrap();
+    let run = |conv: &str| {
+        let out = d.path().join(conv);
+        let r = master(&[
+            "contact-geometry",
+            "--radius",
+            "459",
+            "--radius-right",
+            "460",
+            "--radius-convention",
+            conv,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(r.ok, "{}\n{}", r.stdout, r.stderr);
+        (r, out)
+    };
+    let (offset, out_offset) = run("en15302-offset");
+    let (rigid, out_rigid) = run("rigid-roll");
+    let c7 = number_after(&offset.stdout, "tan gamma_e at 7 mm:");
+    assert!((c7 - 0.492).abs() < 0.05, "{c7}");
+    let c1 = number_after(&offset.stdout, "tan gamma_e at 1 mm:");
+    let c1_rigid = number_after(&rigid.stdout, "tan gamma_e at 1 mm:");
+    assert!(
+        (c1 - 0.280).abs() < (c1_rigid - 0.280).abs(),
+        "{c1} {c1_rigid}"
+    );
+    assert!(
+        offset.stdout.contains("rigid-roll convention"),
+        "{}",
+        offset.stdout
+    );
+    for (out, conv) in [(&out_offset, "en15302-offset"), (&out_rigid, "rigid-roll")] {
+        for f in ["conicity.csv", "contact_detail.csv"] {
+            let head = std::fs::read_to_string(out.join(f)).unwrap();
+            assert!(head.lines().next().unwrap().contains(conv), "{f}: {head}");
+        }
+    }
+    assert_eq!(
+        std::fs::read(out_offset.join("wheel_rail_table.csv")).unwrap(),
+        std::fs::read(out_rigid.join("wheel_rail_table.csv")).unwrap()
+    );
+}
+
+/// An amplitude the method cannot give (the table range ends before the turning point): exit
+/// code 1, the amplitude and the reason named, nothing written.
+#[test]
+fn contact_geometry_without_a_value_fails_and_writes_nothing() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("cg");
+    let r = master(&[
+        "contact-geometry",
+        "--radius",
+        "459",
+        "--radius-right",
+        "460",
+        "--y-max",
+        "7.5",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!r.ok, "{}", r.stdout);
+    assert!(
+        r.stderr.contains("amplitude 7.00 mm") && r.stderr.contains("--amplitude-max"),
+        "{}",
+        r.stderr
+    );
+    assert!(!out.exists());
+    // the same case up to 6.5 mm is complete
+    let r = master(&[
+        "contact-geometry",
+        "--radius",
+        "459",
+        "--radius-right",
+        "460",
+        "--y-max",
+        "7.5",
+        "--amplitude-max",
+        "6.5",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let csv = std::fs::read_to_string(out.join("conicity.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 23); // 1 to 6.5 mm every 0.25 mm
+}
+
+/// The flange two-point contact of E1 is located between the grid rows and flagged in the
+/// detailed table.
+#[test]
+fn contact_geometry_reports_two_point_contact() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("cg");
+    let r = master(&["contact-geometry", "--out", out.to_str().unwrap()]);
+    assert!(r.ok, "{}", r.stderr);
+    let y = number_after(&r.stdout, "two-point contact on the right wheel at y =");
+    assert!(y > 6.3 && y < 6.8, "{y}");
+    let csv = std::fs::read_to_string(out.join("contact_detail.csv")).unwrap();
+    let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = head
+        .iter()
+        .position(|h| *h == "two-point contact right")
+        .unwrap();
+    let flagged: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .filter(|l| l.split(',').nth(col) == Some("1"))
+        .map(|l| l.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(flagged.len(), 2, "{flagged:?}");
+    assert!(flagged.iter().all(|f| (f - y).abs() < 1e-3));
+}
+
+/// Fleet mode: a list of wheel profiles and a folder give one table with a row per profile and
+/// a figure of the conicity at 3 mm with the names and units; a bad profile stops the run,
+/// names the file and writes nothing.
+#[test]
+fn contact_geometry_fleet_table_and_figure() {
+    let d = tempfile::tempdir().unwrap();
+    let fleet = d.path().join("fleet");
+    std::fs::create_dir(&fleet).unwrap();
+    let a = Path::new(env!("CARGO_MANIFEST_DIR")).join("../wheel-rail/data/RUIC519A.dat");
+    std::fs::copy(&a, fleet.join("new_A.dat")).unwrap();
+    write_cylinder_wheel(&fleet.join("cylinder.dat"));
+    std::fs::write(fleet.join("README.md"), "measured 2026\n").unwrap();
+    let out = d.path().join("cg");
+    let r = master(&[
+        "contact-geometry",
+        "--wheel-dir",
+        fleet.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}\n{}", r.stdout, r.stderr);
+    assert!(r.stdout.contains("README.md"), "{}", r.stdout);
+    check_files(&out, &["fleet_conicity.csv", "fleet_conicity_3mm.svg"]);
+    let csv = std::fs::read_to_string(out.join("fleet_conicity.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len(), 3, "{csv}");
+    let head: Vec<&str> = lines[0].split(',').collect();
+    let col3 = head
+        .iter()
+        .position(|h| h.starts_with("tan gamma_e EN 15302 Annex B at 3 mm"))
+        .unwrap();
+    let at3 = |name: &str| -> f64 {
+        let l = lines.iter().find(|l| l.contains(name)).unwrap();
+        l.split(',').nth(col3).unwrap().parse().unwrap()
+    };
+    assert_eq!(at3("cylinder.dat"), 0.0);
+    let e1 = at3("new_A.dat");
+    assert!((e1 - 0.188).abs() < 0.05, "{e1}");
+    let svg = std::fs::read_to_string(out.join("fleet_conicity_3mm.svg")).unwrap();
+    for s in ["cylinder.dat", "new_A.dat", "[-]", "wheel profile"] {
+        assert!(svg.contains(s), "figure lacks {s}");
+    }
+    // the same two files listed explicitly give the same table
+    let out2 = d.path().join("cg2");
+    let r = master(&[
+        "contact-geometry",
+        "--wheels",
+        fleet.join("cylinder.dat").to_str().unwrap(),
+        fleet.join("new_A.dat").to_str().unwrap(),
+        "--out",
+        out2.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    assert_eq!(
+        std::fs::read_to_string(out2.join("fleet_conicity.csv")).unwrap(),
+        csv
+    );
+    // a malformed profile: all or nothing
+    std::fs::write(fleet.join("broken.dat"), "0 0\n1 oops\n2 0\n").unwrap();
+    let out3 = d.path().join("cg3");
+    let r = master(&[
+        "contact-geometry",
+        "--wheel-dir",
+        fleet.to_str().unwrap(),
+        "--out",
+        out3.to_str().unwrap(),
+    ]);
+    assert!(!r.ok);
+    assert!(r.stderr.contains("broken.dat:2:"), "{}", r.stderr);
+    assert!(!out3.exists());
+    // --wheels and --wheel cannot be mixed
+    let r = master(&["contact-geometry", "--wheels", "a.dat", "--wheel", "b.dat"]);
+    assert!(!r.ok && r.stderr.contains("--wheel"), "{}", r.stderr);
+}
+
 #[test]
 fn root_locus_passive_gives_r5_r6() {
     let d = tempfile::tempdir().unwrap();

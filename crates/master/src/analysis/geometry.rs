@@ -6,15 +6,25 @@
 //! 1435.16 mm), with the benchmark profiles built in from `crates/wheel-rail/data/`. Rail A
 //! already contains its inclination, so the default additional inclination is 0; a rail given
 //! upright needs `1:40` (or `1:20`).
+//!
+//! Unequal wheel radii: the bogie-format table is always computed with the rigid wheelset's roll
+//! (the time-domain models' geometry); Δr, the detailed table and the conicity follow the chosen
+//! [`RadiusConvention`] (EN 15302's offset by default), named in their CSV headers. A conicity
+//! the EN 15302 method does not define at some amplitude of the curve is an error naming the
+//! amplitude and the reason, never a blank; a flat tread gives 0. [`fleet`] runs many wheel
+//! profiles into one table.
 
 use std::path::PathBuf;
 
 use wheel_rail::{
-    compute_table, equivalent_conicity, harmonic_linearisation, ContactSetup, ContactTable, Profile,
+    compute_table, ContactRow, ContactSetup, ContactTable, DeltaR, Profile, RadiusConvention,
+    WheelSide,
 };
 
 use super::{AnalysisError, Artefacts, Table};
 use crate::plot::Chart;
+
+pub mod fleet;
 
 /// EN 15302 wheel profile A (built in).
 pub const WHEEL_A: &str = include_str!("../../../wheel-rail/data/RUIC519A.dat");
@@ -93,8 +103,13 @@ pub struct GeometryInputs {
     /// Table covers -y_max..y_max.
     pub y_max_m: f64,
     pub step_m: f64,
-    /// Conicity curve amplitudes: 1 to 7 mm in this step [m].
+    /// Conicity curve amplitudes: from 1 mm to `amplitude_max_m` in this step [m].
     pub conicity_step_m: f64,
+    /// Largest amplitude of the conicity curve [m].
+    pub amplitude_max_m: f64,
+    /// Convention of Δr, the detailed table and the conicity (the bogie-format table is always
+    /// [`RadiusConvention::RigidRoll`]).
+    pub radius_convention: RadiusConvention,
 }
 
 impl Default for GeometryInputs {
@@ -121,44 +136,98 @@ impl Default for GeometryInputs {
             y_max_m: 10e-3,
             step_m: 0.05e-3,
             conicity_step_m: 0.25e-3,
+            amplitude_max_m: 7e-3,
+            radius_convention: RadiusConvention::En15302Offset,
         }
     }
 }
 
-/// Conicity at one amplitude, or why it could not be computed.
-#[derive(Debug, Clone, PartialEq)]
+/// Conicity at one amplitude by the three methods (they share the turning points).
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ConicityPoint {
     pub amplitude_m: f64,
-    /// Reference method (EN 15302 Annex B): (tanγe, wavelength [m]).
-    pub reference: Result<(f64, f64), String>,
+    /// EN 15302 Annex B tanγe; 0 where Δr does not restore (flat tread).
+    pub tan_gamma_e: f64,
+    /// Wavelength of the kinematic oscillation [m] (infinite where tanγe = 0).
+    pub wavelength_m: f64,
+    /// EN 15302 Annex C (linear regression of Δr over the turning points' range) tanγe.
+    pub regression: f64,
     /// Harmonic linearisation tanγ.
-    pub harmonic: Option<f64>,
+    pub harmonic: f64,
+    /// Turning points [m].
+    pub y1_m: f64,
+    pub y2_m: f64,
+    /// A turning point lies beyond the flange limit (the wheel climbs its flange).
+    pub beyond_flange_limit: bool,
 }
 
 /// Result of a contact-geometry run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GeometryResults {
     pub inputs: GeometryInputs,
+    /// In the chosen convention ([`GeometryInputs::radius_convention`]).
     pub table: ContactTable,
-    /// 1 to 7 mm.
+    /// The bogie-format table, rigid roll (the same as `table` for equal radii).
+    pub bogie_table: ContactTable,
+    /// From 1 mm to the largest amplitude.
     pub conicity: Vec<ConicityPoint>,
-    /// At [`SUMMARY_AMPLITUDES_MM`].
+    /// At [`SUMMARY_AMPLITUDES_MM`] up to the largest amplitude.
     pub summary_conicity: Vec<ConicityPoint>,
 }
 
-fn conicity_at(table: &ContactTable, a: f64) -> ConicityPoint {
-    ConicityPoint {
+/// The three methods at amplitude `a` on Δr; an amplitude the EN 15302 method does not define
+/// is an error with its reason.
+pub fn conicity_at(d: &DeltaR, a: f64) -> Result<ConicityPoint, AnalysisError> {
+    let c = d.equivalent_conicity(a)?;
+    let regression = d.linear_regression(a)?.tan_gamma_e;
+    let harmonic = d.harmonic_linearisation(a)?;
+    Ok(ConicityPoint {
         amplitude_m: a,
-        reference: equivalent_conicity(table, a)
-            .map(|c| (c.tan_gamma_e, c.wavelength_m))
-            .map_err(|e| e.to_string()),
-        harmonic: harmonic_linearisation(table, a).ok(),
-    }
+        tan_gamma_e: c.tan_gamma_e,
+        wavelength_m: c.wavelength_m,
+        regression,
+        harmonic,
+        y1_m: c.y1_m,
+        y2_m: c.y2_m,
+        beyond_flange_limit: c.beyond_flange_limit,
+    })
 }
 
-/// Reads the profiles, computes the table and the conicity curve. Profile errors name the
-/// file and line; nothing is written here.
-pub fn contact_geometry(inputs: &GeometryInputs) -> Result<GeometryResults, AnalysisError> {
+/// Amplitudes of the conicity curve: from 1 mm (or the largest amplitude, if smaller) to the
+/// largest amplitude in steps of `step` [m].
+pub fn curve_amplitudes(amplitude_max_m: f64, step_m: f64) -> Vec<f64> {
+    let start = amplitude_max_m.min(1e-3);
+    let n = ((amplitude_max_m - start) / step_m).round().max(0.0) as usize;
+    (0..=n)
+        .map(|i| {
+            if n == 0 {
+                start
+            } else {
+                start + (amplitude_max_m - start) * i as f64 / n as f64
+            }
+        })
+        .collect()
+}
+
+/// The contact set-up of a run (profiles read, options applied and checked).
+pub fn setup_of(inputs: &GeometryInputs) -> Result<ContactSetup, AnalysisError> {
+    let mut setup = ContactSetup::symmetric(
+        inputs.wheel_left.load()?,
+        inputs.rail_left.load()?,
+        inputs.radius_left_m,
+        inputs.gauge_m,
+    );
+    setup.wheel_right = inputs.wheel_right.load()?;
+    setup.rail_right = inputs.rail_right.load()?;
+    setup.nominal_radius_right_m = inputs.radius_right_m;
+    setup.rail_inclination = inputs.inclination;
+    setup.radius_convention = inputs.radius_convention;
+    setup.validate()?;
+    Ok(setup)
+}
+
+/// Checks the numeric options shared by the single and the fleet run.
+pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
     let bad = |option: &'static str, v: f64, reason: &str| AnalysisError::Option {
         option,
         value: v.to_string(),
@@ -181,42 +250,95 @@ pub fn contact_geometry(inputs: &GeometryInputs) -> Result<GeometryResults, Anal
             "must be > 0 mm",
         ));
     }
-    let mut setup = ContactSetup::symmetric(
-        inputs.wheel_left.load()?,
-        inputs.rail_left.load()?,
-        inputs.radius_left_m,
-        inputs.gauge_m,
-    );
-    setup.wheel_right = inputs.wheel_right.load()?;
-    setup.rail_right = inputs.rail_right.load()?;
-    setup.nominal_radius_right_m = inputs.radius_right_m;
-    setup.rail_inclination = inputs.inclination;
-    setup.validate()?;
-    let table = compute_table(&setup, -inputs.y_max_m, inputs.y_max_m, inputs.step_m)?;
-    let n = ((6e-3 / inputs.conicity_step_m).round() as usize).max(1);
-    let conicity: Vec<ConicityPoint> = (0..=n)
-        .map(|i| conicity_at(&table, 1e-3 + 6e-3 * i as f64 / n as f64))
-        .collect();
-    if let Some(Err(why)) = conicity
-        .iter()
-        .all(|c| c.reference.is_err())
-        .then(|| conicity.first().map(|c| c.reference.clone()))
-        .flatten()
+    if !(inputs.amplitude_max_m.is_finite()
+        && inputs.amplitude_max_m > 0.0
+        && inputs.amplitude_max_m < inputs.y_max_m)
     {
-        return Err(AnalysisError::Geometry(format!(
-            "no amplitude from 1 to 7 mm gives a kinematic oscillation (at 1 mm: {why})"
-        )));
+        return Err(bad(
+            "--amplitude-max",
+            inputs.amplitude_max_m * 1e3,
+            "must be > 0 and below --y-max",
+        ));
     }
+    Ok(())
+}
+
+/// Reads the profiles, computes the tables and the conicity curve. Profile errors name the
+/// file and line; an amplitude without a conicity is an error; nothing is written here.
+pub fn contact_geometry(inputs: &GeometryInputs) -> Result<GeometryResults, AnalysisError> {
+    check_options(inputs)?;
+    let setup = setup_of(inputs)?;
+    let table = compute_table(&setup, -inputs.y_max_m, inputs.y_max_m, inputs.step_m)?;
+    let bogie_table = if setup.radius_convention == RadiusConvention::RigidRoll
+        || setup.nominal_radius_left_m == setup.nominal_radius_right_m
+    {
+        table.clone()
+    } else {
+        let rigid = ContactSetup {
+            radius_convention: RadiusConvention::RigidRoll,
+            ..setup
+        };
+        compute_table(&rigid, -inputs.y_max_m, inputs.y_max_m, inputs.step_m)?
+    };
+    let d = DeltaR::from_table(&table);
+    let conicity = curve_amplitudes(inputs.amplitude_max_m, inputs.conicity_step_m)
+        .into_iter()
+        .map(|a| {
+            conicity_at(&d, a).map_err(|e| {
+                AnalysisError::Input(format!(
+                    "{e}\n  (the conicity curve runs to --amplitude-max {:.2} mm; a smaller one, \
+                     or a wider --y-max, gives a complete curve)",
+                    inputs.amplitude_max_m * 1e3
+                ))
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
     let summary_conicity = SUMMARY_AMPLITUDES_MM
         .iter()
-        .map(|a| conicity_at(&table, a * 1e-3))
-        .collect();
+        .filter(|a| **a * 1e-3 <= inputs.amplitude_max_m + 1e-12)
+        .map(|a| conicity_at(&d, a * 1e-3))
+        .collect::<Result<Vec<_>, _>>()?;
     Ok(GeometryResults {
         inputs: inputs.clone(),
         table,
+        bogie_table,
         conicity,
         summary_conicity,
     })
+}
+
+/// One line of the detailed table: a grid row (beyond the flange limit the flange-climbing
+/// state, where the search found one) or a state at a two-point contact.
+struct DetailRow {
+    row: ContactRow,
+    two_point: Option<WheelSide>,
+}
+
+fn detail_rows(table: &ContactTable) -> Vec<DetailRow> {
+    let mut out: Vec<DetailRow> = table
+        .rows
+        .iter()
+        .map(|r| {
+            let climb = table
+                .flange_climb_rows
+                .iter()
+                .find(|c| r.beyond_flange_limit && c.y_m == r.y_m);
+            DetailRow {
+                row: *climb.unwrap_or(r),
+                two_point: None,
+            }
+        })
+        .collect();
+    for j in &table.jumps {
+        for row in [j.before, j.after] {
+            out.push(DetailRow {
+                row: ContactRow { y_m: j.y_m, ..row },
+                two_point: Some(j.side),
+            });
+        }
+    }
+    out.sort_by(|a, b| a.row.y_m.total_cmp(&b.row.y_m));
+    out
 }
 
 impl GeometryResults {
@@ -231,10 +353,11 @@ impl GeometryResults {
     }
 
     pub fn add_artefacts(&self, a: &mut Artefacts) -> Result<(), AnalysisError> {
-        a.add_text("wheel_rail_table.csv", self.table.to_bogie_csv());
+        a.add_text("wheel_rail_table.csv", self.bogie_table.to_bogie_csv());
+        let conv = self.table.radius_convention.name();
         let mut d = Table::new(&[
             "y [mm]",
-            "delta r = r_right - r_left [mm]",
+            &format!("delta r = r_right - r_left [mm] ({conv})"),
             "r_left [mm]",
             "r_right [mm]",
             "tan gamma left",
@@ -247,8 +370,11 @@ impl GeometryResults {
             "contact left track lateral [mm]",
             "contact right track lateral [mm]",
             "beyond flange limit",
+            "two-point contact left",
+            "two-point contact right",
         ]);
-        for r in &self.table.rows {
+        for DetailRow { row: r, two_point } in detail_rows(&self.table) {
+            let flag = |b: bool| if b { 1.0 } else { 0.0 };
             d.rows.push(vec![
                 r.y_m * 1e3,
                 r.delta_r_m * 1e3,
@@ -263,35 +389,46 @@ impl GeometryResults {
                 r.right.rail_lateral_m * 1e3,
                 r.left.track_lateral_m * 1e3,
                 r.right.track_lateral_m * 1e3,
-                if r.beyond_flange_limit { 1.0 } else { 0.0 },
+                flag(r.beyond_flange_limit),
+                flag(two_point == Some(WheelSide::Left)),
+                flag(two_point == Some(WheelSide::Right)),
             ]);
         }
         a.add_table("contact_detail.csv", &d)?;
         let mut c = Table::new(&[
             "amplitude [mm]",
-            "equivalent conicity (EN 15302 reference method)",
-            "wavelength [m]",
+            &format!("equivalent conicity EN 15302 Annex B ({conv})"),
+            "wavelength [m] (inf: not restored)",
+            &format!("equivalent conicity EN 15302 Annex C regression ({conv})"),
             "harmonic linearisation tan gamma",
+            "turning point y1 [mm]",
+            "turning point y2 [mm]",
+            "turning point beyond flange limit",
         ]);
         for p in &self.conicity {
-            let (tg, wl) = p.reference.clone().unwrap_or((f64::NAN, f64::NAN));
             c.rows.push(vec![
                 p.amplitude_m * 1e3,
-                tg,
-                wl,
-                p.harmonic.unwrap_or(f64::NAN),
+                p.tan_gamma_e,
+                p.wavelength_m,
+                p.regression,
+                p.harmonic,
+                p.y1_m * 1e3,
+                p.y2_m * 1e3,
+                if p.beyond_flange_limit { 1.0 } else { 0.0 },
             ]);
         }
         a.add_table("conicity.csv", &c)?;
 
-        let reach: Vec<_> = self.table.reachable_rows().collect();
-        let range = format!(
-            "reachable y {:.2} to {:.2} mm",
-            self.table.y_reachable_min_m * 1e3,
-            self.table.y_reachable_max_m * 1e3
-        );
+        let (lo, hi) = (self.table.y_reachable_min_m, self.table.y_reachable_max_m);
+        let reach: Vec<ContactRow> = self
+            .table
+            .solved_states()
+            .into_iter()
+            .filter(|r| r.y_m >= lo && r.y_m <= hi)
+            .collect();
+        let range = format!("reachable y {:.2} to {:.2} mm", lo * 1e3, hi * 1e3);
         let dr = Chart::new(
-            &format!("Rolling radius difference ({range})"),
+            &format!("Rolling radius difference ({range}, {conv})"),
             "wheelset lateral displacement y [mm]",
             "delta r = r_right - r_left [mm]",
         )
@@ -323,21 +460,19 @@ impl GeometryResults {
                 .collect(),
         );
         a.add_lines("tan_gamma.svg", &tg)?;
-        let pts = |f: fn(&ConicityPoint) -> Option<f64>| -> Vec<(f64, f64)> {
+        let pts = |f: fn(&ConicityPoint) -> f64| -> Vec<(f64, f64)> {
             self.conicity
                 .iter()
-                .filter_map(|p| f(p).map(|v| (p.amplitude_m * 1e3, v)))
+                .map(|p| (p.amplitude_m * 1e3, f(p)))
                 .collect()
         };
         let con = Chart::new(
-            "Equivalent conicity (EN 15302)",
+            &format!("Equivalent conicity (EN 15302, {conv})"),
             "amplitude [mm]",
             "equivalent conicity tan gamma_e [-]",
         )
-        .with_series(
-            "reference method (Annex B)",
-            pts(|p| p.reference.as_ref().ok().map(|r| r.0)),
-        )
+        .with_series("reference method (Annex B)", pts(|p| p.tan_gamma_e))
+        .with_series("linear regression (Annex C)", pts(|p| p.regression))
         .with_series("harmonic linearisation", pts(|p| p.harmonic));
         a.add_lines("conicity.svg", &con)?;
         Ok(())
@@ -352,6 +487,8 @@ impl GeometryResults {
                 y_max_m: i.y_max_m,
                 step_m: i.step_m,
                 conicity_step_m: i.conicity_step_m,
+                amplitude_max_m: i.amplitude_max_m,
+                radius_convention: i.radius_convention,
                 ..GeometryInputs::default()
             };
         let mut s = format!(
@@ -382,23 +519,51 @@ impl GeometryResults {
             ));
         }
         s.push('\n');
-        s.push_str("equivalent conicity (EN 15302 reference method):\n");
+        let conv = self.table.radius_convention.name();
+        if i.radius_left_m != i.radius_right_m {
+            s.push_str(&format!(
+                "radius difference: delta r, contact_detail.csv and the conicity in the {conv} \
+                 convention; wheel_rail_table.csv (bogie format) in the rigid-roll convention\n"
+            ));
+        }
+        for j in &self.table.jumps {
+            s.push_str(&format!(
+                "two-point contact on the {} wheel at y = {:.3} mm ({}, contact points {:.2} mm \
+                 apart on the wheel; delta r {:.3} -> {:.3} mm)\n",
+                j.side.name(),
+                j.y_m * 1e3,
+                if j.involves_flange() {
+                    "tread to flange"
+                } else {
+                    "on the tread"
+                },
+                j.wheel_distance_m() * 1e3,
+                j.before.delta_r_m * 1e3,
+                j.after.delta_r_m * 1e3
+            ));
+        }
+        s.push_str(&format!(
+            "equivalent conicity (EN 15302 Annex B; Annex C regression in brackets; {conv}):\n"
+        ));
         for p in &self.summary_conicity {
             let a_mm = p.amplitude_m * 1e3;
-            match &p.reference {
-                Ok((tg, wl)) => {
-                    s.push_str(&format!(
-                        "  tan gamma_e at {a_mm:.0} mm: {tg:.4} (wavelength {wl:.1} m)"
-                    ));
-                    if is_e1 {
-                        if let Some((_, r)) =
-                            E1_REFERENCE_CONICITY.iter().find(|(aa, _)| *aa == a_mm)
-                        {
-                            s.push_str(&format!("; EN 15302 E1 reference {r:.3}"));
-                        }
-                    }
+            s.push_str(&format!(
+                "  tan gamma_e at {a_mm:.0} mm: {:.4} ({:.4}), wavelength {}",
+                p.tan_gamma_e,
+                p.regression,
+                if p.wavelength_m.is_finite() {
+                    format!("{:.1} m", p.wavelength_m)
+                } else {
+                    "infinite (delta r does not restore)".to_string()
                 }
-                Err(e) => s.push_str(&format!("  tan gamma_e at {a_mm:.0} mm: n/a ({e})")),
+            ));
+            if p.beyond_flange_limit {
+                s.push_str(", turning point on the climbing flange");
+            }
+            if is_e1 {
+                if let Some((_, r)) = E1_REFERENCE_CONICITY.iter().find(|(aa, _)| *aa == a_mm) {
+                    s.push_str(&format!("; EN 15302 E1 reference {r:.3}"));
+                }
             }
             s.push('\n');
         }

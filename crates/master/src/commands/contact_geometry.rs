@@ -3,16 +3,37 @@
 
 use std::path::PathBuf;
 
+use wheel_rail::RadiusConvention;
+
 use super::{CommandError, Context};
+use crate::analysis::geometry::fleet::{fleet, profiles_in};
 use crate::analysis::geometry::{
     contact_geometry, parse_inclination, GeometryInputs, ProfileSource,
 };
 use crate::analysis::{check_cancel, print_report, Artefacts};
 
+/// How unequal wheel radii enter (`--radius-convention`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum RadiusConventionArg {
+    /// EN 15302: the radius difference is an offset of delta r (contact search with equal radii).
+    En15302Offset,
+    /// The rigid wheelset rolled by the radius difference (the bogie tables' geometry).
+    RigidRoll,
+}
+
+impl From<RadiusConventionArg> for RadiusConvention {
+    fn from(a: RadiusConventionArg) -> Self {
+        match a {
+            RadiusConventionArg::En15302Offset => RadiusConvention::En15302Offset,
+            RadiusConventionArg::RigidRoll => RadiusConvention::RigidRoll,
+        }
+    }
+}
+
 /// Options of `master contact-geometry` (the description shown by `--help` is the `after_help`).
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Wheel/rail contact geometry from profiles. Without options: EN 15302 case E1 (wheel A, rail A, 920 mm wheels, gauge 1435.16 mm) with the built-in benchmark profiles.\n\nProfile files: two numbers per line, lateral and vertical in mm (whitespace, comma or semicolon separated), '#' comments, optional header line; lateral positive towards the field side (flange at negative values), vertical up, wheel origin on the nominal rolling circle. A bad file stops the command with file:line and writes nothing.\n\nFiles: wheel_rail_table.csv (the bogie model's contact table format), contact_detail.csv, conicity.csv (1-7 mm), delta_r.svg, tan_gamma.svg, conicity.svg."
+    after_help = "Wheel/rail contact geometry from profiles. Without options: EN 15302 case E1 (wheel A, rail A, 920 mm wheels, gauge 1435.16 mm) with the built-in benchmark profiles.\n\nProfile files: two numbers per line, lateral and vertical in mm (whitespace, comma or semicolon separated), '#' comments, optional header line; lateral positive towards the field side (flange at negative values), vertical up, wheel origin on the nominal rolling circle. A bad file stops the command with file:line and writes nothing.\n\nUnequal radii (--radius-right): delta r, contact_detail.csv and the conicity follow --radius-convention (EN 15302's offset by default, named in the CSV headers); wheel_rail_table.csv is always the rigid wheelset's (rigid-roll), the geometry the bogie model feels.\n\nThe conicity is EN 15302 Annex B (with the Annex C regression and the harmonic linearisation beside it), 0 on a flat tread; an amplitude without a value is an error naming it and why (exit code 1, nothing written).\n\nFiles: wheel_rail_table.csv (the bogie model's contact table format), contact_detail.csv (with the located two-point contacts), conicity.csv (1 mm to --amplitude-max), delta_r.svg, tan_gamma.svg, conicity.svg. With --wheels or --wheel-dir (a fleet of wheel profiles, each on both wheels): fleet_conicity.csv (a row per profile) and fleet_conicity_3mm.svg instead."
 )]
 pub struct Args {
     /// Wheel profile (both sides unless --wheel-right) [default: built-in EN 15302 wheel A].
@@ -46,6 +67,18 @@ pub struct Args {
     /// Table step in y [mm].
     #[arg(long, value_name = "MM", default_value_t = 0.05)]
     pub step: f64,
+    /// Largest amplitude of the conicity curve [mm].
+    #[arg(long, value_name = "MM", default_value_t = 7.0)]
+    pub amplitude_max: f64,
+    /// How unequal wheel radii enter delta r and the conicity.
+    #[arg(long, value_enum, default_value = "en15302-offset")]
+    pub radius_convention: RadiusConventionArg,
+    /// Fleet mode: these wheel profiles, each on both wheels, into one conicity table.
+    #[arg(long, value_name = "FILE", num_args = 1.., conflicts_with_all = ["wheel", "wheel_right"])]
+    pub wheels: Vec<PathBuf>,
+    /// Fleet mode: every profile file (.dat, .txt, .csv, .prf) of this folder, by name.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["wheel", "wheel_right"])]
+    pub wheel_dir: Option<PathBuf>,
     /// Output folder (created if needed; files are written only once everything is computed).
     #[arg(long, value_name = "DIR", default_value = "results/contact-geometry")]
     pub out: PathBuf,
@@ -67,9 +100,31 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         radius_right_m: args.radius_right.unwrap_or(args.radius) * 1e-3,
         y_max_m: args.y_max * 1e-3,
         step_m: args.step * 1e-3,
+        amplitude_max_m: args.amplitude_max * 1e-3,
+        radius_convention: args.radius_convention.into(),
         ..d
     };
     let failed = |e| CommandError::Failed(format!("{e}"));
+    if !args.wheels.is_empty() || args.wheel_dir.is_some() {
+        let mut wheels: Vec<ProfileSource> = args
+            .wheels
+            .iter()
+            .map(|p| ProfileSource::File(p.clone()))
+            .collect();
+        let mut skipped = Vec::new();
+        if let Some(dir) = &args.wheel_dir {
+            let (files, other) = profiles_in(dir).map_err(failed)?;
+            wheels.extend(files.into_iter().map(ProfileSource::File));
+            skipped = other;
+        }
+        let r = fleet(&inputs, &wheels, ctx.cancel).map_err(failed)?;
+        check_cancel(ctx.cancel).map_err(failed)?;
+        let mut files = Artefacts::default();
+        r.add_artefacts(&mut files).map_err(failed)?;
+        files.write_all(&args.out)?;
+        print_report(&r.summary(&skipped), &files, &args.out);
+        return Ok(());
+    }
     let r = contact_geometry(&inputs).map_err(failed)?;
     check_cancel(ctx.cancel).map_err(failed)?;
     let mut files = Artefacts::default();
