@@ -10,8 +10,12 @@
 //! zone, and differs from today's output by up to 0.24 mm in delta r and 0.046 in tan gamma near
 //! the flange root (8 % less tread gravitational stiffness at 1 mm). Overwrite it only together
 //! with a recalibration of fmu-bogie2dof.
+//!
+//! Bogie tables use the rigid wheelset's geometry for unequal radii
+//! ([`RadiusConvention::RigidRoll`]); for this equal-radius case both conventions give the same
+//! rows.
 
-use wheel_rail::{compute_table, equivalent_conicity, ContactSetup, Profile};
+use wheel_rail::{compute_table, equivalent_conicity, ContactSetup, Profile, RadiusConvention};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let here = env!("CARGO_MANIFEST_DIR");
@@ -20,7 +24,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .unwrap_or_else(|| "wheel_rail_A_A.csv".to_string());
     let wheel = Profile::from_file(format!("{here}/data/RUIC519A.dat"))?;
     let rail = Profile::from_file(format!("{here}/data/SUIC519A.dat"))?;
-    let setup = ContactSetup::symmetric(wheel, rail, 0.920 / 2.0, 1.43516);
+    let setup = ContactSetup {
+        radius_convention: RadiusConvention::RigidRoll,
+        ..ContactSetup::symmetric(wheel, rail, 0.920 / 2.0, 1.43516)
+    };
     let table = compute_table(&setup, -10e-3, 10e-3, 0.05e-3)?;
     if let Some(dir) = std::path::Path::new(&out).parent() {
         std::fs::create_dir_all(dir)?;
