@@ -41,6 +41,14 @@ fn tolerance(reference: f64) -> f64 {
 #[test]
 fn e1_conicity_up_to_7_5_mm() {
     let t = table(0.460, RadiusConvention::En15302Offset);
+    // the only contact-point jumps are the tread-to-flange two-point contacts, mirrored; the
+    // fast but continuous motion in the conformal zones (up to 1.1 mm per 0.05 mm step at the
+    // flange root) is not one
+    assert_eq!(t.jumps.len(), 2, "{:?}", t.jumps);
+    for j in &t.jumps {
+        assert!(j.involves_flange() && j.y_m.abs() > 6.3e-3 && j.y_m.abs() < 6.8e-3);
+    }
+    assert!((t.jumps[0].y_m + t.jumps[1].y_m).abs() < 1e-9);
     let mut worst = 0.0_f64;
     for (a, e1, _) in annex_e() {
         let c = equivalent_conicity(&t, a).unwrap();

@@ -10,16 +10,24 @@ use super::{prepare, solve_at, ContactError, ContactRow, ContactSetup, Prepared,
 use crate::contact::RadiusConvention;
 use crate::table::{write_csv, CsvNumbers, CsvRow, GeometryTable, TableError};
 
-/// Two adjacent rows whose contact point on one wheel moves by more than this are searched for
-/// a jump [m]. A continuous contact moves at most ~15 dy in the nearly conformal zones of the
-/// EN 15302 profiles (wheel R14 against rail R13 at the flange root), i.e. 0.7 mm per 0.05 mm
-/// step, so candidates are frequent but cheap; the bisection below tells jumps apart.
+/// Two adjacent rows whose contact point on one wheel moves by more than this [m] ...
 const JUMP_CANDIDATE_M: f64 = 0.25e-3;
+/// ... and by more than this times its movement in either neighbouring step are searched for a
+/// jump. A continuous contact moves fast in nearly conformal zones (up to ~15 dy on the
+/// EN 15302 profiles, wheel R14 against rail R13 at the flange root: 0.7-1.1 mm per 0.05 mm
+/// step) but at a smoothly varying rate (at most ~1.2 times its neighbours' there); a jump adds
+/// its size to one step (E1 flange: 1.85 mm against 1.1 mm next to it).
+const JUMP_OUTLIER: f64 = 1.3;
+/// A candidate whose first midpoint splits the movement with at least this share in the smaller
+/// half moves continuously (a jump puts all of it in one half): one contact solve per
+/// continuous candidate. A jump smaller than about 0.7 times the continuous movement of its grid
+/// step is therefore taken for continuous motion (its Δr effect is below that of the step).
+const JUMP_LINEAR_SHARE: f64 = 0.3;
 /// The bisection stops when the bracket is this narrow [m], far below any profile sampling.
 const JUMP_BRACKET_M: f64 = 1e-8;
 /// A contact point that still moves by more than this across the final bracket jumps [m]
-/// (a continuous one moves ~15 * JUMP_BRACKET_M at most). The bisection of a continuous
-/// candidate stops as soon as the movement across its bracket falls below this (2-4 steps).
+/// (a continuous one moves ~15 * JUMP_BRACKET_M at most). The bisection also stops as soon as
+/// the movement across its bracket falls below this.
 const JUMP_MIN_M: f64 = 0.1e-3;
 
 /// Rolling-radius-difference table over a uniform grid of lateral displacements.
@@ -145,9 +153,11 @@ impl ContactTable {
 /// the reachable range: it and all rows further out repeat the last reachable row (with their
 /// own `y_m` and `beyond_flange_limit = true`). Beyond the flange limit the search goes on while
 /// the wheel climbs its flange ([`ContactTable::flange_climb_rows`]). Between adjacent solved
-/// rows where a contact point moves by more than 0.25 mm, the change is bisected on `y` down
-/// to 1e-8 m; if the contact point still moves by more than 0.1 mm across that bracket, it
-/// jumps there ([`ContactTable::jumps`]). The grid rows themselves do not depend on the jumps.
+/// rows where a contact point moves by more than 0.25 mm and by more than 1.3 times its
+/// movement in the neighbouring steps, the change is bisected on `y` down to 1e-8 m (unless
+/// the first midpoint already splits it, which is continuous motion); if the contact point
+/// still moves by more than 0.1 mm across that bracket, it jumps there
+/// ([`ContactTable::jumps`]). The grid rows themselves do not depend on the jumps.
 pub fn compute_table(
     setup: &ContactSetup,
     y_min_m: f64,
@@ -257,16 +267,25 @@ fn locate_jumps(p: &Prepared, rows: &[ContactRow], climb: &[ContactRow]) -> Vec<
         .collect();
     solved.sort_by(|a, b| a.y_m.total_cmp(&b.y_m));
     let mut jumps = Vec::new();
-    for w in solved.windows(2) {
-        for side in [WheelSide::Left, WheelSide::Right] {
-            let moved = |a: &ContactRow, b: &ContactRow| {
-                (b.wheel(side).wheel_lateral_m - a.wheel(side).wheel_lateral_m).abs()
-            };
-            if moved(w[0], w[1]) <= JUMP_CANDIDATE_M {
+    for side in [WheelSide::Left, WheelSide::Right] {
+        let moved = |a: &ContactRow, b: &ContactRow| {
+            (b.wheel(side).wheel_lateral_m - a.wheel(side).wheel_lateral_m).abs()
+        };
+        let steps: Vec<f64> = solved.windows(2).map(|w| moved(w[0], w[1])).collect();
+        for (i, w) in solved.windows(2).enumerate() {
+            // a jump stands out of the movement in the neighbouring steps
+            let neighbours = [i.checked_sub(1), Some(i + 1)]
+                .into_iter()
+                .flatten()
+                .filter_map(|k| steps.get(k))
+                .fold(0.0_f64, |m, &v| m.max(v));
+            if steps[i] <= JUMP_CANDIDATE_M || steps[i] <= JUMP_OUTLIER * neighbours {
                 continue;
             }
             let (mut a, mut b) = (*w[0], *w[1]);
             let mut failed = false;
+            let mut first = true;
+            let mut continuous = false;
             // follow the half that carries the larger movement; a continuous contact soon
             // moves less than JUMP_MIN_M across the bracket, a jump never does
             while b.y_m - a.y_m > JUMP_BRACKET_M && moved(&a, &b) > JUMP_MIN_M {
@@ -279,13 +298,21 @@ fn locate_jumps(p: &Prepared, rows: &[ContactRow], climb: &[ContactRow]) -> Vec<
                     beyond_flange_limit: a.beyond_flange_limit && b.beyond_flange_limit,
                     ..m.row
                 };
-                if moved(&a, &m) >= moved(&m, &b) {
+                // a continuous contact passes the midpoint near half-way; a jump lies wholly in
+                // one half (JUMP_LINEAR_SHARE)
+                let (left, right) = (moved(&a, &m), moved(&m, &b));
+                if first && left.min(right) > JUMP_LINEAR_SHARE * (left + right) {
+                    continuous = true;
+                    break;
+                }
+                first = false;
+                if left >= right {
                     b = m;
                 } else {
                     a = m;
                 }
             }
-            if !failed && moved(&a, &b) > JUMP_MIN_M {
+            if !failed && !continuous && moved(&a, &b) > JUMP_MIN_M {
                 jumps.push(ContactJump {
                     side,
                     y_m: 0.5 * (a.y_m + b.y_m),
