@@ -22,6 +22,7 @@ pub mod linear;
 pub mod model;
 pub mod nonlinear;
 pub mod params;
+pub mod perf;
 pub mod sim;
 
 pub use model::{Bogie, Inputs, ModelError, Outputs, StepError};

@@ -39,6 +39,7 @@
 pub mod fmu;
 pub mod idf;
 pub mod mppt;
+pub mod perf;
 pub mod signal;
 pub mod skyhook;
 

@@ -40,6 +40,7 @@ pub mod error;
 pub mod fmu;
 pub mod full_active;
 pub mod ode;
+pub mod perf;
 pub mod semi_active;
 pub mod valve;
 
