@@ -9,7 +9,8 @@
 //! stiffness of the synthetic profile (~600 rad/s) omega*h_sub <= 0.06, far inside RK4's
 //! stability and accuracy region. Damper forces and an external track input are held
 //! constant over a communication step (zero-order hold); the internal track generator is
-//! interpolated linearly between the step ends.
+//! evaluated at every RK4 stage's track position (a cubic interpolation on its synthesised
+//! grid, see [`wheel_rail::track`]), so the internal track does not depend on the step.
 //!
 //! Direct feedthrough: accelerations (bogie frame above each wheelset, wheelsets) and the
 //! guiding forces depend on the damper forces and track input at the same instant; call
@@ -198,8 +199,6 @@ pub struct Bogie {
     time_s: f64,
     position_m: f64,
     h_sub_max: f64,
-    /// Track alignment (front, rear) at the current time (internal generator).
-    track_now: [f64; 2],
 }
 
 impl Bogie {
@@ -247,7 +246,7 @@ impl Bogie {
         state[0] = params.initial_lateral_m;
         state[1] = params.initial_yaw_rad;
         let delay = DelayLine::new(2.0 * params.half_wheelbase_m);
-        let mut me = Self {
+        Ok(Self {
             params,
             consts,
             table,
@@ -257,10 +256,7 @@ impl Bogie {
             time_s: 0.0,
             position_m: 0.0,
             h_sub_max,
-            track_now: [0.0; 2],
-        };
-        me.track_now = me.generated_track(0.0);
-        Ok(me)
+        })
     }
 
     /// Parameters in use.
@@ -311,7 +307,7 @@ impl Bogie {
     fn track_at_start(&self, inputs: &Inputs) -> [f64; 2] {
         match self.params.track {
             TrackSource::None => [0.0, 0.0],
-            TrackSource::Internal { .. } => self.track_now,
+            TrackSource::Internal { .. } => self.generated_track(self.position_m),
             TrackSource::External => {
                 let front = inputs.track_lateral_m;
                 let rear = self
@@ -411,22 +407,22 @@ impl Bogie {
     fn step_inner(&mut self, h: f64, inputs: &Inputs) -> Result<Outputs, StepError> {
         let c = self.consts;
         let yt0 = self.track_at_start(inputs);
-        let x_end = self.position_m + c.v * h;
-        let yt1 = match self.params.track {
-            TrackSource::Internal { .. } => self.generated_track(x_end),
-            _ => yt0,
-        };
+        let x0 = self.position_m;
+        let x_end = x0 + c.v * h;
         let n = (h / self.h_sub_max - 1e-9).ceil().max(1.0) as usize;
         let hs = h / n as f64;
         let (fl, fr) = (inputs.damper_left_force_n, inputs.damper_right_force_n);
         let table = &self.table;
+        let generator = self.generator.as_ref();
+        let rear_behind_m = 2.0 * c.p;
+        // internal track at the stage's position, else the value held over the step
         let track = |tau: f64| -> [f64; 2] {
-            let u = tau / h;
-            [
-                yt0[0] + u * (yt1[0] - yt0[0]),
-                yt0[1] + u * (yt1[1] - yt0[1]),
-            ]
+            match generator {
+                Some(g) => g.eval_behind(x0 + c.v * tau, [0.0, rear_behind_m]),
+                None => yt0,
+            }
         };
+        let yt1 = track(h);
         let f = |x: &[f64; N_STATES], tau: f64| rhs(&c, table, x, track(tau), fl, fr).dx;
         let mut x = self.state;
         for k in 0..n {
@@ -457,7 +453,6 @@ impl Bogie {
         self.state = x;
         self.time_s += h;
         self.position_m = x_end;
-        self.track_now = yt1;
         self.outputs_with(yt1, inputs)
     }
 }

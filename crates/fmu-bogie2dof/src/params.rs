@@ -83,7 +83,8 @@ pub enum TrackSource {
     /// delayed by 2p/V).
     #[default]
     External,
-    /// Internal sum-of-cosines generator (ERRI B176 spectrum), reproducible from `seed`.
+    /// Internal ERRI B176 generator ([`wheel_rail::track::TrackGenerator`]: synthesised
+    /// periodic realisation, default band), reproducible from `seed`.
     Internal {
         /// Spectrum level.
         level: PsdLevel,

@@ -747,3 +747,41 @@ fn profiles_aa_table_conventions_and_response() {
     assert!(peaks[0] < 0.1e-3, "{peaks:?}");
     assert!(peaks[1] < 0.1e-3, "{peaks:?}");
 }
+
+/// The internal track is evaluated at every integrator stage's track position, so the model
+/// alone on it does not depend on the communication step (the track under the wheelsets is the
+/// same function of time for any step).
+#[test]
+fn internal_track_does_not_depend_on_the_communication_step() {
+    let run = |h: f64| {
+        let p = Params {
+            speed_mps: 250.0 / 3.6,
+            k_ssx_n_per_m: 4e6,
+            track: TrackSource::Internal {
+                level: PsdLevel::High,
+                seed: 4,
+            },
+            ..Params::default()
+        };
+        let mut b = Bogie::with_table(p, default_table()).unwrap();
+        let mut v = Vec::new();
+        run_closed_loop(&mut b, LoopDamper::None, h, 1.55, &|_| 0.0, &mut |o| {
+            v.push((o.time_s, o.track_front_m, o.wheelset_front_lateral_m))
+        })
+        .unwrap();
+        v
+    };
+    let (a, b) = (run(1e-4), run(1.55e-3));
+    let (mut track_diff, mut motion_diff, mut motion_peak): (f64, f64, f64) = (0.0, 0.0, 0.0);
+    for (k, s) in b.iter().enumerate().step_by(2) {
+        let sa = a[31 * k / 2];
+        assert!((sa.0 - s.0).abs() < 1e-9);
+        track_diff = track_diff.max((sa.1 - s.1).abs());
+        motion_diff = motion_diff.max((sa.2 - s.2).abs());
+        motion_peak = motion_peak.max(s.2.abs());
+    }
+    println!("internal track, h 1e-4 vs 1.55e-3: track {track_diff:e} m, wheelset {motion_diff:e} m of {motion_peak:e} m");
+    assert!(motion_peak > 5e-4, "the track moves the bogie");
+    assert!(track_diff < 1e-12, "{track_diff}");
+    assert!(motion_diff < 1e-3 * motion_peak, "{motion_diff}");
+}
