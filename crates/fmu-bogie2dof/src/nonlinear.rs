@@ -15,7 +15,7 @@
 //! (y_i - y_track,i), no normal-force term except the optional gravitational stiffness, and
 //! no spin dofs; it equals (5.16) exactly (checked against the state matrix in tests).
 
-use wheel_rail::{saturation_factor, GeometryTable};
+use wheel_rail::{saturation_factor, GeometryTable, SegmentHint};
 
 use crate::params::{ModelKind, Params};
 
@@ -43,6 +43,11 @@ pub struct Consts {
     pub load: f64,
     pub mu_p: f64,
     pub nonlinear: bool,
+    /// 1/V, 1/m, 1/J, 1/J_w: the right-hand side multiplies instead of dividing.
+    pub inv_v: f64,
+    pub inv_m: f64,
+    pub inv_j: f64,
+    pub inv_jw: f64,
 }
 
 impl Consts {
@@ -67,6 +72,10 @@ impl Consts {
             load: p.wheel_load_n,
             mu_p: p.friction_coefficient * p.wheel_load_n,
             nonlinear: p.model == ModelKind::NonLinear,
+            inv_v: 1.0 / p.speed_mps,
+            inv_m: 1.0 / p.bogie_mass_kg,
+            inv_j: 1.0 / p.bogie_yaw_inertia_kgm2,
+            inv_jw: 1.0 / p.wheelset_spin_inertia_kgm2,
         }
     }
 }
@@ -90,6 +99,29 @@ pub fn rhs(
     f_left: f64,
     f_right: f64,
 ) -> Eval {
+    rhs_with_hints(
+        c,
+        table,
+        &mut [SegmentHint::default(); 2],
+        x,
+        yt,
+        f_left,
+        f_right,
+    )
+}
+
+/// As [`rhs`], with one contact-table segment hint per wheelset (front, rear) that the caller
+/// keeps from one evaluation to the next (the lookup result is the same for any hint).
+#[inline]
+pub fn rhs_with_hints(
+    c: &Consts,
+    table: &GeometryTable,
+    hints: &mut [SegmentHint; 2],
+    x: &[f64; N_STATES],
+    yt: [f64; 2],
+    f_left: f64,
+    f_right: f64,
+) -> Eval {
     let (y, sig, yd, sigd) = (x[0], x[1], x[2], x[3]);
     let v = c.v;
     let mut lat_sum = 0.0;
@@ -100,20 +132,22 @@ pub fn rhs(
         let yi = y + sgn * c.p * sig;
         let vi = yd + sgn * c.p * sigd;
         let yrel = yi - yt[i];
-        let eps_t = (vi + v * sig) / v;
+        let eps_t = (vi + v * sig) * c.inv_v;
         let lat;
         let long_moment;
         if c.nonlinear {
-            let g = table.lookup(yrel);
+            let g = table.lookup_with_hint(&mut hints[i], yrel);
             let rr = c.r0 + g.delta_r_right_m;
             let rl = c.r0 + g.delta_r_left_m;
             let w = c.omega + x[4 + i];
-            let eps_lr = (v - vi * sig + c.s * sigd - w * rr) / v;
-            let eps_ll = (v - vi * sig - c.s * sigd - w * rl) / v;
+            let eps_lr = (v - vi * sig + c.s * sigd - w * rr) * c.inv_v;
+            let eps_ll = (v - vi * sig - c.s * sigd - w * rl) * c.inv_v;
             let ft = -c.f22 * eps_t;
             let (flr, fll) = (-c.f11 * eps_lr, -c.f11 * eps_ll);
-            let kr = saturation_factor(ft.hypot(flr), c.mu_p);
-            let kl = saturation_factor(ft.hypot(fll), c.mu_p);
+            // resultant creep force per wheel; forces stay far below the square's overflow
+            // (a diverging state is caught as non-finite), so no hypot is needed
+            let kr = saturation_factor((ft * ft + flr * flr).sqrt(), c.mu_p);
+            let kl = saturation_factor((ft * ft + fll * fll).sqrt(), c.mu_p);
             let (ftr, flr) = (kr * ft, kr * flr);
             let (ftl, fll) = (kl * ft, kl * fll);
             let fbl = c.load * g.tan_gamma_left;
@@ -121,10 +155,10 @@ pub fn rhs(
             lat = ftr + ftl + fbl + fbr;
             long_moment = c.s * (flr - fll);
             // (5.27) J_w beta'' + F_LL R_L + F_LR R_R = 0
-            out.dx[4 + i] = -(fll * rl + flr * rr) / c.jw;
+            out.dx[4 + i] = -(fll * rl + flr * rr) * c.inv_jw;
         } else {
             let ft = -c.f22 * eps_t;
-            let flr = -c.f11 * (c.s * sigd / v - c.lambda * yrel / c.r0);
+            let flr = -c.f11 * (c.s * sigd * c.inv_v - c.lambda * yrel / c.r0);
             lat = 2.0 * ft - c.kg * yrel;
             long_moment = 2.0 * c.s * flr; // F_LL = -F_LR
             out.dx[4 + i] = 0.0;
@@ -136,8 +170,8 @@ pub fn rhs(
     let damper_moment = -c.b * f_left + c.b * f_right;
     out.dx[0] = yd;
     out.dx[1] = sigd;
-    out.dx[2] = (lat_sum - 2.0 * c.k_ssy * y) / c.m;
-    out.dx[3] = (yaw - 2.0 * c.k_ssx * c.b * c.b * sig + damper_moment) / c.j;
+    out.dx[2] = (lat_sum - 2.0 * c.k_ssy * y) * c.inv_m;
+    out.dx[3] = (yaw - 2.0 * c.k_ssx * c.b * c.b * sig + damper_moment) * c.inv_j;
     out
 }
 
