@@ -299,8 +299,13 @@ impl ActuatorParams {
 
     /// Load flow (3.63), m^3/s (regularised root).
     pub fn load_flow(&self, z: f64, p_l: f64) -> f64 {
+        self.load_flow_with_gain(self.valve_gain(), z, p_l)
+    }
+
+    /// [`Self::load_flow`] with the valve gain `k` computed by the caller.
+    fn load_flow_with_gain(&self, k: f64, z: f64, p_l: f64) -> f64 {
         let dp = self.supply_pressure_pa - self.tank_pressure_pa - z.signum() * p_l;
-        z * self.valve_gain()
+        z * k
             * orifice_law(
                 self.load_flow_factor() * dp,
                 self.orifice_laminar_pressure_pa,
@@ -425,14 +430,16 @@ pub struct Actuator {
 
 struct ActRhs<'a> {
     p: &'a ActuatorParams,
+    /// [`ActuatorParams::valve_gain`], computed once per step.
+    valve_gain: f64,
     u: f64,
     f_load: f64,
     xd_in: f64,
 }
 
-/// Flows into chambers A and B, and from the supply / to the tank (3.50)-(3.51).
-fn chamber_flows(p: &ActuatorParams, z: f64, pa: f64, pb: f64) -> (f64, f64, f64, f64) {
-    let k = p.valve_gain();
+/// Flows into chambers A and B, and from the supply / to the tank (3.50)-(3.51); `k` is
+/// [`ActuatorParams::valve_gain`].
+fn chamber_flows(p: &ActuatorParams, k: f64, z: f64, pa: f64, pb: f64) -> (f64, f64, f64, f64) {
     let lam = p.orifice_laminar_pressure_pa;
     let (ps, pt) = (p.supply_pressure_pa, p.tank_pressure_pa);
     if z > 0.0 {
@@ -460,7 +467,7 @@ impl Rhs<6> for ActRhs<'_> {
                 dy[0] = vd;
                 dy[1] = w0 * w0 * (self.u - v) - 2.0 * p.valve_damping_ratio * w0 * vd; // (3.48)
                 let z = p.dead_zone(v); // (3.49)
-                let (qa, qb, _, _) = chamber_flows(p, z, pa, pb);
+                let (qa, qb, _, _) = chamber_flows(p, self.valve_gain, z, pa, pb);
                 let xs = x.clamp(-p.half_stroke_m, p.half_stroke_m);
                 let va = p.volume_a0_m3 + p.area_a_m2 * xs; // (3.56)
                 let vb = p.volume_b0_m3 - p.area_b_m2 * xs; // (3.57)
@@ -472,7 +479,7 @@ impl Rhs<6> for ActRhs<'_> {
             ActuatorModel::ReducedOrder => {
                 let z = p.dead_zone(self.u); // (3.60)
                 let pl = pa - pb;
-                let ql = p.load_flow(z, pl); // (3.63)
+                let ql = p.load_flow_with_gain(self.valve_gain, z, pl); // (3.63)
                 let a = p.mean_area_m2();
                 let pl_dot = 4.0 * p.bulk_modulus_pa / p.total_volume_m3()
                     * (ql - a * xd - p.leakage_coeff_m3ps_per_pa * pl); // (3.65)
@@ -493,6 +500,19 @@ impl Rhs<6> for ActRhs<'_> {
             }
         }
         dy
+    }
+
+    fn frozen(&self) -> [bool; 6] {
+        let reduced = self.p.model == ActuatorModel::ReducedOrder;
+        // reduced order: the spool sits at the command; imposed rod: the velocity is an input
+        [
+            reduced,
+            reduced,
+            false,
+            false,
+            false,
+            self.p.rod == RodMode::Imposed,
+        ]
     }
 }
 
@@ -574,6 +594,7 @@ impl Actuator {
         self.apply_inputs(inputs);
         let sys = ActRhs {
             p: &self.params,
+            valve_gain: self.params.valve_gain(),
             u: inputs.spool_command_m,
             f_load: inputs.load_force_n,
             xd_in: inputs.elongation_velocity_mps,
@@ -601,7 +622,7 @@ impl Actuator {
         let (z, pressure_force, q_load, q_s, q_t) = match p.model {
             ActuatorModel::FullOrder => {
                 let z = p.dead_zone(v);
-                let (qa, _, qs, qt) = chamber_flows(p, z, pa, pb);
+                let (qa, _, qs, qt) = chamber_flows(p, p.valve_gain(), z, pa, pb);
                 (z, pa * p.area_a_m2 - pb * p.area_b_m2, qa, qs, qt)
             }
             ActuatorModel::ReducedOrder => {

@@ -167,17 +167,20 @@ impl SemiActiveParams {
 
     /// Velocity function `f(v)` of (3.43), m^3/s (cubic-root shaped).
     pub fn velocity_flow(&self, v: f64) -> f64 {
+        self.velocity_flow_with(v, self.velocity_ref_mps.cbrt())
+    }
+
+    /// [`Self::velocity_flow`] with `v_ref^(1/3)` computed by the caller (once per damper).
+    fn velocity_flow_with(&self, v: f64, velocity_ref_cbrt: f64) -> f64 {
         let vl = self.velocity_linear_mps;
         let m = v.abs().max(vl);
         if m < SQUARE_SAFE {
-            self.velocity_flow_ref_m3ps * v
-                / (self.velocity_ref_mps.cbrt() * (v * v + vl * vl).cbrt())
+            self.velocity_flow_ref_m3ps * v / (velocity_ref_cbrt * (v * v + vl * vl).cbrt())
         } else {
             // v^2 would overflow (and give f = 0): scale by m, (v^2 + vl^2)^(1/3) = m^(2/3) (..)^(1/3).
             let (a, b) = (v / m, vl / m);
             let c = m.cbrt();
-            self.velocity_flow_ref_m3ps
-                * (v / (c * c * self.velocity_ref_mps.cbrt() * (a * a + b * b).cbrt()))
+            self.velocity_flow_ref_m3ps * (v / (c * c * velocity_ref_cbrt * (a * a + b * b).cbrt()))
         }
     }
 
@@ -251,6 +254,8 @@ pub struct SemiActiveDamper {
     /// Last commanded opening and clamp flag.
     opening_command: f64,
     command_clamped: bool,
+    /// `v_ref^(1/3)` of the velocity function, derived from the parameters once.
+    velocity_ref_cbrt: f64,
 }
 
 struct SemiRhs<'a> {
@@ -270,6 +275,11 @@ impl Rhs<2> for SemiRhs<'_> {
         let dp_dot = self.k_over_v * (self.q_in - (self.cf + self.cv * x) * g);
         [dp_dot, self.p.valve.opening_rate(y[1], self.x_cmd)]
     }
+
+    fn frozen(&self) -> [bool; 2] {
+        // an ideal valve's opening is held at the command (opening_rate = 0)
+        [false, self.p.valve.model == ValveModel::Ideal]
+    }
 }
 
 impl SemiActiveDamper {
@@ -286,6 +296,7 @@ impl SemiActiveDamper {
             inputs: SemiActiveInputs::default(),
             opening_command: opening,
             command_clamped: false,
+            velocity_ref_cbrt: params.velocity_ref_mps.cbrt(),
         })
     }
 
@@ -387,7 +398,7 @@ impl SemiActiveDamper {
             k_over_v: p.stiffness_ratio(),
             cf: p.piston_flow_coeff,
             cv: p.valve_flow_coeff(),
-            q_in: p.velocity_flow(inputs.elongation_velocity_mps),
+            q_in: p.velocity_flow_with(inputs.elongation_velocity_mps, self.velocity_ref_cbrt),
             x_cmd,
         };
         let mut y = [self.dp_pa, self.opening];

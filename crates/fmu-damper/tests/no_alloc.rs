@@ -1,0 +1,40 @@
+//! The step path of each damper model (2000 steps of 1 ms of every reference case) allocates nothing: counted with a global allocator (one test in this
+//! binary, so no other test allocates meanwhile).
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use fmu_damper::perf::{DamperCase, DamperWorkload};
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        System.alloc(layout)
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        System.dealloc(ptr, layout)
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn step_path_does_not_allocate() {
+    for case in DamperCase::ALL {
+        let mut model = DamperWorkload::new(case).unwrap();
+        model.run_steps(0, 10).unwrap();
+        let before = ALLOCATIONS.load(Ordering::SeqCst);
+        model.run_steps(10, 2000).unwrap();
+        assert_eq!(
+            ALLOCATIONS.load(Ordering::SeqCst),
+            before,
+            "{}",
+            case.name()
+        );
+    }
+}
