@@ -87,6 +87,18 @@ pub struct Eval {
     pub dx: [f64; N_STATES],
     /// Sum of lateral wheel/rail forces on each wheelset (front, rear) [N], positive right.
     pub guiding: [f64; 2],
+    /// Yaw moment of everything but the yaw dampers [N m]: the damper forces enter only
+    /// `dx[3] = (yaw_moment_without_dampers_nm - b F_L + b F_R) / J`.
+    pub yaw_moment_without_dampers_nm: f64,
+}
+
+impl Eval {
+    /// Yaw acceleration for other damper forces at the same state and track (bit for bit what
+    /// a new evaluation would give).
+    #[inline]
+    pub fn yaw_acc_with_dampers(&self, c: &Consts, f_left: f64, f_right: f64) -> f64 {
+        (self.yaw_moment_without_dampers_nm + (-c.b * f_left + c.b * f_right)) * c.inv_j
+    }
 }
 
 /// x' = f(x) with track alignment `yt` = (front, rear) and damper forces (tension positive).
@@ -167,11 +179,11 @@ pub fn rhs_with_hints(
         lat_sum += lat;
         yaw += long_moment + sgn * c.p * lat;
     }
-    let damper_moment = -c.b * f_left + c.b * f_right;
     out.dx[0] = yd;
     out.dx[1] = sigd;
     out.dx[2] = (lat_sum - 2.0 * c.k_ssy * y) * c.inv_m;
-    out.dx[3] = (yaw - 2.0 * c.k_ssx * c.b * c.b * sig + damper_moment) * c.inv_j;
+    out.yaw_moment_without_dampers_nm = yaw - 2.0 * c.k_ssx * c.b * c.b * sig;
+    out.dx[3] = out.yaw_acc_with_dampers(c, f_left, f_right);
     out
 }
 
