@@ -39,7 +39,7 @@ fn main() {
     }
     for (name, track) in cases {
         let before = load_average();
-        let rtf = realtime_factor(track, 5.0, 5).unwrap();
+        let rtf = realtime_factor(track, 20.0, 7).unwrap();
         println!(
             "bogie non-linear, {name}, 1 ms steps: {rtf:.0} x real time \
              (load average before/after: {before} / {})",

@@ -30,7 +30,7 @@ fn main() {
     }
     for case in DamperCase::ALL {
         let before = load_average();
-        let ns = ns_per_step(case, 2000, 15).unwrap();
+        let ns = ns_per_step(case, 5000, 21).unwrap();
         println!(
             "{:<26} {:>8.0} ns per 1 ms step ({:>6.0} x real time; load average before/after: \
              {before} / {})",
