@@ -205,7 +205,7 @@ fn declare_parameters(v: &mut VariableList<Bogie2Dof>) {
          relative name is looked up in the FMU's resources/ first (shipped: \
          wheel_rail_worn_surrogate.csv, wheel_rail_A_A.csv)",
         |m| m.contact_table.clone(),
-        |m, x| m.contact_table = x.to_string(),
+        |m, x| m.contact_table = x,
     );
     v.parameter(
         "initial.lateral_displacement",

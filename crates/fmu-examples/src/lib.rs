@@ -11,8 +11,8 @@
 //! step, so the remaining error is the coupling error.
 
 use model_description::{
-    DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo, StepError,
-    Variable, VariableList,
+    field_error, DefaultExperiment, Diagnostics, FieldError, FmuModel, InstanceContext, ModelError,
+    ModelInfo, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
 
@@ -37,23 +37,43 @@ fn rk4(x: &mut f64, v: &mut f64, h: f64, accel: impl Fn(f64, f64) -> f64) {
     }
 }
 
-fn positive(name: &str, value: f64) -> Result<(), ModelError> {
+/// A parameter out of range, naming the model field (the glue reports it under the FMI name of
+/// the variable bound to that field).
+#[derive(Debug)]
+struct Invalid {
+    field: &'static str,
+    reason: String,
+}
+
+impl std::fmt::Display for Invalid {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.reason)
+    }
+}
+
+impl FieldError for Invalid {
+    fn field(&self) -> Option<&str> {
+        Some(self.field)
+    }
+}
+
+fn positive(field: &'static str, value: f64) -> Result<(), Invalid> {
     if value > 0.0 && value.is_finite() {
         Ok(())
     } else {
-        Err(ModelError::InvalidParameter {
-            name: name.into(),
+        Err(Invalid {
+            field,
             reason: format!("must be positive, got {value}"),
         })
     }
 }
 
-fn non_negative(name: &str, value: f64) -> Result<(), ModelError> {
+fn non_negative(field: &'static str, value: f64) -> Result<(), Invalid> {
     if value >= 0.0 && value.is_finite() {
         Ok(())
     } else {
-        Err(ModelError::InvalidParameter {
-            name: name.into(),
+        Err(Invalid {
+            field,
             reason: format!("must be >= 0, got {value}"),
         })
     }
@@ -96,52 +116,26 @@ impl FmuModel for MassSpring {
     };
 
     fn variables() -> Vec<Variable<Self>> {
-        let mut v = VariableList::<Self>::new();
-        v.parameter("mass", "Mass", |m| m.mass_kg, |m, x| m.mass_kg = x)
-            .unit("kg")
-            .min(1e-9);
-        v.parameter(
-            "stiffness",
-            "Spring stiffness to ground",
-            |m| m.stiffness_n_per_m,
-            |m, x| m.stiffness_n_per_m = x,
-        )
-        .unit("N/m")
-        .min(0.0);
-        v.parameter(
-            "damping",
-            "Damping to ground",
-            |m| m.damping_ns_per_m,
-            |m, x| m.damping_ns_per_m = x,
-        )
-        .unit("N.s/m")
-        .min(0.0);
-        v.parameter(
-            "initial_position",
-            "Position at the start time",
-            |m| m.initial_position_m,
-            |m, x| m.initial_position_m = x,
-        )
-        .unit("m");
-        v.parameter(
-            "initial_velocity",
-            "Velocity at the start time",
-            |m| m.initial_velocity_mps,
-            |m, x| m.initial_velocity_mps = x,
-        )
-        .unit("m/s");
-        v.input(
-            "force",
-            "External force on the mass",
-            |m| m.force_n,
-            |m, x| m.force_n = x,
-        )
-        .unit("N");
-        v.output("position", "Position", &[], |m| m.position_m)
-            .unit("m");
-        v.output("velocity", "Velocity", &[], |m| m.velocity_mps)
-            .unit("m/s");
-        v.into_vec()
+        let mut v: Vec<Variable<Self>> = Vec::new();
+        model_description::declare! { v;
+            /// Mass
+            parameter "mass" [unit = "kg", min = 1e-9] => mass_kg;
+            /// Spring stiffness to ground
+            parameter "stiffness" [unit = "N/m", min = 0.0] => stiffness_n_per_m;
+            /// Damping to ground
+            parameter "damping" [unit = "N.s/m", min = 0.0] => damping_ns_per_m;
+            /// Position at the start time
+            parameter "initial_position" [unit = "m"] => initial_position_m;
+            /// Velocity at the start time
+            parameter "initial_velocity" [unit = "m/s"] => initial_velocity_mps;
+            /// External force on the mass
+            input "force" [unit = "N"] => force_n;
+            /// Position
+            output "position" [unit = "m"] => position_m;
+            /// Velocity
+            output "velocity" [unit = "m/s"] => velocity_mps;
+        }
+        v
     }
 
     fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
@@ -158,9 +152,12 @@ impl FmuModel for MassSpring {
     }
 
     fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-        positive("mass", self.mass_kg)?;
-        non_negative("stiffness", self.stiffness_n_per_m)?;
-        non_negative("damping", self.damping_ns_per_m)?;
+        let check = || {
+            positive("mass_kg", self.mass_kg)?;
+            non_negative("stiffness_n_per_m", self.stiffness_n_per_m)?;
+            non_negative("damping_ns_per_m", self.damping_ns_per_m)
+        };
+        check().map_err(|e| field_error::<Self>(&e))?;
         self.position_m = self.initial_position_m;
         self.velocity_mps = self.initial_velocity_mps;
         Ok(())
@@ -228,82 +225,35 @@ impl FmuModel for SpringDamperMass {
     };
 
     fn variables() -> Vec<Variable<Self>> {
-        let mut v = VariableList::<Self>::new();
-        v.parameter("mass", "Mass", |m| m.mass_kg, |m, x| m.mass_kg = x)
-            .unit("kg")
-            .min(1e-9);
-        v.parameter(
-            "coupling_stiffness",
-            "Stiffness of the coupling spring",
-            |m| m.coupling_stiffness_n_per_m,
-            |m, x| m.coupling_stiffness_n_per_m = x,
-        )
-        .unit("N/m")
-        .min(0.0);
-        v.parameter(
-            "coupling_damping",
-            "Damping of the coupling damper",
-            |m| m.coupling_damping_ns_per_m,
-            |m, x| m.coupling_damping_ns_per_m = x,
-        )
-        .unit("N.s/m")
-        .min(0.0);
-        v.parameter(
-            "ground_stiffness",
-            "Stiffness to ground",
-            |m| m.ground_stiffness_n_per_m,
-            |m, x| m.ground_stiffness_n_per_m = x,
-        )
-        .unit("N/m")
-        .min(0.0);
-        v.parameter(
-            "ground_damping",
-            "Damping to ground",
-            |m| m.ground_damping_ns_per_m,
-            |m, x| m.ground_damping_ns_per_m = x,
-        )
-        .unit("N.s/m")
-        .min(0.0);
-        v.parameter(
-            "initial_position",
-            "Position at the start time",
-            |m| m.initial_position_m,
-            |m, x| m.initial_position_m = x,
-        )
-        .unit("m");
-        v.parameter(
-            "initial_velocity",
-            "Velocity at the start time",
-            |m| m.initial_velocity_mps,
-            |m, x| m.initial_velocity_mps = x,
-        )
-        .unit("m/s");
-        v.input(
-            "input_position",
-            "Position of the other end of the coupling",
-            |m| m.input_position_m,
-            |m, x| m.input_position_m = x,
-        )
-        .unit("m");
-        v.input(
-            "input_velocity",
-            "Velocity of the other end of the coupling",
-            |m| m.input_velocity_mps,
-            |m, x| m.input_velocity_mps = x,
-        )
-        .unit("m/s");
-        v.output(
-            "coupling_force",
-            "Force of the coupling on the input body",
-            &["input_position", "input_velocity"],
-            |m| m.coupling_force(),
-        )
-        .unit("N");
-        v.output("position", "Position", &[], |m| m.position_m)
-            .unit("m");
-        v.output("velocity", "Velocity", &[], |m| m.velocity_mps)
-            .unit("m/s");
-        v.into_vec()
+        let mut v: Vec<Variable<Self>> = Vec::new();
+        model_description::declare! { v;
+            /// Mass
+            parameter "mass" [unit = "kg", min = 1e-9] => mass_kg;
+            /// Stiffness of the coupling spring
+            parameter "coupling_stiffness" [unit = "N/m", min = 0.0] => coupling_stiffness_n_per_m;
+            /// Damping of the coupling damper
+            parameter "coupling_damping" [unit = "N.s/m", min = 0.0] => coupling_damping_ns_per_m;
+            /// Stiffness to ground
+            parameter "ground_stiffness" [unit = "N/m", min = 0.0] => ground_stiffness_n_per_m;
+            /// Damping to ground
+            parameter "ground_damping" [unit = "N.s/m", min = 0.0] => ground_damping_ns_per_m;
+            /// Position at the start time
+            parameter "initial_position" [unit = "m"] => initial_position_m;
+            /// Velocity at the start time
+            parameter "initial_velocity" [unit = "m/s"] => initial_velocity_mps;
+            /// Position of the other end of the coupling
+            input "input_position" [unit = "m"] => input_position_m;
+            /// Velocity of the other end of the coupling
+            input "input_velocity" [unit = "m/s"] => input_velocity_mps;
+            /// Force of the coupling on the input body
+            output "coupling_force" [unit = "N", depends_on = &["input_position", "input_velocity"]]
+                => |m| m.coupling_force();
+            /// Position
+            output "position" [unit = "m"] => position_m;
+            /// Velocity
+            output "velocity" [unit = "m/s"] => velocity_mps;
+        }
+        v
     }
 
     fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
@@ -323,11 +273,17 @@ impl FmuModel for SpringDamperMass {
     }
 
     fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-        positive("mass", self.mass_kg)?;
-        non_negative("coupling_stiffness", self.coupling_stiffness_n_per_m)?;
-        non_negative("coupling_damping", self.coupling_damping_ns_per_m)?;
-        non_negative("ground_stiffness", self.ground_stiffness_n_per_m)?;
-        non_negative("ground_damping", self.ground_damping_ns_per_m)?;
+        let check = || {
+            positive("mass_kg", self.mass_kg)?;
+            non_negative(
+                "coupling_stiffness_n_per_m",
+                self.coupling_stiffness_n_per_m,
+            )?;
+            non_negative("coupling_damping_ns_per_m", self.coupling_damping_ns_per_m)?;
+            non_negative("ground_stiffness_n_per_m", self.ground_stiffness_n_per_m)?;
+            non_negative("ground_damping_ns_per_m", self.ground_damping_ns_per_m)
+        };
+        check().map_err(|e| field_error::<Self>(&e))?;
         self.position_m = self.initial_position_m;
         self.velocity_mps = self.initial_velocity_mps;
         Ok(())

@@ -61,7 +61,7 @@ impl ModelEntry {
             name: M::INFO.name,
             create: create_erased::<M>,
             describe: xml::model_description::<M>,
-            document: xml::documentation_html::<M>,
+            document: crate::doc::documentation_html::<M>,
             resources: M::INFO.resources,
         }
     }

@@ -457,6 +457,17 @@ impl Component {
 
     fn check_range(&mut self, call: &str, i: usize, value: f64) -> Result<(), Status> {
         let meta = &self.model.metas()[i];
+        if let Some(e) = meta.enumeration {
+            if e.item(value as i32).is_none() {
+                let msg = format!(
+                    "{call}: '{}' = {value} is not an item of the enumeration {} ({})",
+                    meta.name,
+                    e.name,
+                    e.item_list()
+                );
+                return Err(self.error(&msg));
+            }
+        }
         if !value.is_finite() {
             let msg = format!("{call}: '{}' = {value} is not a finite number", meta.name);
             return Err(self.error(&msg));

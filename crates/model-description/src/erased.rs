@@ -126,7 +126,7 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
     fn set_string(&mut self, index: usize, value: &str) -> bool {
         match self.vars.get(index).map(|v| &v.access) {
             Some(Access::String { set: Some(set), .. }) => {
-                set(&mut self.model, value);
+                set(&mut self.model, value.to_string());
                 true
             }
             _ => false,

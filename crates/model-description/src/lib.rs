@@ -1,16 +1,25 @@
 //! FMI 2.0 co-simulation export glue, written once for every model of the project.
 //!
 //! A model crate implements [`FmuModel`] (its variables, defaults, initialisation and step) and
-//! invokes [`export_fmus!`]; from that one declaration come
-//! - `modelDescription.xml` ([`xml::model_description`]): units, ModelStructure with explicit
-//!   dependencies, capability flags, a GUID derived from the interface;
+//! invokes [`export_fmus!`]. Each variable is one line of [`declare!`]: FMI name, the model field
+//! it binds, causality, unit, range, description; choices are Rust enums made FMI Enumerations
+//! by [`fmi_enum!`]. From that one declaration come
+//! - `modelDescription.xml` ([`xml::model_description`]): units, enumeration types,
+//!   ModelStructure with explicit dependencies, capability flags, a GUID derived from the
+//!   interface;
+//! - the accessors behind fmi2Get*/fmi2Set* (plain function pointers, no allocation);
+//! - the documentation's variable table ([`doc::documentation_html`]);
+//! - physics errors under the FMI name of the field they name ([`fields::field_error`]);
 //! - the C API ([`capi`]) with the FMI state machine ([`component::Component`]), value checks,
 //!   logging through the host's callback, FMU state save/restore/serialisation;
 //! - the packaged `.fmu` ([`package`], binary `package-fmus`).
 
 pub mod capi;
 pub mod component;
+pub mod doc;
+pub mod enumeration;
 pub mod erased;
+pub mod fields;
 pub mod model;
 pub mod package;
 pub mod units;
@@ -18,10 +27,15 @@ pub mod variable;
 pub mod xml;
 
 pub use component::{CollectLog, Component, FmiState, Status};
+pub use enumeration::{EnumItem, EnumType, FmiEnum};
+pub use fields::{field_error, FieldError};
 pub use model::{
     DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo, StepError,
 };
-pub use variable::{Causality, VarType, Variability, Variable, VariableList};
+pub use variable::{
+    AlwaysSome, Causality, Codec, FmiValue, Native, Sign, VarType, Variability, Variable,
+    VariableList, ZeroIsNone,
+};
 
 /// Create a component for `M` driven from Rust (tests, tools): the same state machine and
 /// checks as through the C API, with log messages collected in the returned [`CollectLog`].

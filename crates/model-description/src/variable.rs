@@ -1,8 +1,16 @@
-//! One declaration of a model variable: its FMI attributes (for modelDescription.xml) and its
-//! accessors (for fmi2Get*/fmi2Set*). Value references are assigned by the glue in declaration
-//! order, per type, so they cannot collide.
+//! One declaration of a model variable: its FMI attributes (for modelDescription.xml and the
+//! documentation), the physics field it binds (for the accessors and for naming errors), and
+//! its accessors (for fmi2Get*/fmi2Set*). Value references are assigned by the glue in
+//! declaration order, per type, so they cannot collide.
+//!
+//! Models declare their variables with [`crate::declare!`]: one line per variable naming the
+//! FMI variable and the field it binds, with the description as a doc comment. The field's Rust
+//! type decides the FMI type ([`FmiValue`]); a [`Codec`] converts fields whose FMI form differs
+//! (a sign held as `f64` exposed as an Integer, an optional value).
 
-/// FMI 2.0 base type of a scalar variable.
+use crate::enumeration::EnumType;
+
+/// FMI 2.0 base type of a scalar variable (an Enumeration is an Integer with a declared type).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum VarType {
     Real,
@@ -42,6 +50,22 @@ impl Causality {
             Causality::Local => "local",
         }
     }
+
+    /// Whether the host sets variables of this causality (parameters and inputs).
+    pub fn is_settable(self) -> bool {
+        matches!(self, Causality::Parameter | Causality::Input)
+    }
+}
+
+/// The causality keywords of [`crate::declare!`] (`parameter "x" => field;`).
+#[allow(non_upper_case_globals)]
+pub mod kind {
+    use super::Causality;
+    pub const parameter: Causality = Causality::Parameter;
+    pub const calculated_parameter: Causality = Causality::CalculatedParameter;
+    pub const input: Causality = Causality::Input;
+    pub const output: Causality = Causality::Output;
+    pub const local: Causality = Causality::Local;
 }
 
 /// FMI 2.0 variability.
@@ -66,7 +90,8 @@ impl Variability {
     }
 }
 
-/// Typed accessors of one variable. Plain function pointers: no allocation on the get/set path.
+/// Typed accessors of one variable. Plain function pointers: no allocation on the get/set path
+/// (strings excepted: they are copied).
 pub enum Access<M> {
     Real {
         get: fn(&M) -> f64,
@@ -82,7 +107,7 @@ pub enum Access<M> {
     },
     String {
         get: fn(&M) -> String,
-        set: Option<fn(&mut M, &str)>,
+        set: Option<fn(&mut M, String)>,
     },
 }
 
@@ -129,6 +154,181 @@ impl<M> Access<M> {
     }
 }
 
+/// The four FMI scalar types as Rust values: builds the matching [`Access`].
+pub trait Scalar: Sized + 'static {
+    fn access<M>(get: fn(&M) -> Self, set: Option<fn(&mut M, Self)>) -> Access<M>;
+}
+
+impl Scalar for f64 {
+    fn access<M>(get: fn(&M) -> Self, set: Option<fn(&mut M, Self)>) -> Access<M> {
+        Access::Real { get, set }
+    }
+}
+
+impl Scalar for i32 {
+    fn access<M>(get: fn(&M) -> Self, set: Option<fn(&mut M, Self)>) -> Access<M> {
+        Access::Integer { get, set }
+    }
+}
+
+impl Scalar for bool {
+    fn access<M>(get: fn(&M) -> Self, set: Option<fn(&mut M, Self)>) -> Access<M> {
+        Access::Boolean { get, set }
+    }
+}
+
+impl Scalar for String {
+    fn access<M>(get: fn(&M) -> Self, set: Option<fn(&mut M, Self)>) -> Access<M> {
+        Access::String { get, set }
+    }
+}
+
+/// A field type with a natural FMI form: `f64` is a Real, `bool` a Boolean, `String` a String,
+/// `i32`/`u32`/`u64` an Integer (unsigned values saturate at `i32::MAX` when read; a negative
+/// value set into an unsigned field becomes 0, which the declared min or the physics' validation
+/// rejects), and every [`crate::FmiEnum`] an Enumeration.
+pub trait FmiValue {
+    type Fmi: Scalar;
+    /// The Enumeration type of the field, if it is one.
+    const ENUMERATION: Option<&'static EnumType> = None;
+    fn to_fmi(&self) -> Self::Fmi;
+    fn set_fmi(&mut self, value: Self::Fmi);
+}
+
+impl FmiValue for f64 {
+    type Fmi = f64;
+    fn to_fmi(&self) -> f64 {
+        *self
+    }
+    fn set_fmi(&mut self, value: f64) {
+        *self = value;
+    }
+}
+
+impl FmiValue for i32 {
+    type Fmi = i32;
+    fn to_fmi(&self) -> i32 {
+        *self
+    }
+    fn set_fmi(&mut self, value: i32) {
+        *self = value;
+    }
+}
+
+impl FmiValue for bool {
+    type Fmi = bool;
+    fn to_fmi(&self) -> bool {
+        *self
+    }
+    fn set_fmi(&mut self, value: bool) {
+        *self = value;
+    }
+}
+
+impl FmiValue for String {
+    type Fmi = String;
+    fn to_fmi(&self) -> String {
+        self.clone()
+    }
+    fn set_fmi(&mut self, value: String) {
+        *self = value;
+    }
+}
+
+impl FmiValue for u32 {
+    type Fmi = i32;
+    fn to_fmi(&self) -> i32 {
+        i32::try_from(*self).unwrap_or(i32::MAX)
+    }
+    fn set_fmi(&mut self, value: i32) {
+        *self = u32::try_from(value).unwrap_or(0);
+    }
+}
+
+impl FmiValue for u64 {
+    type Fmi = i32;
+    fn to_fmi(&self) -> i32 {
+        i32::try_from(*self).unwrap_or(i32::MAX)
+    }
+    fn set_fmi(&mut self, value: i32) {
+        *self = u64::try_from(value).unwrap_or(0);
+    }
+}
+
+/// How a field of type `F` is read and written as an FMI value. [`Native`] uses the field's
+/// [`FmiValue`]; a model defines its own codec for a field whose FMI form is a convention (e.g.
+/// a sign stored as `f64`, exposed as an Integer of -1 / +1), named in the declaration with
+/// `as Codec`.
+pub trait Codec<F> {
+    type Fmi: Scalar;
+    const ENUMERATION: Option<&'static EnumType> = None;
+    fn get(field: &F) -> Self::Fmi;
+    fn set(field: &mut F, value: Self::Fmi);
+}
+
+/// The field's own FMI form ([`FmiValue`]); the default codec of [`crate::declare!`].
+pub struct Native;
+
+impl<F: FmiValue> Codec<F> for Native {
+    type Fmi = F::Fmi;
+    const ENUMERATION: Option<&'static EnumType> = F::ENUMERATION;
+    fn get(field: &F) -> F::Fmi {
+        field.to_fmi()
+    }
+    fn set(field: &mut F, value: F::Fmi) {
+        field.set_fmi(value);
+    }
+}
+
+/// A sign held as `f64` (+1 / -1), exposed as an Integer: reads 0 only for a zero field, and an
+/// Integer set is stored as that value (the declared range [-1, 1] and the physics' validation
+/// reject anything but +-1).
+pub struct Sign;
+
+impl Codec<f64> for Sign {
+    type Fmi = i32;
+    fn get(field: &f64) -> i32 {
+        if *field > 0.0 {
+            1
+        } else if *field < 0.0 {
+            -1
+        } else {
+            0
+        }
+    }
+    fn set(field: &mut f64, value: i32) {
+        *field = f64::from(value);
+    }
+}
+
+/// An optional value exposed as a Real where 0 means "none" (e.g. an optional stiffness: 0 =
+/// rigid). Reads 0 for `None`; setting 0 gives `None`, anything else `Some`.
+pub struct ZeroIsNone;
+
+impl Codec<Option<f64>> for ZeroIsNone {
+    type Fmi = f64;
+    fn get(field: &Option<f64>) -> f64 {
+        field.unwrap_or(0.0)
+    }
+    fn set(field: &mut Option<f64>, value: f64) {
+        *field = (value != 0.0).then_some(value);
+    }
+}
+
+/// An optional value a model always holds as `Some` (reads 0 for `None`, which the model never
+/// has).
+pub struct AlwaysSome;
+
+impl Codec<Option<f64>> for AlwaysSome {
+    type Fmi = f64;
+    fn get(field: &Option<f64>) -> f64 {
+        field.unwrap_or(0.0)
+    }
+    fn set(field: &mut Option<f64>, value: f64) {
+        *field = Some(value);
+    }
+}
+
 /// The FMI attributes of a variable, independent of the model type.
 #[derive(Clone, Debug)]
 pub struct VarMeta {
@@ -144,13 +344,19 @@ pub struct VarMeta {
     /// For outputs: names of the inputs this output depends on at the same instant
     /// (direct feedthrough). Empty = none. Written to ModelStructure/Outputs.
     pub feedthrough: Vec<&'static str>,
+    /// The model field the variable binds, as a path from the model value (e.g.
+    /// `params.speed_mps`); `None` for a value computed from several fields. The glue names a
+    /// physics error about field `speed_mps` by the variable bound to it.
+    pub binding: Option<String>,
+    /// The Enumeration type, for an Integer that is a choice.
+    pub enumeration: Option<&'static EnumType>,
 }
 
 impl VarMeta {
     /// Whether the variable carries a start value in modelDescription.xml (FMI 2.0, 2.2.7:
     /// parameters and inputs must have one; calculated outputs and locals must not).
     pub fn has_start(&self) -> bool {
-        matches!(self.causality, Causality::Parameter | Causality::Input)
+        self.causality.is_settable()
     }
 
     /// The `initial` attribute written to the XML (None = attribute omitted).
@@ -161,6 +367,14 @@ impl VarMeta {
                 Some("calculated")
             }
             Causality::Input => None,
+        }
+    }
+
+    /// The XML element of the value: Real, Integer, Boolean, String or Enumeration.
+    pub fn type_element(&self) -> &'static str {
+        match self.enumeration {
+            Some(_) => "Enumeration",
+            None => self.var_type.xml_name(),
         }
     }
 }
@@ -180,14 +394,25 @@ impl<M> Clone for Variable<M> {
     }
 }
 
+/// A description from doc-comment lines: trimmed, joined by single spaces.
+pub fn doc_text(lines: &[&str]) -> String {
+    lines
+        .iter()
+        .map(|l| l.trim())
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 impl<M> Variable<M> {
-    /// The one constructor behind the typed ones: parameters (also calculated ones) are fixed,
-    /// other Real variables continuous, other types discrete; `feedthrough` is for outputs only.
+    /// The one constructor: parameters (also calculated ones) are fixed, other Real variables
+    /// continuous, other types discrete; a setter is kept for parameters and inputs only.
     fn new(
-        name: &str,
-        description: &str,
         causality: Causality,
-        feedthrough: &[&'static str],
+        name: &str,
+        description: String,
+        binding: Option<String>,
+        enumeration: Option<&'static EnumType>,
         access: Access<M>,
     ) -> Self {
         let var_type = access.var_type();
@@ -199,7 +424,7 @@ impl<M> Variable<M> {
         Variable {
             meta: VarMeta {
                 name: name.to_string(),
-                description: description.to_string(),
+                description,
                 var_type,
                 causality,
                 variability,
@@ -207,10 +432,143 @@ impl<M> Variable<M> {
                 display_unit: None,
                 min: None,
                 max: None,
-                feedthrough: feedthrough.to_vec(),
+                feedthrough: Vec::new(),
+                binding,
+                enumeration,
             },
             access,
         }
+    }
+
+    /// Append a variable bound to a model field through codec `C` (what [`crate::declare!`]
+    /// expands to). `vars` comes first so that its type fixes the model type before the
+    /// accessor closures are checked. `_field` only names the field's type; `path` is the field
+    /// path for error messages.
+    #[doc(hidden)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn bind_into<'a, F, C: Codec<F>>(
+        vars: &'a mut Vec<Self>,
+        causality: Causality,
+        name: &str,
+        doc: &[&str],
+        path: &str,
+        _field: fn(&M) -> &F,
+        get: fn(&M) -> C::Fmi,
+        set: fn(&mut M, C::Fmi),
+    ) -> Attributes<'a, M> {
+        let set = causality.is_settable().then_some(set);
+        let path: String = path.chars().filter(|c| !c.is_whitespace()).collect();
+        let access = <C::Fmi as Scalar>::access(get, set);
+        vars.push(Self::new(
+            causality,
+            name,
+            doc_text(doc),
+            Some(path),
+            C::ENUMERATION,
+            access,
+        ));
+        let last = vars.len() - 1;
+        Attributes(&mut vars[last])
+    }
+
+    /// Append a read-only variable computed from several fields (`output "x" => |m| expr;`).
+    #[doc(hidden)]
+    pub fn computed_into<'a, T: Scalar>(
+        vars: &'a mut Vec<Self>,
+        causality: Causality,
+        name: &str,
+        doc: &[&str],
+        get: fn(&M) -> T,
+    ) -> Attributes<'a, M> {
+        vars.push(Self::new(
+            causality,
+            name,
+            doc_text(doc),
+            None,
+            None,
+            T::access(get, None),
+        ));
+        let last = vars.len() - 1;
+        Attributes(&mut vars[last])
+    }
+}
+
+/// The attributes of a variable being declared: the bracket of a [`crate::declare!`] line,
+/// `[unit = "m", range = 0.0..=1.0]`, calls these methods.
+pub struct Attributes<'a, M>(&'a mut Variable<M>);
+
+impl<M> Attributes<'_, M> {
+    /// Unit (must be one of [`crate::units::UNITS`]).
+    pub fn unit(&mut self, unit: &'static str) -> &mut Self {
+        self.0.meta.unit = Some(unit);
+        self
+    }
+
+    /// Display unit (must be a display unit of the variable's unit, e.g. km/h of m/s).
+    pub fn display_unit(&mut self, display_unit: &'static str) -> &mut Self {
+        self.0.meta.display_unit = Some(display_unit);
+        self
+    }
+
+    /// Inclusive bounds; a value set outside them is rejected with fmi2Error.
+    pub fn range(&mut self, range: std::ops::RangeInclusive<f64>) -> &mut Self {
+        self.0.meta.min = Some(*range.start());
+        self.0.meta.max = Some(*range.end());
+        self
+    }
+
+    pub fn min(&mut self, min: f64) -> &mut Self {
+        self.0.meta.min = Some(min);
+        self
+    }
+
+    pub fn max(&mut self, max: f64) -> &mut Self {
+        self.0.meta.max = Some(max);
+        self
+    }
+
+    /// For an output: the inputs it depends on at the same instant (direct feedthrough).
+    /// Without it an output declares none, which tells hosts there is no algebraic loop through
+    /// this model.
+    pub fn depends_on(&mut self, inputs: &[&'static str]) -> &mut Self {
+        self.0.meta.feedthrough = inputs.to_vec();
+        self
+    }
+
+    /// A parameter that may be changed between communication steps.
+    pub fn tunable(&mut self, tunable: bool) -> &mut Self {
+        if tunable && self.0.meta.causality == Causality::Parameter {
+            self.0.meta.variability = Variability::Tunable;
+        }
+        self
+    }
+
+    /// A discrete-time (sampled, piecewise constant) variable.
+    pub fn discrete(&mut self, discrete: bool) -> &mut Self {
+        if discrete
+            && matches!(
+                self.0.meta.causality,
+                Causality::Input | Causality::Output | Causality::Local
+            )
+        {
+            self.0.meta.variability = Variability::Discrete;
+        }
+        self
+    }
+}
+
+/// The closure-pair declaration style, kept while the model crates move to [`crate::declare!`].
+impl<M> Variable<M> {
+    fn legacy(
+        name: &str,
+        description: &str,
+        causality: Causality,
+        feedthrough: &[&'static str],
+        access: Access<M>,
+    ) -> Self {
+        let mut v = Self::new(causality, name, description.to_string(), None, None, access);
+        v.meta.feedthrough = feedthrough.to_vec();
+        v
     }
 
     /// A fixed Real parameter (settable before initialisation only).
@@ -224,7 +582,7 @@ impl<M> Variable<M> {
             get,
             set: Some(set),
         };
-        Self::new(name, description, Causality::Parameter, &[], access)
+        Self::legacy(name, description, Causality::Parameter, &[], access)
     }
 
     /// A fixed Integer parameter (enumerations are declared as Integer with min/max).
@@ -238,7 +596,7 @@ impl<M> Variable<M> {
             get,
             set: Some(set),
         };
-        Self::new(name, description, Causality::Parameter, &[], access)
+        Self::legacy(name, description, Causality::Parameter, &[], access)
     }
 
     /// A fixed Boolean parameter.
@@ -252,7 +610,7 @@ impl<M> Variable<M> {
             get,
             set: Some(set),
         };
-        Self::new(name, description, Causality::Parameter, &[], access)
+        Self::legacy(name, description, Causality::Parameter, &[], access)
     }
 
     /// A fixed String parameter (e.g. a file path).
@@ -260,13 +618,13 @@ impl<M> Variable<M> {
         name: &str,
         description: &str,
         get: fn(&M) -> String,
-        set: fn(&mut M, &str),
+        set: fn(&mut M, String),
     ) -> Self {
         let access = Access::String {
             get,
             set: Some(set),
         };
-        Self::new(name, description, Causality::Parameter, &[], access)
+        Self::legacy(name, description, Causality::Parameter, &[], access)
     }
 
     /// A continuous Real input.
@@ -275,7 +633,7 @@ impl<M> Variable<M> {
             get,
             set: Some(set),
         };
-        Self::new(name, description, Causality::Input, &[], access)
+        Self::legacy(name, description, Causality::Input, &[], access)
     }
 
     /// A continuous Real output. `feedthrough` lists the inputs it depends on at the same
@@ -288,7 +646,7 @@ impl<M> Variable<M> {
         get: fn(&M) -> f64,
     ) -> Self {
         let access = Access::Real { get, set: None };
-        Self::new(name, description, Causality::Output, feedthrough, access)
+        Self::legacy(name, description, Causality::Output, feedthrough, access)
     }
 
     /// A discrete Integer output.
@@ -299,7 +657,7 @@ impl<M> Variable<M> {
         get: fn(&M) -> i32,
     ) -> Self {
         let access = Access::Integer { get, set: None };
-        Self::new(name, description, Causality::Output, feedthrough, access)
+        Self::legacy(name, description, Causality::Output, feedthrough, access)
     }
 
     /// A discrete Boolean output.
@@ -310,13 +668,13 @@ impl<M> Variable<M> {
         get: fn(&M) -> bool,
     ) -> Self {
         let access = Access::Boolean { get, set: None };
-        Self::new(name, description, Causality::Output, feedthrough, access)
+        Self::legacy(name, description, Causality::Output, feedthrough, access)
     }
 
     /// A Real parameter computed from others at initialisation (read-only).
     pub fn calculated_parameter(name: &str, description: &str, get: fn(&M) -> f64) -> Self {
         let access = Access::Real { get, set: None };
-        Self::new(
+        Self::legacy(
             name,
             description,
             Causality::CalculatedParameter,
@@ -328,7 +686,7 @@ impl<M> Variable<M> {
     /// A Real local variable (observable, not settable).
     pub fn local(name: &str, description: &str, get: fn(&M) -> f64) -> Self {
         let access = Access::Real { get, set: None };
-        Self::new(name, description, Causality::Local, &[], access)
+        Self::legacy(name, description, Causality::Local, &[], access)
     }
 
     /// Unit (must be one of [`crate::units::UNITS`]).
@@ -417,7 +775,7 @@ impl<M> VariableList<M> {
     push_fn!(parameter(get: fn(&M) -> f64, set: fn(&mut M, f64)));
     push_fn!(integer_parameter(get: fn(&M) -> i32, set: fn(&mut M, i32)));
     push_fn!(boolean_parameter(get: fn(&M) -> bool, set: fn(&mut M, bool)));
-    push_fn!(string_parameter(get: fn(&M) -> String, set: fn(&mut M, &str)));
+    push_fn!(string_parameter(get: fn(&M) -> String, set: fn(&mut M, String)));
     push_fn!(input(get: fn(&M) -> f64, set: fn(&mut M, f64)));
     push_fn!(output(feedthrough: &[&'static str], get: fn(&M) -> f64));
     push_fn!(integer_output(feedthrough: &[&'static str], get: fn(&M) -> i32));
@@ -428,4 +786,90 @@ impl<M> VariableList<M> {
     pub fn into_vec(self) -> Vec<Variable<M>> {
         self.vars
     }
+}
+
+/// Declare variables, one line each, appended to `vars` (a `Vec<Variable<Self>>` whose type is
+/// known, so the accessors type-check) in order:
+///
+/// ```ignore
+/// fn variables() -> Vec<Variable<Self>> {
+///     let mut v: Vec<Variable<Self>> = Vec::new();
+///     model_description::declare! { v;
+///         /// Running speed V
+///         parameter "vehicle.speed" [unit = "m/s", display_unit = "km/h", range = 0.0..=200.0] => params.speed_mps;
+///         /// Wheel/rail force law
+///         parameter "contact.model" => params.model;
+///         /// Sign of the command
+///         parameter "idf.command_sign" [range = -1.0..=1.0] => params.command_sign as Sign;
+///         /// Damper force
+///         output "damper.force" [unit = "N", depends_on = &["damper.elongation_velocity"]] => out.force_n;
+///         /// A value computed from two fields (read-only)
+///         output "damper.end_acceleration" [unit = "m/s2"] => |m| m.arm_m * m.out.yaw_acc_radps2;
+///     }
+///     v
+/// }
+/// ```
+///
+/// The doc comment is the description; the keyword is the causality (`parameter`,
+/// `calculated_parameter`, `input`, `output`, `local`); the bracket holds the attributes, each
+/// a method of [`Attributes`] (`unit`, `display_unit`, `range`, `min`, `max`, `depends_on`,
+/// `tunable`, `discrete`); after `=>` comes the bound field path (the field's type gives the
+/// FMI type, see [`FmiValue`]; `as Codec` picks another [`Codec`]) or a closure for a read-only
+/// value computed from several fields.
+#[macro_export]
+macro_rules! declare {
+    ($vars:ident; $($rest:tt)*) => {
+        $crate::declare!(@entry $vars; $($rest)*);
+    };
+    (@entry $vars:ident;) => {};
+    // A read-only value computed by a closure.
+    (@entry $vars:ident;
+        $(#[doc = $doc:literal])*
+        $kind:ident $name:literal $([ $($key:ident = $val:expr),* $(,)? ])?
+        => |$m:ident| $get:expr;
+        $($rest:tt)*
+    ) => {
+        {
+            #[allow(unused_variables, unused_mut)]
+            let mut var = $crate::variable::Variable::computed_into(
+                &mut $vars,
+                $crate::variable::kind::$kind,
+                $name,
+                &[$($doc),*],
+                |$m| $get,
+            );
+            $($(var.$key($val);)*)?
+        }
+        $crate::declare!(@entry $vars; $($rest)*);
+    };
+    // A bound field, optionally through a codec.
+    (@entry $vars:ident;
+        $(#[doc = $doc:literal])*
+        $kind:ident $name:literal $([ $($key:ident = $val:expr),* $(,)? ])?
+        => $($seg:ident $([$idx:expr])?).+ $(as $codec:ty)?;
+        $($rest:tt)*
+    ) => {
+        {
+            #[allow(unused_variables, unused_mut)]
+            let mut var = $crate::variable::Variable::bind_into::<_, $crate::declare!(@codec $($codec)?)>(
+                &mut $vars,
+                $crate::variable::kind::$kind,
+                $name,
+                &[$($doc),*],
+                stringify!($($seg $([$idx])?).+),
+                |m| &m $(.$seg $([$idx])?)+,
+                |m| <$crate::declare!(@codec $($codec)?) as $crate::variable::Codec<_>>::get(
+                    &m $(.$seg $([$idx])?)+
+                ),
+                |m, x| <$crate::declare!(@codec $($codec)?) as $crate::variable::Codec<_>>::set(
+                    &mut m $(.$seg $([$idx])?)+,
+                    x,
+                ),
+            );
+            $($(var.$key($val);)*)?
+        }
+        $crate::declare!(@entry $vars; $($rest)*);
+    };
+    (@codec) => { $crate::variable::Native };
+    (@codec $codec:ty) => { $codec };
 }

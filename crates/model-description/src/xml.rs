@@ -8,6 +8,7 @@
 use std::collections::{BTreeSet, HashMap};
 use std::fmt::Write as _;
 
+use crate::enumeration::EnumType;
 use crate::model::{FmuModel, InstanceContext, ModelInfo};
 use crate::units;
 use crate::variable::{Access, Causality, VarMeta, VarType, Variable};
@@ -56,6 +57,12 @@ pub enum DeclarationError {
     },
     #[error("model {model}: cannot create a default instance: {reason}")]
     Instantiate { model: String, reason: String },
+    #[error("model {model}: enumeration type '{name}': {reason}")]
+    BadEnumeration {
+        model: String,
+        name: String,
+        reason: String,
+    },
 }
 
 /// A start value read from the default instance.
@@ -106,7 +113,7 @@ pub fn is_structured_name(name: &str) -> bool {
         })
 }
 
-fn escape(s: &str) -> String {
+pub(crate) fn escape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {
@@ -122,7 +129,7 @@ fn escape(s: &str) -> String {
     out
 }
 
-fn fmt_real(x: f64) -> String {
+pub(crate) fn fmt_real(x: f64) -> String {
     // Debug formatting is the shortest representation that parses back to the same f64.
     format!("{x:?}")
 }
@@ -188,6 +195,37 @@ pub fn check_declaration<M: FmuModel>(
             }
         }
     }
+    for e in enumeration_types(vars) {
+        let bad = |reason: String| DeclarationError::BadEnumeration {
+            model: model.clone(),
+            name: e.name.to_string(),
+            reason,
+        };
+        if !is_structured_name(e.name) {
+            return Err(bad("not a valid type name".into()));
+        }
+        if vars.iter().any(|v| v.meta.name == e.name) {
+            return Err(bad("a variable has the same name".into()));
+        }
+        let same_name = enumeration_types(vars)
+            .iter()
+            .filter(|o| o.name == e.name)
+            .count();
+        if same_name > 1 {
+            return Err(bad("two different types have this name".into()));
+        }
+        if e.items.is_empty() {
+            return Err(bad("no items".into()));
+        }
+        for (i, item) in e.items.iter().enumerate() {
+            if e.items[..i]
+                .iter()
+                .any(|o| o.name == item.name || o.value == item.value)
+            {
+                return Err(bad(format!("item '{}' repeats a name or value", item.name)));
+            }
+        }
+    }
     let instance =
         M::instantiate(&InstanceContext::default()).map_err(|e| DeclarationError::Instantiate {
             model: model.clone(),
@@ -217,13 +255,35 @@ pub fn check_declaration<M: FmuModel>(
                     }
                     StartValue::Real(x)
                 }
-                Access::Integer { get, .. } => StartValue::Integer(get(&instance)),
+                Access::Integer { get, .. } => {
+                    let n = get(&instance);
+                    if v.meta.enumeration.is_some_and(|e| e.item(n).is_none()) {
+                        return Err(DeclarationError::BadStart {
+                            model: model.clone(),
+                            name: v.meta.name.clone(),
+                            reason: format!("start value {n} is not an item of its enumeration"),
+                        });
+                    }
+                    StartValue::Integer(n)
+                }
                 Access::Boolean { get, .. } => StartValue::Boolean(get(&instance)),
                 Access::String { get, .. } => StartValue::String(get(&instance)),
             };
             Ok(Some(start))
         })
         .collect()
+}
+
+/// The Enumeration types the variables use, each once, in order of first use (types are
+/// compared by value: two variables of one Rust enum share its type).
+pub fn enumeration_types<M>(vars: &[Variable<M>]) -> Vec<&'static EnumType> {
+    let mut types: Vec<&'static EnumType> = Vec::new();
+    for e in vars.iter().filter_map(|v| v.meta.enumeration) {
+        if !types.contains(&e) {
+            types.push(e);
+        }
+    }
+    types
 }
 
 /// Capability flags of the CoSimulation element. True only where the glue implements it.
@@ -340,6 +400,32 @@ fn render<M: FmuModel>(vars: &[Variable<M>], starts: &[Option<StartValue>]) -> S
         let _ = writeln!(x, "  </UnitDefinitions>");
     }
 
+    let types = enumeration_types(vars);
+    if !types.is_empty() {
+        let _ = writeln!(x, "  <TypeDefinitions>");
+        for e in &types {
+            let _ = writeln!(
+                x,
+                r#"    <SimpleType name="{}" description="{}">"#,
+                escape(e.name),
+                escape(e.description)
+            );
+            let _ = writeln!(x, "      <Enumeration>");
+            for item in e.items {
+                let _ = writeln!(
+                    x,
+                    r#"        <Item name="{}" value="{}" description="{}"/>"#,
+                    escape(item.name),
+                    item.value,
+                    escape(item.description)
+                );
+            }
+            let _ = writeln!(x, "      </Enumeration>");
+            let _ = writeln!(x, "    </SimpleType>");
+        }
+        let _ = writeln!(x, "  </TypeDefinitions>");
+    }
+
     let _ = writeln!(x, "  <LogCategories>");
     for (name, desc) in LOG_CATEGORIES {
         let _ = writeln!(
@@ -374,7 +460,10 @@ fn render<M: FmuModel>(vars: &[Variable<M>], starts: &[Option<StartValue>]) -> S
         if let Some(initial) = m.initial() {
             let _ = write!(x, r#" initial="{initial}""#);
         }
-        let _ = write!(x, ">\n      <{}", m.var_type.xml_name());
+        let _ = write!(x, ">\n      <{}", m.type_element());
+        if let Some(e) = m.enumeration {
+            let _ = write!(x, r#" declaredType="{}""#, escape(e.name));
+        }
         if let Some(Some(start)) = starts.get(i) {
             let s = match start {
                 StartValue::Real(r) => fmt_real(*r),
@@ -475,60 +564,6 @@ fn render<M: FmuModel>(vars: &[Variable<M>], starts: &[Option<StartValue>]) -> S
     let _ = writeln!(x, "  </ModelStructure>");
     let _ = writeln!(x, "</fmiModelDescription>");
     x
-}
-
-/// documentation/index.html: the model's own text plus a generated variable table.
-pub fn documentation_html<M: FmuModel>() -> Result<String, DeclarationError> {
-    let vars = M::variables();
-    let starts = check_declaration::<M>(&vars)?;
-    let vrs = value_references(&vars);
-    let info = M::INFO;
-    let mut h = String::new();
-    let _ = writeln!(
-        h,
-        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{0}</title>\
-         <style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}\
-         table{{border-collapse:collapse}}td,th{{border:1px solid #999;padding:2px 6px}}</style>\
-         </head><body>\n<h1>{0}</h1>\n<p>{1}</p>",
-        escape(info.name),
-        escape(info.description)
-    );
-    h.push_str(info.documentation_html);
-    let _ = writeln!(
-        h,
-        "\n<h2>Variables</h2>\n<table><tr><th>name</th><th>vr</th><th>type</th><th>causality</th>\
-         <th>variability</th><th>start</th><th>unit</th><th>min</th><th>max</th><th>description</th></tr>"
-    );
-    for (i, v) in vars.iter().enumerate() {
-        let m = &v.meta;
-        let start = match starts.get(i) {
-            Some(Some(StartValue::Real(r))) => fmt_real(*r),
-            Some(Some(StartValue::Integer(n))) => n.to_string(),
-            Some(Some(StartValue::Boolean(b))) => b.to_string(),
-            Some(Some(StartValue::String(s))) => escape(s),
-            _ => String::new(),
-        };
-        let _ = writeln!(
-            h,
-            "<tr><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-            escape(&m.name),
-            vrs[i],
-            m.var_type.xml_name(),
-            m.causality.xml_name(),
-            m.variability.xml_name(),
-            start,
-            m.unit.unwrap_or(""),
-            m.min.map(fmt_real).unwrap_or_default(),
-            m.max.map(fmt_real).unwrap_or_default(),
-            escape(&m.description)
-        );
-    }
-    let _ = writeln!(h, "</table>\n<h2>Co-simulation capabilities</h2>\n<ul>");
-    for (k, v) in CAPABILITIES {
-        let _ = writeln!(h, "<li><code>{k}</code> = {v}</li>");
-    }
-    let _ = writeln!(h, "</ul>\n</body></html>");
-    Ok(h)
 }
 
 #[cfg(test)]
