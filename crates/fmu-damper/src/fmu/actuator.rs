@@ -2,52 +2,23 @@
 //! vehicle.
 
 use model_description::{
-    DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo, StepError,
-    Variable, VariableList,
+    field_error, fmi_enum, DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError,
+    ModelInfo, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
 
-use super::{
-    model_error, not_initialised, param_error, step_error, steps_from_fmi, steps_to_fmi, AUTHOR,
-    MAX_STEPS_DESCRIPTION, MAX_STEPS_NAME, MAX_STEPS_RANGE,
-};
+use super::{not_initialised, step_error, AUTHOR};
 use crate::full_active::{
     Actuator, ActuatorInputs, ActuatorModel, ActuatorOutputs, ActuatorParams, RodMode,
     LEAKAGE_LITRE_READING_M3PS_PER_PA,
 };
 
-/// Physics field -> FMI variable, for error messages.
-const NAMES: &[(&str, &str)] = &[
-    ("alpha_m", "valve.saturation"),
-    ("beta_m", "valve.dead_zone"),
-    ("valve_natural_freq_radps", "valve.natural_frequency"),
-    ("valve_damping_ratio", "valve.damping_ratio"),
-    ("discharge_coeff", "valve.discharge_coefficient"),
-    ("orifice_width_m", "valve.area_gradient"),
-    ("orifice_laminar_pressure_pa", "valve.laminar_pressure"),
-    ("oil_density_kgpm3", "oil.density"),
-    ("bulk_modulus_pa", "oil.bulk_modulus"),
-    ("supply_pressure_pa", "supply.pressure"),
-    ("tank_pressure_pa", "tank.pressure"),
-    ("leakage_coeff_m3ps_per_pa", "cylinder.leakage_coefficient"),
-    ("area_a_m2", "cylinder.area_a"),
-    ("area_b_m2", "cylinder.area_b"),
-    ("volume_a0_m3", "cylinder.volume_a0"),
-    ("volume_b0_m3", "cylinder.volume_b0"),
-    ("half_stroke_m", "cylinder.half_stroke"),
-    ("coulomb_friction_n", "friction.coulomb"),
-    ("stribeck_friction_n", "friction.stribeck"),
-    ("viscous_friction_nspm", "friction.viscous"),
-    ("stribeck_velocity_mps", "friction.stribeck_velocity"),
-    ("stribeck_exponent", "friction.stribeck_exponent"),
-    (
-        "friction_reg_velocity_mps",
-        "friction.regularisation_velocity",
-    ),
-    ("spool_command_m", "spool.command"),
-    ("elongation_m", "damper.elongation"),
-    ("elongation_velocity_mps", "damper.elongation_velocity"),
-];
+fmi_enum! {
+    ActuatorModel as "ActuatorOrder", "Order of the actuator model" {
+        FullOrder = 0, "full_order", "(3.46)-(3.59): spool dynamics included";
+        ReducedOrder = 1, "reduced_order", "(3.60)-(3.66): the spool follows the command at once";
+    }
+}
 
 /// Full-active hydraulic actuator FMU (seed 3.4, Table 3-2), rod motion imposed by the vehicle.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -97,332 +68,93 @@ impl FmuModel for FullActiveActuator {
     };
 
     fn variables() -> Vec<Variable<Self>> {
-        let mut v = VariableList::<Self>::new();
-        v.integer_parameter(
-            "actuator.model",
-            "0 = full order (3.46)-(3.59), spool dynamics included; 1 = reduced order \
-             (3.60)-(3.66), spool follows the command at once",
-            |m| match m.params.model {
-                ActuatorModel::FullOrder => 0,
-                ActuatorModel::ReducedOrder => 1,
-            },
-            |m, x| {
-                m.params.model = if x == 1 {
-                    ActuatorModel::ReducedOrder
-                } else {
-                    ActuatorModel::FullOrder
-                }
-            },
-        )
-        .range(0.0, 1.0);
-        v.parameter(
-            "valve.saturation",
-            "alpha of (3.47): orifice opening saturation, Table 3-2",
-            |m| m.params.alpha_m,
-            |m, x| m.params.alpha_m = x,
-        )
-        .unit("m")
-        .display_unit("mm")
-        .min(0.0);
-        v.parameter(
-            "valve.dead_zone",
-            "beta of (3.47): spool dead zone (no flow for |v| < beta), Table 3-2",
-            |m| m.params.beta_m,
-            |m, x| m.params.beta_m = x,
-        )
-        .unit("m")
-        .display_unit("mm")
-        .min(0.0);
-        v.parameter(
-            "valve.natural_frequency",
-            "omega_0 of (3.46): spool loop eigenfrequency, Table 3-2",
-            |m| m.params.valve_natural_freq_radps,
-            |m, x| m.params.valve_natural_freq_radps = x,
-        )
-        .unit("rad/s")
-        .min(0.0);
-        v.parameter(
-            "valve.damping_ratio",
-            "xi of (3.46): spool loop damping ratio, Table 3-2",
-            |m| m.params.valve_damping_ratio,
-            |m, x| m.params.valve_damping_ratio = x,
-        )
-        .unit("1")
-        .min(0.0);
-        v.parameter(
-            "valve.discharge_coefficient",
-            "C_d of (3.52), Table 3-2",
-            |m| m.params.discharge_coeff,
-            |m, x| m.params.discharge_coeff = x,
-        )
-        .unit("1")
-        .range(0.0, 1.0);
-        v.parameter(
-            "valve.area_gradient",
-            "w of (3.52): orifice area gradient (width), Table 3-2",
-            |m| m.params.orifice_width_m,
-            |m, x| m.params.orifice_width_m = x,
-        )
-        .unit("m")
-        .display_unit("mm")
-        .min(0.0);
-        v.parameter(
-            "valve.laminar_pressure",
-            "Laminar core of the regularised orifice laws (3.50)-(3.51), (3.63)",
-            |m| m.params.orifice_laminar_pressure_pa,
-            |m, x| m.params.orifice_laminar_pressure_pa = x,
-        )
-        .unit("Pa")
-        .display_unit("bar")
-        .min(0.0);
-        v.boolean_parameter(
-            "valve.load_flow_half_factor",
-            "Reduced order: keep the 1/2 under the root of (3.63) (consistent with (3.50) and \
-             (3.64)); false = drop it as (3.70)-(3.71) do",
-            |m| m.params.load_flow_half_factor,
-            |m, x| m.params.load_flow_half_factor = x,
-        );
-        v.parameter(
-            "oil.density",
-            "rho of (3.52), Table 3-2",
-            |m| m.params.oil_density_kgpm3,
-            |m, x| m.params.oil_density_kgpm3 = x,
-        )
-        .unit("kg/m3")
-        .min(0.0);
-        v.parameter(
-            "oil.bulk_modulus",
-            "E of (3.53)-(3.55), Table 3-2",
-            |m| m.params.bulk_modulus_pa,
-            |m, x| m.params.bulk_modulus_pa = x,
-        )
-        .unit("Pa")
-        .display_unit("bar")
-        .min(0.0);
-        v.parameter(
-            "supply.pressure",
-            "P_S of (3.50)-(3.51), Table 3-2",
-            |m| m.params.supply_pressure_pa,
-            |m, x| m.params.supply_pressure_pa = x,
-        )
-        .unit("Pa")
-        .display_unit("bar")
-        .min(0.0);
-        v.parameter(
-            "tank.pressure",
-            "P_T of (3.50)-(3.51), Table 3-2 (must be below supply.pressure)",
-            |m| m.params.tank_pressure_pa,
-            |m, x| m.params.tank_pressure_pa = x,
-        )
-        .unit("Pa")
-        .display_unit("bar")
-        .min(0.0);
-        v.parameter(
-            "cylinder.leakage_coefficient",
-            "C_L of (3.53)-(3.54), (3.65): internal leakage per pascal. Table 3-2 prints \
-             \"7e-10 l/s\": read as litres, 7e-13 m3/(s Pa) (see documentation)",
-            |m| m.params.leakage_coeff_m3ps_per_pa,
-            |m, x| m.params.leakage_coeff_m3ps_per_pa = x,
-        )
-        .unit("m3/(s.Pa)")
-        .min(0.0);
-        v.parameter(
-            "cylinder.area_a",
-            "A_A of (3.53), (3.56): piston area on the chamber A side, Table 3-2",
-            |m| m.params.area_a_m2,
-            |m, x| m.params.area_a_m2 = x,
-        )
-        .unit("m2")
-        .display_unit("cm2")
-        .min(0.0);
-        v.parameter(
-            "cylinder.area_b",
-            "A_B of (3.54), (3.57): piston area on the chamber B side, Table 3-2",
-            |m| m.params.area_b_m2,
-            |m, x| m.params.area_b_m2 = x,
-        )
-        .unit("m2")
-        .display_unit("cm2")
-        .min(0.0);
-        v.parameter(
-            "cylinder.volume_a0",
-            "V_A^0 of (3.56): chamber A volume at x = 0, Table 3-2 (must exceed A_A h)",
-            |m| m.params.volume_a0_m3,
-            |m, x| m.params.volume_a0_m3 = x,
-        )
-        .unit("m3")
-        .display_unit("l")
-        .min(0.0);
-        v.parameter(
-            "cylinder.volume_b0",
-            "V_B^0 of (3.57): chamber B volume at x = 0, Table 3-2 (must exceed A_B h)",
-            |m| m.params.volume_b0_m3,
-            |m, x| m.params.volume_b0_m3 = x,
-        )
-        .unit("m3")
-        .display_unit("l")
-        .min(0.0);
-        v.parameter(
-            "cylinder.half_stroke",
-            "h of sat_h in (3.56)-(3.57), Table 3-2",
-            |m| m.params.half_stroke_m,
-            |m, x| m.params.half_stroke_m = x,
-        )
-        .unit("m")
-        .display_unit("mm")
-        .min(0.0);
-        v.parameter(
-            "friction.coulomb",
-            "F_c of (3.59), Table 3-2",
-            |m| m.params.coulomb_friction_n,
-            |m, x| m.params.coulomb_friction_n = x,
-        )
-        .unit("N")
-        .min(0.0);
-        v.parameter(
-            "friction.stribeck",
-            "F_s of (3.59): static (Stribeck) friction, Table 3-2",
-            |m| m.params.stribeck_friction_n,
-            |m, x| m.params.stribeck_friction_n = x,
-        )
-        .unit("N")
-        .min(0.0);
-        v.parameter(
-            "friction.viscous",
-            "c of (3.59): viscous friction, Table 3-2",
-            |m| m.params.viscous_friction_nspm,
-            |m, x| m.params.viscous_friction_nspm = x,
-        )
-        .unit("N.s/m")
-        .min(0.0);
-        v.parameter(
-            "friction.stribeck_velocity",
-            "chi of (3.59): Stribeck velocity, Table 3-2",
-            |m| m.params.stribeck_velocity_mps,
-            |m, x| m.params.stribeck_velocity_mps = x,
-        )
-        .unit("m/s")
-        .display_unit("mm/s")
-        .min(0.0);
-        v.parameter(
-            "friction.stribeck_exponent",
-            "delta of (3.59): Stribeck shape exponent, Table 3-2",
-            |m| m.params.stribeck_exponent,
-            |m, x| m.params.stribeck_exponent = x,
-        )
-        .unit("1")
-        .min(0.0);
-        v.parameter(
-            "friction.regularisation_velocity",
-            "Velocity scale of the regularised sign() of (3.59): tanh(x'/v_reg)",
-            |m| m.params.friction_reg_velocity_mps,
-            |m, x| m.params.friction_reg_velocity_mps = x,
-        )
-        .unit("m/s")
-        .display_unit("mm/s")
-        .min(0.0);
+        let mut v: Vec<Variable<Self>> = Vec::new();
+        model_description::declare! { v;
+            /// Full order (3.46)-(3.59), spool dynamics included, or reduced order (3.60)-(3.66),
+            /// spool follows the command at once
+            parameter "actuator.model" => params.model;
+            /// alpha of (3.47): orifice opening saturation, Table 3-2
+            parameter "valve.saturation" [unit = "m", display_unit = "mm", min = 0.0] => params.alpha_m;
+            /// beta of (3.47): spool dead zone (no flow for |v| < beta), Table 3-2
+            parameter "valve.dead_zone" [unit = "m", display_unit = "mm", min = 0.0] => params.beta_m;
+            /// omega_0 of (3.46): spool loop eigenfrequency, Table 3-2
+            parameter "valve.natural_frequency" [unit = "rad/s", min = 0.0] => params.valve_natural_freq_radps;
+            /// xi of (3.46): spool loop damping ratio, Table 3-2
+            parameter "valve.damping_ratio" [unit = "1", min = 0.0] => params.valve_damping_ratio;
+            /// C_d of (3.52), Table 3-2
+            parameter "valve.discharge_coefficient" [unit = "1", range = 0.0..=1.0] => params.discharge_coeff;
+            /// w of (3.52): orifice area gradient (width), Table 3-2
+            parameter "valve.area_gradient" [unit = "m", display_unit = "mm", min = 0.0] => params.orifice_width_m;
+            /// Laminar core of the regularised orifice laws (3.50)-(3.51), (3.63)
+            parameter "valve.laminar_pressure" [unit = "Pa", display_unit = "bar", min = 0.0] => params.orifice_laminar_pressure_pa;
+            /// Reduced order: keep the 1/2 under the root of (3.63) (consistent with (3.50) and
+            /// (3.64)); false = drop it as (3.70)-(3.71) do
+            parameter "valve.load_flow_half_factor" => params.load_flow_half_factor;
+            /// rho of (3.52), Table 3-2
+            parameter "oil.density" [unit = "kg/m3", min = 0.0] => params.oil_density_kgpm3;
+            /// E of (3.53)-(3.55), Table 3-2
+            parameter "oil.bulk_modulus" [unit = "Pa", display_unit = "bar", min = 0.0] => params.bulk_modulus_pa;
+            /// P_S of (3.50)-(3.51), Table 3-2
+            parameter "supply.pressure" [unit = "Pa", display_unit = "bar", min = 0.0] => params.supply_pressure_pa;
+            /// P_T of (3.50)-(3.51), Table 3-2 (must be below supply.pressure)
+            parameter "tank.pressure" [unit = "Pa", display_unit = "bar", min = 0.0] => params.tank_pressure_pa;
+            /// C_L of (3.53)-(3.54), (3.65): internal leakage per pascal. Table 3-2 prints
+            /// "7e-10 l/s": read as litres, 7e-13 m3/(s Pa) (see documentation)
+            parameter "cylinder.leakage_coefficient" [unit = "m3/(s.Pa)", min = 0.0] => params.leakage_coeff_m3ps_per_pa;
+            /// A_A of (3.53), (3.56): piston area on the chamber A side, Table 3-2
+            parameter "cylinder.area_a" [unit = "m2", display_unit = "cm2", min = 0.0] => params.area_a_m2;
+            /// A_B of (3.54), (3.57): piston area on the chamber B side, Table 3-2
+            parameter "cylinder.area_b" [unit = "m2", display_unit = "cm2", min = 0.0] => params.area_b_m2;
+            /// V_A^0 of (3.56): chamber A volume at x = 0, Table 3-2 (must exceed A_A h)
+            parameter "cylinder.volume_a0" [unit = "m3", display_unit = "l", min = 0.0] => params.volume_a0_m3;
+            /// V_B^0 of (3.57): chamber B volume at x = 0, Table 3-2 (must exceed A_B h)
+            parameter "cylinder.volume_b0" [unit = "m3", display_unit = "l", min = 0.0] => params.volume_b0_m3;
+            /// h of sat_h in (3.56)-(3.57), Table 3-2
+            parameter "cylinder.half_stroke" [unit = "m", display_unit = "mm", min = 0.0] => params.half_stroke_m;
+            /// F_c of (3.59), Table 3-2
+            parameter "friction.coulomb" [unit = "N", min = 0.0] => params.coulomb_friction_n;
+            /// F_s of (3.59): static (Stribeck) friction, Table 3-2
+            parameter "friction.stribeck" [unit = "N", min = 0.0] => params.stribeck_friction_n;
+            /// c of (3.59): viscous friction, Table 3-2
+            parameter "friction.viscous" [unit = "N.s/m", min = 0.0] => params.viscous_friction_nspm;
+            /// chi of (3.59): Stribeck velocity, Table 3-2
+            parameter "friction.stribeck_velocity" [unit = "m/s", display_unit = "mm/s", min = 0.0] => params.stribeck_velocity_mps;
+            /// delta of (3.59): Stribeck shape exponent, Table 3-2
+            parameter "friction.stribeck_exponent" [unit = "1", min = 0.0] => params.stribeck_exponent;
+            /// Velocity scale of the regularised sign() of (3.59): tanh(x'/v_reg)
+            parameter "friction.regularisation_velocity" [unit = "m/s", display_unit = "mm/s", min = 0.0] => params.friction_reg_velocity_mps;
 
-        v.input(
-            "spool.command",
-            "Spool position demand u of (3.46), m; positive feeds chamber A and pushes the rod \
-             out (decreases the tension); beyond alpha + beta the orifice saturates",
-            |m| m.inputs.spool_command_m,
-            |m, x| m.inputs.spool_command_m = x,
-        )
-        .unit("m")
-        .display_unit("mm");
-        v.input(
-            "damper.elongation",
-            "Rod position x imposed by the vehicle, positive = extension (chamber A grows)",
-            |m| m.inputs.elongation_m,
-            |m, x| m.inputs.elongation_m = x,
-        )
-        .unit("m")
-        .display_unit("mm");
-        v.input(
-            "damper.elongation_velocity",
-            "Rod velocity x' imposed by the vehicle, positive = extension",
-            |m| m.inputs.elongation_velocity_mps,
-            |m, x| m.inputs.elongation_velocity_mps = x,
-        )
-        .unit("m/s")
-        .display_unit("mm/s");
+            /// Spool position demand u of (3.46), m; positive feeds chamber A and pushes the rod
+            /// out (decreases the tension); beyond alpha + beta the orifice saturates
+            input "spool.command" [unit = "m", display_unit = "mm"] => inputs.spool_command_m;
+            /// Rod position x imposed by the vehicle, positive = extension (chamber A grows)
+            input "damper.elongation" [unit = "m", display_unit = "mm"] => inputs.elongation_m;
+            /// Rod velocity x' imposed by the vehicle, positive = extension
+            input "damper.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => inputs.elongation_velocity_mps;
 
-        v.output(
-            "damper.force",
-            "Actuator force, positive in tension: -(P_A A_A - P_B A_B - f(x')); the friction \
-             f(x') (3.59) is algebraic in the imposed velocity",
-            &["damper.elongation_velocity"],
-            |m| m.out.force_n,
-        )
-        .unit("N")
-        .display_unit("kN");
-        v.output(
-            "damper.load_pressure",
-            "Load pressure P_L = P_A - P_B (3.61)",
-            &[],
-            |m| m.out.load_pressure_pa,
-        )
-        .unit("Pa")
-        .display_unit("bar");
-        v.output(
-            "chamber_a.pressure",
-            "P_A (3.53); reduced order: (P_S + P_T + P_L)/2 (3.64)",
-            &[],
-            |m| m.out.pressure_a_pa,
-        )
-        .unit("Pa")
-        .display_unit("bar");
-        v.output(
-            "chamber_b.pressure",
-            "P_B (3.54); reduced order: (P_S + P_T - P_L)/2 (3.64)",
-            &[],
-            |m| m.out.pressure_b_pa,
-        )
-        .unit("Pa")
-        .display_unit("bar");
-        v.output(
-            "spool.position",
-            "Spool position v (3.48); reduced order: v = u (3.60)",
-            &["spool.command"],
-            |m| m.out.spool_position_m,
-        )
-        .unit("m")
-        .display_unit("mm");
-        v.output(
-            "damper.hydraulic_power",
-            "Hydraulic power drawn from the supply, P_S Q_S - P_T Q_T",
-            &["spool.command"],
-            |m| m.out.hydraulic_power_w,
-        )
-        .unit("W")
-        .display_unit("kW");
-        v.output(
-            "damper.friction_force",
-            "Friction f(x') of (3.59) at the imposed velocity",
-            &["damper.elongation_velocity"],
-            |m| m.out.friction_force_n,
-        )
-        .unit("N");
-        v.output(
-            "damper.power",
-            "Mechanical power taken from the vehicle, damper.force x damper.elongation_velocity \
-             (negative when the actuator drives the vehicle)",
-            &["damper.elongation_velocity"],
-            // 0 - x, not -x: no -0.0 when the power is zero.
-            |m| 0.0 - m.out.mechanical_power_w,
-        )
-        .unit("W")
-        .display_unit("kW");
-        // Declared last so the other value references stay put.
-        v.integer_parameter(
-            MAX_STEPS_NAME,
-            MAX_STEPS_DESCRIPTION,
-            |m| steps_to_fmi(m.params.solver.max_internal_steps),
-            |m, x| m.params.solver.max_internal_steps = steps_from_fmi(x),
-        )
-        .range(MAX_STEPS_RANGE.0, MAX_STEPS_RANGE.1);
-        v.into_vec()
+            /// Actuator force, positive in tension: -(P_A A_A - P_B A_B - f(x')); the friction
+            /// f(x') (3.59) is algebraic in the imposed velocity
+            output "damper.force" [unit = "N", display_unit = "kN", depends_on = &["damper.elongation_velocity"]] => out.force_n;
+            /// Load pressure P_L = P_A - P_B (3.61)
+            output "damper.load_pressure" [unit = "Pa", display_unit = "bar"] => out.load_pressure_pa;
+            /// P_A (3.53); reduced order: (P_S + P_T + P_L)/2 (3.64)
+            output "chamber_a.pressure" [unit = "Pa", display_unit = "bar"] => out.pressure_a_pa;
+            /// P_B (3.54); reduced order: (P_S + P_T - P_L)/2 (3.64)
+            output "chamber_b.pressure" [unit = "Pa", display_unit = "bar"] => out.pressure_b_pa;
+            /// Spool position v (3.48); reduced order: v = u (3.60)
+            output "spool.position" [unit = "m", display_unit = "mm", depends_on = &["spool.command"]] => out.spool_position_m;
+            /// Hydraulic power drawn from the supply, P_S Q_S - P_T Q_T
+            output "damper.hydraulic_power" [unit = "W", display_unit = "kW", depends_on = &["spool.command"]] => out.hydraulic_power_w;
+            /// Friction f(x') of (3.59) at the imposed velocity
+            output "damper.friction_force" [unit = "N", depends_on = &["damper.elongation_velocity"]] => out.friction_force_n;
+            /// Mechanical power taken from the vehicle, damper.force x damper.elongation_velocity
+            /// (negative when the actuator drives the vehicle)
+            output "damper.power" [unit = "W", display_unit = "kW", depends_on = &["damper.elongation_velocity"]]
+                // 0 - x, not -x: no -0.0 when the power is zero.
+                => |m| 0.0 - m.out.mechanical_power_w;
+        }
+        super::declare_max_steps!(v, params);
+        v
     }
 
     fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
@@ -435,10 +167,10 @@ impl FmuModel for FullActiveActuator {
     }
 
     fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-        let mut a = Actuator::new(self.params).map_err(|e| param_error(&e, NAMES))?;
+        let mut a = Actuator::new(self.params).map_err(|e| field_error::<Self>(&e))?;
         a.set_inputs(&self.inputs)
-            .map_err(|e| model_error(&e, NAMES))?;
-        self.out = a.outputs().map_err(|e| model_error(&e, NAMES))?;
+            .map_err(|e| field_error::<Self>(&e))?;
+        self.out = a.outputs().map_err(|e| field_error::<Self>(&e))?;
         self.actuator = Some(a);
         Ok(())
     }
@@ -446,8 +178,8 @@ impl FmuModel for FullActiveActuator {
     fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
         if let Some(a) = &mut self.actuator {
             a.set_inputs(&self.inputs)
-                .map_err(|e| model_error(&e, NAMES))?;
-            self.out = a.outputs().map_err(|e| model_error(&e, NAMES))?;
+                .map_err(|e| field_error::<Self>(&e))?;
+            self.out = a.outputs().map_err(|e| field_error::<Self>(&e))?;
         }
         Ok(())
     }
@@ -460,7 +192,7 @@ impl FmuModel for FullActiveActuator {
         let mut next = a.clone();
         let out = next
             .step(step, &self.inputs)
-            .map_err(|e| step_error(&e, NAMES))?;
+            .map_err(|e| step_error::<Self>(&e))?;
         *a = next;
         self.out = out;
         Ok(())
@@ -479,7 +211,7 @@ the rod at rest and commands u = 1 mm: the spool settles within about 5 ms, cham
 through the orifice and chamber B empties within about 0.15 s, and the actuator then pushes
 with about -25 kN (P_A near P_S, P_B near P_T: damper.force = -P_S A).</p>
 
-<h2>Full-order model (<code>actuator.model</code> = 0), (3.46)-(3.59)</h2>
+<h2>Full-order model (<code>actuator.model</code> = full_order), (3.46)-(3.59)</h2>
 <pre>
 v'' + 2 xi omega_0 v' + omega_0^2 v = omega_0^2 u                       (3.46), (3.48)
 z = h(v):  alpha sign(v)      if |v| &gt;= alpha + beta
@@ -494,7 +226,7 @@ V_A = V_A^0 + A_A sat_h(x),  V_B = V_B^0 - A_B sat_h(x)                 (3.56), 
 f(x') = sign(x') (F_c + (F_s - F_c) exp(-(|x'|/chi)^delta)) + c x'      (3.59)
 damper.force = -(P_A A_A - P_B A_B - f(x'))                             from (3.58)
 </pre>
-<h2>Reduced-order model (<code>actuator.model</code> = 1), (3.60)-(3.66)</h2>
+<h2>Reduced-order model (<code>actuator.model</code> = reduced_order), (3.60)-(3.66)</h2>
 <pre>
 v = u, z = h(u)                                                         (3.60)
 P_L = P_A - P_B                                                         (3.61)

@@ -43,136 +43,74 @@ mod semi;
 pub use actuator::FullActiveActuator;
 pub use semi::{PassiveYawDamper, SemiActiveDamper};
 
-use model_description::{ModelError, StepError};
+use model_description::{field_error, FieldError, FmuModel, ModelError, StepError};
 
 use crate::error::{ParamError, StepError as PhysicsStepError};
 
 /// Author string written to every modelDescription.xml of this crate.
 const AUTHOR: &str = "rail-fmu project (fmu-damper)";
 
-/// Name of the physics field carried by a parameter error.
-fn param_field(e: &ParamError) -> &'static str {
-    match e {
-        ParamError::NotFinite { name, .. }
-        | ParamError::NotPositive { name, .. }
-        | ParamError::Negative { name, .. }
-        | ParamError::OutOfRange { name, .. } => name,
+/// The physics names the parameter it rejects; the glue reports it under the FMI variable bound
+/// to that field.
+impl FieldError for ParamError {
+    fn field(&self) -> Option<&str> {
+        match self {
+            ParamError::NotFinite { name, .. }
+            | ParamError::NotPositive { name, .. }
+            | ParamError::Negative { name, .. }
+            | ParamError::OutOfRange { name, .. } => Some(name),
+        }
     }
 }
 
-/// Physics field name -> FMI variable name (unknown fields keep their physics name).
-fn fmi_name(field: &'static str, map: &[(&'static str, &'static str)]) -> &'static str {
-    map.iter()
-        .find(|(f, _)| *f == field)
-        .map_or(field, |(_, fmi)| *fmi)
-}
-
-/// `text` with every physics field name (a whole identifier token) replaced by its FMI name,
-/// so messages such as "must exceed area_b_m2 * half_stroke_m" speak the FMU's language.
-fn rename_fields(text: &str, map: &[(&'static str, &'static str)]) -> String {
-    let is_ident = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '.';
-    let mut out = String::with_capacity(text.len() + 16);
-    let mut rest = text;
-    while let Some(start) = rest.find(is_ident) {
-        out.push_str(&rest[..start]);
-        let tail = &rest[start..];
-        let len = tail.find(|c: char| !is_ident(c)).unwrap_or(tail.len());
-        // A sentence's full stop is not part of the name.
-        let token = tail[..len].trim_end_matches('.');
-        let token = if token.is_empty() {
-            &tail[..len]
-        } else {
-            token
-        };
-        out.push_str(
-            map.iter()
-                .find(|(f, _)| *f == token)
-                .map_or(token, |(_, fmi)| *fmi),
-        );
-        rest = &tail[token.len()..];
+impl FieldError for PhysicsStepError {
+    fn field(&self) -> Option<&str> {
+        match self {
+            PhysicsStepError::BadInput { name, .. } => Some(name),
+            PhysicsStepError::Param(p) => p.field(),
+            _ => None,
+        }
     }
-    out.push_str(rest);
-    out
-}
 
-/// A physics parameter error, renamed to the FMI variable.
-fn param_error(e: &ParamError, map: &[(&'static str, &'static str)]) -> ModelError {
-    let name = fmi_name(param_field(e), map);
-    // The physics message names its fields; say which FMI variables those are.
-    ModelError::InvalidParameter {
-        name: name.to_string(),
-        reason: rename_fields(&e.to_string(), map),
+    fn reason(&self) -> String {
+        match self {
+            PhysicsStepError::BadInput { value, .. } => format!("not finite ({value})"),
+            other => other.to_string(),
+        }
     }
 }
 
-/// A physics error outside a step (initialisation, output evaluation).
-fn model_error(e: &PhysicsStepError, map: &[(&'static str, &'static str)]) -> ModelError {
-    match e {
-        PhysicsStepError::BadInput { name, value } => ModelError::InvalidInput {
-            name: fmi_name(name, map).to_string(),
-            reason: format!("not finite ({value})"),
-        },
-        PhysicsStepError::Param(p) => param_error(p, map),
-        other => ModelError::Other(other.to_string()),
-    }
-}
-
-/// A failed physics step: an integrator failure or a non-finite state may go away with a
-/// smaller communication step (fmi2Discard, state unchanged); anything else ends the run.
-fn step_error(e: &PhysicsStepError, map: &[(&'static str, &'static str)]) -> StepError {
+/// A failed physics step of model `M`: an integrator failure or a non-finite state may go away
+/// with a smaller communication step (fmi2Discard, state unchanged); anything else ends the run.
+fn step_error<M: FmuModel>(e: &PhysicsStepError) -> StepError {
     match e {
         PhysicsStepError::Integration { .. } | PhysicsStepError::NonFinite { .. } => {
             StepError::Discard(e.to_string())
         }
-        other => StepError::Error(model_error(other, map)),
+        other => StepError::Error(field_error::<M>(other)),
     }
 }
 
-/// Name, description and range of the integer parameter bounding the integrator's work.
-const MAX_STEPS_NAME: &str = "solver.max_internal_steps";
-const MAX_STEPS_DESCRIPTION: &str =
-    "Maximum number of internal integrator steps (accepted + rejected) per communication step: \
-     bounds the work of one fmi2DoStep (real-time/HIL hosts). Reaching it returns fmi2Discard \
-     with a logged message and the state unchanged (restore an FMU state and retry with a \
-     smaller communication step). Default 20000, far above need (1-50 per 1 ms step)";
-const MAX_STEPS_RANGE: (f64, f64) = (1.0, i32::MAX as f64);
-
-/// The physics' step limit as an FMI Integer (saturating).
-fn steps_to_fmi(n: u32) -> i32 {
-    i32::try_from(n).unwrap_or(i32::MAX)
+/// The integer parameter bounding the integrator's work, declared last in every damper FMU so
+/// the other value references stay put; `$($shell).+` is the path to the physics parameters.
+macro_rules! declare_max_steps {
+    ($v:ident, $($shell:ident).+) => {
+        model_description::declare! { $v;
+            /// Maximum number of internal integrator steps (accepted + rejected) per
+            /// communication step: bounds the work of one fmi2DoStep (real-time/HIL hosts).
+            /// Reaching it returns fmi2Discard with a logged message and the state unchanged
+            /// (restore an FMU state and retry with a smaller communication step). Default
+            /// 20000, far above need (1-50 per 1 ms step)
+            parameter "solver.max_internal_steps" [range = 1.0..=2147483647.0] => $($shell).+.solver.max_internal_steps;
+        }
+    };
 }
-
-/// An FMI Integer as the physics' step limit (the declared range keeps it >= 1; anything
-/// else becomes 0, which the physics' validation rejects by name).
-fn steps_from_fmi(x: i32) -> u32 {
-    u32::try_from(x).unwrap_or(0)
-}
+pub(crate) use declare_max_steps;
 
 fn not_initialised() -> StepError {
     StepError::Error(ModelError::Other(
         "the physics is built in fmi2ExitInitializationMode; no step before it".into(),
     ))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn field_names_are_renamed_as_whole_tokens() {
-        let map = [
-            ("area_b_m2", "cylinder.area_b"),
-            ("half_stroke_m", "cylinder.half_stroke"),
-        ];
-        assert_eq!(
-            rename_fields(
-                "`x` must be > area_b_m2 * half_stroke_m. area_b_m2x ...",
-                &map
-            ),
-            "`x` must be > cylinder.area_b * cylinder.half_stroke. area_b_m2x ..."
-        );
-        assert_eq!(rename_fields("", &map), "");
-    }
 }
 
 #[cfg(feature = "fmi-export")]

@@ -2,41 +2,23 @@
 //! damper ([`PassiveYawDamper`], the same physics at a fixed opening).
 
 use model_description::{
-    DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo, StepError,
-    Variable, VariableList,
+    field_error, fmi_enum, AlwaysSome, DefaultExperiment, Diagnostics, FmuModel, InstanceContext,
+    ModelError, ModelInfo, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
 
-use super::{
-    model_error, not_initialised, param_error, step_error, steps_from_fmi, steps_to_fmi, AUTHOR,
-    MAX_STEPS_DESCRIPTION, MAX_STEPS_NAME, MAX_STEPS_RANGE,
-};
+use super::{not_initialised, step_error, AUTHOR};
 use crate::semi_active::{
     SemiActiveDamper as Physics, SemiActiveInputs, SemiActiveOutputs, SemiActiveParams,
 };
 use crate::valve::ValveModel;
 
-/// Physics field -> FMI variable, for error messages.
-const NAMES: &[(&str, &str)] = &[
-    ("effective_area_m2", "damper.effective_area"),
-    ("chamber_volume_m3", "damper.chamber_volume"),
-    ("bulk_modulus_pa", "damper.bulk_modulus"),
-    ("piston_flow_coeff", "damper.piston_flow_coefficient"),
-    ("velocity_flow_ref_m3ps", "damper.velocity_flow_reference"),
-    ("velocity_ref_mps", "damper.velocity_reference"),
-    ("velocity_linear_mps", "damper.velocity_linear"),
-    ("valve_discharge_coeff", "valve.discharge_coefficient"),
-    ("valve_area_m2", "valve.area"),
-    ("oil_density_kgpm3", "damper.oil_density"),
-    ("laminar_pressure_pa", "damper.laminar_pressure"),
-    ("fixed_opening", "valve.opening"),
-    ("valve.time_constant_s", "valve.time_constant"),
-    ("valve.max_rate_per_s", "valve.rate_limit"),
-    ("valve.full_scale_command_v", "valve.full_scale_command"),
-    ("elongation_m", "damper.elongation"),
-    ("elongation_velocity_mps", "damper.elongation_velocity"),
-    ("valve_command_v", "valve.command"),
-];
+fmi_enum! {
+    ValveModel as "ValveDynamics", "Command-to-opening dynamics of the by-pass valve" {
+        Ideal = 0, "ideal", "The opening follows the command at once (the seed's simulations, R11)";
+        Real = 1, "real", "First-order lag plus rate limit (the seed's HIL valve, R12)";
+    }
+}
 
 /// What both semi-active shells hold: parameters, current inputs, the physics (built at
 /// initialisation) and its last outputs.
@@ -66,8 +48,12 @@ impl SemiShell {
         }
     }
 
-    fn exit_initialization(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError> {
-        let mut d = Physics::new(self.params).map_err(|e| param_error(&e, NAMES))?;
+    /// `M` is the model holding this shell: physics errors are named by its declaration.
+    fn exit_initialization<M: FmuModel>(
+        &mut self,
+        diag: &mut Diagnostics,
+    ) -> Result<(), ModelError> {
+        let mut d = Physics::new(self.params).map_err(|e| field_error::<M>(&e))?;
         if self.params.fixed_opening.is_none() && self.params.valve.model == ValveModel::Real {
             // A real valve starts at rest at the opening commanded at the start time, so a run
             // does not begin with an opening transient the vehicle never asked for.
@@ -75,29 +61,28 @@ impl SemiShell {
                 .params
                 .valve
                 .command(self.inputs.valve_command_v)
-                .map_err(|e| model_error(&e, NAMES))?;
-            d.set_opening(c.opening)
-                .map_err(|e| param_error(&e, NAMES))?;
+                .map_err(|e| field_error::<M>(&e))?;
+            d.set_opening(c.opening).map_err(|e| field_error::<M>(&e))?;
         }
         d.set_inputs(&self.inputs)
-            .map_err(|e| model_error(&e, NAMES))?;
-        self.out = d.outputs().map_err(|e| model_error(&e, NAMES))?;
+            .map_err(|e| field_error::<M>(&e))?;
+        self.out = d.outputs().map_err(|e| field_error::<M>(&e))?;
         self.damper = Some(d);
         self.report_clamp(diag);
         Ok(())
     }
 
     /// Outputs at the current instant with the current inputs (ideal valve opening, power).
-    fn update_outputs(&mut self) -> Result<(), ModelError> {
+    fn update_outputs<M: FmuModel>(&mut self) -> Result<(), ModelError> {
         if let Some(d) = &mut self.damper {
             d.set_inputs(&self.inputs)
-                .map_err(|e| model_error(&e, NAMES))?;
-            self.out = d.outputs().map_err(|e| model_error(&e, NAMES))?;
+                .map_err(|e| field_error::<M>(&e))?;
+            self.out = d.outputs().map_err(|e| field_error::<M>(&e))?;
         }
         Ok(())
     }
 
-    fn do_step(&mut self, h: f64, diag: &mut Diagnostics) -> Result<(), StepError> {
+    fn do_step<M: FmuModel>(&mut self, h: f64, diag: &mut Diagnostics) -> Result<(), StepError> {
         let Some(d) = &mut self.damper else {
             return Err(not_initialised());
         };
@@ -105,7 +90,7 @@ impl SemiShell {
         let mut next = d.clone();
         let out = next
             .step(h, &self.inputs)
-            .map_err(|e| step_error(&e, NAMES))?;
+            .map_err(|e| step_error::<M>(&e))?;
         *d = next;
         self.out = out;
         self.report_clamp(diag);
@@ -127,35 +112,15 @@ impl SemiShell {
     }
 }
 
-/// Access to the shared state, so both shells declare the damper parameters once.
-trait HasShell {
-    fn shell(&self) -> &SemiShell;
-    fn shell_mut(&mut self) -> &mut SemiShell;
-}
-
-/// `HasShell` for a model whose shell is its field `s`.
-macro_rules! impl_has_shell {
-    ($model:ty) => {
-        impl HasShell for $model {
-            fn shell(&self) -> &SemiShell {
-                &self.s
-            }
-            fn shell_mut(&mut self) -> &mut SemiShell {
-                &mut self.s
-            }
-        }
-    };
-}
-
-/// The FMI life cycle of both models: all of it is the shell's.
+/// The FMI life cycle of both models: all of it is the shell's (field `s`).
 macro_rules! delegate_to_shell {
     () => {
         fn exit_initialization(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError> {
-            self.s.exit_initialization(diag)
+            self.s.exit_initialization::<Self>(diag)
         }
 
         fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-            self.s.update_outputs()
+            self.s.update_outputs::<Self>()
         }
 
         fn do_step(
@@ -164,183 +129,63 @@ macro_rules! delegate_to_shell {
             step: f64,
             diag: &mut Diagnostics,
         ) -> Result<(), StepError> {
-            self.s.do_step(step, diag)
+            self.s.do_step::<Self>(step, diag)
         }
     };
 }
 
-/// Parameters of (3.38)-(3.45) common to both shells.
-fn declare_damper_parameters<M: HasShell>(v: &mut VariableList<M>) {
-    v.parameter(
-        "damper.effective_area",
-        "A_eff of (3.38): piston (annulus) area, Table 3-1",
-        |m| m.shell().params.effective_area_m2,
-        |m, x| m.shell_mut().params.effective_area_m2 = x,
-    )
-    .unit("m2")
-    .display_unit("cm2")
-    .min(0.0);
-    v.parameter(
-        "damper.chamber_volume",
-        "V0 of (3.41): chamber volume, Table 3-1 (must be > 0)",
-        |m| m.shell().params.chamber_volume_m3,
-        |m, x| m.shell_mut().params.chamber_volume_m3 = x,
-    )
-    .unit("m3")
-    .display_unit("l")
-    .min(0.0);
-    v.parameter(
-        "damper.bulk_modulus",
-        "K of (3.43): effective bulk modulus (oil + entrained air + hoses), calibrated to R1-R2",
-        |m| m.shell().params.bulk_modulus_pa,
-        |m, x| m.shell_mut().params.bulk_modulus_pa = x,
-    )
-    .unit("Pa")
-    .display_unit("bar")
-    .min(0.0);
-    // Unit m3/(s.Pa^0.5) is not in the glue's unit table: none declared (see the documentation).
-    v.parameter(
-        "damper.piston_flow_coefficient",
-        "C_f of (3.42), m3/(s Pa^0.5): flow through the piston's internal valves, calibrated (R1 at 0 %)",
-        |m| m.shell().params.piston_flow_coeff,
-        |m, x| m.shell_mut().params.piston_flow_coeff = x,
-    )
-    .min(0.0);
-    v.parameter(
-        "damper.velocity_flow_reference",
-        "f(v_ref): value of the cubic-root velocity function of (3.43) at v_ref, calibrated",
-        |m| m.shell().params.velocity_flow_ref_m3ps,
-        |m, x| m.shell_mut().params.velocity_flow_ref_m3ps = x,
-    )
-    .unit("m3/s")
-    .display_unit("l/min")
-    .min(0.0);
-    v.parameter(
-        "damper.velocity_reference",
-        "v_ref: reference velocity of the cubic-root velocity function (scale only)",
-        |m| m.shell().params.velocity_ref_mps,
-        |m, x| m.shell_mut().params.velocity_ref_mps = x,
-    )
-    .unit("m/s")
-    .min(0.0);
-    v.parameter(
-        "damper.velocity_linear",
-        "v_lin: linear core of the cubic-root velocity function (regularisation)",
-        |m| m.shell().params.velocity_linear_mps,
-        |m, x| m.shell_mut().params.velocity_linear_mps = x,
-    )
-    .unit("m/s")
-    .display_unit("mm/s")
-    .min(0.0);
-    v.parameter(
-        "valve.discharge_coefficient",
-        "c_d of (3.44): by-pass orifice discharge coefficient",
-        |m| m.shell().params.valve_discharge_coeff,
-        |m, x| m.shell_mut().params.valve_discharge_coeff = x,
-    )
-    .unit("1")
-    .range(0.0, 1.0);
-    v.parameter(
-        "valve.area",
-        "A_v of (3.44): by-pass passage area when fully open, calibrated (R1 at 100 %)",
-        |m| m.shell().params.valve_area_m2,
-        |m, x| m.shell_mut().params.valve_area_m2 = x,
-    )
-    .unit("m2")
-    .display_unit("cm2")
-    .min(0.0);
-    v.parameter(
-        "damper.oil_density",
-        "rho of (3.44): oil density, Table 3-2",
-        |m| m.shell().params.oil_density_kgpm3,
-        |m, x| m.shell_mut().params.oil_density_kgpm3 = x,
-    )
-    .unit("kg/m3")
-    .min(0.0);
-    v.parameter(
-        "damper.laminar_pressure",
-        "dP_t: laminar core of the regularised orifice laws (3.42), (3.44)",
-        |m| m.shell().params.laminar_pressure_pa,
-        |m, x| m.shell_mut().params.laminar_pressure_pa = x,
-    )
-    .unit("Pa")
-    .display_unit("bar")
-    .min(0.0);
+/// Parameters of (3.38)-(3.45) common to both shells (both hold the shell in field `s`).
+macro_rules! declare_damper_parameters {
+    ($v:ident) => {
+        model_description::declare! { $v;
+            /// A_eff of (3.38): piston (annulus) area, Table 3-1
+            parameter "damper.effective_area" [unit = "m2", display_unit = "cm2", min = 0.0] => s.params.effective_area_m2;
+            /// V0 of (3.41): chamber volume, Table 3-1 (must be > 0)
+            parameter "damper.chamber_volume" [unit = "m3", display_unit = "l", min = 0.0] => s.params.chamber_volume_m3;
+            /// K of (3.43): effective bulk modulus (oil + entrained air + hoses), calibrated to R1-R2
+            parameter "damper.bulk_modulus" [unit = "Pa", display_unit = "bar", min = 0.0] => s.params.bulk_modulus_pa;
+            /// C_f of (3.42), m3/(s Pa^0.5): flow through the piston's internal valves, calibrated (R1 at 0 %)
+            parameter "damper.piston_flow_coefficient" [min = 0.0] => s.params.piston_flow_coeff;
+            /// f(v_ref): value of the cubic-root velocity function of (3.43) at v_ref, calibrated
+            parameter "damper.velocity_flow_reference" [unit = "m3/s", display_unit = "l/min", min = 0.0] => s.params.velocity_flow_ref_m3ps;
+            /// v_ref: reference velocity of the cubic-root velocity function (scale only)
+            parameter "damper.velocity_reference" [unit = "m/s", min = 0.0] => s.params.velocity_ref_mps;
+            /// v_lin: linear core of the cubic-root velocity function (regularisation)
+            parameter "damper.velocity_linear" [unit = "m/s", display_unit = "mm/s", min = 0.0] => s.params.velocity_linear_mps;
+            /// c_d of (3.44): by-pass orifice discharge coefficient
+            parameter "valve.discharge_coefficient" [unit = "1", range = 0.0..=1.0] => s.params.valve_discharge_coeff;
+            /// A_v of (3.44): by-pass passage area when fully open, calibrated (R1 at 100 %)
+            parameter "valve.area" [unit = "m2", display_unit = "cm2", min = 0.0] => s.params.valve_area_m2;
+            /// rho of (3.44): oil density, Table 3-2
+            parameter "damper.oil_density" [unit = "kg/m3", min = 0.0] => s.params.oil_density_kgpm3;
+            /// dP_t: laminar core of the regularised orifice laws (3.42), (3.44)
+            parameter "damper.laminar_pressure" [unit = "Pa", display_unit = "bar", min = 0.0] => s.params.laminar_pressure_pa;
+        }
+    };
 }
 
-/// The integrator's work bound, declared last so the other value references stay put.
-fn declare_solver_parameter<M: HasShell>(v: &mut VariableList<M>) {
-    v.integer_parameter(
-        MAX_STEPS_NAME,
-        MAX_STEPS_DESCRIPTION,
-        |m| steps_to_fmi(m.shell().params.solver.max_internal_steps),
-        |m, x| m.shell_mut().params.solver.max_internal_steps = steps_from_fmi(x),
-    )
-    .range(MAX_STEPS_RANGE.0, MAX_STEPS_RANGE.1);
+/// The motion inputs and the force outputs of both shells.
+macro_rules! declare_motion_inputs {
+    ($v:ident) => {
+        model_description::declare! { $v;
+            /// Damper elongation, positive = extension (not used by the simplified model)
+            input "damper.elongation" [unit = "m", display_unit = "mm"] => s.inputs.elongation_m;
+            /// Damper elongation velocity, positive = extension
+            input "damper.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => s.inputs.elongation_velocity_mps;
+        }
+    };
 }
 
-fn declare_motion_inputs<M: HasShell>(v: &mut VariableList<M>) {
-    v.input(
-        "damper.elongation",
-        "Damper elongation, positive = extension (not used by the simplified model)",
-        |m| m.shell().inputs.elongation_m,
-        |m, x| m.shell_mut().inputs.elongation_m = x,
-    )
-    .unit("m")
-    .display_unit("mm");
-    v.input(
-        "damper.elongation_velocity",
-        "Damper elongation velocity, positive = extension",
-        |m| m.shell().inputs.elongation_velocity_mps,
-        |m, x| m.shell_mut().inputs.elongation_velocity_mps = x,
-    )
-    .unit("m/s")
-    .display_unit("mm/s");
-}
-
-fn declare_force_outputs<M: HasShell>(v: &mut VariableList<M>) {
-    v.output(
-        "damper.force",
-        "Damper force A_eff dP (3.38), positive in tension (opposing extension); from the \
-         pressure state, no direct feedthrough",
-        &[],
-        |m| m.shell().out.force_n,
-    )
-    .unit("N")
-    .display_unit("kN");
-    v.output(
-        "damper.pressure_difference",
-        "dP = P_A - P_B (rebound minus compression chamber), state of (3.45)",
-        &[],
-        |m| m.shell().out.pressure_difference_pa,
-    )
-    .unit("Pa")
-    .display_unit("bar");
-}
-
-/// The two powers, declared after the valve outputs; only the loss power's description and
-/// feedthrough (the valve command moves the opening at once, or not at all) differ per model.
-fn declare_power_outputs<M: HasShell>(
-    v: &mut VariableList<M>,
-    dissipated_description: &str,
-    dissipated_feedthrough: &[&'static str],
-) {
-    v.output(
-        "damper.dissipated_power",
-        dissipated_description,
-        dissipated_feedthrough,
-        |m| m.shell().out.dissipated_power_w,
-    )
-    .unit("W")
-    .display_unit("kW");
-    v.output(
-        "damper.power",
-        "Mechanical power taken from the vehicle, damper.force x damper.elongation_velocity",
-        &["damper.elongation_velocity"],
-        |m| m.shell().out.mechanical_power_w,
-    )
-    .unit("W")
-    .display_unit("kW");
+macro_rules! declare_force_outputs {
+    ($v:ident) => {
+        model_description::declare! { $v;
+            /// Damper force A_eff dP (3.38), positive in tension (opposing extension); from the
+            /// pressure state, no direct feedthrough
+            output "damper.force" [unit = "N", display_unit = "kN"] => s.out.force_n;
+            /// dP = P_A - P_B (rebound minus compression chamber), state of (3.45)
+            output "damper.pressure_difference" [unit = "Pa", display_unit = "bar"] => s.out.pressure_difference_pa;
+        }
+    };
 }
 
 /// Default inputs of the default experiment: a constant extension at 0.05 m/s.
@@ -357,8 +202,6 @@ fn demo_inputs() -> SemiActiveInputs {
 pub struct SemiActiveDamper {
     s: SemiShell,
 }
-
-impl_has_shell!(SemiActiveDamper);
 
 impl FmuModel for SemiActiveDamper {
     const INFO: ModelInfo = ModelInfo {
@@ -378,93 +221,42 @@ impl FmuModel for SemiActiveDamper {
     };
 
     fn variables() -> Vec<Variable<Self>> {
-        let mut v = VariableList::<Self>::new();
-        declare_damper_parameters(&mut v);
-        v.integer_parameter(
-            "valve.model",
-            "Command-to-opening dynamics: 0 = ideal (opening follows the command at once), \
-             1 = real (first-order lag + rate limit)",
-            |m| match m.s.params.valve.model {
-                ValveModel::Ideal => 0,
-                ValveModel::Real => 1,
-            },
-            |m, x| {
-                m.s.params.valve.model = if x == 1 {
-                    ValveModel::Real
-                } else {
-                    ValveModel::Ideal
-                }
-            },
-        )
-        .range(0.0, 1.0);
-        v.parameter(
-            "valve.time_constant",
-            "Lag time constant of the real valve (seed HIL valve: 0.1-0.2 s, R12)",
-            |m| m.s.params.valve.time_constant_s,
-            |m, x| m.s.params.valve.time_constant_s = x,
-        )
-        .unit("s")
-        .display_unit("ms")
-        .min(0.0);
-        v.parameter(
-            "valve.rate_limit",
-            "Maximum opening rate of the real valve (full travel needs at least 50 ms)",
-            |m| m.s.params.valve.max_rate_per_s,
-            |m, x| m.s.params.valve.max_rate_per_s = x,
-        )
-        .unit("1/s")
-        .min(0.0);
-        v.parameter(
-            "valve.full_scale_command",
-            "Command giving full opening (0 V = closed)",
-            |m| m.s.params.valve.full_scale_command_v,
-            |m, x| m.s.params.valve.full_scale_command_v = x,
-        )
-        .unit("V")
-        .min(0.0);
-
-        declare_motion_inputs(&mut v);
-        // No min/max: an out-of-range command is clamped and reported (see documentation).
-        v.input(
-            "valve.command",
-            "Valve command, 0 V = closed (maximum damping) .. 10 V = fully open; values \
-             outside are clamped, with a warning on entry into the clamped state",
-            |m| m.s.inputs.valve_command_v,
-            |m, x| m.s.inputs.valve_command_v = x,
-        )
-        .unit("V");
-
-        declare_force_outputs(&mut v);
-        v.output(
-            "valve.opening",
-            "Actual valve opening x_v (ideal valve: the clamped command at once; real valve: \
-             lagged state)",
-            &["valve.command"],
-            |m| m.s.out.valve_opening,
-        )
-        .unit("1")
-        .display_unit("%");
-        v.output(
-            "valve.opening_command",
-            "Commanded opening after clamping, command / full scale in [0, 1]",
-            &["valve.command"],
-            |m| m.s.out.valve_opening_command,
-        )
-        .unit("1")
-        .display_unit("%");
-        v.boolean_output(
-            "valve.command_clamped",
-            "True while valve.command is outside [0, full scale] and clamped",
-            &["valve.command"],
-            |m| m.s.out.command_clamped,
-        );
-        declare_power_outputs(
-            &mut v,
-            "Orifice loss power dP (Q_f + Q_v) >= 0",
-            &["valve.command"],
-        );
-        declare_solver_parameter(&mut v);
-        v.into_vec()
+        let mut v: Vec<Variable<Self>> = Vec::new();
+        declare_damper_parameters!(v);
+        model_description::declare! { v;
+            /// Command-to-opening dynamics: ideal (opening follows the command at once) or real
+            /// (first-order lag + rate limit)
+            parameter "valve.model" => s.params.valve.model;
+            /// Lag time constant of the real valve (seed HIL valve: 0.1-0.2 s, R12)
+            parameter "valve.time_constant" [unit = "s", display_unit = "ms", min = 0.0] => s.params.valve.time_constant_s;
+            /// Maximum opening rate of the real valve (full travel needs at least 50 ms)
+            parameter "valve.rate_limit" [unit = "1/s", min = 0.0] => s.params.valve.max_rate_per_s;
+            /// Command giving full opening (0 V = closed)
+            parameter "valve.full_scale_command" [unit = "V", min = 0.0] => s.params.valve.full_scale_command_v;
+        }
+        declare_motion_inputs!(v);
+        model_description::declare! { v;
+            // No min/max: an out-of-range command is clamped and reported (see documentation).
+            /// Valve command, 0 V = closed (maximum damping) .. 10 V = fully open; values
+            /// outside are clamped, with a warning on entry into the clamped state
+            input "valve.command" [unit = "V"] => s.inputs.valve_command_v;
+        }
+        declare_force_outputs!(v);
+        model_description::declare! { v;
+            /// Actual valve opening x_v (ideal valve: the clamped command at once; real valve:
+            /// lagged state)
+            output "valve.opening" [unit = "1", display_unit = "%", depends_on = &["valve.command"]] => s.out.valve_opening;
+            /// Commanded opening after clamping, command / full scale in [0, 1]
+            output "valve.opening_command" [unit = "1", display_unit = "%", depends_on = &["valve.command"]] => s.out.valve_opening_command;
+            /// True while valve.command is outside [0, full scale] and clamped
+            output "valve.command_clamped" [depends_on = &["valve.command"]] => s.out.command_clamped;
+            /// Orifice loss power dP (Q_f + Q_v) >= 0
+            output "damper.dissipated_power" [unit = "W", display_unit = "kW", depends_on = &["valve.command"]] => s.out.dissipated_power_w;
+            /// Mechanical power taken from the vehicle, damper.force x damper.elongation_velocity
+            output "damper.power" [unit = "W", display_unit = "kW", depends_on = &["damper.elongation_velocity"]] => s.out.mechanical_power_w;
+        }
+        super::declare_max_steps!(v, s.params);
+        v
     }
 
     fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
@@ -481,8 +273,6 @@ impl FmuModel for SemiActiveDamper {
 pub struct PassiveYawDamper {
     s: SemiShell,
 }
-
-impl_has_shell!(PassiveYawDamper);
 
 impl FmuModel for PassiveYawDamper {
     const INFO: ModelInfo = ModelInfo {
@@ -501,27 +291,22 @@ impl FmuModel for PassiveYawDamper {
     };
 
     fn variables() -> Vec<Variable<Self>> {
-        let mut v = VariableList::<Self>::new();
-        declare_damper_parameters(&mut v);
-        v.parameter(
-            "valve.opening",
-            "Fixed by-pass valve opening (seed 4.3 passive reference: 30 %)",
-            // Always Some: set by instantiate and by this setter.
-            |m| m.s.params.fixed_opening.unwrap_or(0.0),
-            |m, x| m.s.params.fixed_opening = Some(x),
-        )
-        .unit("1")
-        .display_unit("%")
-        .range(0.0, 1.0);
-        declare_motion_inputs(&mut v);
-        declare_force_outputs(&mut v);
-        declare_power_outputs(
-            &mut v,
-            "Orifice loss power dP (Q_f + Q_v) >= 0 (from the state: no feedthrough)",
-            &[],
-        );
-        declare_solver_parameter(&mut v);
-        v.into_vec()
+        let mut v: Vec<Variable<Self>> = Vec::new();
+        declare_damper_parameters!(v);
+        model_description::declare! { v;
+            /// Fixed by-pass valve opening (seed 4.3 passive reference: 30 %)
+            parameter "valve.opening" [unit = "1", display_unit = "%", range = 0.0..=1.0] => s.params.fixed_opening as AlwaysSome;
+        }
+        declare_motion_inputs!(v);
+        declare_force_outputs!(v);
+        model_description::declare! { v;
+            /// Orifice loss power dP (Q_f + Q_v) >= 0 (from the state: no feedthrough)
+            output "damper.dissipated_power" [unit = "W", display_unit = "kW"] => s.out.dissipated_power_w;
+            /// Mechanical power taken from the vehicle, damper.force x damper.elongation_velocity
+            output "damper.power" [unit = "W", display_unit = "kW", depends_on = &["damper.elongation_velocity"]] => s.out.mechanical_power_w;
+        }
+        super::declare_max_steps!(v, s.params);
+        v
     }
 
     fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
@@ -644,8 +429,8 @@ closed (0 V): the force rises towards its steady value of about 39 kN (21 kN at 
 <h2>Valve</h2>
 <pre>
 x_cmd = clamp(valve.command / full_scale, 0, 1)         0 V closed (maximum damping), 10 V open
-ideal (valve.model = 0):  x_v = x_cmd                    (the seed's simulations, R11)
-real  (valve.model = 1):  x_v' = clamp((x_cmd - x_v)/tau, -r_max, r_max)
+ideal (valve.model = ideal): x_v = x_cmd                   (the seed's simulations, R11)
+real  (valve.model = real):  x_v' = clamp((x_cmd - x_v)/tau, -r_max, r_max)
 </pre>
 <p>tau = <code>valve.time_constant</code> (default 0.15 s: the seed's HIL valve shows a 0.1-0.2 s
 command-to-opening lag, R12), r_max = <code>valve.rate_limit</code> (default 20 /s: the coil current
