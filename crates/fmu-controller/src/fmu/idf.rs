@@ -1,26 +1,13 @@
 //! `IdealDamperForceController` FMU: the IDF board of [`crate::idf`].
 
 use model_description::{
-    DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo, StepError,
-    Variable, VariableList,
+    field_error, DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo,
+    Sign, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
 
-use super::{param_error, report_input_fault, sign_to_int, AUTHOR};
+use super::{report_input_fault, AUTHOR};
 use crate::idf::{Idf, IdfInputs, IdfOutputs, IdfParams};
-
-const NAMES: &[(&str, &str)] = &[
-    ("sample_time_s", "sample_time"),
-    ("c_v_nspm", "c_v"),
-    ("k_p_m_per_n", "k_p"),
-    ("command_sign", "command_sign"),
-    ("u_max_m", "u_max"),
-];
-
-const INPUT_NAMES: &[(&str, &str)] = &[
-    ("elongation_velocity_mps", "damper.elongation_velocity"),
-    ("measured_force_n", "damper.force"),
-];
 
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 struct Reported {
@@ -41,7 +28,7 @@ pub struct IdealDamperForceController {
 
 impl IdealDamperForceController {
     fn build(&mut self) -> Result<(), ModelError> {
-        self.ctrl = Idf::new(self.params.clone()).map_err(|e| param_error(e, NAMES))?;
+        self.ctrl = Idf::new(self.params.clone()).map_err(|e| field_error::<Self>(&e))?;
         self.out = self.ctrl.outputs();
         Ok(())
     }
@@ -93,115 +80,45 @@ impl FmuModel for IdealDamperForceController {
     };
 
     fn variables() -> Vec<Variable<Self>> {
-        let mut v = VariableList::<Self>::new();
-        v.parameter(
-            "c_v",
-            "Viscous gain of the reference force (3.14) (section 4.5, Table 4-3)",
-            |m| m.params.c_v_nspm,
-            |m, x| m.params.c_v_nspm = x,
-        )
-        .unit("N.s/m")
-        .display_unit("kN.s/m")
-        .min(0.0);
-        // Unit m/N is not in the project's unit table: stated in the description instead.
-        v.parameter(
-            "k_p",
-            "Proportional gain of (3.15), in m of spool per N of force error",
-            |m| m.params.k_p_m_per_n,
-            |m, x| m.params.k_p_m_per_n = x,
-        )
-        .min(0.0);
-        v.parameter(
-            "u_max",
-            "Spool command saturation (Table 3-2: spool stroke alpha = 1 mm)",
-            |m| m.params.u_max_m,
-            |m, x| m.params.u_max_m = x,
-        )
-        .unit("m")
-        .display_unit("mm")
-        .min(0.0);
-        v.integer_parameter(
-            "command_sign",
-            "+1: u = k_p (F_ref - F); -1: u = k_p (F - F_ref) (seed's printed (3.15)). \
-             Must make a positive command increase the measured tension (see documentation)",
-            |m| sign_to_int(m.params.command_sign),
-            |m, x| m.params.command_sign = f64::from(x),
-        )
-        .range(-1.0, 1.0);
-        v.parameter(
-            "sample_time",
-            "Board sample time (1 kHz board)",
-            |m| m.params.sample_time_s,
-            |m, x| m.params.sample_time_s = x,
-        )
-        .unit("s")
-        .display_unit("ms")
-        .min(0.0);
+        let mut v: Vec<Variable<Self>> = Vec::new();
+        model_description::declare! { v;
+            /// Viscous gain of the reference force (3.14) (section 4.5, Table 4-3)
+            parameter "c_v" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => params.c_v_nspm;
+            // Unit m/N is not in the project's unit table: stated in the description instead.
+            /// Proportional gain of (3.15), in m of spool per N of force error
+            parameter "k_p" [min = 0.0] => params.k_p_m_per_n;
+            /// Spool command saturation (Table 3-2: spool stroke alpha = 1 mm)
+            parameter "u_max" [unit = "m", display_unit = "mm", min = 0.0] => params.u_max_m;
+            /// +1: u = k_p (F_ref - F); -1: u = k_p (F - F_ref) (seed's printed (3.15)).
+            /// Must make a positive command increase the measured tension (see documentation)
+            parameter "command_sign" [range = -1.0..=1.0] => params.command_sign as Sign;
+            /// Board sample time (1 kHz board)
+            parameter "sample_time" [unit = "s", display_unit = "ms", min = 0.0] => params.sample_time_s;
 
-        v.input(
-            "damper.elongation_velocity",
-            "Damper (actuator rod) elongation velocity, positive = extension",
-            |m| m.inputs.elongation_velocity_mps,
-            |m, x| m.inputs.elongation_velocity_mps = x,
-        )
-        .unit("m/s");
-        v.input(
-            "damper.force",
-            "Measured actuator force, tension positive",
-            |m| m.inputs.measured_force_n,
-            |m, x| m.inputs.measured_force_n = x,
-        )
-        .unit("N")
-        .display_unit("kN");
+            /// Damper (actuator rod) elongation velocity, positive = extension
+            input "damper.elongation_velocity" [unit = "m/s"] => inputs.elongation_velocity_mps;
+            /// Measured actuator force, tension positive
+            input "damper.force" [unit = "N", display_unit = "kN"] => inputs.measured_force_n;
 
-        v.output(
-            "spool.command",
-            "Spool position command u (3.15), saturated to +-u_max",
-            &[],
-            |m| m.out.spool_command_m,
-        )
-        .unit("m")
-        .display_unit("mm")
-        .discrete();
-        v.output(
-            "force_reference",
-            "Reference force F_ref = c_v v (3.14), tension positive",
-            &[],
-            |m| m.out.force_ref_n,
-        )
-        .unit("N")
-        .display_unit("kN")
-        .discrete();
-        v.output("force_error", "Force error F_ref - F", &[], |m| {
-            m.out.force_error_n
-        })
-        .unit("N")
-        .display_unit("kN")
-        .discrete();
-        v.boolean_output(
-            "saturated",
-            "True if the spool command is clamped at +-u_max",
-            &[],
-            |m| m.out.saturated,
-        );
-        v.boolean_output(
-            "input_fault",
-            "True if an input of the last step was not finite (sample dropped, command held)",
-            &[],
-            |m| m.out.input_fault,
-        );
-        v.integer_output(
-            "dropped_samples",
-            "Board samples dropped because of non-finite inputs since the start",
-            &[],
-            |m| i32::try_from(m.out.dropped_samples).unwrap_or(i32::MAX),
-        );
-        v.into_vec()
+            /// Spool position command u (3.15), saturated to +-u_max
+            output "spool.command" [unit = "m", display_unit = "mm", discrete = true] => out.spool_command_m;
+            /// Reference force F_ref = c_v v (3.14), tension positive
+            output "force_reference" [unit = "N", display_unit = "kN", discrete = true] => out.force_ref_n;
+            /// Force error F_ref - F
+            output "force_error" [unit = "N", display_unit = "kN", discrete = true] => out.force_error_n;
+            /// True if the spool command is clamped at +-u_max
+            output "saturated" => out.saturated;
+            /// True if an input of the last step was not finite (sample dropped, command held)
+            output "input_fault" => out.input_fault;
+            /// Board samples dropped because of non-finite inputs since the start
+            output "dropped_samples" => out.dropped_samples;
+        }
+        v
     }
 
     fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
         let params = IdfParams::default();
-        let ctrl = Idf::new(params.clone()).map_err(|e| param_error(e, NAMES))?;
+        let ctrl = Idf::new(params.clone()).map_err(|e| field_error::<Self>(&e))?;
         let out = ctrl.outputs();
         Ok(Self {
             params,
@@ -213,7 +130,7 @@ impl FmuModel for IdealDamperForceController {
         })
     }
 
-    board_life_cycle!(INPUT_NAMES);
+    board_life_cycle!();
 }
 
 const DOC: &str = r#"

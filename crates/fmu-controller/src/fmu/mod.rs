@@ -22,10 +22,9 @@
 /// controllers (inside `impl FmuModel`). The model provides the fields `ctrl` (with
 /// `step(h, &inputs)`), `inputs`, `out`, `initialized`, `reported` and the methods `build()`
 /// (controller and outputs from the parameters), `reported_after_init()` (what the log counts as
-/// already reported at the start) and `report(t_end, &out, diag)` (log changes);
-/// `$input_names` maps the physics' input fields to the FMI names for step errors.
+/// already reported at the start) and `report(t_end, &out, diag)` (log changes).
 macro_rules! board_life_cycle {
-    ($input_names:expr) => {
+    () => {
         fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
             self.build()?;
             self.reported = self.reported_after_init();
@@ -52,7 +51,7 @@ macro_rules! board_life_cycle {
             let out = self
                 .ctrl
                 .step(step, &self.inputs)
-                .map_err(|e| $crate::fmu::step_error(e, $input_names))?;
+                .map_err(|e| $crate::fmu::step_error::<Self>(&e))?;
             self.report(time + step, &out, diag);
             self.out = out;
             Ok(())
@@ -68,50 +67,47 @@ pub use idf::IdealDamperForceController;
 pub use mppt::MpptController;
 pub use skyhook::SkyHookController;
 
-use model_description::{Diagnostics, ModelError, StepError};
+use model_description::{field_error, Diagnostics, FieldError, FmuModel, StepError};
 
 use crate::{ParamError, StepError as PhysicsStepError};
 
 /// Author string written to every modelDescription.xml of this crate.
 const AUTHOR: &str = "rail-fmu project (fmu-controller)";
 
-/// A physics parameter error, renamed to the FMI variable through `map` (physics field name ->
-/// FMI name); unknown fields keep their physics name.
-fn param_error(e: ParamError, map: &[(&str, &str)]) -> ModelError {
-    let name = map
-        .iter()
-        .find(|(field, _)| *field == e.name)
-        .map_or(e.name, |(_, fmi)| *fmi);
-    ModelError::InvalidParameter {
-        name: name.to_string(),
-        reason: e.reason,
+/// The physics names the parameter it rejects (a field of its `*Params`); the glue reports it
+/// under the FMI variable bound to that field.
+impl FieldError for ParamError {
+    fn field(&self) -> Option<&str> {
+        Some(self.name)
+    }
+
+    fn reason(&self) -> String {
+        self.reason.clone()
     }
 }
 
-fn invalid(name: impl Into<String>, reason: impl Into<String>) -> ModelError {
-    ModelError::InvalidParameter {
-        name: name.into(),
-        reason: reason.into(),
-    }
-}
-
-/// A failed physics step. Inputs are finite (the glue checks them at set time) and the step is
-/// finite and positive (the glue checks it too), so the only realistic case is a non-finite
-/// output: the controller state is then garbage and the run cannot go on (fmi2Error).
-fn step_error(e: PhysicsStepError, inputs: &[(&str, &str)]) -> StepError {
-    match e {
-        PhysicsStepError::NonFiniteInput { name, value } => {
-            let fmi = inputs
-                .iter()
-                .find(|(field, _)| *field == name)
-                .map_or(name, |(_, fmi)| *fmi);
-            StepError::Error(ModelError::InvalidInput {
-                name: fmi.to_string(),
-                reason: format!("not finite ({value})"),
-            })
+impl FieldError for PhysicsStepError {
+    fn field(&self) -> Option<&str> {
+        match self {
+            PhysicsStepError::NonFiniteInput { name, .. } => Some(name),
+            _ => None,
         }
-        other => StepError::Error(ModelError::Other(other.to_string())),
     }
+
+    fn reason(&self) -> String {
+        match self {
+            PhysicsStepError::NonFiniteInput { value, .. } => format!("not finite ({value})"),
+            other => other.to_string(),
+        }
+    }
+}
+
+/// A failed physics step of model `M`. Inputs are finite (the glue checks them at set time) and
+/// the step is finite and positive (the glue checks it too), so the only realistic case is a
+/// non-finite output: the controller state is then garbage and the run cannot go on
+/// (fmi2Error).
+fn step_error<M: FmuModel>(e: &PhysicsStepError) -> StepError {
+    StepError::Error(field_error::<M>(e))
 }
 
 /// Log the start (warning) and the end (event) of the physics' hold path for non-finite
@@ -133,18 +129,6 @@ fn report_input_fault(
             diag.event(format!("t = {t_end:.6} s: inputs finite again"));
         }
         *reported = input_fault;
-    }
-}
-
-/// Integer parameter holding +1 / -1 (declared with range [-1, 1]; 0 is rejected at
-/// initialisation by the physics' validation).
-fn sign_to_int(x: f64) -> i32 {
-    if x > 0.0 {
-        1
-    } else if x < 0.0 {
-        -1
-    } else {
-        0
     }
 }
 

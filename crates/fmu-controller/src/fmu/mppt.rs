@@ -1,39 +1,20 @@
 //! `MpptController` FMU: the MPPT board of [`crate::mppt`].
 
 use model_description::{
-    DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo, StepError,
-    Variable, VariableList,
+    field_error, fmi_enum, DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError,
+    ModelInfo, Sign, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
 
-use super::{param_error, report_input_fault, sign_to_int, AUTHOR};
+use super::{report_input_fault, AUTHOR};
 use crate::mppt::{ForceNormaliser, Mppt, MpptInputs, MpptOutputs, MpptParams};
 
-/// Physics field -> FMI variable name (for error messages).
-const NAMES: &[(&str, &str)] = &[
-    ("sample_time_s", "sample_time"),
-    ("update_period_s", "period"),
-    ("rms_window_s", "rms_window"),
-    ("filter_order", "filter_order"),
-    ("band_low_hz", "band_low"),
-    ("band_high_hz", "band_high"),
-    ("k_acc", "k_acc"),
-    ("k_force", "k_F"),
-    ("k_j_v", "k_J"),
-    ("delta_v_v", "Delta_V"),
-    ("acc_threshold_mps2", "threshold"),
-    ("a_lim_mps2", "a_lim"),
-    ("force_norm_n", "F_norm"),
-    ("initial_command_v", "initial_command"),
-    ("initial_direction", "initial_direction"),
-    ("command_min_v", "command_min"),
-    ("command_max_v", "command_max"),
-];
-
-const INPUT_NAMES: &[(&str, &str)] = &[
-    ("bogie_accel_mps2", "bogie.lateral_acceleration"),
-    ("damper_force_n", "damper.force"),
-];
+fmi_enum! {
+    ForceNormaliser as "ForceNormaliser", "Force normaliser of the MPPT cost (3.2)" {
+        Fixed = 0, "fixed", "The fixed value F_norm (default: J depends on the current state only)";
+        RunningMax = 1, "running_max", "The running maximum of the rms force, from F_norm (the seed literally)";
+    }
+}
 
 /// What was last reported, so that the log shows changes only.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
@@ -58,7 +39,7 @@ pub struct MpptController {
 
 impl MpptController {
     fn build(&mut self) -> Result<(), ModelError> {
-        self.ctrl = Mppt::new(self.params.clone()).map_err(|e| param_error(e, NAMES))?;
+        self.ctrl = Mppt::new(self.params.clone()).map_err(|e| field_error::<Self>(&e))?;
         self.out = self.ctrl.outputs();
         Ok(())
     }
@@ -139,257 +120,80 @@ impl FmuModel for MpptController {
     };
 
     fn variables() -> Vec<Variable<Self>> {
-        let mut v = VariableList::<Self>::new();
-        v.parameter(
-            "k_acc",
-            "Weight k_x of the acceleration term of the cost (3.2); Table 4-2: 1",
-            |m| m.params.k_acc,
-            |m, x| m.params.k_acc = x,
-        )
-        .unit("1")
-        .min(0.0);
-        v.parameter(
-            "k_F",
-            "Weight k_F of the force term of the cost (3.2); Table 4-2: 0 = MPPT1, 4 = MPPT2",
-            |m| m.params.k_force,
-            |m, x| m.params.k_force = x,
-        )
-        .unit("1")
-        .min(0.0);
-        v.parameter(
-            "k_J",
-            "Cost gain k_J of the hill-climb step (3.3) (not in the seed)",
-            |m| m.params.k_j_v,
-            |m, x| m.params.k_j_v = x,
-        )
-        .unit("V")
-        .min(0.0);
-        v.parameter(
-            "period",
-            "Valve update period (seed: every second); integer multiple of sample_time",
-            |m| m.params.update_period_s,
-            |m, x| m.params.update_period_s = x,
-        )
-        .unit("s")
-        .min(0.0);
-        v.parameter(
-            "rms_window",
-            "Length of the moving rms windows of acceleration and force",
-            |m| m.params.rms_window_s,
-            |m, x| m.params.rms_window_s = x,
-        )
-        .unit("s")
-        .min(0.0);
-        v.parameter(
-            "Delta_V",
-            "Emergency closing step of the instability override (3.5) (not in the seed)",
-            |m| m.params.delta_v_v,
-            |m, x| m.params.delta_v_v = x,
-        )
-        .unit("V")
-        .min(0.0);
-        v.parameter(
-            "threshold",
-            "Instability threshold on the rms band-passed acceleration (3.5); default a_lim",
-            |m| m.params.acc_threshold_mps2,
-            |m, x| m.params.acc_threshold_mps2 = x,
-        )
-        .unit("m/s2")
-        .min(0.0);
-        v.parameter(
-            "a_lim",
-            "EN 14363 lateral acceleration limit normalising (3.2), (12 - m/5)/2 (seed 4.2)",
-            |m| m.params.a_lim_mps2,
-            |m, x| m.params.a_lim_mps2 = x,
-        )
-        .unit("m/s2")
-        .min(0.0);
-        v.parameter(
-            "F_norm",
-            "Force normaliser of (3.2) (fixed value, or start of the running maximum)",
-            |m| m.params.force_norm_n,
-            |m, x| m.params.force_norm_n = x,
-        )
-        .unit("N")
-        .display_unit("kN")
-        .min(0.0);
-        v.integer_parameter(
-            "force_normaliser",
-            "0 = fixed F_norm (default), 1 = running maximum of the rms force (seed literal)",
-            |m| match m.params.force_normaliser {
-                ForceNormaliser::Fixed => 0,
-                ForceNormaliser::RunningMax => 1,
-            },
-            |m, x| {
-                m.params.force_normaliser = if x == 1 {
-                    ForceNormaliser::RunningMax
-                } else {
-                    ForceNormaliser::Fixed
-                }
-            },
-        )
-        .range(0.0, 1.0);
-        v.parameter(
-            "initial_command",
-            "Valve command before the first update (0 V = closed, maximum damping)",
-            |m| m.params.initial_command_v,
-            |m, x| m.params.initial_command_v = x,
-        )
-        .unit("V")
-        .range(0.0, 10.0);
-        v.integer_parameter(
-            "initial_direction",
-            "Initial hill-climb direction: +1 opening, -1 closing",
-            |m| sign_to_int(m.params.initial_direction),
-            |m, x| m.params.initial_direction = f64::from(x),
-        )
-        .range(-1.0, 1.0);
-        v.parameter(
-            "command_min",
-            "Lower command saturation (seed 4.4.1: 0 V)",
-            |m| m.params.command_min_v,
-            |m, x| m.params.command_min_v = x,
-        )
-        .unit("V")
-        .range(0.0, 10.0);
-        v.parameter(
-            "command_max",
-            "Upper command saturation (seed 4.4.1: 10 V)",
-            |m| m.params.command_max_v,
-            |m, x| m.params.command_max_v = x,
-        )
-        .unit("V")
-        .range(0.0, 10.0);
-        v.parameter(
-            "sample_time",
-            "Board sample time (1 kHz board)",
-            |m| m.params.sample_time_s,
-            |m, x| m.params.sample_time_s = x,
-        )
-        .unit("s")
-        .display_unit("ms")
-        .min(0.0);
-        v.integer_parameter(
-            "filter_order",
-            "Order of the Butterworth band-pass on the acceleration: 2 or 4",
-            |m| i32::try_from(m.params.filter_order).unwrap_or(i32::MAX),
-            |m, x| m.params.filter_order = u32::try_from(x).unwrap_or(0),
-        )
-        .range(2.0, 4.0);
-        v.parameter(
-            "band_low",
-            "Band-pass lower -3 dB edge, f0 - 2 Hz (EN 14363 via seed 4.2)",
-            |m| m.params.band_low_hz,
-            |m, x| m.params.band_low_hz = x,
-        )
-        .unit("Hz")
-        .min(0.0);
-        v.parameter(
-            "band_high",
-            "Band-pass upper -3 dB edge, f0 + 2 Hz",
-            |m| m.params.band_high_hz,
-            |m, x| m.params.band_high_hz = x,
-        )
-        .unit("Hz")
-        .min(0.0);
+        let mut v: Vec<Variable<Self>> = Vec::new();
+        model_description::declare! { v;
+            /// Weight k_x of the acceleration term of the cost (3.2); Table 4-2: 1
+            parameter "k_acc" [unit = "1", min = 0.0] => params.k_acc;
+            /// Weight k_F of the force term of the cost (3.2); Table 4-2: 0 = MPPT1, 4 = MPPT2
+            parameter "k_F" [unit = "1", min = 0.0] => params.k_force;
+            /// Cost gain k_J of the hill-climb step (3.3) (not in the seed)
+            parameter "k_J" [unit = "V", min = 0.0] => params.k_j_v;
+            /// Valve update period (seed: every second); integer multiple of sample_time
+            parameter "period" [unit = "s", min = 0.0] => params.update_period_s;
+            /// Length of the moving rms windows of acceleration and force
+            parameter "rms_window" [unit = "s", min = 0.0] => params.rms_window_s;
+            /// Emergency closing step of the instability override (3.5) (not in the seed)
+            parameter "Delta_V" [unit = "V", min = 0.0] => params.delta_v_v;
+            /// Instability threshold on the rms band-passed acceleration (3.5); default a_lim
+            parameter "threshold" [unit = "m/s2", min = 0.0] => params.acc_threshold_mps2;
+            /// EN 14363 lateral acceleration limit normalising (3.2), (12 - m/5)/2 (seed 4.2)
+            parameter "a_lim" [unit = "m/s2", min = 0.0] => params.a_lim_mps2;
+            /// Force normaliser of (3.2) (fixed value, or start of the running maximum)
+            parameter "F_norm" [unit = "N", display_unit = "kN", min = 0.0] => params.force_norm_n;
+            /// Fixed F_norm (default) or the running maximum of the rms force (seed literal)
+            parameter "force_normaliser" => params.force_normaliser;
+            /// Valve command before the first update (0 V = closed, maximum damping)
+            parameter "initial_command" [unit = "V", range = 0.0..=10.0] => params.initial_command_v;
+            /// Initial hill-climb direction: +1 opening, -1 closing
+            parameter "initial_direction" [range = -1.0..=1.0] => params.initial_direction as Sign;
+            /// Lower command saturation (seed 4.4.1: 0 V)
+            parameter "command_min" [unit = "V", range = 0.0..=10.0] => params.command_min_v;
+            /// Upper command saturation (seed 4.4.1: 10 V)
+            parameter "command_max" [unit = "V", range = 0.0..=10.0] => params.command_max_v;
+            /// Board sample time (1 kHz board)
+            parameter "sample_time" [unit = "s", display_unit = "ms", min = 0.0] => params.sample_time_s;
+            /// Order of the Butterworth band-pass on the acceleration: 2 or 4
+            parameter "filter_order" [range = 2.0..=4.0] => params.filter_order;
+            /// Band-pass lower -3 dB edge, f0 - 2 Hz (EN 14363 via seed 4.2)
+            parameter "band_low" [unit = "Hz", min = 0.0] => params.band_low_hz;
+            /// Band-pass upper -3 dB edge, f0 + 2 Hz
+            parameter "band_high" [unit = "Hz", min = 0.0] => params.band_high_hz;
 
-        v.input(
-            "bogie.lateral_acceleration",
-            "Bogie frame lateral acceleration (band-passed on the board)",
-            |m| m.inputs.bogie_accel_mps2,
-            |m, x| m.inputs.bogie_accel_mps2 = x,
-        )
-        .unit("m/s2");
-        v.input(
-            "damper.force",
-            "Yaw damper force, tension positive (only its rms is used)",
-            |m| m.inputs.damper_force_n,
-            |m, x| m.inputs.damper_force_n = x,
-        )
-        .unit("N")
-        .display_unit("kN");
+            /// Bogie frame lateral acceleration (band-passed on the board)
+            input "bogie.lateral_acceleration" [unit = "m/s2"] => inputs.bogie_accel_mps2;
+            /// Yaw damper force, tension positive (only its rms is used)
+            input "damper.force" [unit = "N", display_unit = "kN"] => inputs.damper_force_n;
 
-        v.output(
-            "valve.command",
-            "By-pass valve command, 0 V = closed (maximum damping) .. 10 V = open",
-            &[],
-            |m| m.out.command_v,
-        )
-        .unit("V")
-        .discrete();
-        v.output(
-            "valve.opening",
-            "Valve opening = command / 10 V",
-            &[],
-            |m| m.out.opening,
-        )
-        .unit("1")
-        .display_unit("%")
-        .discrete();
-        v.output("cost", "Cost J at the last update (3.2)", &[], |m| {
-            m.out.cost
-        })
-        .unit("1")
-        .discrete();
-        v.output(
-            "rms_acceleration",
-            "rms of the band-passed bogie acceleration at the last update",
-            &[],
-            |m| m.out.rms_accel_mps2,
-        )
-        .unit("m/s2")
-        .discrete();
-        v.output(
-            "rms_force",
-            "rms of the damper force at the last update",
-            &[],
-            |m| m.out.rms_force_n,
-        )
-        .unit("N")
-        .display_unit("kN")
-        .discrete();
-        v.output(
-            "filtered_acceleration",
-            "Latest band-passed acceleration sample",
-            &[],
-            |m| m.out.filtered_accel_mps2,
-        )
-        .unit("m/s2")
-        .discrete();
-        v.integer_output(
-            "direction",
-            "Hill-climb direction (3.4): +1 opening, -1 closing",
-            &[],
-            |m| sign_to_int(m.out.direction),
-        );
-        v.boolean_output(
-            "override_active",
-            "True if the last update was the instability override (3.5)",
-            &[],
-            |m| m.out.override_active,
-        );
-        v.integer_output("updates", "Number of valve updates performed", &[], |m| {
-            i32::try_from(m.out.updates).unwrap_or(i32::MAX)
-        });
-        v.boolean_output(
-            "input_fault",
-            "True if an input of the last step was not finite (sample dropped, command held)",
-            &[],
-            |m| m.out.input_fault,
-        );
-        v.integer_output(
-            "dropped_samples",
-            "Board samples dropped because of non-finite inputs since the start",
-            &[],
-            |m| i32::try_from(m.out.dropped_samples).unwrap_or(i32::MAX),
-        );
-        v.into_vec()
+            /// By-pass valve command, 0 V = closed (maximum damping) .. 10 V = open
+            output "valve.command" [unit = "V", discrete = true] => out.command_v;
+            /// Valve opening = command / 10 V
+            output "valve.opening" [unit = "1", display_unit = "%", discrete = true] => out.opening;
+            /// Cost J at the last update (3.2)
+            output "cost" [unit = "1", discrete = true] => out.cost;
+            /// rms of the band-passed bogie acceleration at the last update
+            output "rms_acceleration" [unit = "m/s2", discrete = true] => out.rms_accel_mps2;
+            /// rms of the damper force at the last update
+            output "rms_force" [unit = "N", display_unit = "kN", discrete = true] => out.rms_force_n;
+            /// Latest band-passed acceleration sample
+            output "filtered_acceleration" [unit = "m/s2", discrete = true] => out.filtered_accel_mps2;
+            /// Hill-climb direction (3.4): +1 opening, -1 closing
+            output "direction" => out.direction as Sign;
+            /// True if the last update was the instability override (3.5)
+            output "override_active" => out.override_active;
+            /// Number of valve updates performed
+            output "updates" => out.updates;
+            /// True if an input of the last step was not finite (sample dropped, command held)
+            output "input_fault" => out.input_fault;
+            /// Board samples dropped because of non-finite inputs since the start
+            output "dropped_samples" => out.dropped_samples;
+        }
+        v
     }
 
     fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
         // Single source of the start values: the physics crate's MPPT2 defaults.
         let params = MpptParams::default();
-        let ctrl = Mppt::new(params.clone()).map_err(|e| param_error(e, NAMES))?;
+        let ctrl = Mppt::new(params.clone()).map_err(|e| field_error::<Self>(&e))?;
         let out = ctrl.outputs();
         Ok(Self {
             params,
@@ -401,7 +205,7 @@ impl FmuModel for MpptController {
         })
     }
 
-    board_life_cycle!(INPUT_NAMES);
+    board_life_cycle!();
 }
 
 const DOC: &str = r#"

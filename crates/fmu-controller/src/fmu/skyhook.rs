@@ -2,12 +2,12 @@
 //! damping-vs-opening table as fixed-size array parameters `table.opening[i]`, `table.damping[i]`.
 
 use model_description::{
-    DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo, StepError,
-    Variable, VariableList,
+    field_error, fmi_enum, DefaultExperiment, Diagnostics, FieldError, FmuModel, InstanceContext,
+    ModelError, ModelInfo, Sign, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
 
-use super::{invalid, param_error, report_input_fault, sign_to_int, AUTHOR};
+use super::{report_input_fault, AUTHOR};
 use crate::skyhook::{
     DampingTable, SkyHook, SkyHookInputs, SkyHookMode, SkyHookOutputs, SkyHookParams,
     VelocitySource, DAMPING_TABLE_4HZ,
@@ -16,22 +16,38 @@ use crate::skyhook::{
 /// Number of points of the damping table parameters (that of the measured default table).
 pub const TABLE_LEN: usize = DAMPING_TABLE_4HZ.len();
 
-const NAMES: &[(&str, &str)] = &[
-    ("sample_time_s", "sample_time"),
-    ("velocity_filter_corner_hz", "filter_corner"),
-    ("absolute_sign", "absolute_sign"),
-    ("c_sky_nspm", "c_sky"),
-    ("c_min_nspm", "c_min"),
-    ("c_max_nspm", "c_max"),
-    ("damping_table", "table"),
-    ("initial_command_v", "initial_command"),
-];
+fmi_enum! {
+    SkyHookMode as "SkyHookLaw", "Sky-hook law" {
+        OnOff = 0, "on_off", "On/off (3.13): c_max when the condition holds, c_min otherwise";
+        Continuous = 1, "continuous", "Continuous (3.11): c_sky x' / (x' - x0') within [c_min, c_max]";
+    }
+}
 
-const INPUT_NAMES: &[(&str, &str)] = &[
-    ("sensor_accel_mps2", "sensor.acceleration"),
-    ("abs_velocity_mps", "sensor.velocity"),
-    ("elongation_velocity_mps", "damper.elongation_velocity"),
-];
+fmi_enum! {
+    VelocitySource as "SkyHookVelocitySource", "Where the sky-hook velocity x' comes from" {
+        EstimatedFromAcceleration = 0, "estimated", "High-pass + leaky integrator of sensor.acceleration (seed 2.3.2)";
+        Ideal = 1, "ideal", "The input sensor.velocity";
+    }
+}
+
+/// A damping-table point out of order, naming the array element (`table_opening[i]`), which
+/// the glue reports as the FMI variable bound to it.
+struct TableError {
+    field: String,
+    reason: String,
+}
+
+impl std::fmt::Display for TableError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.reason)
+    }
+}
+
+impl FieldError for TableError {
+    fn field(&self) -> Option<&str> {
+        Some(&self.field)
+    }
+}
 
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 struct Reported {
@@ -53,85 +69,49 @@ pub struct SkyHookController {
     reported: Reported,
 }
 
-type Get = fn(&SkyHookController) -> f64;
-type Set = fn(&mut SkyHookController, f64);
-
-fn get_opening<const I: usize>(m: &SkyHookController) -> f64 {
-    m.table_opening[I]
-}
-fn set_opening<const I: usize>(m: &mut SkyHookController, x: f64) {
-    m.table_opening[I] = x;
-}
-fn get_damping<const I: usize>(m: &SkyHookController) -> f64 {
-    m.table_damping[I]
-}
-fn set_damping<const I: usize>(m: &mut SkyHookController, x: f64) {
-    m.table_damping[I] = x;
-}
-
-macro_rules! table_access {
-    ($($i:literal),*) => {
-        [$((
-            get_opening::<$i> as Get,
-            set_opening::<$i> as Set,
-            get_damping::<$i> as Get,
-            set_damping::<$i> as Set,
-        )),*]
-    };
-}
-
-/// Accessors of `table.opening[i+1]`, `table.damping[i+1]` (fails to compile if the default
-/// table changes length: add or remove entries here).
-const TABLE_ACCESS: [(Get, Set, Get, Set); TABLE_LEN] = table_access!(0, 1, 2, 3, 4, 5, 6, 7, 8);
-
 impl SkyHookController {
-    /// Table from the array parameters, checked point by point so the error names the variable.
-    fn table(&self) -> Result<DampingTable, ModelError> {
+    /// Table from the array parameters, checked point by point so the error names the element.
+    fn table(&self) -> Result<DampingTable, TableError> {
+        let bad = |array: &str, i: usize, reason: String| TableError {
+            field: format!("{array}[{i}]"),
+            reason,
+        };
         for i in 1..TABLE_LEN {
-            if self.table_opening[i] <= self.table_opening[i - 1] {
-                return Err(invalid(
-                    format!("table.opening[{}]", i + 1),
-                    format!(
-                        "openings must be strictly increasing: {} after {}",
-                        self.table_opening[i],
-                        self.table_opening[i - 1]
-                    ),
+            let (o, o_prev) = (self.table_opening[i], self.table_opening[i - 1]);
+            if o <= o_prev {
+                return Err(bad(
+                    "table_opening",
+                    i,
+                    format!("openings must be strictly increasing: {o} after {o_prev}"),
                 ));
             }
-            if self.table_damping[i] >= self.table_damping[i - 1] {
-                return Err(invalid(
-                    format!("table.damping[{}]", i + 1),
-                    format!(
-                        "damping must decrease strictly with the opening: {} after {}",
-                        self.table_damping[i],
-                        self.table_damping[i - 1]
-                    ),
+            let (c, c_prev) = (self.table_damping[i], self.table_damping[i - 1]);
+            if c >= c_prev {
+                return Err(bad(
+                    "table_damping",
+                    i,
+                    format!("damping must decrease strictly with the opening: {c} after {c_prev}"),
                 ));
             }
         }
-        for i in 0..TABLE_LEN {
-            if self.table_damping[i] <= 0.0 {
-                return Err(invalid(
-                    format!("table.damping[{}]", i + 1),
-                    format!("must be > 0, got {}", self.table_damping[i]),
-                ));
+        for (i, &c) in self.table_damping.iter().enumerate() {
+            if c <= 0.0 {
+                return Err(bad("table_damping", i, format!("must be > 0, got {c}")));
             }
         }
-        let table = DampingTable {
+        Ok(DampingTable {
             points: self
                 .table_opening
                 .iter()
                 .copied()
                 .zip(self.table_damping.iter().copied())
                 .collect(),
-        };
-        table.validate().map_err(|e| param_error(e, NAMES))?;
-        Ok(table)
+        })
     }
 
     fn build(&mut self) -> Result<(), ModelError> {
-        self.params.damping_table = self.table()?;
-        self.ctrl = SkyHook::new(self.params.clone()).map_err(|e| param_error(e, NAMES))?;
+        self.params.damping_table = self.table().map_err(|e| field_error::<Self>(&e))?;
+        self.ctrl = SkyHook::new(self.params.clone()).map_err(|e| field_error::<Self>(&e))?;
         self.out = self.ctrl.outputs();
         Ok(())
     }
@@ -185,208 +165,102 @@ impl FmuModel for SkyHookController {
     };
 
     fn variables() -> Vec<Variable<Self>> {
-        let mut v = VariableList::<Self>::new();
-        v.integer_parameter(
-            "mode",
-            "0 = on/off (3.13), 1 = continuous (3.11)",
-            |m| match m.params.mode {
-                SkyHookMode::OnOff => 0,
-                SkyHookMode::Continuous => 1,
-            },
-            |m, x| {
-                m.params.mode = if x == 1 {
-                    SkyHookMode::Continuous
-                } else {
-                    SkyHookMode::OnOff
-                }
-            },
-        )
-        .range(0.0, 1.0);
-        v.integer_parameter(
-            "velocity_source",
-            "Absolute velocity x': 0 = estimated from sensor.acceleration \
-             (high-pass + leaky integrator, seed 2.3.2), 1 = ideal input sensor.velocity",
-            |m| match m.params.velocity_source {
-                VelocitySource::EstimatedFromAcceleration => 0,
-                VelocitySource::Ideal => 1,
-            },
-            |m, x| {
-                m.params.velocity_source = if x == 1 {
-                    VelocitySource::Ideal
-                } else {
-                    VelocitySource::EstimatedFromAcceleration
-                }
-            },
-        )
-        .range(0.0, 1.0);
-        v.integer_parameter(
-            "absolute_sign",
-            "Sign applied to sensor.acceleration / sensor.velocity to give x' of (3.6): a mounting \
-             convention (the study uses -1 left, +1 right with the lateral frame acceleration)",
-            |m| sign_to_int(m.params.absolute_sign),
-            |m, x| m.params.absolute_sign = f64::from(x),
-        )
-        .range(-1.0, 1.0);
-        v.parameter(
-            "c_sky",
-            "Sky-hook damping c_sky (3.6), (3.11) (not in the seed: same as c_v of (3.14))",
-            |m| m.params.c_sky_nspm,
-            |m, x| m.params.c_sky_nspm = x,
-        )
-        .unit("N.s/m")
-        .display_unit("kN.s/m")
-        .min(0.0);
-        v.parameter(
-            "c_min",
-            "Off-state / lower damping bound c_min (3.11), (3.13); default: open end of the table",
-            |m| m.params.c_min_nspm,
-            |m, x| m.params.c_min_nspm = x,
-        )
-        .unit("N.s/m")
-        .display_unit("kN.s/m")
-        .min(0.0);
-        v.parameter(
-            "c_max",
-            "On-state / upper damping bound c_max (3.11), (3.13); default: closed end of the table",
-            |m| m.params.c_max_nspm,
-            |m, x| m.params.c_max_nspm = x,
-        )
-        .unit("N.s/m")
-        .display_unit("kN.s/m")
-        .min(0.0);
-        v.parameter(
-            "filter_corner",
-            "Corner of the high-pass and of the leaky integrator of the velocity estimate",
-            |m| m.params.velocity_filter_corner_hz,
-            |m, x| m.params.velocity_filter_corner_hz = x,
-        )
-        .unit("Hz")
-        .min(0.0);
-        v.parameter(
-            "sample_time",
-            "Board sample time (1 kHz board)",
-            |m| m.params.sample_time_s,
-            |m, x| m.params.sample_time_s = x,
-        )
-        .unit("s")
-        .display_unit("ms")
-        .min(0.0);
-        v.parameter(
-            "initial_command",
-            "Valve command before the first sample (0 V = closed)",
-            |m| m.params.initial_command_v,
-            |m, x| m.params.initial_command_v = x,
-        )
-        .unit("V")
-        .range(0.0, 10.0);
-        for (i, (go, so, _, _)) in TABLE_ACCESS.iter().enumerate() {
-            v.parameter(
-                &format!("table.opening[{}]", i + 1),
-                "Damper valve opening of table point (strictly increasing)",
-                *go,
-                *so,
-            )
-            .unit("1")
-            .range(0.0, 1.0);
-        }
-        for (i, (_, _, gd, sd)) in TABLE_ACCESS.iter().enumerate() {
-            v.parameter(
-                &format!("table.damping[{}]", i + 1),
-                "Equivalent damping of the damper at table.opening[i] (strictly decreasing; \
-                 default: measured on SemiActiveDamper at 4 Hz, 1 mm)",
-                *gd,
-                *sd,
-            )
-            .unit("N.s/m")
-            .display_unit("kN.s/m")
-            .min(0.0);
-        }
+        let mut v: Vec<Variable<Self>> = Vec::new();
+        model_description::declare! { v;
+            /// On/off (3.13) or continuous (3.11)
+            parameter "mode" => params.mode;
+            /// Absolute velocity x': estimated from sensor.acceleration (high-pass + leaky
+            /// integrator, seed 2.3.2) or the ideal input sensor.velocity
+            parameter "velocity_source" => params.velocity_source;
+            /// Sign applied to sensor.acceleration / sensor.velocity to give x' of (3.6): a mounting
+            /// convention (the study uses -1 left, +1 right with the lateral frame acceleration)
+            parameter "absolute_sign" [range = -1.0..=1.0] => params.absolute_sign as Sign;
+            /// Sky-hook damping c_sky (3.6), (3.11) (not in the seed: same as c_v of (3.14))
+            parameter "c_sky" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => params.c_sky_nspm;
+            /// Off-state / lower damping bound c_min (3.11), (3.13); default: open end of the table
+            parameter "c_min" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => params.c_min_nspm;
+            /// On-state / upper damping bound c_max (3.11), (3.13); default: closed end of the table
+            parameter "c_max" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => params.c_max_nspm;
+            /// Corner of the high-pass and of the leaky integrator of the velocity estimate
+            parameter "filter_corner" [unit = "Hz", min = 0.0] => params.velocity_filter_corner_hz;
+            /// Board sample time (1 kHz board)
+            parameter "sample_time" [unit = "s", display_unit = "ms", min = 0.0] => params.sample_time_s;
+            /// Valve command before the first sample (0 V = closed)
+            parameter "initial_command" [unit = "V", range = 0.0..=10.0] => params.initial_command_v;
+            /// Damper valve opening of table point (strictly increasing)
+            parameter "table.opening[1]" [unit = "1", range = 0.0..=1.0] => table_opening[0];
+            /// Damper valve opening of table point (strictly increasing)
+            parameter "table.opening[2]" [unit = "1", range = 0.0..=1.0] => table_opening[1];
+            /// Damper valve opening of table point (strictly increasing)
+            parameter "table.opening[3]" [unit = "1", range = 0.0..=1.0] => table_opening[2];
+            /// Damper valve opening of table point (strictly increasing)
+            parameter "table.opening[4]" [unit = "1", range = 0.0..=1.0] => table_opening[3];
+            /// Damper valve opening of table point (strictly increasing)
+            parameter "table.opening[5]" [unit = "1", range = 0.0..=1.0] => table_opening[4];
+            /// Damper valve opening of table point (strictly increasing)
+            parameter "table.opening[6]" [unit = "1", range = 0.0..=1.0] => table_opening[5];
+            /// Damper valve opening of table point (strictly increasing)
+            parameter "table.opening[7]" [unit = "1", range = 0.0..=1.0] => table_opening[6];
+            /// Damper valve opening of table point (strictly increasing)
+            parameter "table.opening[8]" [unit = "1", range = 0.0..=1.0] => table_opening[7];
+            /// Damper valve opening of table point (strictly increasing)
+            parameter "table.opening[9]" [unit = "1", range = 0.0..=1.0] => table_opening[8];
+            /// Equivalent damping of the damper at table.opening[i] (strictly decreasing;
+            /// default: measured on SemiActiveDamper at 4 Hz, 1 mm)
+            parameter "table.damping[1]" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => table_damping[0];
+            /// Equivalent damping of the damper at table.opening[i] (strictly decreasing;
+            /// default: measured on SemiActiveDamper at 4 Hz, 1 mm)
+            parameter "table.damping[2]" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => table_damping[1];
+            /// Equivalent damping of the damper at table.opening[i] (strictly decreasing;
+            /// default: measured on SemiActiveDamper at 4 Hz, 1 mm)
+            parameter "table.damping[3]" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => table_damping[2];
+            /// Equivalent damping of the damper at table.opening[i] (strictly decreasing;
+            /// default: measured on SemiActiveDamper at 4 Hz, 1 mm)
+            parameter "table.damping[4]" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => table_damping[3];
+            /// Equivalent damping of the damper at table.opening[i] (strictly decreasing;
+            /// default: measured on SemiActiveDamper at 4 Hz, 1 mm)
+            parameter "table.damping[5]" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => table_damping[4];
+            /// Equivalent damping of the damper at table.opening[i] (strictly decreasing;
+            /// default: measured on SemiActiveDamper at 4 Hz, 1 mm)
+            parameter "table.damping[6]" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => table_damping[5];
+            /// Equivalent damping of the damper at table.opening[i] (strictly decreasing;
+            /// default: measured on SemiActiveDamper at 4 Hz, 1 mm)
+            parameter "table.damping[7]" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => table_damping[6];
+            /// Equivalent damping of the damper at table.opening[i] (strictly decreasing;
+            /// default: measured on SemiActiveDamper at 4 Hz, 1 mm)
+            parameter "table.damping[8]" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => table_damping[7];
+            /// Equivalent damping of the damper at table.opening[i] (strictly decreasing;
+            /// default: measured on SemiActiveDamper at 4 Hz, 1 mm)
+            parameter "table.damping[9]" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => table_damping[8];
 
-        v.input(
-            "sensor.acceleration",
-            "Accelerometer whose integral (x absolute_sign) is the sky-hook velocity x' of (3.6): \
-             the bogie's lateral acceleration as in the seed's co-simulation (4.4), or the \
-             damper end's along its axis; used with velocity_source = 0",
-            |m| m.inputs.sensor_accel_mps2,
-            |m, x| m.inputs.sensor_accel_mps2 = x,
-        )
-        .unit("m/s2");
-        v.input(
-            "sensor.velocity",
-            "Velocity of the same sensor (ideal x'); used with velocity_source = 1",
-            |m| m.inputs.abs_velocity_mps,
-            |m, x| m.inputs.abs_velocity_mps = x,
-        )
-        .unit("m/s");
-        v.input(
-            "damper.elongation_velocity",
-            "Damper elongation velocity x' - x0', positive = extension",
-            |m| m.inputs.elongation_velocity_mps,
-            |m, x| m.inputs.elongation_velocity_mps = x,
-        )
-        .unit("m/s");
+            /// Accelerometer whose integral (x absolute_sign) is the sky-hook velocity x' of (3.6):
+            /// the bogie's lateral acceleration as in the seed's co-simulation (4.4), or the
+            /// damper end's along its axis; used with velocity_source = 0
+            input "sensor.acceleration" [unit = "m/s2"] => inputs.sensor_accel_mps2;
+            /// Velocity of the same sensor (ideal x'); used with velocity_source = 1
+            input "sensor.velocity" [unit = "m/s"] => inputs.abs_velocity_mps;
+            /// Damper elongation velocity x' - x0', positive = extension
+            input "damper.elongation_velocity" [unit = "m/s"] => inputs.elongation_velocity_mps;
 
-        v.output(
-            "valve.command",
-            "By-pass valve command, 0 V = closed (maximum damping) .. 10 V = open",
-            &[],
-            |m| m.out.command_v,
-        )
-        .unit("V")
-        .discrete();
-        v.output(
-            "valve.opening",
-            "Valve opening = command / 10 V (table inverse of damping_desired)",
-            &[],
-            |m| m.out.opening,
-        )
-        .unit("1")
-        .display_unit("%")
-        .discrete();
-        v.output(
-            "damping_desired",
-            "Desired damping from (3.11) or (3.13)",
-            &[],
-            |m| m.out.c_desired_nspm,
-        )
-        .unit("N.s/m")
-        .display_unit("kN.s/m")
-        .discrete();
-        // Unit m2/s2 is not in the project's unit table: stated in the description instead.
-        v.output(
-            "condition",
-            "Condition function x' (x' - x0') = x' v_e, in m2/s2 (3.11), (3.13)",
-            &[],
-            |m| m.out.condition,
-        )
-        .discrete();
-        v.output(
-            "absolute_velocity",
-            "Sky-hook velocity x' used by the law (estimated or ideal, times absolute_sign)",
-            &[],
-            |m| m.out.abs_velocity_mps,
-        )
-        .unit("m/s")
-        .discrete();
-        v.boolean_output(
-            "on_state",
-            "True when the condition function is >= 0 (damping demanded)",
-            &[],
-            |m| m.out.on_state,
-        );
-        v.boolean_output(
-            "input_fault",
-            "True if a used input of the last step was not finite (sample dropped, command held)",
-            &[],
-            |m| m.out.input_fault,
-        );
-        v.integer_output(
-            "dropped_samples",
-            "Board samples dropped because of non-finite inputs since the start",
-            &[],
-            |m| i32::try_from(m.out.dropped_samples).unwrap_or(i32::MAX),
-        );
-        v.into_vec()
+            /// By-pass valve command, 0 V = closed (maximum damping) .. 10 V = open
+            output "valve.command" [unit = "V", discrete = true] => out.command_v;
+            /// Valve opening = command / 10 V (table inverse of damping_desired)
+            output "valve.opening" [unit = "1", display_unit = "%", discrete = true] => out.opening;
+            /// Desired damping from (3.11) or (3.13)
+            output "damping_desired" [unit = "N.s/m", display_unit = "kN.s/m", discrete = true] => out.c_desired_nspm;
+            // Unit m2/s2 is not in the project's unit table: stated in the description instead.
+            /// Condition function x' (x' - x0') = x' v_e, in m2/s2 (3.11), (3.13)
+            output "condition" [discrete = true] => out.condition;
+            /// Sky-hook velocity x' used by the law (estimated or ideal, times absolute_sign)
+            output "absolute_velocity" [unit = "m/s", discrete = true] => out.abs_velocity_mps;
+            /// True when the condition function is >= 0 (damping demanded)
+            output "on_state" => out.on_state;
+            /// True if a used input of the last step was not finite (sample dropped, command held)
+            output "input_fault" => out.input_fault;
+            /// Board samples dropped because of non-finite inputs since the start
+            output "dropped_samples" => out.dropped_samples;
+        }
+        v
     }
 
     fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
@@ -399,7 +273,7 @@ impl FmuModel for SkyHookController {
                 table_damping[i] = c;
             }
         }
-        let ctrl = SkyHook::new(params.clone()).map_err(|e| param_error(e, NAMES))?;
+        let ctrl = SkyHook::new(params.clone()).map_err(|e| field_error::<Self>(&e))?;
         let out = ctrl.outputs();
         Ok(Self {
             params,
@@ -413,7 +287,7 @@ impl FmuModel for SkyHookController {
         })
     }
 
-    board_life_cycle!(INPUT_NAMES);
+    board_life_cycle!();
 }
 
 const DOC: &str = r#"
