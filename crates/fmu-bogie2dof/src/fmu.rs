@@ -5,8 +5,8 @@
 use std::path::PathBuf;
 
 use model_description::{
-    DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo, StepError,
-    Variable, VariableList,
+    field_error, fmi_enum, DefaultExperiment, Diagnostics, FieldError, FmuModel, InstanceContext,
+    ModelError, ModelInfo, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
 
@@ -18,69 +18,96 @@ pub const FMU_DEFAULT_SPEED_MPS: f64 = 300.0 / 3.6;
 /// Initial lateral displacement of the FMU's start values [m].
 pub const FMU_DEFAULT_INITIAL_LATERAL_M: f64 = 3e-3;
 
-/// Physics field -> FMI variable, for error messages.
-const NAMES: &[(&str, &str)] = &[
-    ("speed_mps", "vehicle.speed"),
-    ("bogie_mass_kg", "bogie.mass"),
-    ("bogie_yaw_inertia_kgm2", "bogie.yaw_inertia"),
-    ("wheelset_spin_inertia_kgm2", "wheelset.spin_inertia"),
-    ("half_wheelbase_m", "bogie.half_wheelbase"),
-    ("half_contact_gauge_m", "wheelset.half_contact_gauge"),
-    ("damper_arm_m", "damper.lateral_arm"),
-    ("wheel_radius_m", "wheelset.wheel_radius"),
-    ("k_ssy_n_per_m", "suspension.lateral_stiffness"),
-    ("k_ssx_n_per_m", "suspension.longitudinal_stiffness"),
-    ("conicity", "linear.conicity"),
-    (
-        "gravity_stiffness_n_per_m",
-        "linear.gravitational_stiffness",
-    ),
-    ("f11_n", "creep.f11"),
-    ("f22_n", "creep.f22"),
-    ("creep_reduction", "creep.reduction_factor"),
-    ("wheel_load_n", "wheelset.wheel_load"),
-    ("friction_coefficient", "contact.friction_coefficient"),
-    ("initial_lateral_m", "initial.lateral_displacement"),
-    ("initial_yaw_rad", "initial.yaw_angle"),
-    ("contact", "contact.table"),
-];
-
-fn fmi_name(field: &str) -> &'static str {
-    NAMES
-        .iter()
-        .find(|(f, _)| *f == field)
-        .map_or("parameter", |(_, n)| *n)
-}
-
-fn param_error(e: &ParamError) -> ModelError {
-    ModelError::InvalidParameter {
-        name: fmi_name(e.name).to_string(),
-        reason: e.reason.clone(),
+fmi_enum! {
+    ModelKind as "WheelRailForceLaw", "Wheel/rail force law of the time-domain model" {
+        Linear = 0, "linear", "(5.1)-(5.18): Kalker linear creep, constant conicity and gravitational stiffness";
+        NonLinear = 1, "nonlinear", "(5.19)-(5.27): contact table, Vermeulen-Johnson saturation, wheelset spin dofs";
     }
 }
 
-fn physics_error(e: &PhysicsModelError) -> ModelError {
-    match e {
-        PhysicsModelError::Param(p) => param_error(p),
-        PhysicsModelError::Contact(c) => ModelError::InvalidParameter {
-            name: "contact.table".into(),
-            reason: c.to_string(),
-        },
+/// Where the lateral track alignment comes from (the FMI choice behind the physics'
+/// [`TrackSource`], whose internal generator also carries level and seed).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum TrackChoice {
+    None,
+    External,
+    Internal,
+}
+
+fmi_enum! {
+    TrackChoice as "TrackSource", "Source of the lateral track alignment" {
+        None = 0, "none", "Ideal straight track";
+        External = 1, "external", "The input track.lateral_alignment at the front wheelset (the rear sees it 2p/V later)";
+        Internal = 2, "internal", "The built-in ERRI B176 generator (track.level, track.seed)";
     }
 }
 
-fn output_error(e: &PStep) -> ModelError {
-    match e {
-        PStep::NonFiniteInput { name, value } => ModelError::InvalidInput {
-            name: match *name {
-                "damper_left_force_n" => "damper_left.force",
-                "damper_right_force_n" => "damper_right.force",
-                _ => "track.lateral_alignment",
-            }
-            .into(),
-            reason: format!("not finite ({value})"),
-        },
-        other => ModelError::Other(other.to_string()),
+/// ERRI B176 spectrum level of the internal generator (the FMI choice behind the track
+/// generator's [`PsdLevel`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum TrackLevel {
+    Low,
+    High,
+}
+
+fmi_enum! {
+    TrackLevel as "TrackLevel", "ERRI B176 spectrum level of the internal track generator" {
+        Low = 0, "low", "A = 2.119e-7 m rad";
+        High = 1, "high", "A = 6.125e-7 m rad";
+    }
+}
+
+impl From<TrackLevel> for PsdLevel {
+    fn from(level: TrackLevel) -> Self {
+        match level {
+            TrackLevel::Low => PsdLevel::Low,
+            TrackLevel::High => PsdLevel::High,
+        }
+    }
+}
+
+/// The physics names the parameter it rejects (a field of [`Params`]); the glue reports it
+/// under the FMI variable bound to that field.
+impl FieldError for ParamError {
+    fn field(&self) -> Option<&str> {
+        Some(self.name)
+    }
+
+    fn reason(&self) -> String {
+        self.reason.clone()
+    }
+}
+
+impl FieldError for PhysicsModelError {
+    fn field(&self) -> Option<&str> {
+        match self {
+            PhysicsModelError::Param(p) => p.field(),
+            // The contact table is the shell's field `contact`.
+            PhysicsModelError::Contact(_) => Some("contact"),
+        }
+    }
+
+    fn reason(&self) -> String {
+        match self {
+            PhysicsModelError::Param(p) => p.reason(),
+            PhysicsModelError::Contact(c) => c.to_string(),
+        }
+    }
+}
+
+impl FieldError for PStep {
+    fn field(&self) -> Option<&str> {
+        match self {
+            PStep::NonFiniteInput { name, .. } => Some(name),
+            _ => None,
+        }
+    }
+
+    fn reason(&self) -> String {
+        match self {
+            PStep::NonFiniteInput { value, .. } => format!("not finite ({value})"),
+            other => other.to_string(),
+        }
     }
 }
 
@@ -89,10 +116,11 @@ fn output_error(e: &PStep) -> ModelError {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Bogie2Dof {
     params: Params,
-    track_source: i32,
-    track_level: i32,
+    track_source: TrackChoice,
+    track_level: TrackLevel,
     track_seed: i32,
-    contact_table: String,
+    /// The contact-table parameter as set: a keyword or a file (see [`Self::contact_source`]).
+    contact: String,
     resource_dir: Option<PathBuf>,
     inputs: Inputs,
     bogie: Option<Bogie>,
@@ -108,7 +136,7 @@ impl Bogie2Dof {
     /// The contact-table parameter resolved: keywords, then a file under the FMU's
     /// resources/ folder, then the path as given.
     fn contact_source(&self) -> ContactSource {
-        match ContactSource::from_path_str(&self.contact_table) {
+        match ContactSource::from_path_str(&self.contact) {
             ContactSource::File(p) => {
                 let path = PathBuf::from(&p);
                 if path.is_relative() {
@@ -140,244 +168,21 @@ impl Bogie2Dof {
         }
     }
 
-    fn build_params(&self) -> Result<Params, ModelError> {
-        let level = match self.track_level {
-            0 => PsdLevel::Low,
-            _ => PsdLevel::High,
-        };
+    fn build_params(&self) -> Params {
         let track = match self.track_source {
-            0 => TrackSource::None,
-            1 => TrackSource::External,
-            _ => TrackSource::Internal {
-                level,
+            TrackChoice::None => TrackSource::None,
+            TrackChoice::External => TrackSource::External,
+            TrackChoice::Internal => TrackSource::Internal {
+                level: self.track_level.into(),
                 seed: u64::from(self.track_seed.unsigned_abs()),
             },
         };
-        Ok(Params {
+        Params {
             track,
             contact: self.contact_source(),
             ..self.params.clone()
-        })
+        }
     }
-}
-
-fn declare_parameters(v: &mut VariableList<Bogie2Dof>) {
-    v.parameter(
-        "vehicle.speed",
-        "Running speed V (> 0: the creepages (5.8)-(5.11) divide by V)",
-        |m| m.params.speed_mps,
-        |m, x| m.params.speed_mps = x,
-    )
-    .unit("m/s")
-    .display_unit("km/h")
-    .range(0.0, 200.0);
-    v.integer_parameter(
-        "model",
-        "Wheel/rail force law: 0 = linear (5.1)-(5.18) (Kalker, constant conicity and \
-         gravitational stiffness), 1 = non-linear (5.19)-(5.27) (contact table, \
-         Vermeulen-Johnson saturation, spin dofs)",
-        |m| match m.params.model {
-            ModelKind::Linear => 0,
-            ModelKind::NonLinear => 1,
-        },
-        |m, x| {
-            m.params.model = if x == 0 {
-                ModelKind::Linear
-            } else {
-                ModelKind::NonLinear
-            }
-        },
-    )
-    .range(0.0, 1.0);
-    v.parameter(
-        "contact.friction_coefficient",
-        "mu of the saturation (5.21)-(5.25), in (0, 1]; dry rail 0.3-0.4",
-        |m| m.params.friction_coefficient,
-        |m, x| m.params.friction_coefficient = x,
-    )
-    .unit("1")
-    .range(0.0, 1.0);
-    v.string_parameter(
-        "contact.table",
-        "Wheel/rail contact table of the non-linear model: \"\" = built-in default (worn-profile \
-         surrogate), \"worn\", \"AA\" (EN 15302 profiles A/A), \"synthetic\" (cone + flange), or \
-         a CSV file (y_m,delta_r_left_m,delta_r_right_m,tan_gamma_left,tan_gamma_right); a \
-         relative name is looked up in the FMU's resources/ first (shipped: \
-         wheel_rail_worn_surrogate.csv, wheel_rail_A_A.csv)",
-        |m| m.contact_table.clone(),
-        |m, x| m.contact_table = x,
-    );
-    v.parameter(
-        "initial.lateral_displacement",
-        "Initial lateral displacement y of the bogie centre (positive right)",
-        |m| m.params.initial_lateral_m,
-        |m, x| m.params.initial_lateral_m = x,
-    )
-    .unit("m")
-    .display_unit("mm")
-    .range(-0.05, 0.05);
-    v.parameter(
-        "initial.yaw_angle",
-        "Initial yaw angle sigma (positive nose-left)",
-        |m| m.params.initial_yaw_rad,
-        |m, x| m.params.initial_yaw_rad = x,
-    )
-    .unit("rad")
-    .display_unit("deg")
-    .range(-0.05, 0.05);
-    v.parameter(
-        "bogie.mass",
-        "m: bogie frame + two wheelsets (seed 4.2: 6.1 t from a_lim)",
-        |m| m.params.bogie_mass_kg,
-        |m, x| m.params.bogie_mass_kg = x,
-    )
-    .unit("kg")
-    .display_unit("t")
-    .min(0.0);
-    v.parameter(
-        "bogie.yaw_inertia",
-        "J: yaw inertia of frame + wheelsets (Manchester Benchmark: 10 973 kg m2)",
-        |m| m.params.bogie_yaw_inertia_kgm2,
-        |m, x| m.params.bogie_yaw_inertia_kgm2 = x,
-    )
-    .unit("kg.m2")
-    .min(0.0);
-    v.parameter(
-        "wheelset.spin_inertia",
-        "J_w: spin inertia of one wheelset (Manchester: 112 kg m2), non-linear model",
-        |m| m.params.wheelset_spin_inertia_kgm2,
-        |m, x| m.params.wheelset_spin_inertia_kgm2 = x,
-    )
-    .unit("kg.m2")
-    .min(0.0);
-    v.parameter(
-        "bogie.half_wheelbase",
-        "p: half wheelbase (seed: wheelbase 2.5 m)",
-        |m| m.params.half_wheelbase_m,
-        |m, x| m.params.half_wheelbase_m = x,
-    )
-    .unit("m")
-    .min(0.0);
-    v.parameter(
-        "wheelset.half_contact_gauge",
-        "s: half distance between the contact points (MPE 2019: 0.7465 m)",
-        |m| m.params.half_contact_gauge_m,
-        |m, x| m.params.half_contact_gauge_m = x,
-    )
-    .unit("m")
-    .min(0.0);
-    v.parameter(
-        "damper.lateral_arm",
-        "b: lateral arm of the yaw dampers and of k_ssx (MPE 2019: 1.35 m)",
-        |m| m.params.damper_arm_m,
-        |m, x| m.params.damper_arm_m = x,
-    )
-    .unit("m")
-    .min(0.0);
-    v.parameter(
-        "wheelset.wheel_radius",
-        "R0: nominal rolling radius (Manchester: 0.46 m)",
-        |m| m.params.wheel_radius_m,
-        |m, x| m.params.wheel_radius_m = x,
-    )
-    .unit("m")
-    .min(0.0);
-    v.parameter(
-        "wheelset.wheel_load",
-        "P: static vertical load per wheel (70 kN; Table 4-1's 27.52 kN per wheelset is not \
-         plausible)",
-        |m| m.params.wheel_load_n,
-        |m, x| m.params.wheel_load_n = x,
-    )
-    .unit("N")
-    .display_unit("kN")
-    .min(0.0);
-    v.parameter(
-        "suspension.lateral_stiffness",
-        "k_ssy: secondary lateral stiffness per side (Manchester: 160 kN/m)",
-        |m| m.params.k_ssy_n_per_m,
-        |m, x| m.params.k_ssy_n_per_m = x,
-    )
-    .unit("N/m")
-    .display_unit("kN/m")
-    .min(0.0);
-    v.parameter(
-        "suspension.longitudinal_stiffness",
-        "k_ssx: effective longitudinal secondary stiffness per side at arm b (air spring + \
-         mountings, yaw damper excluded); calibrated for R5 with the passive damper",
-        |m| m.params.k_ssx_n_per_m,
-        |m, x| m.params.k_ssx_n_per_m = x,
-    )
-    .unit("N/m")
-    .display_unit("kN/m")
-    .min(0.0);
-    v.parameter(
-        "creep.f11",
-        "f11: Kalker longitudinal creep coefficient per wheel (Hertz + Kalker at 70 kN)",
-        |m| m.params.f11_n,
-        |m, x| m.params.f11_n = x,
-    )
-    .unit("N")
-    .min(0.0);
-    v.parameter(
-        "creep.f22",
-        "f22: Kalker lateral creep coefficient per wheel (Hertz + Kalker at 70 kN)",
-        |m| m.params.f22_n,
-        |m, x| m.params.f22_n = x,
-    )
-    .unit("N")
-    .min(0.0);
-    v.parameter(
-        "creep.reduction_factor",
-        "kappa in (0, 1]: reduction of f11, f22 (Polach 2005), both models; calibrated 0.6",
-        |m| m.params.creep_reduction,
-        |m, x| m.params.creep_reduction = x,
-    )
-    .unit("1")
-    .range(0.0, 1.0);
-    v.parameter(
-        "linear.conicity",
-        "lambda: equivalent conicity of the linear model (default: the default table's \
-         describing function at 1 mm)",
-        |m| m.params.conicity,
-        |m, x| m.params.conicity = x,
-    )
-    .unit("1")
-    .range(0.0, 1.0);
-    v.parameter(
-        "linear.gravitational_stiffness",
-        "k_g: lateral contact-angle stiffness per wheelset of the linear model (default: the \
-         default table at 1 mm, P = 70 kN)",
-        |m| m.params.gravity_stiffness_n_per_m,
-        |m, x| m.params.gravity_stiffness_n_per_m = x,
-    )
-    .unit("N/m")
-    .display_unit("MN/m")
-    .min(0.0);
-    v.integer_parameter(
-        "track.source",
-        "Lateral track alignment: 0 = none (ideal track), 1 = external input \
-         track.lateral_alignment (at the front wheelset; the rear sees it 2p/V later), \
-         2 = internal ERRI B176 generator (track.level, track.seed)",
-        |m| m.track_source,
-        |m, x| m.track_source = x,
-    )
-    .range(0.0, 2.0);
-    v.integer_parameter(
-        "track.level",
-        "ERRI B176 spectrum level of the internal generator: 0 = low (A = 2.119e-7 m rad), \
-         1 = high (A = 6.125e-7 m rad)",
-        |m| m.track_level,
-        |m, x| m.track_level = x,
-    )
-    .range(0.0, 1.0);
-    v.integer_parameter(
-        "track.seed",
-        "Random seed of the internal generator's phases (reproducible)",
-        |m| m.track_seed,
-        |m, x| m.track_seed = x,
-    )
-    .range(0.0, f64::from(i32::MAX));
 }
 
 const FT_ACC: &[&str] = &[
@@ -386,233 +191,6 @@ const FT_ACC: &[&str] = &[
     "track.lateral_alignment",
 ];
 const FT_TRACK: &[&str] = &["track.lateral_alignment"];
-
-fn declare_io(v: &mut VariableList<Bogie2Dof>) {
-    v.input(
-        "damper_left.force",
-        "Left yaw damper force, positive in tension",
-        |m| m.inputs.damper_left_force_n,
-        |m, x| m.inputs.damper_left_force_n = x,
-    )
-    .unit("N")
-    .display_unit("kN");
-    v.input(
-        "damper_right.force",
-        "Right yaw damper force, positive in tension",
-        |m| m.inputs.damper_right_force_n,
-        |m, x| m.inputs.damper_right_force_n = x,
-    )
-    .unit("N")
-    .display_unit("kN");
-    v.input(
-        "track.lateral_alignment",
-        "Lateral track alignment at the front wheelset, positive right (track.source = 1)",
-        |m| m.inputs.track_lateral_m,
-        |m, x| m.inputs.track_lateral_m = x,
-    )
-    .unit("m")
-    .display_unit("mm");
-
-    v.output(
-        "damper_left.elongation",
-        "Left damper elongation e_L = +b sigma (extension positive), from the state",
-        &[],
-        |m| m.out.damper_left_elongation_m,
-    )
-    .unit("m")
-    .display_unit("mm");
-    v.output(
-        "damper_left.elongation_velocity",
-        "Left damper elongation velocity +b sigma'",
-        &[],
-        |m| m.out.damper_left_velocity_mps,
-    )
-    .unit("m/s")
-    .display_unit("mm/s");
-    v.output(
-        "damper_right.elongation",
-        "Right damper elongation e_R = -b sigma (extension positive), from the state",
-        &[],
-        |m| m.out.damper_right_elongation_m,
-    )
-    .unit("m")
-    .display_unit("mm");
-    v.output(
-        "damper_right.elongation_velocity",
-        "Right damper elongation velocity -b sigma'",
-        &[],
-        |m| m.out.damper_right_velocity_mps,
-    )
-    .unit("m/s")
-    .display_unit("mm/s");
-    v.output(
-        "damper_left.end_absolute_velocity",
-        "Absolute velocity of the bogie-side end of the left damper along its axis, positive \
-         in the direction that extends the damper (+b sigma'; the car body does not move)",
-        &[],
-        |m| m.out.damper_left_velocity_mps,
-    )
-    .unit("m/s")
-    .display_unit("mm/s");
-    v.output(
-        "damper_right.end_absolute_velocity",
-        "Same for the right damper (-b sigma')",
-        &[],
-        |m| m.out.damper_right_velocity_mps,
-    )
-    .unit("m/s")
-    .display_unit("mm/s");
-    v.output(
-        "damper_left.end_absolute_acceleration",
-        "Absolute acceleration of the bogie-side end of the left damper along its axis, \
-         positive towards extension (+b sigma''), for the sky-hook accelerometer",
-        FT_ACC,
-        |m| m.params.damper_arm_m * m.out.yaw_acc_radps2,
-    )
-    .unit("m/s2");
-    v.output(
-        "damper_right.end_absolute_acceleration",
-        "Same for the right damper (-b sigma'')",
-        FT_ACC,
-        |m| -m.params.damper_arm_m * m.out.yaw_acc_radps2,
-    )
-    .unit("m/s2");
-    v.output(
-        "frame.lateral_acceleration_front",
-        "Bogie frame lateral acceleration above the front wheelset y'' - p sigma'' (EN 14363 \
-         stability quantity)",
-        FT_ACC,
-        |m| m.out.frame_acc_front_mps2,
-    )
-    .unit("m/s2");
-    v.output(
-        "frame.lateral_acceleration_rear",
-        "Bogie frame lateral acceleration above the rear wheelset y'' + p sigma''",
-        FT_ACC,
-        |m| m.out.frame_acc_rear_mps2,
-    )
-    .unit("m/s2");
-    for (front, name_d, name_r, name_a, name_g) in [
-        (
-            true,
-            "wheelset_front.lateral_displacement",
-            "wheelset_front.lateral_displacement_relative",
-            "wheelset_front.lateral_acceleration",
-            "wheelset_front.guiding_force",
-        ),
-        (
-            false,
-            "wheelset_rear.lateral_displacement",
-            "wheelset_rear.lateral_displacement_relative",
-            "wheelset_rear.lateral_acceleration",
-            "wheelset_rear.guiding_force",
-        ),
-    ] {
-        let which = if front {
-            "front (leading, at +p)"
-        } else {
-            "rear (at -p)"
-        };
-        v.output(
-            name_d,
-            &format!("Lateral displacement of the {which} wheelset, y -+ p sigma"),
-            &[],
-            if front {
-                |m: &Bogie2Dof| m.out.wheelset_front_lateral_m
-            } else {
-                |m: &Bogie2Dof| m.out.wheelset_rear_lateral_m
-            },
-        )
-        .unit("m")
-        .display_unit("mm");
-        v.output(
-            name_r,
-            &format!("Lateral displacement of the {which} wheelset relative to the track"),
-            FT_TRACK,
-            if front {
-                |m: &Bogie2Dof| m.out.wheelset_front_rel_track_m
-            } else {
-                |m: &Bogie2Dof| m.out.wheelset_rear_rel_track_m
-            },
-        )
-        .unit("m")
-        .display_unit("mm");
-        v.output(
-            name_a,
-            &format!(
-                "Lateral acceleration of the {which} wheelset (rigid primary suspension: \
-                 that of the frame above it)"
-            ),
-            FT_ACC,
-            if front {
-                |m: &Bogie2Dof| m.out.wheelset_front_acc_mps2
-            } else {
-                |m: &Bogie2Dof| m.out.wheelset_rear_acc_mps2
-            },
-        )
-        .unit("m/s2");
-        v.output(
-            name_g,
-            &format!(
-                "Sum Y of the lateral wheel/rail forces on the {which} wheelset (force of \
-                 the rails on the wheelset, positive right)"
-            ),
-            FT_TRACK,
-            if front {
-                |m: &Bogie2Dof| m.out.guiding_force_front_n
-            } else {
-                |m: &Bogie2Dof| m.out.guiding_force_rear_n
-            },
-        )
-        .unit("N")
-        .display_unit("kN");
-    }
-    v.output(
-        "bogie.yaw_angle",
-        "Bogie yaw angle sigma (positive nose-left)",
-        &[],
-        |m| m.out.yaw_rad,
-    )
-    .unit("rad")
-    .display_unit("deg");
-    v.output("bogie.yaw_rate", "Bogie yaw rate sigma'", &[], |m| {
-        m.out.yaw_rate_radps
-    })
-    .unit("rad/s")
-    .display_unit("deg/s");
-    v.output(
-        "bogie.lateral_displacement",
-        "Lateral displacement y of the bogie centre (positive right)",
-        &[],
-        |m| m.out.bogie_lateral_m,
-    )
-    .unit("m")
-    .display_unit("mm");
-    v.output(
-        "bogie.lateral_velocity",
-        "Lateral velocity y' of the bogie centre",
-        &[],
-        |m| m.out.bogie_lateral_velocity_mps,
-    )
-    .unit("m/s")
-    .display_unit("mm/s");
-    v.output(
-        "track.alignment_front",
-        "Track lateral alignment under the front wheelset (input or internal generator)",
-        FT_TRACK,
-        |m| m.out.track_front_m,
-    )
-    .unit("m")
-    .display_unit("mm");
-    v.output(
-        "track.alignment_rear",
-        "Track lateral alignment under the rear wheelset (delayed by 2p/V)",
-        FT_TRACK,
-        |m| m.out.track_rear_m,
-    )
-    .unit("m")
-    .display_unit("mm");
-}
 
 impl FmuModel for Bogie2Dof {
     const INFO: ModelInfo = ModelInfo {
@@ -642,10 +220,136 @@ impl FmuModel for Bogie2Dof {
     };
 
     fn variables() -> Vec<Variable<Self>> {
-        let mut v = VariableList::<Self>::new();
-        declare_parameters(&mut v);
-        declare_io(&mut v);
-        v.into_vec()
+        let mut v: Vec<Variable<Self>> = Vec::new();
+        model_description::declare! { v;
+            /// Running speed V (> 0: the creepages (5.8)-(5.11) divide by V)
+            parameter "vehicle.speed" [unit = "m/s", display_unit = "km/h", range = 0.0..=200.0] => params.speed_mps;
+            /// Wheel/rail force law: linear (5.1)-(5.18) (Kalker, constant conicity and
+            /// gravitational stiffness) or non-linear (5.19)-(5.27) (contact table,
+            /// Vermeulen-Johnson saturation, spin dofs)
+            parameter "model" => params.model;
+            /// mu of the saturation (5.21)-(5.25), in (0, 1]; dry rail 0.3-0.4
+            parameter "contact.friction_coefficient" [unit = "1", range = 0.0..=1.0] => params.friction_coefficient;
+            /// Wheel/rail contact table of the non-linear model: "" = built-in default
+            /// (worn-profile surrogate), "worn", "AA" (EN 15302 profiles A/A), "synthetic" (cone +
+            /// flange), or a CSV file (y_m,delta_r_left_m,delta_r_right_m,tan_gamma_left,tan_gamma_right);
+            /// a relative name is looked up in the FMU's resources/ first (shipped:
+            /// wheel_rail_worn_surrogate.csv, wheel_rail_A_A.csv)
+            parameter "contact.table" => contact;
+            /// Initial lateral displacement y of the bogie centre (positive right)
+            parameter "initial.lateral_displacement" [unit = "m", display_unit = "mm", range = -0.05..=0.05] => params.initial_lateral_m;
+            /// Initial yaw angle sigma (positive nose-left)
+            parameter "initial.yaw_angle" [unit = "rad", display_unit = "deg", range = -0.05..=0.05] => params.initial_yaw_rad;
+            /// m: bogie frame + two wheelsets (seed 4.2: 6.1 t from a_lim)
+            parameter "bogie.mass" [unit = "kg", display_unit = "t", min = 0.0] => params.bogie_mass_kg;
+            /// J: yaw inertia of frame + wheelsets (Manchester Benchmark: 10 973 kg m2)
+            parameter "bogie.yaw_inertia" [unit = "kg.m2", min = 0.0] => params.bogie_yaw_inertia_kgm2;
+            /// J_w: spin inertia of one wheelset (Manchester: 112 kg m2), non-linear model
+            parameter "wheelset.spin_inertia" [unit = "kg.m2", min = 0.0] => params.wheelset_spin_inertia_kgm2;
+            /// p: half wheelbase (seed: wheelbase 2.5 m)
+            parameter "bogie.half_wheelbase" [unit = "m", min = 0.0] => params.half_wheelbase_m;
+            /// s: half distance between the contact points (MPE 2019: 0.7465 m)
+            parameter "wheelset.half_contact_gauge" [unit = "m", min = 0.0] => params.half_contact_gauge_m;
+            /// b: lateral arm of the yaw dampers and of k_ssx (MPE 2019: 1.35 m)
+            parameter "damper.lateral_arm" [unit = "m", min = 0.0] => params.damper_arm_m;
+            /// R0: nominal rolling radius (Manchester: 0.46 m)
+            parameter "wheelset.wheel_radius" [unit = "m", min = 0.0] => params.wheel_radius_m;
+            /// P: static vertical load per wheel (70 kN; Table 4-1's 27.52 kN per wheelset is not
+            /// plausible)
+            parameter "wheelset.wheel_load" [unit = "N", display_unit = "kN", min = 0.0] => params.wheel_load_n;
+            /// k_ssy: secondary lateral stiffness per side (Manchester: 160 kN/m)
+            parameter "suspension.lateral_stiffness" [unit = "N/m", display_unit = "kN/m", min = 0.0] => params.k_ssy_n_per_m;
+            /// k_ssx: effective longitudinal secondary stiffness per side at arm b (air spring +
+            /// mountings, yaw damper excluded); calibrated for R5 with the passive damper
+            parameter "suspension.longitudinal_stiffness" [unit = "N/m", display_unit = "kN/m", min = 0.0] => params.k_ssx_n_per_m;
+            /// f11: Kalker longitudinal creep coefficient per wheel (Hertz + Kalker at 70 kN)
+            parameter "creep.f11" [unit = "N", min = 0.0] => params.f11_n;
+            /// f22: Kalker lateral creep coefficient per wheel (Hertz + Kalker at 70 kN)
+            parameter "creep.f22" [unit = "N", min = 0.0] => params.f22_n;
+            /// kappa in (0, 1]: reduction of f11, f22 (Polach 2005), both models; calibrated 0.6
+            parameter "creep.reduction_factor" [unit = "1", range = 0.0..=1.0] => params.creep_reduction;
+            /// lambda: equivalent conicity of the linear model (default: the default table's
+            /// describing function at 1 mm)
+            parameter "linear.conicity" [unit = "1", range = 0.0..=1.0] => params.conicity;
+            /// k_g: lateral contact-angle stiffness per wheelset of the linear model (default: the
+            /// default table at 1 mm, P = 70 kN)
+            parameter "linear.gravitational_stiffness" [unit = "N/m", display_unit = "MN/m", min = 0.0] => params.gravity_stiffness_n_per_m;
+            /// Lateral track alignment: none (ideal track), external input
+            /// track.lateral_alignment (at the front wheelset; the rear sees it 2p/V later), or
+            /// the internal ERRI B176 generator (track.level, track.seed)
+            parameter "track.source" => track_source;
+            /// ERRI B176 spectrum level of the internal generator: low (A = 2.119e-7 m rad) or
+            /// high (A = 6.125e-7 m rad)
+            parameter "track.level" => track_level;
+            /// Random seed of the internal generator's phases (reproducible)
+            parameter "track.seed" [range = 0.0..=2147483647.0] => track_seed;
+
+            /// Left yaw damper force, positive in tension
+            input "damper_left.force" [unit = "N", display_unit = "kN"] => inputs.damper_left_force_n;
+            /// Right yaw damper force, positive in tension
+            input "damper_right.force" [unit = "N", display_unit = "kN"] => inputs.damper_right_force_n;
+            /// Lateral track alignment at the front wheelset, positive right (track.source = external)
+            input "track.lateral_alignment" [unit = "m", display_unit = "mm"] => inputs.track_lateral_m;
+
+            /// Left damper elongation e_L = +b sigma (extension positive), from the state
+            output "damper_left.elongation" [unit = "m", display_unit = "mm"] => out.damper_left_elongation_m;
+            /// Left damper elongation velocity +b sigma'
+            output "damper_left.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper_left_velocity_mps;
+            /// Right damper elongation e_R = -b sigma (extension positive), from the state
+            output "damper_right.elongation" [unit = "m", display_unit = "mm"] => out.damper_right_elongation_m;
+            /// Right damper elongation velocity -b sigma'
+            output "damper_right.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper_right_velocity_mps;
+            /// Absolute velocity of the bogie-side end of the left damper along its axis, positive
+            /// in the direction that extends the damper (+b sigma'; the car body does not move)
+            output "damper_left.end_absolute_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper_left_velocity_mps;
+            /// Same for the right damper (-b sigma')
+            output "damper_right.end_absolute_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper_right_velocity_mps;
+            /// Absolute acceleration of the bogie-side end of the left damper along its axis,
+            /// positive towards extension (+b sigma''), for the sky-hook accelerometer
+            output "damper_left.end_absolute_acceleration" [unit = "m/s2", depends_on = FT_ACC]
+                => |m| m.params.damper_arm_m * m.out.yaw_acc_radps2;
+            /// Same for the right damper (-b sigma'')
+            output "damper_right.end_absolute_acceleration" [unit = "m/s2", depends_on = FT_ACC]
+                => |m| -m.params.damper_arm_m * m.out.yaw_acc_radps2;
+            /// Bogie frame lateral acceleration above the front wheelset y'' - p sigma'' (EN 14363
+            /// stability quantity)
+            output "frame.lateral_acceleration_front" [unit = "m/s2", depends_on = FT_ACC] => out.frame_acc_front_mps2;
+            /// Bogie frame lateral acceleration above the rear wheelset y'' + p sigma''
+            output "frame.lateral_acceleration_rear" [unit = "m/s2", depends_on = FT_ACC] => out.frame_acc_rear_mps2;
+            /// Lateral displacement of the front (leading, at +p) wheelset, y -+ p sigma
+            output "wheelset_front.lateral_displacement" [unit = "m", display_unit = "mm"] => out.wheelset_front_lateral_m;
+            /// Lateral displacement of the front (leading, at +p) wheelset relative to the track
+            output "wheelset_front.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.wheelset_front_rel_track_m;
+            /// Lateral acceleration of the front (leading, at +p) wheelset (rigid primary
+            /// suspension: that of the frame above it)
+            output "wheelset_front.lateral_acceleration" [unit = "m/s2", depends_on = FT_ACC] => out.wheelset_front_acc_mps2;
+            /// Sum Y of the lateral wheel/rail forces on the front (leading, at +p) wheelset
+            /// (force of the rails on the wheelset, positive right)
+            output "wheelset_front.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => out.guiding_force_front_n;
+            /// Lateral displacement of the rear (at -p) wheelset, y -+ p sigma
+            output "wheelset_rear.lateral_displacement" [unit = "m", display_unit = "mm"] => out.wheelset_rear_lateral_m;
+            /// Lateral displacement of the rear (at -p) wheelset relative to the track
+            output "wheelset_rear.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.wheelset_rear_rel_track_m;
+            /// Lateral acceleration of the rear (at -p) wheelset (rigid primary suspension: that
+            /// of the frame above it)
+            output "wheelset_rear.lateral_acceleration" [unit = "m/s2", depends_on = FT_ACC] => out.wheelset_rear_acc_mps2;
+            /// Sum Y of the lateral wheel/rail forces on the rear (at -p) wheelset (force of the
+            /// rails on the wheelset, positive right)
+            output "wheelset_rear.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => out.guiding_force_rear_n;
+            /// Bogie yaw angle sigma (positive nose-left)
+            output "bogie.yaw_angle" [unit = "rad", display_unit = "deg"] => out.yaw_rad;
+            /// Bogie yaw rate sigma'
+            output "bogie.yaw_rate" [unit = "rad/s", display_unit = "deg/s"] => out.yaw_rate_radps;
+            /// Lateral displacement y of the bogie centre (positive right)
+            output "bogie.lateral_displacement" [unit = "m", display_unit = "mm"] => out.bogie_lateral_m;
+            /// Lateral velocity y' of the bogie centre
+            output "bogie.lateral_velocity" [unit = "m/s", display_unit = "mm/s"] => out.bogie_lateral_velocity_mps;
+            /// Track lateral alignment under the front wheelset (input or internal generator)
+            output "track.alignment_front" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.track_front_m;
+            /// Track lateral alignment under the rear wheelset (delayed by 2p/V)
+            output "track.alignment_rear" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.track_rear_m;
+        }
+        v
     }
 
     fn instantiate(ctx: &InstanceContext) -> Result<Self, ModelError> {
@@ -656,10 +360,10 @@ impl FmuModel for Bogie2Dof {
         };
         let mut me = Self {
             params,
-            track_source: 1,
-            track_level: 0,
+            track_source: TrackChoice::External,
+            track_level: TrackLevel::Low,
             track_seed: 1,
-            contact_table: String::new(),
+            contact: String::new(),
             resource_dir: ctx.resource_dir.clone(),
             inputs: Inputs::default(),
             bogie: None,
@@ -670,17 +374,23 @@ impl FmuModel for Bogie2Dof {
     }
 
     fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-        let params = self.build_params()?;
-        params.validate().map_err(|e| param_error(&e))?;
-        let b = Bogie::new(params).map_err(|e| physics_error(&e))?;
-        self.out = b.outputs(&self.inputs).map_err(|e| output_error(&e))?;
+        let params = self.build_params();
+        params.validate().map_err(|e| field_error::<Self>(&e))?;
+        let b = Bogie::new(params).map_err(|e| field_error::<Self>(&e))?;
+        self.out = b
+            .outputs(&self.inputs)
+            .map_err(|e| field_error::<Self>(&e))?;
         self.bogie = Some(b);
         Ok(())
     }
 
     fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
         match &self.bogie {
-            Some(b) => self.out = b.outputs(&self.inputs).map_err(|e| output_error(&e))?,
+            Some(b) => {
+                self.out = b
+                    .outputs(&self.inputs)
+                    .map_err(|e| field_error::<Self>(&e))?
+            }
             None => self.preview_outputs(),
         }
         Ok(())

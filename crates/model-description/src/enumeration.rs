@@ -47,7 +47,7 @@ pub trait FmiEnum: Sized + 'static {
     fn from_value(value: i32) -> Option<Self>;
 }
 
-impl<E: FmiEnum> crate::variable::FmiValue for E {
+impl<E: FmiEnum> crate::codec::FmiValue for E {
     type Fmi = i32;
     const ENUMERATION: Option<&'static EnumType> = Some(E::TYPE);
     fn to_fmi(&self) -> i32 {

@@ -15,6 +15,7 @@
 //! - the packaged `.fmu` ([`package`], binary `package-fmus`).
 
 pub mod capi;
+pub mod codec;
 pub mod component;
 pub mod doc;
 pub mod enumeration;
@@ -26,16 +27,14 @@ pub mod units;
 pub mod variable;
 pub mod xml;
 
+pub use codec::{AlwaysSome, Codec, FmiValue, Native, Sign, ZeroIsNone};
 pub use component::{CollectLog, Component, FmiState, Status};
 pub use enumeration::{EnumItem, EnumType, FmiEnum};
 pub use fields::{field_error, FieldError};
 pub use model::{
     DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo, StepError,
 };
-pub use variable::{
-    AlwaysSome, Causality, Codec, FmiValue, Native, Sign, VarType, Variability, Variable,
-    VariableList, ZeroIsNone,
-};
+pub use variable::{Causality, VarType, Variability, Variable};
 
 /// Create a component for `M` driven from Rust (tests, tools): the same state machine and
 /// checks as through the C API, with log messages collected in the returned [`CollectLog`].

@@ -5,9 +5,10 @@
 //!
 //! Models declare their variables with [`crate::declare!`]: one line per variable naming the
 //! FMI variable and the field it binds, with the description as a doc comment. The field's Rust
-//! type decides the FMI type ([`FmiValue`]); a [`Codec`] converts fields whose FMI form differs
-//! (a sign held as `f64` exposed as an Integer, an optional value).
+//! type decides the FMI type ([`crate::FmiValue`]); a [`Codec`] converts fields whose FMI form
+//! differs (a sign held as `f64` exposed as an Integer, an optional value).
 
+use crate::codec::{Codec, Scalar};
 use crate::enumeration::EnumType;
 
 /// FMI 2.0 base type of a scalar variable (an Enumeration is an Integer with a declared type).
@@ -151,181 +152,6 @@ impl<M> Access<M> {
             Access::Boolean { set, .. } => set.is_some(),
             Access::String { set, .. } => set.is_some(),
         }
-    }
-}
-
-/// The four FMI scalar types as Rust values: builds the matching [`Access`].
-pub trait Scalar: Sized + 'static {
-    fn access<M>(get: fn(&M) -> Self, set: Option<fn(&mut M, Self)>) -> Access<M>;
-}
-
-impl Scalar for f64 {
-    fn access<M>(get: fn(&M) -> Self, set: Option<fn(&mut M, Self)>) -> Access<M> {
-        Access::Real { get, set }
-    }
-}
-
-impl Scalar for i32 {
-    fn access<M>(get: fn(&M) -> Self, set: Option<fn(&mut M, Self)>) -> Access<M> {
-        Access::Integer { get, set }
-    }
-}
-
-impl Scalar for bool {
-    fn access<M>(get: fn(&M) -> Self, set: Option<fn(&mut M, Self)>) -> Access<M> {
-        Access::Boolean { get, set }
-    }
-}
-
-impl Scalar for String {
-    fn access<M>(get: fn(&M) -> Self, set: Option<fn(&mut M, Self)>) -> Access<M> {
-        Access::String { get, set }
-    }
-}
-
-/// A field type with a natural FMI form: `f64` is a Real, `bool` a Boolean, `String` a String,
-/// `i32`/`u32`/`u64` an Integer (unsigned values saturate at `i32::MAX` when read; a negative
-/// value set into an unsigned field becomes 0, which the declared min or the physics' validation
-/// rejects), and every [`crate::FmiEnum`] an Enumeration.
-pub trait FmiValue {
-    type Fmi: Scalar;
-    /// The Enumeration type of the field, if it is one.
-    const ENUMERATION: Option<&'static EnumType> = None;
-    fn to_fmi(&self) -> Self::Fmi;
-    fn set_fmi(&mut self, value: Self::Fmi);
-}
-
-impl FmiValue for f64 {
-    type Fmi = f64;
-    fn to_fmi(&self) -> f64 {
-        *self
-    }
-    fn set_fmi(&mut self, value: f64) {
-        *self = value;
-    }
-}
-
-impl FmiValue for i32 {
-    type Fmi = i32;
-    fn to_fmi(&self) -> i32 {
-        *self
-    }
-    fn set_fmi(&mut self, value: i32) {
-        *self = value;
-    }
-}
-
-impl FmiValue for bool {
-    type Fmi = bool;
-    fn to_fmi(&self) -> bool {
-        *self
-    }
-    fn set_fmi(&mut self, value: bool) {
-        *self = value;
-    }
-}
-
-impl FmiValue for String {
-    type Fmi = String;
-    fn to_fmi(&self) -> String {
-        self.clone()
-    }
-    fn set_fmi(&mut self, value: String) {
-        *self = value;
-    }
-}
-
-impl FmiValue for u32 {
-    type Fmi = i32;
-    fn to_fmi(&self) -> i32 {
-        i32::try_from(*self).unwrap_or(i32::MAX)
-    }
-    fn set_fmi(&mut self, value: i32) {
-        *self = u32::try_from(value).unwrap_or(0);
-    }
-}
-
-impl FmiValue for u64 {
-    type Fmi = i32;
-    fn to_fmi(&self) -> i32 {
-        i32::try_from(*self).unwrap_or(i32::MAX)
-    }
-    fn set_fmi(&mut self, value: i32) {
-        *self = u64::try_from(value).unwrap_or(0);
-    }
-}
-
-/// How a field of type `F` is read and written as an FMI value. [`Native`] uses the field's
-/// [`FmiValue`]; a model defines its own codec for a field whose FMI form is a convention (e.g.
-/// a sign stored as `f64`, exposed as an Integer of -1 / +1), named in the declaration with
-/// `as Codec`.
-pub trait Codec<F> {
-    type Fmi: Scalar;
-    const ENUMERATION: Option<&'static EnumType> = None;
-    fn get(field: &F) -> Self::Fmi;
-    fn set(field: &mut F, value: Self::Fmi);
-}
-
-/// The field's own FMI form ([`FmiValue`]); the default codec of [`crate::declare!`].
-pub struct Native;
-
-impl<F: FmiValue> Codec<F> for Native {
-    type Fmi = F::Fmi;
-    const ENUMERATION: Option<&'static EnumType> = F::ENUMERATION;
-    fn get(field: &F) -> F::Fmi {
-        field.to_fmi()
-    }
-    fn set(field: &mut F, value: F::Fmi) {
-        field.set_fmi(value);
-    }
-}
-
-/// A sign held as `f64` (+1 / -1), exposed as an Integer: reads 0 only for a zero field, and an
-/// Integer set is stored as that value (the declared range [-1, 1] and the physics' validation
-/// reject anything but +-1).
-pub struct Sign;
-
-impl Codec<f64> for Sign {
-    type Fmi = i32;
-    fn get(field: &f64) -> i32 {
-        if *field > 0.0 {
-            1
-        } else if *field < 0.0 {
-            -1
-        } else {
-            0
-        }
-    }
-    fn set(field: &mut f64, value: i32) {
-        *field = f64::from(value);
-    }
-}
-
-/// An optional value exposed as a Real where 0 means "none" (e.g. an optional stiffness: 0 =
-/// rigid). Reads 0 for `None`; setting 0 gives `None`, anything else `Some`.
-pub struct ZeroIsNone;
-
-impl Codec<Option<f64>> for ZeroIsNone {
-    type Fmi = f64;
-    fn get(field: &Option<f64>) -> f64 {
-        field.unwrap_or(0.0)
-    }
-    fn set(field: &mut Option<f64>, value: f64) {
-        *field = (value != 0.0).then_some(value);
-    }
-}
-
-/// An optional value a model always holds as `Some` (reads 0 for `None`, which the model never
-/// has).
-pub struct AlwaysSome;
-
-impl Codec<Option<f64>> for AlwaysSome {
-    type Fmi = f64;
-    fn get(field: &Option<f64>) -> f64 {
-        field.unwrap_or(0.0)
-    }
-    fn set(field: &mut Option<f64>, value: f64) {
-        *field = Some(value);
     }
 }
 
@@ -557,237 +383,6 @@ impl<M> Attributes<'_, M> {
     }
 }
 
-/// The closure-pair declaration style, kept while the model crates move to [`crate::declare!`].
-impl<M> Variable<M> {
-    fn legacy(
-        name: &str,
-        description: &str,
-        causality: Causality,
-        feedthrough: &[&'static str],
-        access: Access<M>,
-    ) -> Self {
-        let mut v = Self::new(causality, name, description.to_string(), None, None, access);
-        v.meta.feedthrough = feedthrough.to_vec();
-        v
-    }
-
-    /// A fixed Real parameter (settable before initialisation only).
-    pub fn parameter(
-        name: &str,
-        description: &str,
-        get: fn(&M) -> f64,
-        set: fn(&mut M, f64),
-    ) -> Self {
-        let access = Access::Real {
-            get,
-            set: Some(set),
-        };
-        Self::legacy(name, description, Causality::Parameter, &[], access)
-    }
-
-    /// A fixed Integer parameter (enumerations are declared as Integer with min/max).
-    pub fn integer_parameter(
-        name: &str,
-        description: &str,
-        get: fn(&M) -> i32,
-        set: fn(&mut M, i32),
-    ) -> Self {
-        let access = Access::Integer {
-            get,
-            set: Some(set),
-        };
-        Self::legacy(name, description, Causality::Parameter, &[], access)
-    }
-
-    /// A fixed Boolean parameter.
-    pub fn boolean_parameter(
-        name: &str,
-        description: &str,
-        get: fn(&M) -> bool,
-        set: fn(&mut M, bool),
-    ) -> Self {
-        let access = Access::Boolean {
-            get,
-            set: Some(set),
-        };
-        Self::legacy(name, description, Causality::Parameter, &[], access)
-    }
-
-    /// A fixed String parameter (e.g. a file path).
-    pub fn string_parameter(
-        name: &str,
-        description: &str,
-        get: fn(&M) -> String,
-        set: fn(&mut M, String),
-    ) -> Self {
-        let access = Access::String {
-            get,
-            set: Some(set),
-        };
-        Self::legacy(name, description, Causality::Parameter, &[], access)
-    }
-
-    /// A continuous Real input.
-    pub fn input(name: &str, description: &str, get: fn(&M) -> f64, set: fn(&mut M, f64)) -> Self {
-        let access = Access::Real {
-            get,
-            set: Some(set),
-        };
-        Self::legacy(name, description, Causality::Input, &[], access)
-    }
-
-    /// A continuous Real output. `feedthrough` lists the inputs it depends on at the same
-    /// instant; an output computed from states only passes `&[]`, which tells hosts there is
-    /// no algebraic loop through this model.
-    pub fn output(
-        name: &str,
-        description: &str,
-        feedthrough: &[&'static str],
-        get: fn(&M) -> f64,
-    ) -> Self {
-        let access = Access::Real { get, set: None };
-        Self::legacy(name, description, Causality::Output, feedthrough, access)
-    }
-
-    /// A discrete Integer output.
-    pub fn integer_output(
-        name: &str,
-        description: &str,
-        feedthrough: &[&'static str],
-        get: fn(&M) -> i32,
-    ) -> Self {
-        let access = Access::Integer { get, set: None };
-        Self::legacy(name, description, Causality::Output, feedthrough, access)
-    }
-
-    /// A discrete Boolean output.
-    pub fn boolean_output(
-        name: &str,
-        description: &str,
-        feedthrough: &[&'static str],
-        get: fn(&M) -> bool,
-    ) -> Self {
-        let access = Access::Boolean { get, set: None };
-        Self::legacy(name, description, Causality::Output, feedthrough, access)
-    }
-
-    /// A Real parameter computed from others at initialisation (read-only).
-    pub fn calculated_parameter(name: &str, description: &str, get: fn(&M) -> f64) -> Self {
-        let access = Access::Real { get, set: None };
-        Self::legacy(
-            name,
-            description,
-            Causality::CalculatedParameter,
-            &[],
-            access,
-        )
-    }
-
-    /// A Real local variable (observable, not settable).
-    pub fn local(name: &str, description: &str, get: fn(&M) -> f64) -> Self {
-        let access = Access::Real { get, set: None };
-        Self::legacy(name, description, Causality::Local, &[], access)
-    }
-
-    /// Unit (must be one of [`crate::units::UNITS`]).
-    pub fn unit(&mut self, unit: &'static str) -> &mut Self {
-        self.meta.unit = Some(unit);
-        self
-    }
-
-    /// Display unit (must be a display unit of the variable's unit, e.g. km/h of m/s).
-    pub fn display_unit(&mut self, display_unit: &'static str) -> &mut Self {
-        self.meta.display_unit = Some(display_unit);
-        self
-    }
-
-    /// Inclusive bounds; a value set outside them is rejected with fmi2Error.
-    pub fn range(&mut self, min: f64, max: f64) -> &mut Self {
-        self.meta.min = Some(min);
-        self.meta.max = Some(max);
-        self
-    }
-
-    pub fn min(&mut self, min: f64) -> &mut Self {
-        self.meta.min = Some(min);
-        self
-    }
-
-    pub fn max(&mut self, max: f64) -> &mut Self {
-        self.meta.max = Some(max);
-        self
-    }
-
-    /// A parameter that may be changed between communication steps.
-    pub fn tunable(&mut self) -> &mut Self {
-        if self.meta.causality == Causality::Parameter {
-            self.meta.variability = Variability::Tunable;
-        }
-        self
-    }
-
-    /// A discrete-time (sampled, piecewise constant) variable.
-    pub fn discrete(&mut self) -> &mut Self {
-        if matches!(
-            self.meta.causality,
-            Causality::Input | Causality::Output | Causality::Local
-        ) {
-            self.meta.variability = Variability::Discrete;
-        }
-        self
-    }
-}
-
-/// The declaration of a model's variables, in order. Its methods fix the model type, so the
-/// accessor closures need no type annotations:
-///
-/// ```ignore
-/// let mut v = VariableList::<Self>::new();
-/// v.parameter("mass", "Mass", |m| m.mass_kg, |m, x| m.mass_kg = x).unit("kg").min(0.0);
-/// v.output("position", "Position", &[], |m| m.position_m).unit("m");
-/// v.into_vec()
-/// ```
-pub struct VariableList<M> {
-    vars: Vec<Variable<M>>,
-}
-
-impl<M> Default for VariableList<M> {
-    fn default() -> Self {
-        VariableList { vars: Vec::new() }
-    }
-}
-
-macro_rules! push_fn {
-    ($name:ident ( $($arg:ident : $ty:ty),* )) => {
-        pub fn $name(&mut self, name: &str, description: &str, $($arg: $ty),*) -> &mut Variable<M> {
-            self.vars.push(Variable::$name(name, description, $($arg),*));
-            let last = self.vars.len() - 1;
-            &mut self.vars[last]
-        }
-    };
-}
-
-impl<M> VariableList<M> {
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    push_fn!(parameter(get: fn(&M) -> f64, set: fn(&mut M, f64)));
-    push_fn!(integer_parameter(get: fn(&M) -> i32, set: fn(&mut M, i32)));
-    push_fn!(boolean_parameter(get: fn(&M) -> bool, set: fn(&mut M, bool)));
-    push_fn!(string_parameter(get: fn(&M) -> String, set: fn(&mut M, String)));
-    push_fn!(input(get: fn(&M) -> f64, set: fn(&mut M, f64)));
-    push_fn!(output(feedthrough: &[&'static str], get: fn(&M) -> f64));
-    push_fn!(integer_output(feedthrough: &[&'static str], get: fn(&M) -> i32));
-    push_fn!(boolean_output(feedthrough: &[&'static str], get: fn(&M) -> bool));
-    push_fn!(calculated_parameter(get: fn(&M) -> f64));
-    push_fn!(local(get: fn(&M) -> f64));
-
-    pub fn into_vec(self) -> Vec<Variable<M>> {
-        self.vars
-    }
-}
-
 /// Declare variables, one line each, appended to `vars` (a `Vec<Variable<Self>>` whose type is
 /// known, so the accessors type-check) in order:
 ///
@@ -814,7 +409,7 @@ impl<M> VariableList<M> {
 /// `calculated_parameter`, `input`, `output`, `local`); the bracket holds the attributes, each
 /// a method of [`Attributes`] (`unit`, `display_unit`, `range`, `min`, `max`, `depends_on`,
 /// `tunable`, `discrete`); after `=>` comes the bound field path (the field's type gives the
-/// FMI type, see [`FmiValue`]; `as Codec` picks another [`Codec`]) or a closure for a read-only
+/// FMI type, see [`crate::FmiValue`]; `as Codec` picks another [`Codec`]) or a closure for a read-only
 /// value computed from several fields.
 #[macro_export]
 macro_rules! declare {
@@ -858,10 +453,10 @@ macro_rules! declare {
                 &[$($doc),*],
                 stringify!($($seg $([$idx])?).+),
                 |m| &m $(.$seg $([$idx])?)+,
-                |m| <$crate::declare!(@codec $($codec)?) as $crate::variable::Codec<_>>::get(
+                |m| <$crate::declare!(@codec $($codec)?) as $crate::codec::Codec<_>>::get(
                     &m $(.$seg $([$idx])?)+
                 ),
-                |m, x| <$crate::declare!(@codec $($codec)?) as $crate::variable::Codec<_>>::set(
+                |m, x| <$crate::declare!(@codec $($codec)?) as $crate::codec::Codec<_>>::set(
                     &mut m $(.$seg $([$idx])?)+,
                     x,
                 ),
@@ -870,6 +465,6 @@ macro_rules! declare {
         }
         $crate::declare!(@entry $vars; $($rest)*);
     };
-    (@codec) => { $crate::variable::Native };
+    (@codec) => { $crate::codec::Native };
     (@codec $codec:ty) => { $codec };
 }
