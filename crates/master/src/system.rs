@@ -163,9 +163,10 @@ pub fn split_ref(s: &str) -> Option<(&str, &str)> {
 fn type_of(t: VarType) -> Option<ScalarType> {
     match t {
         VarType::Real => Some(ScalarType::Real),
-        VarType::Integer => Some(ScalarType::Integer),
+        // An Enumeration's value is an Integer (FMI 2.0: fmi2SetInteger / fmi2GetInteger).
+        VarType::Integer | VarType::Enumeration => Some(ScalarType::Integer),
         VarType::Boolean => Some(ScalarType::Boolean),
-        VarType::String | VarType::Enumeration => None,
+        VarType::String => None,
     }
 }
 
@@ -176,11 +177,11 @@ pub fn json_value_for(t: VarType, v: &Value) -> Result<f64, String> {
             .as_f64()
             .filter(|x| x.is_finite())
             .ok_or_else(|| format!("{n} is not a finite number")),
-        (VarType::Integer, Value::Number(n)) => n
+        (VarType::Integer | VarType::Enumeration, Value::Number(n)) => n
             .as_i64()
             .filter(|x| i32::try_from(*x).is_ok())
             .map(|x| x as f64)
-            .ok_or_else(|| format!("{n} is not a 32-bit integer (variable is Integer)")),
+            .ok_or_else(|| format!("{n} is not a 32-bit integer (variable is {t})")),
         (VarType::Boolean, Value::Bool(b)) => Ok(if *b { 1.0 } else { 0.0 }),
         (t, v) => Err(format!("a {t} variable cannot take the value {v}")),
     }
