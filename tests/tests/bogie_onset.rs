@@ -40,7 +40,7 @@ fn run(speed_kmh: f64, initial_m: f64) -> (f64, f64) {
         r#"{{
   "instances": [
     {{"name": "bogie", "fmu": "Bogie2Dof.fmu", "parameters": {{
-        "vehicle.speed": {v}, "model": 0, "track.source": 0,
+        "vehicle.speed": {v}, "contact.model": 0, "track.source": 0,
         "initial.lateral_displacement": {y0}, "initial.yaw_angle": 0.0}}}},
     {{"name": "dl", "fmu": "PassiveYawDamper.fmu"}},
     {{"name": "dr", "fmu": "PassiveYawDamper.fmu"}}

@@ -44,7 +44,7 @@ fn mppt2_on_a_stroked_damper_opens_the_valve_and_lowers_its_cost() {
     type C = MpptController;
     let (amp, w, h) = (3.0e-3, 2.0 * std::f64::consts::PI * 4.0, 1.0e-3);
     let mut damper = start::<D>(&[]);
-    let mut ctrl = start::<C>(&[("initial_command", 0.0), ("k_F", 4.0)]);
+    let mut ctrl = start::<C>(&[("valve.initial_command", 0.0), ("cost.force_weight", 4.0)]);
     let mut costs = Vec::new();
     let mut command = 0.0;
     let n = 30_000; // 30 s: 30 MPPT updates
@@ -69,7 +69,7 @@ fn mppt2_on_a_stroked_damper_opens_the_valve_and_lowers_its_cost() {
         assert!(ctrl.do_step(t, h) <= Status::Warning);
         command = get::<C>(&mut ctrl, "valve.command");
         if k % 1000 == 999 {
-            costs.push(get::<C>(&mut ctrl, "cost"));
+            costs.push(get::<C>(&mut ctrl, "cost.value"));
         }
     }
     // Compare the mean cost of the first and the last 5 updates (the stroke varies, so single
@@ -107,7 +107,7 @@ fn idf_drives_the_full_active_actuator_onto_the_ideal_damper_force() {
         assert!(ctrl.do_step(t, h) <= Status::Warning);
         spool = get::<C>(&mut ctrl, "spool.command");
         if t >= 1.0 {
-            let f_ref = get::<C>(&mut ctrl, "force_reference");
+            let f_ref = get::<C>(&mut ctrl, "reference.force");
             err2 += (force - f_ref).powi(2);
             ref2 += f_ref.powi(2);
         }

@@ -227,7 +227,7 @@ impl FmuModel for Bogie2Dof {
             /// Wheel/rail force law: linear (5.1)-(5.18) (Kalker, constant conicity and
             /// gravitational stiffness) or non-linear (5.19)-(5.27) (contact table,
             /// Vermeulen-Johnson saturation, spin dofs)
-            parameter "model" => params.model;
+            parameter "contact.model" => params.model;
             /// mu of the saturation (5.21)-(5.25), in (0, 1]; dry rail 0.3-0.4
             parameter "contact.friction_coefficient" [unit = "1", range = 0.0..=1.0] => params.friction_coefficient;
             /// Wheel/rail contact table of the non-linear model: "" = built-in default
@@ -241,13 +241,13 @@ impl FmuModel for Bogie2Dof {
             /// Initial yaw angle sigma (positive nose-left)
             parameter "initial.yaw_angle" [unit = "rad", display_unit = "deg", range = -0.05..=0.05] => params.initial_yaw_rad;
             /// m: bogie frame + two wheelsets (seed 4.2: 6.1 t from a_lim)
-            parameter "bogie.mass" [unit = "kg", display_unit = "t", min = 0.0] => params.bogie_mass_kg;
+            parameter "inertia.mass" [unit = "kg", display_unit = "t", min = 0.0] => params.bogie_mass_kg;
             /// J: yaw inertia of frame + wheelsets (Manchester Benchmark: 10 973 kg m2)
-            parameter "bogie.yaw_inertia" [unit = "kg.m2", min = 0.0] => params.bogie_yaw_inertia_kgm2;
+            parameter "inertia.yaw" [unit = "kg.m2", min = 0.0] => params.bogie_yaw_inertia_kgm2;
             /// J_w: spin inertia of one wheelset (Manchester: 112 kg m2), non-linear model
             parameter "wheelset.spin_inertia" [unit = "kg.m2", min = 0.0] => params.wheelset_spin_inertia_kgm2;
             /// p: half wheelbase (seed: wheelbase 2.5 m)
-            parameter "bogie.half_wheelbase" [unit = "m", min = 0.0] => params.half_wheelbase_m;
+            parameter "geometry.half_wheelbase" [unit = "m", min = 0.0] => params.half_wheelbase_m;
             /// s: half distance between the contact points (MPE 2019: 0.7465 m)
             parameter "wheelset.half_contact_gauge" [unit = "m", min = 0.0] => params.half_contact_gauge_m;
             /// b: lateral arm of the yaw dampers and of k_ssx (MPE 2019: 1.35 m)

@@ -177,8 +177,8 @@ fn bad_parameters_are_rejected_by_name() {
         assert_eq!(c.exit_initialization_mode(), Status::Ok);
     }
     for name in [
-        "bogie.mass",
-        "bogie.yaw_inertia",
+        "inertia.mass",
+        "inertia.yaw",
         "suspension.lateral_stiffness",
         "suspension.longitudinal_stiffness",
         "creep.f11",
@@ -187,8 +187,8 @@ fn bad_parameters_are_rejected_by_name() {
         at_set(name, -1.0);
     }
     for name in [
-        "bogie.mass",
-        "bogie.yaw_inertia",
+        "inertia.mass",
+        "inertia.yaw",
         "creep.f22",
         "creep.reduction_factor",
         "wheelset.wheel_load",
@@ -199,7 +199,7 @@ fn bad_parameters_are_rejected_by_name() {
     }
     at_set("contact.friction_coefficient", 1.2);
     at_set("vehicle.speed", -10.0);
-    at_set("bogie.mass", f64::NAN);
+    at_set("inertia.mass", f64::NAN);
     // a contact table that does not exist
     let (mut c, log) = new();
     assert_eq!(
@@ -210,8 +210,12 @@ fn bad_parameters_are_rejected_by_name() {
     assert!(logged(&log.take(), Status::Error, "'contact.table'"));
     // an out-of-range choice
     let (mut c, log) = new();
-    assert_eq!(c.set_integer(&[vr("model")], &[2]), Status::Error);
-    assert!(logged(&log.take(), Status::Error, "'model'"));
+    assert_eq!(c.set_integer(&[vr("contact.model")], &[2]), Status::Error);
+    assert!(logged(
+        &log.take(),
+        Status::Error,
+        "'contact.model' = 2 is not an item of the enumeration WheelRailForceLaw"
+    ));
 }
 
 /// Accelerations change at once when the damper forces are set (declared feedthrough);
@@ -262,7 +266,10 @@ fn start_values_and_contact_tables() {
     let (mut c, _log) = new();
     assert_eq!(get(&mut c, "vehicle.speed"), FMU_DEFAULT_SPEED_MPS);
     let mut model = [0];
-    assert_eq!(c.get_integer(&[vr("model")], &mut model), Status::Ok);
+    assert_eq!(
+        c.get_integer(&[vr("contact.model")], &mut model),
+        Status::Ok
+    );
     assert_eq!(model[0], 1);
     // the A/A table shipped in resources/ is found by its name
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("resources");

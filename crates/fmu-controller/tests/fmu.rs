@@ -105,11 +105,11 @@ fn run_default_experiment<M: FmuModel>() -> Component {
 fn default_experiments_run_with_finite_outputs() {
     let mut c = run_default_experiment::<MpptController>();
     // 10 s with a 1 s period: ten updates; with zero inputs J = 0 and the valve stays closed.
-    assert_eq!(get_i::<MpptController>(&mut c, "updates"), 10);
+    assert_eq!(get_i::<MpptController>(&mut c, "hill_climb.updates"), 10);
     assert_eq!(get_r::<MpptController>(&mut c, "valve.command"), 0.0);
     let mut c = run_default_experiment::<SkyHookController>();
     // zero inputs: condition 0 counts as "on" -> c_max -> closed valve
-    assert!(get_b::<SkyHookController>(&mut c, "on_state"));
+    assert!(get_b::<SkyHookController>(&mut c, "control.on_state"));
     assert_eq!(get_r::<SkyHookController>(&mut c, "valve.command"), 0.0);
     let mut c = run_default_experiment::<IdealDamperForceController>();
     assert_eq!(
@@ -135,8 +135,8 @@ fn mppt_fmu_equals_physics() {
     type M = MpptController;
     let (mut c, _log) = init::<M>();
     // MPPT1 preset from a half-open valve
-    assert_eq!(set_r::<M>(&mut c, "k_F", 0.0), Status::Ok);
-    assert_eq!(set_r::<M>(&mut c, "initial_command", 5.0), Status::Ok);
+    assert_eq!(set_r::<M>(&mut c, "cost.force_weight", 0.0), Status::Ok);
+    assert_eq!(set_r::<M>(&mut c, "valve.initial_command", 5.0), Status::Ok);
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
     let mut p = Mppt::new(MpptParams {
         initial_command_v: 5.0,
@@ -165,21 +165,24 @@ fn mppt_fmu_equals_physics() {
             .unwrap();
         assert_eq!(get_r::<M>(&mut c, "valve.command"), o.command_v, "t={t}");
         assert_eq!(get_r::<M>(&mut c, "valve.opening"), o.opening);
-        assert_eq!(get_r::<M>(&mut c, "cost"), o.cost);
-        assert_eq!(get_r::<M>(&mut c, "rms_acceleration"), o.rms_accel_mps2);
-        assert_eq!(get_r::<M>(&mut c, "rms_force"), o.rms_force_n);
+        assert_eq!(get_r::<M>(&mut c, "cost.value"), o.cost);
         assert_eq!(
-            get_r::<M>(&mut c, "filtered_acceleration"),
+            get_r::<M>(&mut c, "cost.rms_acceleration"),
+            o.rms_accel_mps2
+        );
+        assert_eq!(get_r::<M>(&mut c, "cost.rms_force"), o.rms_force_n);
+        assert_eq!(
+            get_r::<M>(&mut c, "band_pass.acceleration"),
             o.filtered_accel_mps2
         );
         assert_eq!(
-            f64::from(get_i::<M>(&mut c, "direction")),
+            f64::from(get_i::<M>(&mut c, "hill_climb.direction")),
             o.direction,
             "t={t}"
         );
-        assert_eq!(get_b::<M>(&mut c, "override_active"), o.override_active);
-        assert_eq!(get_i::<M>(&mut c, "updates") as u64, o.updates);
-        assert!(!get_b::<M>(&mut c, "input_fault"));
+        assert_eq!(get_b::<M>(&mut c, "override.active"), o.override_active);
+        assert_eq!(get_i::<M>(&mut c, "hill_climb.updates") as u64, o.updates);
+        assert!(!get_b::<M>(&mut c, "board.input_fault"));
         moved |= o.command_v != 5.0;
     }
     assert!(moved, "the drive should move the valve");
@@ -200,9 +203,12 @@ fn skyhook_fmu_equals_physics() {
     type M = SkyHookController;
     for (mode, source) in [(0, 0), (1, 0), (1, 1)] {
         let (mut c, _log) = init::<M>();
-        assert_eq!(set_i::<M>(&mut c, "mode", mode), Status::Ok);
-        assert_eq!(set_i::<M>(&mut c, "velocity_source", source), Status::Ok);
-        assert_eq!(set_r::<M>(&mut c, "c_sky", 200e3), Status::Ok);
+        assert_eq!(set_i::<M>(&mut c, "control.mode", mode), Status::Ok);
+        assert_eq!(
+            set_i::<M>(&mut c, "sensor.velocity_source", source),
+            Status::Ok
+        );
+        assert_eq!(set_r::<M>(&mut c, "damping.sky_hook", 200e3), Status::Ok);
         assert_eq!(c.exit_initialization_mode(), Status::Ok);
         let mut p = SkyHook::new(SkyHookParams {
             mode: if mode == 1 {
@@ -243,10 +249,13 @@ fn skyhook_fmu_equals_physics() {
                 .unwrap();
             assert_eq!(get_r::<M>(&mut c, "valve.command"), o.command_v);
             assert_eq!(get_r::<M>(&mut c, "valve.opening"), o.opening);
-            assert_eq!(get_r::<M>(&mut c, "damping_desired"), o.c_desired_nspm);
-            assert_eq!(get_r::<M>(&mut c, "condition"), o.condition);
-            assert_eq!(get_r::<M>(&mut c, "absolute_velocity"), o.abs_velocity_mps);
-            assert_eq!(get_b::<M>(&mut c, "on_state"), o.on_state);
+            assert_eq!(get_r::<M>(&mut c, "damping.desired"), o.c_desired_nspm);
+            assert_eq!(get_r::<M>(&mut c, "control.condition"), o.condition);
+            assert_eq!(
+                get_r::<M>(&mut c, "sensor.absolute_velocity"),
+                o.abs_velocity_mps
+            );
+            assert_eq!(get_b::<M>(&mut c, "control.on_state"), o.on_state);
             if o.on_state {
                 n_on += 1;
             } else {
@@ -264,8 +273,11 @@ fn skyhook_fmu_equals_physics() {
 fn idf_fmu_equals_physics() {
     type M = IdealDamperForceController;
     let (mut c, _log) = init::<M>();
-    assert_eq!(set_i::<M>(&mut c, "command_sign", -1), Status::Ok);
-    assert_eq!(set_r::<M>(&mut c, "k_p", 2e-7), Status::Ok);
+    assert_eq!(
+        set_i::<M>(&mut c, "force_loop.command_sign", -1),
+        Status::Ok
+    );
+    assert_eq!(set_r::<M>(&mut c, "force_loop.gain", 2e-7), Status::Ok);
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
     let mut p = Idf::new(IdfParams {
         command_sign: -1.0,
@@ -295,9 +307,9 @@ fn idf_fmu_equals_physics() {
             )
             .unwrap();
         assert_eq!(get_r::<M>(&mut c, "spool.command"), o.spool_command_m);
-        assert_eq!(get_r::<M>(&mut c, "force_reference"), o.force_ref_n);
-        assert_eq!(get_r::<M>(&mut c, "force_error"), o.force_error_n);
-        assert_eq!(get_b::<M>(&mut c, "saturated"), o.saturated);
+        assert_eq!(get_r::<M>(&mut c, "reference.force"), o.force_ref_n);
+        assert_eq!(get_r::<M>(&mut c, "force_loop.error"), o.force_error_n);
+        assert_eq!(get_b::<M>(&mut c, "spool.command_saturated"), o.saturated);
         saturated += usize::from(o.saturated);
     }
     assert!(saturated > 0 && saturated < 2000);
@@ -339,47 +351,51 @@ fn invalid_parameters_are_rejected_with_their_name() {
     type M = MpptController;
     // negative period: outside the declared range, rejected when set
     let (mut c, log) = init::<M>();
-    assert_set_rejects(set_r::<M>(&mut c, "period", -1.0), &log, "period");
+    assert_set_rejects(
+        set_r::<M>(&mut c, "hill_climb.period", -1.0),
+        &log,
+        "hill_climb.period",
+    );
     // zero period / not a multiple of the sample time: rejected at initialisation
     assert_exit_rejects::<M>(
-        |c| assert_eq!(set_r::<M>(c, "period", 0.0), Status::Ok),
-        "period",
+        |c| assert_eq!(set_r::<M>(c, "hill_climb.period", 0.0), Status::Ok),
+        "hill_climb.period",
     );
     assert_exit_rejects::<M>(
-        |c| assert_eq!(set_r::<M>(c, "period", 1.0005), Status::Ok),
-        "period",
+        |c| assert_eq!(set_r::<M>(c, "hill_climb.period", 1.0005), Status::Ok),
+        "hill_climb.period",
     );
     assert_exit_rejects::<M>(
-        |c| assert_eq!(set_i::<M>(c, "filter_order", 3), Status::Ok),
-        "filter_order",
+        |c| assert_eq!(set_i::<M>(c, "band_pass.order", 3), Status::Ok),
+        "band_pass.order",
     );
     assert_exit_rejects::<M>(
-        |c| assert_eq!(set_r::<M>(c, "band_high", 1.0), Status::Ok),
-        "band_high",
-    );
-    assert_exit_rejects::<M>(
-        |c| {
-            assert_eq!(set_r::<M>(c, "command_max", 5.0), Status::Ok);
-            assert_eq!(set_r::<M>(c, "initial_command", 8.0), Status::Ok);
-        },
-        "initial_command",
-    );
-    assert_exit_rejects::<M>(
-        |c| assert_eq!(set_i::<M>(c, "initial_direction", 0), Status::Ok),
-        "initial_direction",
+        |c| assert_eq!(set_r::<M>(c, "band_pass.high", 1.0), Status::Ok),
+        "band_pass.high",
     );
     assert_exit_rejects::<M>(
         |c| {
-            assert_eq!(set_r::<M>(c, "k_acc", 0.0), Status::Ok);
-            assert_eq!(set_r::<M>(c, "k_F", 0.0), Status::Ok);
+            assert_eq!(set_r::<M>(c, "valve.command_max", 5.0), Status::Ok);
+            assert_eq!(set_r::<M>(c, "valve.initial_command", 8.0), Status::Ok);
         },
-        "k_acc",
+        "valve.initial_command",
+    );
+    assert_exit_rejects::<M>(
+        |c| assert_eq!(set_i::<M>(c, "hill_climb.initial_direction", 0), Status::Ok),
+        "hill_climb.initial_direction",
+    );
+    assert_exit_rejects::<M>(
+        |c| {
+            assert_eq!(set_r::<M>(c, "cost.acceleration_weight", 0.0), Status::Ok);
+            assert_eq!(set_r::<M>(c, "cost.force_weight", 0.0), Status::Ok);
+        },
+        "cost.acceleration_weight",
     );
 
     type S = SkyHookController;
     assert_exit_rejects::<S>(
-        |c| assert_eq!(set_r::<S>(c, "c_min", 500e3), Status::Ok),
-        "c_min",
+        |c| assert_eq!(set_r::<S>(c, "damping.min", 500e3), Status::Ok),
+        "damping.min",
     );
     // damping must fall with the opening
     assert_exit_rejects::<S>(
@@ -395,12 +411,12 @@ fn invalid_parameters_are_rejected_with_their_name() {
         "table.damping[9]",
     );
     assert_exit_rejects::<S>(
-        |c| assert_eq!(set_r::<S>(c, "sample_time", 0.0), Status::Ok),
-        "sample_time",
+        |c| assert_eq!(set_r::<S>(c, "board.sample_time", 0.0), Status::Ok),
+        "board.sample_time",
     );
     assert_exit_rejects::<S>(
-        |c| assert_eq!(set_i::<S>(c, "absolute_sign", 0), Status::Ok),
-        "absolute_sign",
+        |c| assert_eq!(set_i::<S>(c, "sensor.sign", 0), Status::Ok),
+        "sensor.sign",
     );
     let (mut c, log) = init::<S>();
     assert_set_rejects(
@@ -408,16 +424,16 @@ fn invalid_parameters_are_rejected_with_their_name() {
         &log,
         "table.opening[2]",
     );
-    assert_set_rejects(set_i::<S>(&mut c, "mode", 2), &log, "mode");
+    assert_set_rejects(set_i::<S>(&mut c, "control.mode", 2), &log, "control.mode");
 
     type I = IdealDamperForceController;
     assert_exit_rejects::<I>(
-        |c| assert_eq!(set_i::<I>(c, "command_sign", 0), Status::Ok),
-        "command_sign",
+        |c| assert_eq!(set_i::<I>(c, "force_loop.command_sign", 0), Status::Ok),
+        "force_loop.command_sign",
     );
     assert_exit_rejects::<I>(
-        |c| assert_eq!(set_r::<I>(c, "u_max", 0.0), Status::Ok),
-        "u_max",
+        |c| assert_eq!(set_r::<I>(c, "spool.command_limit", 0.0), Status::Ok),
+        "spool.command_limit",
     );
 
     // a rejected initialisation can be repaired and completed
@@ -435,16 +451,16 @@ fn a_changed_table_is_used() {
     // 0 -> 400 kN.s/m, 1 -> 10 kN.s/m (other points on the line) gives opening 70/390.
     type S = SkyHookController;
     let (mut c, _log) = init::<S>();
-    assert_eq!(set_i::<S>(&mut c, "mode", 1), Status::Ok);
-    assert_eq!(set_i::<S>(&mut c, "velocity_source", 1), Status::Ok);
+    assert_eq!(set_i::<S>(&mut c, "control.mode", 1), Status::Ok);
+    assert_eq!(set_i::<S>(&mut c, "sensor.velocity_source", 1), Status::Ok);
     for i in 0..9 {
         let o = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8, 1.0][i];
         let name = format!("table.damping[{}]", i + 1);
         assert_eq!(set_r::<S>(&mut c, &name, 400e3 - 390e3 * o), Status::Ok);
     }
     // c_min/c_max do not follow a changed table (documented): set them to its ends.
-    assert_eq!(set_r::<S>(&mut c, "c_max", 400e3), Status::Ok);
-    assert_eq!(set_r::<S>(&mut c, "c_min", 10e3), Status::Ok);
+    assert_eq!(set_r::<S>(&mut c, "damping.max", 400e3), Status::Ok);
+    assert_eq!(set_r::<S>(&mut c, "damping.min", 10e3), Status::Ok);
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
     let ins = [
         vr::<S>("sensor.velocity"),
@@ -456,7 +472,7 @@ fn a_changed_table_is_used() {
     }
     let cmd = get_r::<S>(&mut c, "valve.command");
     assert!((cmd - 10.0 * 70.0 / 390.0).abs() < 1e-12, "{cmd}");
-    assert_eq!(get_r::<S>(&mut c, "damping_desired"), 330e3);
+    assert_eq!(get_r::<S>(&mut c, "damping.desired"), 330e3);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -515,7 +531,7 @@ fn step_size_independence_through_the_fmu() {
     let a = run_grid::<MpptController>(
         &|c| {
             assert_eq!(
-                set_r::<MpptController>(c, "initial_command", 5.0),
+                set_r::<MpptController>(c, "valve.initial_command", 5.0),
                 Status::Ok
             )
         },
@@ -527,7 +543,7 @@ fn step_size_independence_through_the_fmu() {
     let b = run_grid::<MpptController>(
         &|c| {
             assert_eq!(
-                set_r::<MpptController>(c, "initial_command", 5.0),
+                set_r::<MpptController>(c, "valve.initial_command", 5.0),
                 Status::Ok
             )
         },
@@ -549,7 +565,10 @@ fn step_size_independence_through_the_fmu() {
     ];
     for mode in [0, 1] {
         let setup = move |c: &mut Component| {
-            assert_eq!(set_i::<SkyHookController>(c, "mode", mode), Status::Ok)
+            assert_eq!(
+                set_i::<SkyHookController>(c, "control.mode", mode),
+                Status::Ok
+            )
         };
         let a = run_grid::<SkyHookController>(&setup, &ins, &sd, 1e-4, 2.0);
         let b = run_grid::<SkyHookController>(&setup, &ins, &sd, 1e-3, 2.0);
@@ -645,9 +664,13 @@ fn nan_input_rejected_at_set_time() {
     // the instance goes on with the previous input
     assert_eq!(c.state(), FmiState::StepComplete);
     assert_eq!(c.do_step(1e-3, 1e-3), Status::Ok);
-    assert!(!get_b::<I>(&mut c, "input_fault"));
+    assert!(!get_b::<I>(&mut c, "board.input_fault"));
     // fixed parameters cannot change after initialisation
-    assert_set_rejects(set_r::<I>(&mut c, "c_v", 1.0), &log, "c_v");
+    assert_set_rejects(
+        set_r::<I>(&mut c, "reference.damping", 1.0),
+        &log,
+        "reference.damping",
+    );
 }
 
 #[test]
@@ -655,11 +678,14 @@ fn initialization_mode_previews_initial_outputs() {
     type M = MpptController;
     let (mut c, _log) = init::<M>();
     assert_eq!(get_r::<M>(&mut c, "valve.command"), 0.0);
-    assert_eq!(set_r::<M>(&mut c, "initial_command", 6.5), Status::Ok);
+    assert_eq!(set_r::<M>(&mut c, "valve.initial_command", 6.5), Status::Ok);
     assert_eq!(get_r::<M>(&mut c, "valve.command"), 6.5);
     assert_eq!(get_r::<M>(&mut c, "valve.opening"), 0.65);
-    assert_eq!(set_i::<M>(&mut c, "initial_direction", -1), Status::Ok);
-    assert_eq!(get_i::<M>(&mut c, "direction"), -1);
+    assert_eq!(
+        set_i::<M>(&mut c, "hill_climb.initial_direction", -1),
+        Status::Ok
+    );
+    assert_eq!(get_i::<M>(&mut c, "hill_climb.direction"), -1);
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
     assert_eq!(get_r::<M>(&mut c, "valve.command"), 6.5);
     // the first board sample's command appears one sample later: still the initial command
@@ -686,7 +712,7 @@ fn warnings_and_events_only_on_change() {
         assert!(s <= Status::Warning);
         warning_steps += usize::from(s == Status::Warning);
     }
-    assert!(get_b::<M>(&mut c, "override_active"));
+    assert!(get_b::<M>(&mut c, "override.active"));
     let msgs = log.take();
     let warnings: Vec<_> = msgs
         .iter()
@@ -710,14 +736,14 @@ fn warnings_and_events_only_on_change() {
     for k in 0..100 {
         statuses.push(c.do_step(k as f64 * 1e-3, 1e-3));
     }
-    assert!(get_b::<I>(&mut c, "saturated"));
+    assert!(get_b::<I>(&mut c, "spool.command_saturated"));
     assert_eq!(
         statuses.iter().filter(|s| **s == Status::Warning).count(),
         1
     );
     assert_eq!(set_r::<I>(&mut c, "damper.force", 0.0), Status::Ok);
     assert_eq!(c.do_step(0.1, 2e-3), Status::Ok);
-    assert!(!get_b::<I>(&mut c, "saturated"));
+    assert!(!get_b::<I>(&mut c, "spool.command_saturated"));
     let msgs = log.take();
     assert_eq!(
         msgs.iter()
@@ -739,13 +765,13 @@ fn warnings_and_events_only_on_change() {
         vr::<S>("damper.elongation_velocity"),
     ];
     let mut switches = 0;
-    let mut last = get_b::<S>(&mut c, "on_state");
+    let mut last = get_b::<S>(&mut c, "control.on_state");
     for k in 0..2000 {
         let t = k as f64 * 1e-3;
         let (a, xa, ve) = skyhook_drive(t);
         assert_eq!(c.set_real(&ins, &[a, xa, ve]), Status::Ok);
         assert_eq!(c.do_step(t, 1e-3), Status::Ok);
-        let on = get_b::<S>(&mut c, "on_state");
+        let on = get_b::<S>(&mut c, "control.on_state");
         switches += usize::from(on != last);
         last = on;
     }

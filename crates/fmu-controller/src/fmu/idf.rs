@@ -83,17 +83,17 @@ impl FmuModel for IdealDamperForceController {
         let mut v: Vec<Variable<Self>> = Vec::new();
         model_description::declare! { v;
             /// Viscous gain of the reference force (3.14) (section 4.5, Table 4-3)
-            parameter "c_v" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => params.c_v_nspm;
+            parameter "reference.damping" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => params.c_v_nspm;
             // Unit m/N is not in the project's unit table: stated in the description instead.
             /// Proportional gain of (3.15), in m of spool per N of force error
-            parameter "k_p" [min = 0.0] => params.k_p_m_per_n;
+            parameter "force_loop.gain" [min = 0.0] => params.k_p_m_per_n;
             /// Spool command saturation (Table 3-2: spool stroke alpha = 1 mm)
-            parameter "u_max" [unit = "m", display_unit = "mm", min = 0.0] => params.u_max_m;
+            parameter "spool.command_limit" [unit = "m", display_unit = "mm", min = 0.0] => params.u_max_m;
             /// +1: u = k_p (F_ref - F); -1: u = k_p (F - F_ref) (seed's printed (3.15)).
             /// Must make a positive command increase the measured tension (see documentation)
-            parameter "command_sign" [range = -1.0..=1.0] => params.command_sign as Sign;
+            parameter "force_loop.command_sign" [range = -1.0..=1.0] => params.command_sign as Sign;
             /// Board sample time (1 kHz board)
-            parameter "sample_time" [unit = "s", display_unit = "ms", min = 0.0] => params.sample_time_s;
+            parameter "board.sample_time" [unit = "s", display_unit = "ms", min = 0.0] => params.sample_time_s;
 
             /// Damper (actuator rod) elongation velocity, positive = extension
             input "damper.elongation_velocity" [unit = "m/s"] => inputs.elongation_velocity_mps;
@@ -103,15 +103,15 @@ impl FmuModel for IdealDamperForceController {
             /// Spool position command u (3.15), saturated to +-u_max
             output "spool.command" [unit = "m", display_unit = "mm", discrete = true] => out.spool_command_m;
             /// Reference force F_ref = c_v v (3.14), tension positive
-            output "force_reference" [unit = "N", display_unit = "kN", discrete = true] => out.force_ref_n;
+            output "reference.force" [unit = "N", display_unit = "kN", discrete = true] => out.force_ref_n;
             /// Force error F_ref - F
-            output "force_error" [unit = "N", display_unit = "kN", discrete = true] => out.force_error_n;
+            output "force_loop.error" [unit = "N", display_unit = "kN", discrete = true] => out.force_error_n;
             /// True if the spool command is clamped at +-u_max
-            output "saturated" => out.saturated;
+            output "spool.command_saturated" => out.saturated;
             /// True if an input of the last step was not finite (sample dropped, command held)
-            output "input_fault" => out.input_fault;
+            output "board.input_fault" => out.input_fault;
             /// Board samples dropped because of non-finite inputs since the start
-            output "dropped_samples" => out.dropped_samples;
+            output "board.dropped_samples" => out.dropped_samples;
         }
         v
     }
@@ -136,33 +136,33 @@ impl FmuModel for IdealDamperForceController {
 const DOC: &str = r#"
 <h2>Law</h2>
 <p>Ideal damper force (IDF) control of the full-active actuator, seed section 3.2.2. Each board
-sample (period <code>sample_time</code>, 1 ms):</p>
+sample (period <code>board.sample_time</code>, 1 ms):</p>
 <pre>
-F_ref = c_v v                                           (3.14)
+F_ref = c_v v                                           (3.14), c_v = reference.damping
 u     = command_sign k_p (F_ref - F),  |u| &lt;= u_max      (3.15)
 </pre>
 <p>v = <code>damper.elongation_velocity</code> (positive = extension), F = <code>damper.force</code>
 (tension positive, the project's damper convention, so a passive viscous damper gives F = +c v and
 F_ref is the force of an ideal viscous damper). u = <code>spool.command</code> is the spool position
-demand in metres, saturated at <code>u_max</code> = alpha = 1 mm (Table 3-2; beyond it the orifice
+demand in metres, saturated at u_max (<code>spool.command_limit</code>) = alpha = 1 mm (Table 3-2; beyond it the orifice
 saturates anyway, (3.47)).</p>
-<h2>Sign (<code>command_sign</code>)</h2>
-<p>The loop is stable only if a positive <code>command_sign</code> x u <em>increases</em> the measured
+<h2>Sign (<code>force_loop.command_sign</code>)</h2>
+<p>The loop is stable only if a positive command_sign x u <em>increases</em> the measured
 tension. Default -1, which our FullActiveActuator needs (its test closes the loop with -1;
 +1 runs away). The seed's printed form u = k_p (F_YD - F_ref) also corresponds to -1. The project's full-active actuator (fmu-damper, as documented at the time of
 writing: a positive spool position feeds chamber A, whose pressure pushes the rod towards
 extension, and its force output is tension positive = minus the push force) is of the kind that
-needs <b>command_sign = -1</b>; check the actuator's documentation before coupling, a wrong sign
+needs <b><code>force_loop.command_sign</code> = -1</b>; check the actuator's documentation before coupling, a wrong sign
 makes the loop run away to the saturation.</p>
 <h2>Gain</h2>
-<p>The seed tunes k_p by trial and error. Default 3e-7 m/N: with the Table 3-2 actuator's force
+<p>The seed tunes k_p (<code>force_loop.gain</code>) by trial and error. Default 3e-7 m/N: with the Table 3-2 actuator's force
 rate per spool travel of about 7.1e8 N/(s m) the force loop crosses over near 210 rad/s, ten
 times the hunting frequency (R6), leaving about 58 deg of phase margin after the 1 ms board delay
 and the 1200 rad/s valve (3.46). The spool saturates for force errors above u_max/k_p = 3.3 kN.
 The valve dead zone (beta = 0.3 alpha) leaves a force error band that a pure P law does not
 remove.</p>
 <h2>Timing and co-simulation</h2>
-<p>Samples at <code>start_time + k sample_time</code>; the command computed from the inputs sampled at
+<p>Samples at <code>start_time + k board.sample_time</code>; the command computed from the inputs sampled at
 t_k is output from t_(k+1) on (one sample of computational delay), so no output depends on the
 inputs at the same instant (no direct feedthrough, no algebraic loop with the actuator). With a
 communication step dividing the sample time the results are independent of the step. NaN/inf

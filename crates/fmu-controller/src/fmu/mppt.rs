@@ -123,41 +123,41 @@ impl FmuModel for MpptController {
         let mut v: Vec<Variable<Self>> = Vec::new();
         model_description::declare! { v;
             /// Weight k_x of the acceleration term of the cost (3.2); Table 4-2: 1
-            parameter "k_acc" [unit = "1", min = 0.0] => params.k_acc;
+            parameter "cost.acceleration_weight" [unit = "1", min = 0.0] => params.k_acc;
             /// Weight k_F of the force term of the cost (3.2); Table 4-2: 0 = MPPT1, 4 = MPPT2
-            parameter "k_F" [unit = "1", min = 0.0] => params.k_force;
+            parameter "cost.force_weight" [unit = "1", min = 0.0] => params.k_force;
             /// Cost gain k_J of the hill-climb step (3.3) (not in the seed)
-            parameter "k_J" [unit = "V", min = 0.0] => params.k_j_v;
-            /// Valve update period (seed: every second); integer multiple of sample_time
-            parameter "period" [unit = "s", min = 0.0] => params.update_period_s;
+            parameter "hill_climb.gain" [unit = "V", min = 0.0] => params.k_j_v;
+            /// Valve update period (seed: every second); integer multiple of board.sample_time
+            parameter "hill_climb.period" [unit = "s", min = 0.0] => params.update_period_s;
             /// Length of the moving rms windows of acceleration and force
-            parameter "rms_window" [unit = "s", min = 0.0] => params.rms_window_s;
+            parameter "cost.rms_window" [unit = "s", min = 0.0] => params.rms_window_s;
             /// Emergency closing step of the instability override (3.5) (not in the seed)
-            parameter "Delta_V" [unit = "V", min = 0.0] => params.delta_v_v;
-            /// Instability threshold on the rms band-passed acceleration (3.5); default a_lim
-            parameter "threshold" [unit = "m/s2", min = 0.0] => params.acc_threshold_mps2;
+            parameter "override.closing_step" [unit = "V", min = 0.0] => params.delta_v_v;
+            /// Instability threshold on the rms band-passed acceleration (3.5); default cost.acceleration_limit
+            parameter "override.threshold" [unit = "m/s2", min = 0.0] => params.acc_threshold_mps2;
             /// EN 14363 lateral acceleration limit normalising (3.2), (12 - m/5)/2 (seed 4.2)
-            parameter "a_lim" [unit = "m/s2", min = 0.0] => params.a_lim_mps2;
+            parameter "cost.acceleration_limit" [unit = "m/s2", min = 0.0] => params.a_lim_mps2;
             /// Force normaliser of (3.2) (fixed value, or start of the running maximum)
-            parameter "F_norm" [unit = "N", display_unit = "kN", min = 0.0] => params.force_norm_n;
+            parameter "cost.force_norm" [unit = "N", display_unit = "kN", min = 0.0] => params.force_norm_n;
             /// Fixed F_norm (default) or the running maximum of the rms force (seed literal)
-            parameter "force_normaliser" => params.force_normaliser;
+            parameter "cost.force_normaliser" => params.force_normaliser;
             /// Valve command before the first update (0 V = closed, maximum damping)
-            parameter "initial_command" [unit = "V", range = 0.0..=10.0] => params.initial_command_v;
+            parameter "valve.initial_command" [unit = "V", range = 0.0..=10.0] => params.initial_command_v;
             /// Initial hill-climb direction: +1 opening, -1 closing
-            parameter "initial_direction" [range = -1.0..=1.0] => params.initial_direction as Sign;
+            parameter "hill_climb.initial_direction" [range = -1.0..=1.0] => params.initial_direction as Sign;
             /// Lower command saturation (seed 4.4.1: 0 V)
-            parameter "command_min" [unit = "V", range = 0.0..=10.0] => params.command_min_v;
+            parameter "valve.command_min" [unit = "V", range = 0.0..=10.0] => params.command_min_v;
             /// Upper command saturation (seed 4.4.1: 10 V)
-            parameter "command_max" [unit = "V", range = 0.0..=10.0] => params.command_max_v;
+            parameter "valve.command_max" [unit = "V", range = 0.0..=10.0] => params.command_max_v;
             /// Board sample time (1 kHz board)
-            parameter "sample_time" [unit = "s", display_unit = "ms", min = 0.0] => params.sample_time_s;
+            parameter "board.sample_time" [unit = "s", display_unit = "ms", min = 0.0] => params.sample_time_s;
             /// Order of the Butterworth band-pass on the acceleration: 2 or 4
-            parameter "filter_order" [range = 2.0..=4.0] => params.filter_order;
+            parameter "band_pass.order" [range = 2.0..=4.0] => params.filter_order;
             /// Band-pass lower -3 dB edge, f0 - 2 Hz (EN 14363 via seed 4.2)
-            parameter "band_low" [unit = "Hz", min = 0.0] => params.band_low_hz;
+            parameter "band_pass.low" [unit = "Hz", min = 0.0] => params.band_low_hz;
             /// Band-pass upper -3 dB edge, f0 + 2 Hz
-            parameter "band_high" [unit = "Hz", min = 0.0] => params.band_high_hz;
+            parameter "band_pass.high" [unit = "Hz", min = 0.0] => params.band_high_hz;
 
             /// Bogie frame lateral acceleration (band-passed on the board)
             input "bogie.lateral_acceleration" [unit = "m/s2"] => inputs.bogie_accel_mps2;
@@ -169,23 +169,23 @@ impl FmuModel for MpptController {
             /// Valve opening = command / 10 V
             output "valve.opening" [unit = "1", display_unit = "%", discrete = true] => out.opening;
             /// Cost J at the last update (3.2)
-            output "cost" [unit = "1", discrete = true] => out.cost;
+            output "cost.value" [unit = "1", discrete = true] => out.cost;
             /// rms of the band-passed bogie acceleration at the last update
-            output "rms_acceleration" [unit = "m/s2", discrete = true] => out.rms_accel_mps2;
+            output "cost.rms_acceleration" [unit = "m/s2", discrete = true] => out.rms_accel_mps2;
             /// rms of the damper force at the last update
-            output "rms_force" [unit = "N", display_unit = "kN", discrete = true] => out.rms_force_n;
+            output "cost.rms_force" [unit = "N", display_unit = "kN", discrete = true] => out.rms_force_n;
             /// Latest band-passed acceleration sample
-            output "filtered_acceleration" [unit = "m/s2", discrete = true] => out.filtered_accel_mps2;
+            output "band_pass.acceleration" [unit = "m/s2", discrete = true] => out.filtered_accel_mps2;
             /// Hill-climb direction (3.4): +1 opening, -1 closing
-            output "direction" => out.direction as Sign;
+            output "hill_climb.direction" => out.direction as Sign;
             /// True if the last update was the instability override (3.5)
-            output "override_active" => out.override_active;
+            output "override.active" => out.override_active;
             /// Number of valve updates performed
-            output "updates" => out.updates;
+            output "hill_climb.updates" => out.updates;
             /// True if an input of the last step was not finite (sample dropped, command held)
-            output "input_fault" => out.input_fault;
+            output "board.input_fault" => out.input_fault;
             /// Board samples dropped because of non-finite inputs since the start
-            output "dropped_samples" => out.dropped_samples;
+            output "board.dropped_samples" => out.dropped_samples;
         }
         v
     }
@@ -211,11 +211,12 @@ impl FmuModel for MpptController {
 const DOC: &str = r#"
 <h2>Law</h2>
 <p>Maximum power point tracking of the semi-active yaw damper's by-pass valve, seed section
-3.2.1.1. A sampled board (period <code>sample_time</code>, default 1 ms) band-passes the bogie
-lateral acceleration (Butterworth, order <code>filter_order</code>, edges <code>band_low</code> ..
-<code>band_high</code> = f0 &plusmn; 2 Hz with f0 = 4 Hz, EN 14363 via seed 4.2), keeps moving
-rms values of the filtered acceleration and of the damper force over <code>rms_window</code>,
-and every <code>period</code> (default 1 s, "every one second") updates the command:</p>
+3.2.1.1. A sampled board (period <code>board.sample_time</code>, default 1 ms) band-passes the
+bogie lateral acceleration (Butterworth, order <code>band_pass.order</code>, edges
+<code>band_pass.low</code> .. <code>band_pass.high</code> = f0 &plusmn; 2 Hz with f0 = 4 Hz, EN 14363
+via seed 4.2), keeps moving rms values of the filtered acceleration and of the damper force over
+<code>cost.rms_window</code>, and every <code>hill_climb.period</code> (default 1 s, "every one
+second") updates the command:</p>
 <pre>
 J = k_acc (rms_a / a_lim)^2 + k_F (rms_F / F_norm)^2                      (3.2)
 direction kept if J &lt; J_old, reversed if J &gt;= J_old                       (3.4)
@@ -228,22 +229,33 @@ update. 0 V = valve closed = maximum damping (the safe power-up state, default i
 10 V = fully open; <code>valve.opening</code> = command / 10 V.</p>
 <h2>Presets (Table 4-2)</h2>
 <ul>
-<li><b>MPPT1</b>: <code>k_acc = 1</code>, <code>k_F = 0</code> (acceleration only).</li>
-<li><b>MPPT2</b> (default): <code>k_acc = 1</code>, <code>k_F = 4</code> (acceleration and force).</li>
+<li><b>MPPT1</b>: k_acc = 1, k_F = 0 (acceleration only).</li>
+<li><b>MPPT2</b> (default): k_acc = 1, k_F = 4 (acceleration and force).</li>
+</ul>
+<h2>Symbols and variables</h2>
+<table border="1">
+<tr><th>symbol</th><th>variable</th></tr>
+<tr><td>k_acc, k_F</td><td>cost.acceleration_weight, cost.force_weight</td></tr>
+<tr><td>a_lim, F_norm</td><td>cost.acceleration_limit, cost.force_norm</td></tr>
+<tr><td>k_J</td><td>hill_climb.gain</td></tr>
+<tr><td>Delta_V, threshold</td><td>override.closing_step, override.threshold</td></tr>
+<tr><td>command_min, command_max</td><td>valve.command_min, valve.command_max</td></tr>
+</table>
+<ul>
 </ul>
 <h2>Interpretations (seed silent or garbled)</h2>
 <ul>
 <li><code>max(RMS(F))</code> in (3.2) is a running maximum in the seed, which mixes normalisers
-between J and J_old. Default: fixed <code>F_norm</code> = 10 kN (about the rms force of a closed
-valve at hunting amplitude, R1); <code>force_normaliser = 1</code> gives the seed's running maximum
-starting from F_norm.</li>
-<li><code>k_J</code> = 1 V and <code>Delta_V</code> = 2 V are not given in the seed (2 V per update
+between J and J_old. Default: fixed F_norm = 10 kN (about the rms force of a closed valve at
+hunting amplitude, R1); <code>cost.force_normaliser</code> = running_max gives the seed's running
+maximum starting from F_norm.</li>
+<li>k_J = 1 V and Delta_V = 2 V are not given in the seed (2 V per update
 closes a fully open valve in 5 s, as in Fig. 4.18).</li>
-<li><code>threshold</code> = <code>a_lim</code> = 5.39 m/s2, the EN 14363 limit of the seed's bogie.</li>
+<li>threshold = a_lim = 5.39 m/s2, the EN 14363 limit of the seed's bogie.</li>
 <li>An update period containing a dropped sample is skipped (command held, J_old kept).</li>
 </ul>
 <h2>Timing and co-simulation</h2>
-<p>Samples at <code>start_time + k sample_time</code>. The command computed from the inputs sampled at
+<p>Samples at <code>start_time + k board.sample_time</code>. The command computed from the inputs sampled at
 t_k is output from t_(k+1) on (one sample of computational delay, as on a real board), so no output
 depends on the inputs at the same instant: ModelStructure declares no direct feedthrough and a
 controller-damper loop has no algebraic loop. With a communication step that divides the sample

@@ -168,25 +168,25 @@ impl FmuModel for SkyHookController {
         let mut v: Vec<Variable<Self>> = Vec::new();
         model_description::declare! { v;
             /// On/off (3.13) or continuous (3.11)
-            parameter "mode" => params.mode;
+            parameter "control.mode" => params.mode;
             /// Absolute velocity x': estimated from sensor.acceleration (high-pass + leaky
             /// integrator, seed 2.3.2) or the ideal input sensor.velocity
-            parameter "velocity_source" => params.velocity_source;
+            parameter "sensor.velocity_source" => params.velocity_source;
             /// Sign applied to sensor.acceleration / sensor.velocity to give x' of (3.6): a mounting
             /// convention (the study uses -1 left, +1 right with the lateral frame acceleration)
-            parameter "absolute_sign" [range = -1.0..=1.0] => params.absolute_sign as Sign;
+            parameter "sensor.sign" [range = -1.0..=1.0] => params.absolute_sign as Sign;
             /// Sky-hook damping c_sky (3.6), (3.11) (not in the seed: same as c_v of (3.14))
-            parameter "c_sky" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => params.c_sky_nspm;
+            parameter "damping.sky_hook" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => params.c_sky_nspm;
             /// Off-state / lower damping bound c_min (3.11), (3.13); default: open end of the table
-            parameter "c_min" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => params.c_min_nspm;
+            parameter "damping.min" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => params.c_min_nspm;
             /// On-state / upper damping bound c_max (3.11), (3.13); default: closed end of the table
-            parameter "c_max" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => params.c_max_nspm;
+            parameter "damping.max" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => params.c_max_nspm;
             /// Corner of the high-pass and of the leaky integrator of the velocity estimate
-            parameter "filter_corner" [unit = "Hz", min = 0.0] => params.velocity_filter_corner_hz;
+            parameter "sensor.filter_corner" [unit = "Hz", min = 0.0] => params.velocity_filter_corner_hz;
             /// Board sample time (1 kHz board)
-            parameter "sample_time" [unit = "s", display_unit = "ms", min = 0.0] => params.sample_time_s;
+            parameter "board.sample_time" [unit = "s", display_unit = "ms", min = 0.0] => params.sample_time_s;
             /// Valve command before the first sample (0 V = closed)
-            parameter "initial_command" [unit = "V", range = 0.0..=10.0] => params.initial_command_v;
+            parameter "valve.initial_command" [unit = "V", range = 0.0..=10.0] => params.initial_command_v;
             /// Damper valve opening of table point (strictly increasing)
             parameter "table.opening[1]" [unit = "1", range = 0.0..=1.0] => table_opening[0];
             /// Damper valve opening of table point (strictly increasing)
@@ -233,32 +233,32 @@ impl FmuModel for SkyHookController {
             /// default: measured on SemiActiveDamper at 4 Hz, 1 mm)
             parameter "table.damping[9]" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => table_damping[8];
 
-            /// Accelerometer whose integral (x absolute_sign) is the sky-hook velocity x' of (3.6):
+            /// Accelerometer whose integral (x sensor.sign) is the sky-hook velocity x' of (3.6):
             /// the bogie's lateral acceleration as in the seed's co-simulation (4.4), or the
-            /// damper end's along its axis; used with velocity_source = 0
+            /// damper end's along its axis; used with sensor.velocity_source = estimated
             input "sensor.acceleration" [unit = "m/s2"] => inputs.sensor_accel_mps2;
-            /// Velocity of the same sensor (ideal x'); used with velocity_source = 1
+            /// Velocity of the same sensor (ideal x'); used with sensor.velocity_source = ideal
             input "sensor.velocity" [unit = "m/s"] => inputs.abs_velocity_mps;
             /// Damper elongation velocity x' - x0', positive = extension
             input "damper.elongation_velocity" [unit = "m/s"] => inputs.elongation_velocity_mps;
 
             /// By-pass valve command, 0 V = closed (maximum damping) .. 10 V = open
             output "valve.command" [unit = "V", discrete = true] => out.command_v;
-            /// Valve opening = command / 10 V (table inverse of damping_desired)
+            /// Valve opening = command / 10 V (table inverse of damping.desired)
             output "valve.opening" [unit = "1", display_unit = "%", discrete = true] => out.opening;
             /// Desired damping from (3.11) or (3.13)
-            output "damping_desired" [unit = "N.s/m", display_unit = "kN.s/m", discrete = true] => out.c_desired_nspm;
+            output "damping.desired" [unit = "N.s/m", display_unit = "kN.s/m", discrete = true] => out.c_desired_nspm;
             // Unit m2/s2 is not in the project's unit table: stated in the description instead.
             /// Condition function x' (x' - x0') = x' v_e, in m2/s2 (3.11), (3.13)
-            output "condition" [discrete = true] => out.condition;
-            /// Sky-hook velocity x' used by the law (estimated or ideal, times absolute_sign)
-            output "absolute_velocity" [unit = "m/s", discrete = true] => out.abs_velocity_mps;
+            output "control.condition" [discrete = true] => out.condition;
+            /// Sky-hook velocity x' used by the law (estimated or ideal, times sensor.sign)
+            output "sensor.absolute_velocity" [unit = "m/s", discrete = true] => out.abs_velocity_mps;
             /// True when the condition function is >= 0 (damping demanded)
-            output "on_state" => out.on_state;
+            output "control.on_state" => out.on_state;
             /// True if a used input of the last step was not finite (sample dropped, command held)
-            output "input_fault" => out.input_fault;
+            output "board.input_fault" => out.input_fault;
             /// Board samples dropped because of non-finite inputs since the start
-            output "dropped_samples" => out.dropped_samples;
+            output "board.dropped_samples" => out.dropped_samples;
         }
         v
     }
@@ -292,21 +292,22 @@ impl FmuModel for SkyHookController {
 
 const DOC: &str = r#"
 <h2>Law</h2>
-<p>Sky-hook control of the semi-active yaw damper, seed section 3.2.1.2. The ideal sky-hook force
+<p>Sky-hook control of the semi-active yaw damper, seed section 3.2.1.2 (law chosen by
+<code>control.mode</code>). The ideal sky-hook force
 is F_sky = c_sky x' (3.6) with x' the absolute velocity of the bogie-side damper end; the damper
-can only give F = c (x' - x0'), so each board sample (period <code>sample_time</code>, 1 ms)
+can only give F = c (x' - x0'), so each board sample (period <code>board.sample_time</code>, 1 ms)
 chooses the damping</p>
 <pre>
-mode = 1, continuous (3.11):  c = clamp(c_sky x' / (x' - x0'), c_min, c_max)  if x' (x' - x0') &gt;= 0
-                              c = c_min                                        otherwise
-mode = 0, on/off (3.13):      c = c_max  if x' (x' - x0') &gt;= 0,  c_min otherwise
+continuous (3.11):  c = clamp(c_sky x' / (x' - x0'), c_min, c_max)  if x' (x' - x0') &gt;= 0
+                    c = c_min                                        otherwise
+on/off (3.13):      c = c_max  if x' (x' - x0') &gt;= 0,  c_min otherwise
 </pre>
 <p>and turns c into a valve opening by inverting the damper's equivalent damping-vs-opening table
 (piecewise linear, clamped: damping above the closed value gives 0 V, below the open value 10 V);
 <code>valve.command</code> = 10 V x opening, 0 V = closed = maximum damping.</p>
 <h2>Sign conventions</h2>
 <p>Damper elongation positive = extension, x' - x0' = <code>damper.elongation_velocity</code>,
-damper force tension positive (F = +c v_e). x' = <code>absolute_sign</code> times the integrated
+damper force tension positive (F = +c v_e). x' = <code>sensor.sign</code> times the integrated
 <code>sensor.acceleration</code> (or <code>sensor.velocity</code>).</p>
 <h2>Which velocity is x' (interpretation)</h2>
 <p>The seed's co-simulation (section 4.4) gives the controller only the damper's piston velocity
@@ -315,30 +316,31 @@ acceleration: lateral and yaw motion of a hunting bogie are roughly in quadratur
 x' (x' - x0') changes sign twice per cycle, and the valve switches frequently between open and
 closed as in the seed's Figs. 4.19-4.20. Connect the bogie's lateral frame acceleration to
 <code>sensor.acceleration</code> for that behaviour (the project's study does, with
-<code>absolute_sign</code> = -1 on the left damper and +1 on the right so both switch together).
+<code>sensor.sign</code> = -1 on the left damper and +1 on the right so both switch together).
 The textbook alternative, the absolute acceleration of the bogie-side damper end along the damper
 axis, gives x' = x' - x0' when the car body does not move: the condition is then always &gt;= 0 and
 the damper stays closed except for the phase lead of the estimate.</p>
 <h2>Velocity estimate (seed 2.3.2)</h2>
-<p><code>velocity_source = 0</code> (default): x' is estimated from
+<p><code>sensor.velocity_source</code> = estimated (default): x' is estimated from
 <code>sensor.acceleration</code> by a first-order high-pass and a leaky integrator with
-the same corner <code>filter_corner</code> (0.3 Hz), G(s) = s/(s + w_c)^2: at 4 Hz the gain is
+the same corner <code>sensor.filter_corner</code> (0.3 Hz), G(s) = s/(s + w_c)^2: at 4 Hz the gain is
 within 1 % of an integrator and the phase lead 8.6 deg; an accelerometer offset gives no velocity.
-<code>velocity_source = 1</code> uses <code>sensor.velocity</code>.</p>
+<code>sensor.velocity_source</code> = ideal uses <code>sensor.velocity</code>.</p>
 <h2>Damping table</h2>
 <p><code>table.opening[i]</code> / <code>table.damping[i]</code>, i = 1..9: openings strictly
 increasing in [0, 1], damping strictly decreasing; checked at fmi2ExitInitializationMode (the
 offending element is named). The defaults are the equivalent damping c_eq = Im(F/x)/omega of the
 project's SemiActiveDamper at 4 Hz and 1 mm amplitude, measured on its calibrated model
 (325.7 kN.s/m closed ... 24.3 kN.s/m open; an end-to-end test re-measures them). Replace them by
-your damper's table when you use another damper. <code>c_min</code> and <code>c_max</code> default
-to the table's ends but do not follow a changed table. <code>c_sky</code> = 330 kN.s/m is not in
+your damper's table when you use another damper. c_min and c_max (<code>damping.min</code>,
+<code>damping.max</code>) default to the table's ends but do not follow a changed table. c_sky
+(<code>damping.sky_hook</code>) = 330 kN.s/m is not in
 the seed (same magnitude as c_v of (3.14)).</p>
 <h2>Timing and co-simulation</h2>
-<p>Samples at <code>start_time + k sample_time</code>; the command computed from the inputs sampled at
+<p>Samples at <code>start_time + k board.sample_time</code>; the command computed from the inputs sampled at
 t_k is output from t_(k+1) on (one sample of computational delay), so no output depends on the
 inputs at the same instant (no direct feedthrough, no algebraic loop with the damper). With a
 communication step dividing the sample time the results are independent of the step. NaN/inf inputs
 are rejected when set (fmi2Error); the unused absolute input may be anything finite. Switching of
-<code>on_state</code> is logged as an event (logEvents) when it changes.</p>
+<code>control.on_state</code> is logged as an event (logEvents) when it changes.</p>
 "#;

@@ -269,7 +269,7 @@ of giving NaN. sign(x') in (3.59) is regularised as tanh(x'/v_reg), v_reg = 1 mm
 damper's convention. A <b>positive spool command feeds chamber A</b> (z &gt; 0, Q_A &gt; 0), whose
 pressure pushes the rod out: it <b>decreases</b> <code>damper.force</code> (towards compression). A
 force controller u = k_p (F_ref - F) on this actuator therefore needs a command sign of -1
-(<code>command_sign = -1</code> in the project's IDF controller FMU); with +1 the loop runs away to
+(<code>force_loop.command_sign = -1</code> in the project's IDF controller FMU); with +1 the loop runs away to
 the saturation. <code>damper.power</code> = F x' is the power taken from the vehicle (negative when the
 actuator drives it); <code>damper.hydraulic_power</code> = P_S Q_S - P_T Q_T is drawn from the
 supply.</p>

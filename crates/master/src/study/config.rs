@@ -15,8 +15,8 @@
 //! * each controller takes the signals of its own side: the left MPPT board the frame
 //!   acceleration over the front axle box, the right one over the rear axle box; sky-hook the
 //!   same accelerations and the elongation velocity of its own damper; IDF the elongation
-//!   velocity and force of its own actuator. IDF `command_sign = -1` (a positive spool command
-//!   pushes the rod out, i.e. compression in the tension-positive convention).
+//!   velocity and force of its own actuator. IDF `force_loop.command_sign = -1` (a positive
+//!   spool command pushes the rod out, i.e. compression in the tension-positive convention).
 //! * MPPT band-pass 2-8 Hz instead of the controller's default 2-6 Hz: our bogie hunts at
 //!   4.4 Hz at onset but its flange-contact limit cycles run at 5.5-6.5 Hz (EN 14363: f0 +- 2 Hz).
 //! * MPPT instability threshold (3.5) = 2.7 m/s^2 = a_lim / 2 (the seed gives no number): the
@@ -24,7 +24,7 @@
 //!   threshold = a_lim the emergency closing stopped half way (4 V) and the limit cycle stayed.
 //! * Sky-hook: x' of (3.6) is estimated from the frame lateral acceleration over the axle box
 //!   of the controller's side (the signal the seed's co-simulation gives the controllers, 4.4),
-//!   `absolute_sign` -1 left / +1 right so both dampers switch together; otherwise the
+//!   `sensor.sign` -1 left / +1 right so both dampers switch together; otherwise the
 //!   controller's defaults (corner 0.3 Hz; c_sky = 330 kNs/m; damping table of our damper at
 //!   4 Hz). See fmu-controller's skyhook module for why not the damper end's velocity.
 //! * The bogie starts centred (initial displacement 0) on the irregular track; the
@@ -207,7 +207,7 @@ pub mod var {
     pub const FORCE_RIGHT_DAMPER: &str = "damper_right.damper.force";
     pub const FORCE_LEFT_ACTUATOR: &str = "actuator_left.damper.force";
     pub const FORCE_RIGHT_ACTUATOR: &str = "actuator_right.damper.force";
-    pub const FORCE_REFERENCE_LEFT: &str = "idf_left.force_reference";
+    pub const FORCE_REFERENCE_LEFT: &str = "idf_left.reference.force";
     /// Mechanical power taken from the vehicle, F v (the seed's "dissipated power").
     pub const POWER_LEFT: &str = "actuator_left.damper.power";
     pub const POWER_RIGHT: &str = "actuator_right.damper.power";
@@ -217,10 +217,10 @@ pub mod var {
     pub const COMMAND_LEFT: &str = "controller_left.valve.command";
     pub const COMMAND_RIGHT: &str = "controller_right.valve.command";
     pub const OPENING_LEFT: &str = "damper_left.valve.opening";
-    pub const MPPT_INITIAL_LEFT: &str = "controller_left.initial_command";
-    pub const MPPT_INITIAL_RIGHT: &str = "controller_right.initial_command";
-    pub const CV_LEFT: &str = "idf_left.c_v";
-    pub const CV_RIGHT: &str = "idf_right.c_v";
+    pub const MPPT_INITIAL_LEFT: &str = "controller_left.valve.initial_command";
+    pub const MPPT_INITIAL_RIGHT: &str = "controller_right.valve.initial_command";
+    pub const CV_LEFT: &str = "idf_left.reference.damping";
+    pub const CV_RIGHT: &str = "idf_right.reference.damping";
 }
 
 /// Where the study takes its system descriptions and FMUs from.
@@ -453,7 +453,7 @@ mod tests {
             .iter()
             .find(|i| i.name == "controller_left")
             .unwrap();
-        assert_eq!(ctl.parameters["initial_command"], Value::from(8.0));
+        assert_eq!(ctl.parameters["valve.initial_command"], Value::from(8.0));
         let ideal = RunRequest::new("p-", configuration("passive").unwrap(), 220.0, None, 5.0);
         assert_eq!(ideal.name, "p-passive_v220_ideal");
         assert_eq!(ideal.parameters()[var::TRACK_SOURCE], Value::from(0));
