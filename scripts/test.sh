@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The project's test command (also what CI runs): installs what it needs, checks formatting and
-# lints, builds and packages every FMU, runs all Rust tests, validates and simulates every FMU
-# with fmpy and compares fmpy's results with the same physics called directly from Rust.
+# lints, builds and packages every FMU, checks every FMU with the third-party validators (when
+# ../shared/validators is there), runs all Rust tests, validates and simulates every FMU with fmpy
+# and compares fmpy's results with the same physics called directly from Rust.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
@@ -26,6 +27,27 @@ package_fmus
 
 step "portable binaries: each FMU binary fits its platform folder; Linux ones need glibc <= 2.17"
 cargo run --release -q -p fmu-binary -- dist/*.fmu
+
+step "third-party validators (fmusim, fmuCheck) on every FMU in dist/"
+# ../shared/validators/check_fmu.sh (relative to the repository root) runs fmusim validate and
+# simulate and fmuCheck on one FMU over its default experiment; it is not part of this
+# repository, so the step is skipped, saying so, where it is not installed.
+validators="../shared/validators/check_fmu.sh"
+if [ -x "$validators" ]; then
+    failed=0
+    for fmu in dist/*.fmu; do
+        if "$validators" "$fmu" > "target/validators-$(basename "$fmu" .fmu).log" 2>&1; then
+            echo "$fmu: PASS"
+        else
+            echo "$fmu: FAIL"
+            cat "target/validators-$(basename "$fmu" .fmu).log"
+            failed=1
+        fi
+    done
+    [ "$failed" -eq 0 ] || { echo "third-party validators failed"; exit 1; }
+else
+    echo "SKIPPED: $validators not found (the third-party validators are not installed here)"
+fi
 
 step "fmpy: validate and simulate every FMU in dist/"
 rm -rf target/fmpy

@@ -1,4 +1,5 @@
-"""Validate every FMU in a folder with fmpy and simulate it over its default experiment.
+"""Validate every FMU in a folder with fmpy, check its Enumerations as fmpy reads them, and
+simulate it over its default experiment.
 
 Usage: python check_fmus.py DIST_DIR OUT_DIR
 Writes OUT_DIR/<model>.csv (time and every output) for the Rust cross-check
@@ -10,6 +11,27 @@ import sys
 
 from fmpy import read_model_description, simulate_fmu
 from fmpy.validation import validate_fmu
+
+
+def check_enumerations(md):
+    """Every Enumeration variable resolves, in fmpy, to its declared type with named items, and
+    its start value is one of them (what a host shows the user). Prints what fmpy shows."""
+    problems = []
+    for v in md.modelVariables:
+        if v.type != "Enumeration":
+            continue
+        t = v.declaredType
+        if t is None or not t.items:
+            problems.append(f"{v.name}: no declared type with items")
+            continue
+        items = {str(i.value): i.name for i in t.items}
+        if v.start is not None and str(v.start) not in items:
+            problems.append(f"{v.name}: start {v.start} is not an item of {t.name}")
+            continue
+        shown = ", ".join(f"{k} = {n}" for k, n in items.items())
+        start = f"start {items[str(v.start)]}" if v.start is not None else "no start"
+        print(f"  {v.name}: {t.name} ({shown}), {start}")
+    return problems
 
 
 def main(dist, out):
@@ -29,6 +51,13 @@ def main(dist, out):
                 print(f"  {p}")
             continue
         md = read_model_description(path)
+        enum_problems = check_enumerations(md)
+        if enum_problems:
+            failed += 1
+            print(f"{name}: {len(enum_problems)} enumeration problem(s)")
+            for p in enum_problems:
+                print(f"  {p}")
+            continue
         de = md.defaultExperiment
         start, stop, step = float(de.startTime), float(de.stopTime), float(de.stepSize)
         outputs = [v.name for v in md.modelVariables if v.causality == "output" and v.type == "Real"]

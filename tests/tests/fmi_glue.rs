@@ -338,3 +338,30 @@ fn unsupported_functions_return_error_with_message() {
     let version = unsafe { std::ffi::CStr::from_ptr(inst.b().fmi2GetVersion()) };
     assert_eq!(version.to_str(), Ok("2.0"));
 }
+
+#[test]
+fn a_literal_hash_reaches_the_host_logger_doubled() {
+    // FMI 2.0 reserves '#' in log messages for variable references (#r12#); the MPPT logs
+    // "valve update #1", which a strict logger (fmuCheck) would misread.
+    let f = TestFmu::open_dist("MpptController").unwrap();
+    let inst = f.instantiate("hash").unwrap();
+    let on = unsafe {
+        inst.b()
+            .fmi2SetDebugLogging(inst.component, 1, 0, std::ptr::null())
+    };
+    assert_eq!(on, OK);
+    assert_eq!(inst.initialize(0.0), OK);
+    let h = 1.0e-3;
+    for k in 0..1100 {
+        assert!(inst.do_step(k as f64 * h, h) <= WARNING);
+    }
+    let msgs = inst.messages();
+    let update = msgs
+        .iter()
+        .find(|m| m.contains("valve update"))
+        .unwrap_or_else(|| panic!("no valve update logged: {msgs:?}"));
+    assert!(update.contains("valve update ##1:"), "{update}");
+    for m in &msgs {
+        assert!(!m.replace("##", "").contains('#'), "a bare '#' in: {m}");
+    }
+}

@@ -4,7 +4,8 @@
 //! GUID, so the same library is shipped in each model's FMU under its modelIdentifier.
 //!
 //! Every function catches panics (none crosses the C boundary), checks its pointers, and
-//! reports failures through the host's logger with the message passed as a `%s` argument.
+//! reports failures through the host's logger with the message passed as a `%s` argument and
+//! every '#' doubled (FMI 2.0 reserves '#' for variable references in log messages).
 
 #![allow(clippy::missing_safety_doc)]
 
@@ -114,11 +115,17 @@ fn c_string_lossy(s: &str) -> CString {
     CString::new(s.replace('\0', " ")).unwrap_or_default()
 }
 
+/// A log message as the host's logger receives it: FMI 2.0 (2.1.5) reserves '#' for variable
+/// references such as `#r12#`, so a literal '#' is written '##'; NUL bytes become spaces.
+pub fn host_message(message: &str) -> CString {
+    c_string_lossy(&message.replace('#', "##"))
+}
+
 impl LogSink for HostLogger {
     fn log(&mut self, status: Status, category: &str, message: &str) {
         if let Some(cb) = self.callback {
             let category = c_string_lossy(category);
-            let message = c_string_lossy(message);
+            let message = host_message(message);
             // SAFETY: a logger the host gave us; the message goes in as a "%s" argument, never
             // as the format string, so '%' in a message cannot be misread.
             unsafe {
@@ -181,7 +188,7 @@ unsafe fn early_log(functions: *const fmi2CallbackFunctions, name: *const c_char
     }
     let f = &*functions;
     if let Some(cb) = f.logger {
-        let message = c_string_lossy(msg);
+        let message = host_message(msg);
         let fallback = c"";
         let name = if name.is_null() {
             fallback.as_ptr()

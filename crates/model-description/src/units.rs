@@ -1,5 +1,7 @@
 //! Unit definitions written to `<UnitDefinitions>`: SI base-unit exponents per unit, plus
-//! display units (km/h for m/s, kN for N, bar for Pa, mm for m, deg for rad, % for 1).
+//! display units (km/h for m/s, kN for N, bar for Pa, mm for m, deg for rad, % for 1). A unit
+//! whose SI exponents are not integers (an orifice coefficient in m3/(s.Pa^0.5)) is written
+//! without a BaseUnit, which FMI 2.0 allows.
 
 /// A unit and its SI base-unit exponents (kg, m, s, A, K, mol, cd, rad).
 #[derive(Clone, Copy, Debug)]
@@ -10,6 +12,9 @@ pub struct UnitDef {
     pub s: i32,
     pub a: i32,
     pub rad: i32,
+    /// Whether the exponents above are the unit's (false: no integer exponents exist, no
+    /// BaseUnit is written).
+    pub base: bool,
     /// (name, factor, offset): display value = factor * value + offset.
     pub display: &'static [(&'static str, f64, f64)],
 }
@@ -30,7 +35,19 @@ const fn unit(
         s,
         a,
         rad,
+        base: true,
         display,
+    }
+}
+
+/// A unit with no integer SI exponents (no BaseUnit in the XML).
+const fn unit_without_base(
+    name: &'static str,
+    display: &'static [(&'static str, f64, f64)],
+) -> UnitDef {
+    UnitDef {
+        base: false,
+        ..unit(name, 0, 0, 0, 0, 0, display)
     }
 }
 
@@ -53,6 +70,8 @@ pub const UNITS: &[UnitDef] = &[
     unit("m3", 0, 3, 0, 0, 0, &[("l", 1000.0, 0.0)]),
     unit("m3/s", 0, 3, -1, 0, 0, &[("l/min", 60000.0, 0.0)]),
     unit("m3/(s.Pa)", -1, 4, 1, 0, 0, &[]),
+    // Orifice flow coefficient Q = C sqrt(dP): kg^-1/2 m^7/2, no integer exponents.
+    unit_without_base("m3/(s.Pa^0.5)", &[]),
     unit("kg", 1, 0, 0, 0, 0, &[("t", 1.0e-3, 0.0)]),
     unit("kg.m2", 1, 2, 0, 0, 0, &[]),
     unit("kg/m3", 1, -3, 0, 0, 0, &[]),

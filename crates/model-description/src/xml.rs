@@ -57,6 +57,16 @@ pub enum DeclarationError {
     },
     #[error("model {model}: cannot create a default instance: {reason}")]
     Instantiate { model: String, reason: String },
+    #[error(
+        "model {model}: DefaultExperiment from {start} to {stop} s is not a whole number of \
+         {step} s steps in floating point (strict hosts refuse it)"
+    )]
+    BadDefaultExperiment {
+        model: String,
+        start: f64,
+        stop: f64,
+        step: f64,
+    },
     #[error("model {model}: enumeration type '{name}': {reason}")]
     BadEnumeration {
         model: String,
@@ -195,6 +205,15 @@ pub fn check_declaration<M: FmuModel>(
             }
         }
     }
+    let de = M::INFO.default_experiment;
+    if !default_experiment_is_exact(de.start_time, de.stop_time, de.step_size) {
+        return Err(DeclarationError::BadDefaultExperiment {
+            model,
+            start: de.start_time,
+            stop: de.stop_time,
+            step: de.step_size,
+        });
+    }
     for e in enumeration_types(vars) {
         let bad = |reason: String| DeclarationError::BadEnumeration {
             model: model.clone(),
@@ -272,6 +291,18 @@ pub fn check_declaration<M: FmuModel>(
             Ok(Some(start))
         })
         .collect()
+}
+
+/// Whether `stop - start` is a whole number n of `step`s exactly in floating point: `(stop -
+/// start) / step == n` and `start + n step == stop`. Strict hosts (fmusim) refuse a default
+/// experiment where 0.3 / 1e-4 = 2999.9999999999995.
+pub fn default_experiment_is_exact(start: f64, stop: f64, step: f64) -> bool {
+    if !(start.is_finite() && stop.is_finite() && step.is_finite() && step > 0.0 && stop > start) {
+        return false;
+    }
+    let ratio = (stop - start) / step;
+    let n = ratio.round();
+    ratio == n && start + n * step == stop
 }
 
 /// The Enumeration types the variables use, each once, in order of first use (types are
@@ -373,19 +404,27 @@ fn render<M: FmuModel>(vars: &[Variable<M>], starts: &[Option<StartValue>]) -> S
     if !used.is_empty() {
         let _ = writeln!(x, "  <UnitDefinitions>");
         for def in units::UNITS.iter().filter(|u| used.contains(u.name)) {
-            let _ = write!(x, r#"    <Unit name="{}"><BaseUnit"#, escape(def.name));
-            for (attr, exp) in [
-                ("kg", def.kg),
-                ("m", def.m),
-                ("s", def.s),
-                ("A", def.a),
-                ("rad", def.rad),
-            ] {
-                if exp != 0 {
-                    let _ = write!(x, r#" {attr}="{exp}""#);
-                }
+            let _ = write!(x, r#"    <Unit name="{}""#, escape(def.name));
+            if !def.base && def.display.is_empty() {
+                let _ = writeln!(x, "/>");
+                continue;
             }
-            let _ = write!(x, "/>");
+            let _ = write!(x, ">");
+            if def.base {
+                let _ = write!(x, "<BaseUnit");
+                for (attr, exp) in [
+                    ("kg", def.kg),
+                    ("m", def.m),
+                    ("s", def.s),
+                    ("A", def.a),
+                    ("rad", def.rad),
+                ] {
+                    if exp != 0 {
+                        let _ = write!(x, r#" {attr}="{exp}""#);
+                    }
+                }
+                let _ = write!(x, "/>");
+            }
             for (name, factor, offset) in def.display {
                 let _ = write!(
                     x,
@@ -584,6 +623,15 @@ mod tests {
     #[test]
     fn escaping() {
         assert_eq!(escape(r#"<a & "b">"#), "&lt;a &amp; &quot;b&quot;&gt;");
+    }
+
+    #[test]
+    fn default_experiments_that_strict_hosts_accept() {
+        assert!(default_experiment_is_exact(0.0, 5.0, 1e-3));
+        assert!(default_experiment_is_exact(0.0, 0.25, 1e-4));
+        assert!(!default_experiment_is_exact(0.0, 0.3, 1e-4));
+        assert!(!default_experiment_is_exact(0.0, 1.0, 0.0));
+        assert!(!default_experiment_is_exact(0.0, 1.0, 0.3));
     }
 
     #[test]

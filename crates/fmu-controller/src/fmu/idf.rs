@@ -84,9 +84,8 @@ impl FmuModel for IdealDamperForceController {
         model_description::declare! { v;
             /// Viscous gain of the reference force (3.14) (section 4.5, Table 4-3)
             parameter "reference.damping" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => params.c_v_nspm;
-            // Unit m/N is not in the project's unit table: stated in the description instead.
-            /// Proportional gain of (3.15), in m of spool per N of force error
-            parameter "force_loop.gain" [min = 0.0] => params.k_p_m_per_n;
+            /// k_p: proportional gain of (3.15), m of spool per N of force error
+            parameter "force_loop.gain" [unit = "m/N", min = 0.0] => params.k_p_m_per_n;
             /// Spool command saturation (Table 3-2: spool stroke alpha = 1 mm)
             parameter "spool.command_limit" [unit = "m", display_unit = "mm", min = 0.0] => params.u_max_m;
             /// +1: u = k_p (F_ref - F); -1: u = k_p (F - F_ref) (seed's printed (3.15)).

@@ -82,7 +82,11 @@ impl SkyHookController {
                 return Err(bad(
                     "table_opening",
                     i,
-                    format!("openings must be strictly increasing: {o} after {o_prev}"),
+                    format!(
+                        "openings must increase strictly: {o} is not above table_opening[{}] = \
+                         {o_prev}",
+                        i - 1
+                    ),
                 ));
             }
             let (c, c_prev) = (self.table_damping[i], self.table_damping[i - 1]);
@@ -90,7 +94,11 @@ impl SkyHookController {
                 return Err(bad(
                     "table_damping",
                     i,
-                    format!("damping must decrease strictly with the opening: {c} after {c_prev}"),
+                    format!(
+                        "damping must decrease strictly with the opening: {c} is not below \
+                         table_damping[{}] = {c_prev}",
+                        i - 1
+                    ),
                 ));
             }
         }
@@ -248,9 +256,8 @@ impl FmuModel for SkyHookController {
             output "valve.opening" [unit = "1", display_unit = "%", discrete = true] => out.opening;
             /// Desired damping from (3.11) or (3.13)
             output "damping.desired" [unit = "N.s/m", display_unit = "kN.s/m", discrete = true] => out.c_desired_nspm;
-            // Unit m2/s2 is not in the project's unit table: stated in the description instead.
-            /// Condition function x' (x' - x0') = x' v_e, in m2/s2 (3.11), (3.13)
-            output "control.condition" [discrete = true] => out.condition;
+            /// Condition function x' (x' - x0') = x' v_e (3.11), (3.13)
+            output "control.condition" [unit = "m2/s2", discrete = true] => out.condition;
             /// Sky-hook velocity x' used by the law (estimated or ideal, times sensor.sign)
             output "sensor.absolute_velocity" [unit = "m/s", discrete = true] => out.abs_velocity_mps;
             /// True when the condition function is >= 0 (damping demanded)

@@ -60,7 +60,8 @@ impl FmuModel for FullActiveActuator {
         version: "0.1.0",
         default_experiment: DefaultExperiment {
             start_time: 0.0,
-            stop_time: 0.3,
+            // 0.25 s is 2500 steps exactly in floating point (0.3 / 1e-4 is not).
+            stop_time: 0.25,
             step_size: 1e-4,
         },
         documentation_html: ACTUATOR_DOC,

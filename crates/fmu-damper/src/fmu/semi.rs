@@ -144,8 +144,8 @@ macro_rules! declare_damper_parameters {
             parameter "damper.chamber_volume" [unit = "m3", display_unit = "l", min = 0.0] => s.params.chamber_volume_m3;
             /// K of (3.43): effective bulk modulus (oil + entrained air + hoses), calibrated to R1-R2
             parameter "damper.bulk_modulus" [unit = "Pa", display_unit = "bar", min = 0.0] => s.params.bulk_modulus_pa;
-            /// C_f of (3.42), m3/(s Pa^0.5): flow through the piston's internal valves, calibrated (R1 at 0 %)
-            parameter "damper.piston_flow_coefficient" [min = 0.0] => s.params.piston_flow_coeff;
+            /// C_f of (3.42): flow through the piston's internal valves, calibrated (R1 at 0 %)
+            parameter "damper.piston_flow_coefficient" [unit = "m3/(s.Pa^0.5)", min = 0.0] => s.params.piston_flow_coeff;
             /// f(v_ref): value of the cubic-root velocity function of (3.43) at v_ref, calibrated
             parameter "damper.velocity_flow_reference" [unit = "m3/s", display_unit = "l/min", min = 0.0] => s.params.velocity_flow_ref_m3ps;
             /// v_ref: reference velocity of the cubic-root velocity function (scale only)
