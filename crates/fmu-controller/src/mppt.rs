@@ -163,10 +163,16 @@ impl MpptParams {
         check_finite_pos("rms_window_s", self.rms_window_s)?;
         let w = self.rms_window_s / self.sample_time_s;
         if w.round() < 1.0 {
-            return Err(ParamError::new("rms_window_s", "shorter than one sample"));
+            return Err(ParamError::new(
+                "rms_window_s",
+                "shorter than one sample of sample_time_s",
+            ));
         }
         if w > 1e7 {
-            return Err(ParamError::new("rms_window_s", "more than 1e7 samples"));
+            return Err(ParamError::new(
+                "rms_window_s",
+                "more than 1e7 samples of sample_time_s",
+            ));
         }
         BandPass::butterworth(
             self.filter_order,

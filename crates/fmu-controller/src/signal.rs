@@ -139,7 +139,10 @@ impl BandPass {
         if f_high_hz >= 0.9 * nyq {
             return Err(ParamError::new(
                 "band_high_hz",
-                format!("must be below 0.9 x Nyquist = {} Hz", 0.9 * nyq),
+                format!(
+                    "must be below 0.9 x Nyquist of sample_time_s = {} Hz",
+                    0.9 * nyq
+                ),
             ));
         }
         // Pre-warped analog edges so the digital -3 dB points are exact.

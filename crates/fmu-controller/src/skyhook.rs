@@ -222,7 +222,7 @@ impl SkyHookParams {
         if self.velocity_filter_corner_hz > 0.05 / self.sample_time_s {
             return Err(ParamError::new(
                 "velocity_filter_corner_hz",
-                "must be below a tenth of the Nyquist frequency",
+                "must be below a tenth of the Nyquist frequency of sample_time_s",
             ));
         }
         check_sign("absolute_sign", self.absolute_sign)?;

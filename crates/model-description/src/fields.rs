@@ -59,11 +59,11 @@ pub fn variable_for_field<'a>(metas: &'a [VarMeta], field: &str) -> Option<&'a V
 }
 
 /// `text` with every physics field name in it (an identifier token containing '_', optionally
-/// dotted: `area_b_m2`, `valve.time_constant_s`) replaced by the FMI name of the variable bound
+/// dotted or indexed: `area_b_m2`, `valve.time_constant_s`, `table_opening[2]`) replaced by the FMI name of the variable bound
 /// to it, so messages such as "must exceed area_b_m2 * half_stroke_m" speak the FMU's language.
 /// Plain words stay as they are.
 pub fn rename_fields(text: &str, metas: &[VarMeta]) -> String {
-    let is_ident = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '.';
+    let is_ident = |c: char| c.is_ascii_alphanumeric() || matches!(c, '_' | '.' | '[' | ']');
     let mut out = String::with_capacity(text.len() + 16);
     let mut rest = text;
     while let Some(start) = rest.find(is_ident) {
@@ -158,6 +158,7 @@ mod tests {
             meta("damper.stroke", "out.elongation_m", Causality::Output),
             meta("a.x", "p.x_m", Causality::Parameter),
             meta("b.x", "q.x_m", Causality::Parameter),
+            meta("table.x[3]", "table_x[2]", Causality::Parameter),
         ]
     }
 
@@ -193,6 +194,10 @@ mod tests {
             "`x` must be > cylinder.area_b * cylinder.half_stroke. area_b_m2x contact ..."
         );
         assert_eq!(rename_fields("", &m), "");
+        assert_eq!(
+            rename_fields("must exceed table_x[2] = 1 (in [0, 1])", &m),
+            "must exceed table.x[3] = 1 (in [0, 1])"
+        );
     }
 
     struct E(&'static str);
