@@ -381,3 +381,37 @@ fn every_parameter_error_names_a_declared_variable() {
     );
     cross_parameter_error::<SkyHookController>(&[("table.damping[4]", 5e5)], &["table.damping[4]"]);
 }
+
+fn state_round_trip<M: FmuModel>() {
+    let name = M::INFO.name;
+    let de = M::INFO.default_experiment;
+    let (mut c, log) = rust_component::<M>(InstanceContext::default()).unwrap();
+    let check = |c: &mut Component, when: &str| {
+        let snap = c.get_fmu_state().ok().unwrap();
+        let bytes = c.serialize_fmu_state(&snap).ok().unwrap();
+        assert!(
+            c.deserialize_fmu_state(&bytes).is_ok(),
+            "{name}: the state {when} does not deserialise: {:?}",
+            log.take()
+        );
+    };
+    check(&mut c, "after instantiation");
+    assert_eq!(
+        c.setup_experiment(de.start_time, Some(de.stop_time)),
+        Status::Ok
+    );
+    assert_eq!(c.enter_initialization_mode(), Status::Ok);
+    assert!(c.exit_initialization_mode() <= Status::Warning);
+    check(&mut c, "after initialisation");
+    for k in 0..200 {
+        let t = de.start_time + k as f64 * de.step_size;
+        assert!(c.do_step(t, de.step_size) <= Status::Warning, "{name}");
+    }
+    check(&mut c, "after 200 steps");
+}
+
+/// The deserialiser refuses non-finite numbers: no model may hold one in a legitimate state.
+#[test]
+fn every_model_state_passes_the_deserialisation_checks() {
+    for_each_model!(state_round_trip);
+}

@@ -2,13 +2,15 @@
 //! Thin: parameters map onto [`Params`], inputs onto [`Inputs`], outputs come from
 //! [`Outputs`]; the FMI machinery is in `model-description`.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use model_description::{
-    field_error, fmi_enum, DefaultExperiment, Diagnostics, FieldError, FmuModel, InstanceContext,
-    ModelError, ModelInfo, StepError, Variable,
+    field_error, fmi_enum, read_parameter_file, DefaultExperiment, Diagnostics, FieldError,
+    FmuModel, InstanceContext, ModelError, ModelInfo, StepError, Variable,
+    MAX_PARAMETER_FILE_BYTES,
 };
 use serde::{Deserialize, Serialize};
+use wheel_rail::GeometryTable;
 
 use crate::model::{Bogie, Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep};
 use crate::params::{ContactSource, ModelKind, ParamError, Params, PsdLevel, TrackSource};
@@ -92,6 +94,21 @@ impl FieldError for PhysicsModelError {
             PhysicsModelError::Param(p) => p.reason(),
             PhysicsModelError::Contact(c) => c.to_string(),
         }
+    }
+}
+
+/// A contact-table file refused or unreadable: about the shell's field `contact`.
+struct ContactFileError(String);
+
+impl std::fmt::Display for ContactFileError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl FieldError for ContactFileError {
+    fn field(&self) -> Option<&str> {
+        Some("contact")
     }
 }
 
@@ -234,7 +251,8 @@ impl FmuModel for Bogie2Dof {
             /// (worn-profile surrogate), "worn", "AA" (EN 15302 profiles A/A), "synthetic" (cone +
             /// flange), or a CSV file (y_m,delta_r_left_m,delta_r_right_m,tan_gamma_left,tan_gamma_right);
             /// a relative name is looked up in the FMU's resources/ first (shipped:
-            /// wheel_rail_worn_surrogate.csv, wheel_rail_A_A.csv)
+            /// wheel_rail_worn_surrogate.csv, wheel_rail_A_A.csv); a regular file of at most
+            /// 64 MiB (a FIFO, device or directory is refused without being opened)
             parameter "contact.table" => contact;
             /// Initial lateral displacement y of the bogie centre (positive right)
             parameter "initial.lateral_displacement" [unit = "m", display_unit = "mm", range = -0.05..=0.05] => params.initial_lateral_m;
@@ -376,7 +394,19 @@ impl FmuModel for Bogie2Dof {
     fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
         let params = self.build_params();
         params.validate().map_err(|e| field_error::<Self>(&e))?;
-        let b = Bogie::new(params).map_err(|e| field_error::<Self>(&e))?;
+        let b = match &params.contact {
+            // A file named by the host: a regular file of sane size only, checked before it is
+            // opened (a FIFO must not block the host, /dev/zero must not fill its memory).
+            ContactSource::File(path) => {
+                let text = read_parameter_file(Path::new(path), MAX_PARAMETER_FILE_BYTES)
+                    .map_err(|e| field_error::<Self>(&ContactFileError(e.to_string())))?;
+                let table = GeometryTable::parse_csv(&text, path)
+                    .map_err(|e| field_error::<Self>(&PhysicsModelError::from(e)))?;
+                Bogie::with_table(params, table)
+            }
+            _ => Bogie::new(params),
+        }
+        .map_err(|e| field_error::<Self>(&e))?;
         self.out = b
             .outputs(&self.inputs)
             .map_err(|e| field_error::<Self>(&e))?;

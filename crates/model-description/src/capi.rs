@@ -121,6 +121,22 @@ pub fn host_message(message: &str) -> CString {
     c_string_lossy(&message.replace('#', "##"))
 }
 
+/// Most value references (or log categories) one call may pass. FMI sets no bound, but a
+/// host passing a wrong count (e.g. 2^31-1) must get fmi2Error, not a read past its arrays or
+/// an allocation abort; 2^20 is far above any model here (the largest has 63 variables).
+pub const MAX_VALUES_PER_CALL: usize = 1 << 20;
+
+/// Largest serialised FMU state accepted (256 MiB; the largest here, a bogie with a fine
+/// contact table, is well below 1 MiB).
+pub const MAX_STATE_BYTES: usize = 1 << 28;
+
+fn too_many(cc: &mut CComponent, call: &str, n: usize) -> Status {
+    cc.component.error(&format!(
+        "{call}: {n} values in one call is more than the {MAX_VALUES_PER_CALL} this FMU accepts \
+         (a wrong count?)"
+    ))
+}
+
 impl LogSink for HostLogger {
     fn log(&mut self, status: Status, category: &str, message: &str) {
         if let Some(cb) = self.callback {
@@ -147,6 +163,9 @@ pub struct CComponent {
     component: Component,
     /// Cached bytes of the last serialised state (size query, then serialise).
     serialized: Option<(usize, Vec<u8>)>,
+    /// Booleans converted from/to fmi2Boolean, kept so that the get/set path allocates only
+    /// when a call passes more values than any before.
+    booleans: Vec<bool>,
 }
 
 unsafe fn str_arg<'a>(p: *const c_char) -> Option<&'a str> {
@@ -271,6 +290,7 @@ pub unsafe fn instantiate(
         Box::into_raw(Box::new(CComponent {
             component,
             serialized: None,
+            booleans: Vec::new(),
         })) as fmi2Component
     }));
     result.unwrap_or(std::ptr::null_mut())
@@ -342,6 +362,9 @@ pub unsafe fn set_debug_logging(
     categories: *const fmi2String,
 ) -> fmi2Status {
     with(c, "fmi2SetDebugLogging", |cc| {
+        if n > MAX_VALUES_PER_CALL {
+            return too_many(cc, "fmi2SetDebugLogging", n);
+        }
         let Some(cats) = slice(categories, n) else {
             return null_arg(cc, "fmi2SetDebugLogging");
         };
@@ -400,6 +423,9 @@ pub unsafe fn get_real(
     value: *mut fmi2Real,
 ) -> fmi2Status {
     with(c, "fmi2GetReal", |cc| {
+        if n > MAX_VALUES_PER_CALL {
+            return too_many(cc, "fmi2GetReal", n);
+        }
         match (slice(vr, n), slice_mut(value, n)) {
             (Some(vr), Some(value)) => cc.component.get_real(vr, value),
             _ => null_arg(cc, "fmi2GetReal"),
@@ -414,6 +440,9 @@ pub unsafe fn get_integer(
     value: *mut fmi2Integer,
 ) -> fmi2Status {
     with(c, "fmi2GetInteger", |cc| {
+        if n > MAX_VALUES_PER_CALL {
+            return too_many(cc, "fmi2GetInteger", n);
+        }
         match (slice(vr, n), slice_mut(value, n)) {
             (Some(vr), Some(value)) => cc.component.get_integer(vr, value),
             _ => null_arg(cc, "fmi2GetInteger"),
@@ -428,15 +457,21 @@ pub unsafe fn get_boolean(
     value: *mut fmi2Boolean,
 ) -> fmi2Status {
     with(c, "fmi2GetBoolean", |cc| {
+        if n > MAX_VALUES_PER_CALL {
+            return too_many(cc, "fmi2GetBoolean", n);
+        }
         match (slice(vr, n), slice_mut(value, n)) {
             (Some(vr), Some(value)) => {
-                let mut buf = vec![false; n];
+                let mut buf = std::mem::take(&mut cc.booleans);
+                buf.clear();
+                buf.resize(n, false);
                 let s = cc.component.get_boolean(vr, &mut buf);
                 if s <= Status::Warning {
-                    for (o, b) in value.iter_mut().zip(buf) {
-                        *o = fmi2Boolean::from(b);
+                    for (o, b) in value.iter_mut().zip(&buf) {
+                        *o = fmi2Boolean::from(*b);
                     }
                 }
+                cc.booleans = buf;
                 s
             }
             _ => null_arg(cc, "fmi2GetBoolean"),
@@ -451,6 +486,9 @@ pub unsafe fn get_string(
     value: *mut fmi2String,
 ) -> fmi2Status {
     with(c, "fmi2GetString", |cc| {
+        if n > MAX_VALUES_PER_CALL {
+            return too_many(cc, "fmi2GetString", n);
+        }
         match (slice(vr, n), slice_mut(value, n)) {
             (Some(vr), Some(value)) => {
                 let mut buf = vec![String::new(); n];
@@ -476,6 +514,9 @@ pub unsafe fn set_real(
     value: *const fmi2Real,
 ) -> fmi2Status {
     with(c, "fmi2SetReal", |cc| {
+        if n > MAX_VALUES_PER_CALL {
+            return too_many(cc, "fmi2SetReal", n);
+        }
         match (slice(vr, n), slice(value, n)) {
             (Some(vr), Some(value)) => cc.component.set_real(vr, value),
             _ => null_arg(cc, "fmi2SetReal"),
@@ -490,6 +531,9 @@ pub unsafe fn set_integer(
     value: *const fmi2Integer,
 ) -> fmi2Status {
     with(c, "fmi2SetInteger", |cc| {
+        if n > MAX_VALUES_PER_CALL {
+            return too_many(cc, "fmi2SetInteger", n);
+        }
         match (slice(vr, n), slice(value, n)) {
             (Some(vr), Some(value)) => cc.component.set_integer(vr, value),
             _ => null_arg(cc, "fmi2SetInteger"),
@@ -504,10 +548,17 @@ pub unsafe fn set_boolean(
     value: *const fmi2Boolean,
 ) -> fmi2Status {
     with(c, "fmi2SetBoolean", |cc| {
+        if n > MAX_VALUES_PER_CALL {
+            return too_many(cc, "fmi2SetBoolean", n);
+        }
         match (slice(vr, n), slice(value, n)) {
             (Some(vr), Some(value)) => {
-                let b: Vec<bool> = value.iter().map(|v| *v != 0).collect();
-                cc.component.set_boolean(vr, &b)
+                let mut buf = std::mem::take(&mut cc.booleans);
+                buf.clear();
+                buf.extend(value.iter().map(|v| *v != 0));
+                let s = cc.component.set_boolean(vr, &buf);
+                cc.booleans = buf;
+                s
             }
             _ => null_arg(cc, "fmi2SetBoolean"),
         }
@@ -521,6 +572,9 @@ pub unsafe fn set_string(
     value: *const fmi2String,
 ) -> fmi2Status {
     with(c, "fmi2SetString", |cc| {
+        if n > MAX_VALUES_PER_CALL {
+            return too_many(cc, "fmi2SetString", n);
+        }
         match (slice(vr, n), slice(value, n)) {
             (Some(vr), Some(value)) => {
                 let mut strs = Vec::with_capacity(n);
@@ -662,6 +716,12 @@ pub unsafe fn deserialize_fmu_state(
     with(c, "fmi2DeSerializeFMUstate", |cc| {
         if state.is_null() {
             return null_arg(cc, "fmi2DeSerializeFMUstate");
+        }
+        if size > MAX_STATE_BYTES {
+            return cc.component.error(&format!(
+                "fmi2DeSerializeFMUstate: {size} bytes is more than the {MAX_STATE_BYTES} a \
+                 serialised state of this FMU can have (a wrong size?)"
+            ));
         }
         let Some(bytes) = slice(buffer as *const u8, size) else {
             return null_arg(cc, "fmi2DeSerializeFMUstate");

@@ -718,20 +718,35 @@ impl Component {
     }
 
     pub fn deserialize_fmu_state(&mut self, bytes: &[u8]) -> Result<Box<Snapshot>, Status> {
-        let header: SnapshotHeader = match bincode::deserialize(bytes) {
+        const CALL: &str = "fmi2DeSerializeFMUstate";
+        let header: SnapshotHeader = match strict_bincode(bytes) {
             Ok(h) => h,
             Err(e) => {
-                let msg = format!("fmi2DeSerializeFMUstate: not a serialised state: {e}");
+                let msg = format!(
+                    "{CALL}: {} bytes are not exactly one serialised state of this FMU: {e}",
+                    bytes.len()
+                );
                 return Err(self.error(&msg));
             }
         };
         if header.magic != MAGIC {
-            return Err(self.error("fmi2DeSerializeFMUstate: not a serialised state of this FMU"));
+            return Err(self.error(&format!("{CALL}: not a serialised state of this FMU")));
         }
-        let Some(model) = self.model.deserialize(&header.model) else {
-            return Err(self.error(
-                "fmi2DeSerializeFMUstate: the serialised state belongs to another model or version",
-            ));
+        let times_ok = header.time.is_finite()
+            && header.start_time.is_finite()
+            && header
+                .stop_time
+                .is_none_or(|s| s.is_finite() && s >= header.start_time);
+        if !times_ok {
+            let msg = format!(
+                "{CALL}: the serialised state has an invalid time (t = {}, start {}, stop {:?})",
+                header.time, header.start_time, header.stop_time
+            );
+            return Err(self.error(&msg));
+        }
+        let model = match self.model.deserialize(&header.model) {
+            Ok(m) => m,
+            Err(reason) => return Err(self.error(&format!("{CALL}: {reason}"))),
         };
         Ok(Box::new(Snapshot {
             model,
@@ -741,4 +756,18 @@ impl Component {
             stop_time: header.stop_time,
         }))
     }
+}
+
+/// Decode bincode bytes (the legacy fixed-integer format `bincode::serialize` writes) strictly:
+/// every byte must belong to the value (no trailing bytes), and no length prefix may make the
+/// decoder allocate more than the input's size.
+pub(crate) fn strict_bincode<T: serde::de::DeserializeOwned>(
+    bytes: &[u8],
+) -> Result<T, bincode::Error> {
+    use bincode::Options;
+    bincode::DefaultOptions::new()
+        .with_fixint_encoding()
+        .with_limit(bytes.len() as u64)
+        .reject_trailing_bytes()
+        .deserialize(bytes)
 }

@@ -30,7 +30,9 @@ pub trait ErasedModel: Send {
     /// Overwrite an existing snapshot in place (fmi2GetFMUstate with a non-null state).
     fn update_snapshot(&self, snapshot: &mut (dyn Any + Send)) -> bool;
     fn serialize(&self, snapshot: &(dyn Any + Send)) -> Option<Vec<u8>>;
-    fn deserialize(&self, bytes: &[u8]) -> Option<Box<dyn Any + Send>>;
+    /// A snapshot from serialised bytes: refused if they do not decode exactly (no trailing
+    /// bytes), belong to another model, or hold a non-finite number.
+    fn deserialize(&self, bytes: &[u8]) -> Result<Box<dyn Any + Send>, String>;
 }
 
 /// A model value plus its variable table.
@@ -183,12 +185,18 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
         .ok()
     }
 
-    fn deserialize(&self, bytes: &[u8]) -> Option<Box<dyn Any + Send>> {
-        let tagged: Tagged<M> = bincode::deserialize(bytes).ok()?;
+    fn deserialize(&self, bytes: &[u8]) -> Result<Box<dyn Any + Send>, String> {
+        let tagged: Tagged<M> = crate::component::strict_bincode(bytes)
+            .map_err(|e| format!("not a serialised state of model {}: {e}", M::INFO.name))?;
         if tagged.model_name != M::INFO.name {
-            return None;
+            return Err(format!(
+                "the serialised state belongs to model '{}', not {}",
+                tagged.model_name,
+                M::INFO.name
+            ));
         }
-        Some(Box::new(tagged.model))
+        crate::finite::check_finite(&tagged.model).map_err(|e| e.to_string())?;
+        Ok(Box::new(tagged.model))
     }
 }
 

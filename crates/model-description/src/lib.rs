@@ -21,6 +21,8 @@ pub mod doc;
 pub mod enumeration;
 pub mod erased;
 pub mod fields;
+pub mod files;
+pub mod finite;
 pub mod model;
 pub mod package;
 pub mod units;
@@ -31,6 +33,7 @@ pub use codec::{AlwaysSome, Codec, FmiValue, Native, Sign, ZeroIsNone};
 pub use component::{CollectLog, Component, FmiState, Status};
 pub use enumeration::{EnumItem, EnumType, FmiEnum};
 pub use fields::{field_error, FieldError};
+pub use files::{read_parameter_file, ParameterFileError, MAX_PARAMETER_FILE_BYTES};
 pub use model::{
     DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo, StepError,
 };
