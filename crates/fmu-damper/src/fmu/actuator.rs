@@ -154,7 +154,7 @@ impl FmuModel for FullActiveActuator {
                 // 0 - x, not -x: no -0.0 when the power is zero.
                 => |m| 0.0 - m.out.mechanical_power_w;
         }
-        super::declare_max_steps!(v, params);
+        super::declare_appended_parameters!(v, params);
         v
     }
 

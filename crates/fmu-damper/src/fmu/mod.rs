@@ -91,9 +91,9 @@ fn step_error<M: FmuModel>(e: &PhysicsStepError) -> StepError {
     }
 }
 
-/// The integer parameter bounding the integrator's work, declared last in every damper FMU so
-/// the other value references stay put; `$($shell).+` is the path to the physics parameters.
-macro_rules! declare_max_steps {
+/// The parameters every damper FMU gained after its first release, declared last so the other
+/// value references stay put; `$($shell).+` is the path to the physics parameters.
+macro_rules! declare_appended_parameters {
     ($v:ident, $($shell:ident).+) => {
         model_description::declare! { $v;
             /// Maximum number of internal integrator steps (accepted + rejected) per
@@ -105,7 +105,7 @@ macro_rules! declare_max_steps {
         }
     };
 }
-pub(crate) use declare_max_steps;
+pub(crate) use declare_appended_parameters;
 
 fn not_initialised() -> StepError {
     StepError::Error(ModelError::Other(

@@ -255,7 +255,7 @@ impl FmuModel for SemiActiveDamper {
             /// Mechanical power taken from the vehicle, damper.force x damper.elongation_velocity
             output "damper.power" [unit = "W", display_unit = "kW", depends_on = &["damper.elongation_velocity"]] => s.out.mechanical_power_w;
         }
-        super::declare_max_steps!(v, s.params);
+        super::declare_appended_parameters!(v, s.params);
         v
     }
 
@@ -305,7 +305,7 @@ impl FmuModel for PassiveYawDamper {
             /// Mechanical power taken from the vehicle, damper.force x damper.elongation_velocity
             output "damper.power" [unit = "W", display_unit = "kW", depends_on = &["damper.elongation_velocity"]] => s.out.mechanical_power_w;
         }
-        super::declare_max_steps!(v, s.params);
+        super::declare_appended_parameters!(v, s.params);
         v
     }
 
