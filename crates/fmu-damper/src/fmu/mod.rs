@@ -102,6 +102,9 @@ macro_rules! declare_appended_parameters {
             /// (restore an FMU state and retry with a smaller communication step). Default
             /// 20000, far above need (1-50 per 1 ms step)
             parameter "solver.max_internal_steps" [range = 1.0..=2147483647.0] => $($shell).+.solver.max_internal_steps;
+            /// k_m: stiffness of the damper's installation (mountings, bushes) in series with it,
+            /// 0 = rigid (default); MPE 2019: about 10 MN/m for a yaw damper
+            parameter "damper.mounting_stiffness" [unit = "N/m", display_unit = "MN/m", min = 0.0] => $($shell).+.mounting_stiffness_n_per_m as model_description::ZeroIsNone;
         }
     };
 }
