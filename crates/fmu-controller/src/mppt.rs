@@ -36,7 +36,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::signal::{BandPass, RmsWindow};
+use crate::signal::{band_pass, BandPass, RmsWindow};
 use crate::{
     check_finite_nonneg, check_finite_pos, check_sign, finite_out, NanPolicy, ParamError,
     SampleClock, StepError,
@@ -174,7 +174,7 @@ impl MpptParams {
                 "more than 1e7 samples of sample_time_s",
             ));
         }
-        BandPass::butterworth(
+        band_pass(
             self.filter_order,
             self.band_low_hz,
             self.band_high_hz,
@@ -274,7 +274,7 @@ pub struct Mppt {
 impl Mppt {
     pub fn new(params: MpptParams) -> Result<Self, ParamError> {
         params.validate()?;
-        let filter = BandPass::butterworth(
+        let filter = band_pass(
             params.filter_order,
             params.band_low_hz,
             params.band_high_hz,
@@ -573,7 +573,7 @@ mod tests {
         assert_eq!(a.outputs().updates, 12);
         // rms at the 3rd update (window 2..3 s, filter settled): 3 |H(3.7)| / sqrt 2 with the
         // 11 Hz component attenuated by |H(11)|.
-        let bp = BandPass::butterworth(4, 2.0, 6.0, 1e-3).unwrap();
+        let bp = band_pass(4, 2.0, 6.0, 1e-3).unwrap();
         let (h37, h11) = (bp.magnitude(3.7, 1e-3), bp.magnitude(11.0, 1e-3));
         let expect = ((3.0 * h37).powi(2) / 2.0 + (0.3 * h11).powi(2) / 2.0).sqrt();
         let o3 = lb[2999].1;

@@ -23,8 +23,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "open {op:.1}: peak 1mm {:8.0} N  3mm {:8.0} N  phase1 {:5.1} phase3 {:5.1}",
             l1.peak_force_n,
             l3.peak_force_n,
-            l1.transfer.arg_deg(),
-            l3.transfer.arg_deg()
+            l1.transfer.arg().to_degrees(),
+            l3.transfer.arg().to_degrees()
         );
     }
     for op in [0.0, 0.3, 1.0] {

@@ -15,12 +15,12 @@
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
-use crate::complex::Complex;
 use crate::error::{check_opening_input, positive_input, StepError};
 use crate::full_active::{
     dead_zone_describing_gain, Actuator, ActuatorInputs, ActuatorModel, ActuatorParams, RodMode,
 };
 use crate::semi_active::{SemiActiveDamper, SemiActiveInputs, SemiActiveParams};
+use num_complex::Complex64;
 
 /// Samples per period of the sinusoidal tests (communication steps).
 pub const STEPS_PER_PERIOD: usize = 400;
@@ -48,7 +48,7 @@ pub struct HysteresisLoop {
     /// Largest |force| over the period, N.
     pub peak_force_n: f64,
     /// First-harmonic force/displacement ratio, N/m.
-    pub transfer: Complex,
+    pub transfer: Complex64,
 }
 
 /// One point of the damper force/displacement FRF.
@@ -66,11 +66,11 @@ pub struct DamperFrfPoint {
     pub c_eq_ns_per_m: f64,
 }
 
-fn first_harmonic(samples: &[f64], times: &[f64], omega: f64) -> Complex {
+fn first_harmonic(samples: &[f64], times: &[f64], omega: f64) -> Complex64 {
     let n = samples.len() as f64;
-    let mut acc = Complex::default();
+    let mut acc = Complex64::default();
     for (s, t) in samples.iter().zip(times) {
-        acc = acc + Complex::new((omega * t).cos(), -(omega * t).sin()).scale(*s);
+        acc += Complex64::new((omega * t).cos(), -(omega * t).sin()).scale(*s);
     }
     acc.scale(2.0 / n)
 }
@@ -94,9 +94,9 @@ pub fn hysteresis_loop(
     let mut xs = vec![0.0; n];
     let mut vs = vec![0.0; n];
     let mut fs = vec![0.0; n];
-    let mut prev: Option<Complex> = None;
-    let mut transfer = Complex::default();
-    let x1 = Complex::new(0.0, -amplitude_m); // phasor of X sin(wt)
+    let mut prev: Option<Complex64> = None;
+    let mut transfer = Complex64::default();
+    let x1 = Complex64::new(0.0, -amplitude_m); // phasor of X sin(wt)
     for period in 0..MAX_PERIODS {
         let t0 = period as f64 / freq_hz;
         for k in 0..n {
@@ -115,7 +115,7 @@ pub fn hysteresis_loop(
         }
         transfer = first_harmonic(&fs, &time, omega) / x1;
         if let Some(p) = prev {
-            if period + 1 >= MIN_PERIODS && (transfer - p).abs() <= CONVERGENCE * transfer.abs() {
+            if period + 1 >= MIN_PERIODS && (transfer - p).norm() <= CONVERGENCE * transfer.norm() {
                 break;
             }
         }
@@ -158,8 +158,8 @@ pub fn damper_frf_point(
     let omega = 2.0 * PI * freq_hz;
     Ok(DamperFrfPoint {
         freq_hz,
-        modulus_n_per_m: l.transfer.abs(),
-        phase_deg: l.transfer.arg_deg(),
+        modulus_n_per_m: l.transfer.norm(),
+        phase_deg: l.transfer.arg().to_degrees(),
         k_eq_n_per_m: l.transfer.re,
         c_eq_ns_per_m: l.transfer.im / omega,
     })
@@ -238,9 +238,9 @@ pub fn actuator_frf(
         let h = 1.0 / (f * n as f64);
         let mut time = vec![0.0; n];
         let mut vel = vec![0.0; n];
-        let mut prev: Option<Complex> = None;
-        let mut g = Complex::default();
-        let u1 = Complex::new(0.0, -amplitude_m);
+        let mut prev: Option<Complex64> = None;
+        let mut g = Complex64::default();
+        let u1 = Complex64::new(0.0, -amplitude_m);
         for period in 0..MAX_PERIODS {
             let t0 = period as f64 / f;
             for k in 0..n {
@@ -256,7 +256,7 @@ pub fn actuator_frf(
             g = first_harmonic(&vel, &time, omega) / u1;
             if let Some(pv) = prev {
                 // Absolute floor: inside the dead zone the response is ~0.
-                if period + 1 >= MIN_PERIODS && (g - pv).abs() <= 1e-4 * g.abs() + 1e-9 {
+                if period + 1 >= MIN_PERIODS && (g - pv).norm() <= 1e-4 * g.norm() + 1e-9 {
                     break;
                 }
             }
@@ -265,8 +265,8 @@ pub fn actuator_frf(
         out.push(ActuatorFrfPoint {
             freq_hz: f,
             omega_radps: omega,
-            modulus_per_s: g.abs(),
-            phase_deg: g.arg_deg(),
+            modulus_per_s: g.norm(),
+            phase_deg: g.arg().to_degrees(),
         });
     }
     Ok(out)
@@ -291,13 +291,13 @@ pub fn linearised_actuator_frf(
         .map(|&f| {
             let omega = 2.0 * PI * f;
             let g = params
-                .linearised_tf(Complex::jw(omega), z_hat, load_pressure_hat_pa)
+                .linearised_tf(Complex64::new(0.0, omega), z_hat, load_pressure_hat_pa)
                 .scale(n_dz);
             ActuatorFrfPoint {
                 freq_hz: f,
                 omega_radps: omega,
-                modulus_per_s: g.abs(),
-                phase_deg: g.arg_deg(),
+                modulus_per_s: g.norm(),
+                phase_deg: g.arg().to_degrees(),
             }
         })
         .collect())

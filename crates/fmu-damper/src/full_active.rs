@@ -67,10 +67,10 @@
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
-use crate::complex::Complex;
 use crate::error::{finite_input, non_negative, positive, ParamError, StepError};
 use crate::ode::{integrate, Rhs, SolverSettings};
 use crate::semi_active::orifice_law;
+use num_complex::Complex64;
 
 /// `C_L` if Table 3-2's "7e-10 l/s" is read as litres per second per pascal
 /// (7e-13 m^3/(s Pa), a typical servo-cylinder value). The default follows the
@@ -347,27 +347,27 @@ impl ActuatorParams {
     }
 
     /// Spool loop transfer function `v/u` (3.46).
-    pub fn valve_tf(&self, s: Complex) -> Complex {
+    pub fn valve_tf(&self, s: Complex64) -> Complex64 {
         let w0 = self.valve_natural_freq_radps;
-        let w2 = Complex::from(w0 * w0);
+        let w2 = Complex64::from(w0 * w0);
         w2 / (s * s + s.scale(2.0 * self.valve_damping_ratio * w0) + w2)
     }
 
     /// Cylinder transfer function `x'/Q_L` (3.67), (m/s)/(m^3/s).
-    pub fn cylinder_tf(&self, s: Complex) -> Complex {
+    pub fn cylinder_tf(&self, s: Complex64) -> Complex64 {
         let wc = self.cylinder_eigenfrequency_radps();
         let xi = self.cylinder_damping_ratio();
-        let den = (s * s).scale(1.0 / (wc * wc)) + s.scale(2.0 * xi / wc) + Complex::from(1.0);
-        Complex::from(1.0 / self.mean_area_m2()) / den
+        let den = (s * s).scale(1.0 / (wc * wc)) + s.scale(2.0 * xi / wc) + Complex64::from(1.0);
+        Complex64::from(1.0 / self.mean_area_m2()) / den
     }
 
     /// Linearised reduced-order transfer function `x'/z` (3.73) at `(z_hat, P_L_hat)`.
-    pub fn linearised_tf(&self, s: Complex, z_hat: f64, p_l_hat: f64) -> Complex {
+    pub fn linearised_tf(&self, s: Complex64, z_hat: f64, p_l_hat: f64) -> Complex64 {
         let g = self.cylinder_tf(s);
         let cq = self.flow_gain(p_l_hat);
         let cqp = self.flow_pressure_coeff(z_hat, p_l_hat);
-        let ms = s.scale(self.moving_mass_kg) + Complex::from(self.viscous_friction_nspm);
-        let den = Complex::from(1.0) + (ms * g).scale(cqp / self.mean_area_m2());
+        let ms = s.scale(self.moving_mass_kg) + Complex64::from(self.viscous_friction_nspm);
+        let den = Complex64::from(1.0) + (ms * g).scale(cqp / self.mean_area_m2());
         g.scale(cq) / den
     }
 

@@ -35,7 +35,6 @@
 //! a typical servo-cylinder value that leaves the full force available.
 
 pub mod characterise;
-pub mod complex;
 pub mod error;
 pub mod fmu;
 pub mod full_active;
@@ -45,11 +44,11 @@ pub mod semi_active;
 pub mod valve;
 
 pub use characterise::equivalent_stiffness_damping;
-pub use complex::Complex;
 pub use error::{ParamError, StepError};
 pub use full_active::{
     Actuator, ActuatorInputs, ActuatorModel, ActuatorOutputs, ActuatorParams, RodMode,
 };
+pub use num_complex::Complex64;
 pub use ode::SolverSettings;
 pub use semi_active::{SemiActiveDamper, SemiActiveInputs, SemiActiveOutputs, SemiActiveParams};
 pub use valve::{ValveCommand, ValveModel, ValveParams};

@@ -6,7 +6,7 @@
 use fmu_damper::characterise::{actuator_frf, linearised_actuator_frf};
 use fmu_damper::full_active::dead_zone_describing_gain;
 use fmu_damper::{
-    Actuator, ActuatorInputs, ActuatorModel, ActuatorParams, Complex, RodMode, StepError,
+    Actuator, ActuatorInputs, ActuatorModel, ActuatorParams, Complex64, RodMode, StepError,
 };
 use std::f64::consts::PI;
 
@@ -17,8 +17,8 @@ fn r3_cylinder_eigenfrequency() {
     let wc = p.cylinder_eigenfrequency_radps();
     assert!((wc - 319.7).abs() < 0.01 * 319.7, "{wc}");
     // The linear cylinder model (3.67) has its -90 deg phase at omega_c.
-    let g = p.cylinder_tf(Complex::jw(wc));
-    assert!((g.arg_deg() + 90.0).abs() < 1e-9);
+    let g = p.cylinder_tf(Complex64::new(0.0, wc));
+    assert!((g.arg().to_degrees() + 90.0).abs() < 1e-9);
 }
 
 /// The dead zone (3.47) with the corrected condition: no flow for |v| < beta.
@@ -104,7 +104,7 @@ fn imposed_sine(
     amp: f64,
     h: f64,
     midpoint: bool,
-) -> (Complex, Vec<f64>) {
+) -> (Complex64, Vec<f64>) {
     let p = ActuatorParams {
         model,
         rod: RodMode::Imposed,
@@ -116,7 +116,7 @@ fn imposed_sine(
     let n_per = (1.0 / (freq * h)).round() as usize;
     let periods = 6;
     let mut forces = Vec::new();
-    let mut h1 = Complex::default();
+    let mut h1 = Complex64::default();
     for k in 0..n_per * periods {
         let ts = if midpoint {
             (k as f64 + 0.5) * h
@@ -134,10 +134,10 @@ fn imposed_sine(
         forces.push(o.push_force_n + o.friction_force_n);
         if k >= n_per * (periods - 1) {
             let t = (k + 1) as f64 * h;
-            h1 = h1 + Complex::new((w * t).cos(), -(w * t).sin()).scale(o.force_n);
+            h1 += Complex64::new((w * t).cos(), -(w * t).sin()).scale(o.force_n);
         }
     }
-    let h1 = h1.scale(2.0 / n_per as f64) / Complex::new(0.0, -amp);
+    let h1 = h1.scale(2.0 / n_per as f64) / Complex64::new(0.0, -amp);
     (h1, forces)
 }
 

@@ -12,7 +12,7 @@ use std::f64::consts::PI;
 
 use fmu_damper::characterise::damper_frf_point;
 use fmu_damper::{
-    Actuator, ActuatorInputs, ActuatorParams, Complex, ParamError, RodMode, SemiActiveDamper,
+    Actuator, ActuatorInputs, ActuatorParams, Complex64, ParamError, RodMode, SemiActiveDamper,
     SemiActiveInputs, SemiActiveParams,
 };
 use model_description::{rust_component, value_reference, FmuModel, InstanceContext, Status};
@@ -67,8 +67,8 @@ fn a_stiff_mounting_converges_to_the_rigid_damper() {
 /// The series-spring prediction of the mounted damper's c_eq from the rigid damper's
 /// k_eq, c_eq at the same stroke.
 fn series_c_eq(k_eq: f64, c_eq: f64, k_m: f64, omega: f64) -> f64 {
-    let zd = Complex::new(k_eq, omega * c_eq);
-    let km = Complex::from(k_m);
+    let zd = Complex64::new(k_eq, omega * c_eq);
+    let km = Complex64::from(k_m);
     (zd * km / (zd + km)).im / omega
 }
 

@@ -335,7 +335,7 @@ impl DamperResults {
                 s.push_str(&format!(
                     " {} %: {:.0} deg;",
                     pct(l.opening),
-                    l.transfer.arg_deg()
+                    l.transfer.arg().to_degrees()
                 ));
             }
             s.pop();
