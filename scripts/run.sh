@@ -10,5 +10,5 @@ step "package the FMUs into dist/"
 package_fmus
 
 step "default study -> results/"
-cargo run --release -q -p master -- study --fmus dist --out results "$@"
+cargo run --release -q -p rail-study --bin master -- study --fmus dist --out results "$@"
 echo "report: results/REPORT.md"

@@ -1,7 +1,7 @@
 """fmpy driving MassSpring + SpringDamperMass in a Python loop (fmpy.fmi2.FMU2Slave), the same
 coupling as the master's Gauss-Seidel in feedthrough order: step ms, copy its position and
 velocity to sdm, step sdm, copy its coupling force to ms. Used by the master's benchmark
-crates/master/benches/coupled_vs_monolithic.rs.
+crates/rail-study/benches/coupled_vs_monolithic.rs.
 
 Usage: python bench_fmpy_loop.py DIST_DIR STOP_TIME STEP REPEATS
 Prints `fmpy_wall_per_sim_s <seconds>`: wall time of the stepping loop (after initialisation,

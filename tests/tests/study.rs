@@ -15,8 +15,8 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::sync::OnceLock;
 
-use master::study::run::scenario;
-use master::study::{run_study, Critical, Sources, StudyOptions, StudyResults, StudySettings};
+use rail_study::study::run::scenario;
+use rail_study::study::{run_study, Critical, Sources, StudyOptions, StudyResults, StudySettings};
 
 static CANCEL: AtomicBool = AtomicBool::new(false);
 static RESULTS: OnceLock<Result<StudyResults, String>> = OnceLock::new();
@@ -50,12 +50,12 @@ fn results() -> &'static StudyResults {
         let start = std::time::Instant::now();
         let r = run_study(&StudySettings::quick(), &opts).map_err(|e| e.to_string())?;
         // the report must be writable from these results (plots need the kept runs)
-        let timing = master::study::Timing {
+        let timing = rail_study::study::Timing {
             wall_s: start.elapsed().as_secs_f64(),
             threads,
         };
         let md =
-            master::study::write_outputs(&r, out.path(), &timing).map_err(|e| e.to_string())?;
+            rail_study::study::write_outputs(&r, out.path(), &timing).map_err(|e| e.to_string())?;
         if !md.contains("Critical speeds") || !out.path().join("rms_vs_speed.svg").is_file() {
             return Err("report or rms plot missing".into());
         }
@@ -81,7 +81,7 @@ fn vcr(id: &str) -> f64 {
     critical(id).at_least_kmh()
 }
 
-fn scenario_metrics(name: &str) -> &'static master::study::metrics::RunMetrics {
+fn scenario_metrics(name: &str) -> &'static rail_study::study::metrics::RunMetrics {
     let r = results()
         .scenario(name)
         .unwrap_or_else(|| panic!("scenario {name} missing"));

@@ -1,13 +1,16 @@
-//! FMI 2.0 co-simulation master for the bogie / yaw damper FMUs.
+//! A generic FMI 2.0 co-simulation master: import any co-simulation FMU, couple several per a
+//! JSON system description, run parameter sweeps in parallel, write the results. It knows
+//! nothing of the models it couples (no model crate is linked); the railway study and its
+//! analyses live in `rail-study`, whose `master` binary composes [`cli`] with its own
+//! subcommands.
 //!
 //! * [`fmu`]: open and check a `.fmu`, instantiate it (through the `fmi` crate), drive it.
 //! * [`model_description`]: the parts of modelDescription.xml the master needs.
 //! * [`system`]: JSON system description -> validated [`coupling::CouplingPlan`] -> run.
 //! * [`coupling`]: Jacobi / Gauss-Seidel fixed-step master over any [`slave::Slave`].
 //! * [`runset`]: parameter sweeps in parallel.
-//! * [`signal`], [`en14363`]: band-pass, sliding rms, EN 14363 stability assessment.
-//! * [`plot`], [`output`]: SVG charts and atomic CSV/JSON output.
-//! * [`commands`]: the `master` subcommands.
+//! * [`output`]: atomic CSV/JSON output.
+//! * [`cli`]: the generic subcommands (run, sweep, inspect) and the binary's common main.
 //!
 //! A coupled run in a test is three lines:
 //! ```no_run
@@ -18,16 +21,11 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-pub mod analysis;
-pub mod commands;
+pub mod cli;
 pub mod coupling;
-pub mod en14363;
 pub mod fmu;
 pub mod model_description;
 pub mod output;
-pub mod plot;
 pub mod runset;
-pub mod signal;
 pub mod slave;
-pub mod study;
 pub mod system;

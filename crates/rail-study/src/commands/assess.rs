@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use super::{CommandError, Context};
 use crate::analysis::assess::{assess_table, Criterion, ResultsTable};
 use crate::analysis::{print_report, Artefacts};
 use crate::en14363::StabilitySettings;
+use master::cli::{CommandError, Context};
 
 /// EN 14363 quantity of the signals.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

@@ -6,11 +6,11 @@ use std::path::PathBuf;
 
 use fmu_damper::{ActuatorParams, SemiActiveParams};
 
-use super::{CommandError, Context};
 use crate::analysis::damper::{
     characterise_actuator, characterise_damper, ActuatorOptions, DamperOptions,
 };
 use crate::analysis::{print_report, AnalysisError, Artefacts};
+use master::cli::{CommandError, Context};
 
 /// Which model to characterise.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

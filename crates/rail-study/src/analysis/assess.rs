@@ -292,7 +292,7 @@ impl AssessReport {
         for (k, (name, a)) in self.signals.iter().enumerate() {
             legend.push_str(&format!(
                 "{k},{},{},{},{},{}\n",
-                crate::output::csv_field(name),
+                master::output::csv_field(name),
                 a.dominant_frequency_hz,
                 a.max_rms,
                 a.limit,

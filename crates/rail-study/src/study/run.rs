@@ -1,5 +1,5 @@
 //! Running the study: every batch of runs goes through the master's run sets
-//! ([`crate::runset::execute`]: parallel on a rayon pool, one folder per run with
+//! ([`master::runset::execute`]: parallel on a rayon pool, one folder per run with
 //! system.json / results.csv / summary.json, failures kept), the numbers of each run are
 //! computed from its full-rate output inside the worker, and the stored results.csv is
 //! decimated to [`StudySettings::stored_rate_hz`].
@@ -11,16 +11,16 @@ use std::sync::Mutex;
 
 use serde_json::Value;
 
-use crate::coupling::SimOutput;
 use crate::en14363::acceleration_limit;
-use crate::runset::{execute, run_job_fmu, Job, SweepError};
 use crate::study::config::{
     configuration, required_fmus, var, Configuration, Family, RunRequest, Sources,
 };
 use crate::study::critical::{Critical, CurvePoint};
 use crate::study::metrics::{decimate, run_metrics, MetricSpec, RunMetrics, BOGIE_MASS_T};
 use crate::study::settings::StudySettings;
-use crate::system::SystemError;
+use master::coupling::SimOutput;
+use master::runset::{execute, run_job_fmu, Job, SweepError};
+use master::system::SystemError;
 
 /// Why the study stopped.
 #[derive(Debug, thiserror::Error)]
@@ -34,7 +34,7 @@ pub enum StudyError {
     #[error(transparent)]
     Sweep(#[from] SweepError),
     #[error(transparent)]
-    Output(#[from] crate::output::OutputError),
+    Output(#[from] master::output::OutputError),
     #[error(transparent)]
     Plot(#[from] crate::plot::PlotError),
     #[error("cancelled")]

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use crate::output::{write_bytes_atomic, OutputError};
+use master::output::{write_bytes_atomic, OutputError};
 
 #[derive(Debug, thiserror::Error)]
 pub enum PlotError {

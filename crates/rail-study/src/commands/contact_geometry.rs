@@ -5,12 +5,12 @@ use std::path::PathBuf;
 
 use wheel_rail::RadiusConvention;
 
-use super::{CommandError, Context};
 use crate::analysis::geometry::fleet::{fleet, profiles_in};
 use crate::analysis::geometry::{
     contact_geometry, parse_inclination, GeometryInputs, ProfileSource,
 };
 use crate::analysis::{check_cancel, print_report, Artefacts};
+use master::cli::{CommandError, Context};
 
 /// How unequal wheel radii enter (`--radius-convention`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

@@ -6,7 +6,7 @@
 //!   and order) vs the master;
 //! * a run set of 8 runs of that system on 2 worker threads vs 1 (the master's `sweep --jobs`).
 //!
-//! `cargo bench -p master --bench coupled_vs_monolithic`; needs dist/ (scripts/test.sh or
+//! `cargo bench -p rail-study --bench coupled_vs_monolithic`; needs dist/ (scripts/test.sh or
 //! `cargo run --release -p model-description --bin package-fmus`); the fmpy ratio needs the
 //! venv (RAIL_PYTHON or .venv/bin/python). Prints the ratios and writes target/bench-ratios.txt.
 //! All three simulations must end in the same state (checked), so they compute the same thing.

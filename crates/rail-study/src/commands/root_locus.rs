@@ -5,9 +5,9 @@ use std::path::PathBuf;
 
 use fmu_bogie2dof::Params;
 
-use super::{CommandError, Context};
 use crate::analysis::locus::{parse_damper, root_locus, speed_grid_kmh, DamperSpec};
 use crate::analysis::{check_cancel, print_report, Artefacts};
+use master::cli::{CommandError, Context};
 
 /// Options of `master root-locus` (the description shown by `--help` is the `after_help`).
 #[derive(Debug, clap::Args)]

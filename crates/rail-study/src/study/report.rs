@@ -3,13 +3,13 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::output::{write_bytes_atomic, write_csv_atomic, write_json_atomic};
 use crate::plot::Chart;
 use crate::study::config::{configuration, var};
 use crate::study::critical::Critical;
 use crate::study::run::{
     scenario, ConfigResult, StudyError, StudyResults, HIL_CONFIGS, HISTORY_CONFIGS,
 };
+use master::output::{write_bytes_atomic, write_csv_atomic, write_json_atomic};
 
 /// Timing of the whole study, measured by the caller.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -101,7 +101,7 @@ fn fmt_opt(v: Option<f64>, scale: f64, prec: usize) -> String {
 
 /// Writes every output file and REPORT.md into `out`; returns the report text.
 pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<String, StudyError> {
-    std::fs::create_dir_all(out).map_err(|source| crate::output::OutputError::Io {
+    std::fs::create_dir_all(out).map_err(|source| master::output::OutputError::Io {
         path: out.to_path_buf(),
         source,
     })?;
@@ -153,10 +153,10 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             .iter()
             .map(|s| format!("rms seed {s} [m/s2]")),
     );
-    crate::output::write_atomic(&out.join("rms_vs_speed.csv"), |w| {
+    master::output::write_atomic(&out.join("rms_vs_speed.csv"), |w| {
         let line = |w: &mut dyn std::io::Write, f: &[String]| {
-            let l: Vec<String> = f.iter().map(|x| crate::output::csv_field(x)).collect();
-            writeln!(w, "{}", l.join(",")).map_err(|source| crate::output::OutputError::Io {
+            let l: Vec<String> = f.iter().map(|x| master::output::csv_field(x)).collect();
+            writeln!(w, "{}", l.join(",")).map_err(|source| master::output::OutputError::Io {
                 path: out.join("rms_vs_speed.csv"),
                 source,
             })

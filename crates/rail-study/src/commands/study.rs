@@ -5,10 +5,10 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use super::{CommandError, Context};
 use crate::study::{
     run_study, write_outputs, Sources, StudyError, StudyOptions, StudySettings, Timing,
 };
+use master::cli::{CommandError, Context};
 
 /// Run the stability study and write REPORT.md, plots and CSVs.
 #[derive(Debug, clap::Args)]
@@ -37,7 +37,7 @@ impl From<StudyError> for CommandError {
             StudyError::System(e) => CommandError::System(e),
             StudyError::Sweep(e) => CommandError::Sweep(e),
             StudyError::Output(e) => CommandError::Output(e),
-            StudyError::Plot(e) => CommandError::Plot(e),
+            StudyError::Plot(e) => e.into(),
             other => CommandError::Failed(other.to_string()),
         }
     }

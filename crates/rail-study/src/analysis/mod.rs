@@ -13,8 +13,8 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::output::{csv_field, write_bytes_atomic, OutputError};
 use crate::plot::{Chart, PlotError};
+use master::output::{csv_field, write_bytes_atomic, OutputError};
 
 pub mod assess;
 pub mod damper;

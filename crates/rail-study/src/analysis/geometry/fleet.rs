@@ -16,7 +16,7 @@ use wheel_rail::{compute_table, DeltaR};
 
 use super::{check_options, conicity_at, setup_of, ConicityPoint, GeometryInputs, ProfileSource};
 use crate::analysis::{AnalysisError, Artefacts};
-use crate::output::csv_field;
+use master::output::csv_field;
 use crate::plot::PlotError;
 
 /// File name endings read from a `--wheel-dir` folder (case-insensitive).

@@ -6,7 +6,7 @@
 //! * [`settings`]: the full and the `--quick` study.
 //! * [`metrics`]: numbers of one run (EN 14363 rms, oscillation amplitude, peak force...).
 //! * [`critical`]: critical speed from an rms curve, bisection.
-//! * [`run`]: runs the batches through [`crate::runset`] (parallel, one folder per run).
+//! * [`run`]: runs the batches through [`master::runset`] (parallel, one folder per run).
 //! * [`report`]: CSVs, SVG charts and REPORT.md.
 //!
 //! From a test: `run_study(&StudySettings::quick(), &opts)` gives [`run::StudyResults`].

@@ -8,9 +8,9 @@
 //!   amplitude, a decaying motion as a small one.
 //! * Damper force peak, rms hydraulic power (full-active), mean valve command over the tail.
 
-use crate::coupling::SimOutput;
 use crate::en14363::{assess_lateral_acceleration, AssessError, StabilitySettings};
 use crate::study::config::var;
+use master::coupling::SimOutput;
 
 /// Bogie mass of the seed [t] (a_lim = 5.39 m/s^2, seed 4.2).
 pub const BOGIE_MASS_T: f64 = 6.1;
@@ -202,7 +202,7 @@ pub fn decimate(out: &SimOutput, factor: usize) -> SimOutput {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::coupling::Summary;
+    use master::coupling::Summary;
     use std::f64::consts::PI;
 
     /// A synthetic run: hunting at `f` Hz with acceleration amplitude `acc` and displacement

@@ -35,8 +35,8 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use crate::runset::{sanitize, Job, RunSet, RunSpec};
-use crate::system::{LoadedSystem, SystemDescription, SystemError};
+use master::runset::{sanitize, Job, RunSet, RunSpec};
+use master::system::{LoadedSystem, SystemDescription, SystemError};
 
 /// Control family of a configuration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]

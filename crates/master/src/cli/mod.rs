@@ -1,0 +1,121 @@
+//! The generic subcommands of the `master` binary (run, sweep, inspect; one file each) and the
+//! binary's common main ([`run_command`]: logger, Ctrl-C, error chain, exit status).
+//!
+//! The binary itself lives in the `rail-study` crate, which adds the railway subcommands:
+//! its `Command` enum flattens [`GenericCommand`] and its `main` calls [`run_command`]. A
+//! subcommand is a `clap::Args` struct plus an `execute(&Args, &Context) -> Result<(),
+//! CommandError>`.
+
+use std::io::IsTerminal;
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+pub mod inspect;
+pub mod run;
+pub mod sweep;
+
+/// Shared state of a command invocation.
+pub struct Context {
+    /// Set by the Ctrl-C handler; long loops check it.
+    pub cancel: &'static AtomicBool,
+    /// Whether to draw progress bars (stderr is a terminal and not --quiet).
+    pub progress: bool,
+}
+
+/// Error of any subcommand; the binary prints it and exits non-zero.
+#[derive(Debug, thiserror::Error)]
+pub enum CommandError {
+    #[error(transparent)]
+    Run(#[from] crate::system::RunError),
+    #[error(transparent)]
+    System(#[from] crate::system::SystemError),
+    #[error(transparent)]
+    Sweep(#[from] crate::runset::SweepError),
+    #[error(transparent)]
+    Fmu(#[from] crate::fmu::FmuError),
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    #[error("{0}")]
+    Failed(String),
+    /// An error of a subcommand defined outside this crate (its source chain is printed).
+    #[error(transparent)]
+    Other(Box<dyn std::error::Error + Send + Sync>),
+}
+
+/// Options of every subcommand.
+#[derive(Debug, clap::Args)]
+pub struct GlobalArgs {
+    /// Log level of the master and of FMU logger messages (error, warn, info, debug, trace).
+    #[arg(long, global = true, default_value = "info")]
+    pub log_level: log::LevelFilter,
+    /// No progress bars.
+    #[arg(short, long, global = true)]
+    pub quiet: bool,
+}
+
+/// The generic subcommands.
+#[derive(Debug, clap::Subcommand)]
+pub enum GenericCommand {
+    /// Run one system description and write results as CSV.
+    Run(run::Args),
+    /// Run parameter variations of a system in parallel.
+    Sweep(sweep::Args),
+    /// Check an FMU and print its variables.
+    Inspect(inspect::Args),
+}
+
+impl GenericCommand {
+    pub fn execute(&self, ctx: &Context) -> Result<(), CommandError> {
+        match self {
+            GenericCommand::Run(a) => run::execute(a, ctx),
+            GenericCommand::Sweep(a) => sweep::execute(a, ctx),
+            GenericCommand::Inspect(a) => inspect::execute(a, ctx),
+        }
+    }
+}
+
+static CANCEL: AtomicBool = AtomicBool::new(false);
+
+/// The main of a `master` binary: installs the FMU logger at the requested level and the
+/// Ctrl-C handler (first Ctrl-C: stop at the next communication point; second: exit 130), runs
+/// `command`, prints an error with its chain of causes. Exit status 0 on success, 130 after
+/// Ctrl-C, 1 on any other error.
+pub fn run_command<F>(global: &GlobalArgs, command: F) -> ExitCode
+where
+    F: FnOnce(&Context) -> Result<(), CommandError>,
+{
+    crate::fmu::install_logger(global.log_level);
+    if let Err(e) = ctrlc::set_handler(|| {
+        if CANCEL.swap(true, Ordering::SeqCst) {
+            // second Ctrl-C: give up immediately
+            std::process::exit(130);
+        }
+        eprintln!("interrupt: stopping at the next communication point (Ctrl-C again to abort)");
+    }) {
+        eprintln!("warning: cannot install the Ctrl-C handler: {e}");
+    }
+    let ctx = Context {
+        cancel: &CANCEL,
+        progress: !global.quiet && std::io::stderr().is_terminal(),
+    };
+    match command(&ctx) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            let mut src = std::error::Error::source(&e);
+            while let Some(s) = src {
+                // thiserror(transparent) repeats the message; print only new information
+                let msg = s.to_string();
+                if !e.to_string().contains(&msg) {
+                    eprintln!("  caused by: {msg}");
+                }
+                src = s.source();
+            }
+            if CANCEL.load(Ordering::SeqCst) {
+                ExitCode::from(130)
+            } else {
+                ExitCode::FAILURE
+            }
+        }
+    }
+}
