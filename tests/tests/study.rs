@@ -12,14 +12,17 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::OnceLock;
 
-use rail_study::study::run::scenario;
+use rail_study::study::config::required_fmus;
+use rail_study::study::run::{configurations_used, scenario};
 use rail_study::study::{run_study, Critical, Sources, StudyOptions, StudyResults, StudySettings};
 
 static CANCEL: AtomicBool = AtomicBool::new(false);
 static RESULTS: OnceLock<Result<StudyResults, String>> = OnceLock::new();
+/// FMU archives unpacked while the study ran (nothing else in this test binary unpacks FMUs).
+static UNPACKED: AtomicU64 = AtomicU64::new(0);
 
 fn dist() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../dist")
@@ -48,7 +51,12 @@ fn results() -> &'static StudyResults {
             cancel: &CANCEL,
         };
         let start = std::time::Instant::now();
+        let unpacked_before = master::fmu::extraction_count();
         let r = run_study(&StudySettings::quick(), &opts).map_err(|e| e.to_string())?;
+        UNPACKED.store(
+            master::fmu::extraction_count() - unpacked_before,
+            Ordering::SeqCst,
+        );
         // the report must be writable from these results (plots need the kept runs)
         let timing = rail_study::study::Timing {
             wall_s: start.elapsed().as_secs_f64(),
@@ -95,6 +103,18 @@ fn no_run_failed() {
     let r = results();
     assert!(r.failures.is_empty(), "failed runs: {:?}", r.failures);
     assert!(r.simulated_s > 0.0);
+}
+
+/// Each configuration's FMUs are unpacked once for all its runs (sweep, bisection, scenarios),
+/// not once per run and instance.
+#[test]
+fn each_configuration_unpacks_its_fmus_once() {
+    let r = results();
+    let used = configurations_used(&StudySettings::quick()).unwrap();
+    let expected: usize = used.iter().map(|c| required_fmus(&[c]).len()).sum();
+    assert!(expected >= 2 * used.len(), "{expected}");
+    assert_eq!(UNPACKED.load(Ordering::SeqCst), expected as u64);
+    assert!(r.runs > expected, "{} runs", r.runs);
 }
 
 /// R8: passive limit exceeded at about 280-300 km/h; accepted 260-320 km/h. The quick grid

@@ -5,8 +5,8 @@
 //! absent `dependencies` attribute (= depends on everything) from an empty one (= depends on
 //! nothing), and rejects any attribute it does not know (e.g. `canHandleMultipleSetPerTimeInstant`).
 //! So the master reads the few things it needs itself, with `xmlparser`, and reports errors with
-//! a line number. Loading the binary and calling it is still done by the `fmi` crate (see
-//! [`crate::fmu`]).
+//! a line number. This is the only parse of the description: the binary is loaded and called
+//! from it (see [`crate::fmu`]).
 
 use std::collections::HashMap;
 
@@ -178,6 +178,7 @@ pub struct CoSimulationCaps {
     pub can_get_and_set_fmu_state: bool,
     pub can_serialize_fmu_state: bool,
     pub can_handle_variable_communication_step_size: bool,
+    pub can_be_instantiated_only_once_per_process: bool,
 }
 
 /// `<DefaultExperiment>`.
@@ -377,6 +378,8 @@ impl ModelDescription {
                                     can_serialize_fmu_state: e.bool("canSerializeFMUstate")?,
                                     can_handle_variable_communication_step_size: e
                                         .bool("canHandleVariableCommunicationStepSize")?,
+                                    can_be_instantiated_only_once_per_process: e
+                                        .bool("canBeInstantiatedOnlyOncePerProcess")?,
                                 });
                             }
                             ("fmiModelDescription", "ModelExchange") => {

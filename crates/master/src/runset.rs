@@ -11,8 +11,10 @@
 //! `runs` is one job; with neither, the base alone is run. Keys are `instance.variable`.
 //! Each job is self-contained (its resolved system description, FMU paths absolute) and is
 //! written to `<outdir>/<run>/system.json`, with `results.csv` and `summary.json` beside it.
-//! Jobs run on a rayon pool; each job instantiates its own FMU instances (never shared across
-//! threads) and frees them when done. A failed job is reported in its own summary and in
+//! The base system is prepared once ([`PreparedSystem`]: FMUs unpacked and loaded once, plan
+//! built once); a job is then its start values and stop time ([`run_job`]). Jobs run on a
+//! rayon pool; each job instantiates its own FMU instances (never shared across threads) and
+//! frees them when done. A failed job is reported in its own summary and in
 //! `<outdir>/sweep.json`; the other jobs go on.
 
 use std::collections::BTreeMap;
@@ -24,7 +26,7 @@ use serde_json::Value;
 
 use crate::coupling::{RunOptions, SimOutput, Summary};
 use crate::output::{write_csv_atomic, write_json_atomic, OutputError};
-use crate::system::{split_ref, LoadedSystem, SystemDescription, SystemError};
+use crate::system::{split_ref, LoadedSystem, PreparedSystem, SystemDescription, SystemError};
 
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -109,15 +111,29 @@ pub fn sanitize(name: &str) -> String {
 impl RunSet {
     /// Reads a run-set file and expands it into jobs.
     pub fn load_jobs(path: &Path) -> Result<Vec<Job>, SystemError> {
+        Ok(Self::load(path)?.1)
+    }
+
+    /// Reads a run-set file: its base system and its jobs.
+    pub fn load(path: &Path) -> Result<(LoadedSystem, Vec<Job>), SystemError> {
         let text = std::fs::read_to_string(path).map_err(|source| SystemError::Read {
             path: path.to_path_buf(),
             source,
         })?;
         let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-        Self::jobs_from_str(&text, &base_dir, &path.display().to_string())
+        Self::from_str_with_base(&text, &base_dir, &path.display().to_string())
     }
 
     pub fn jobs_from_str(text: &str, base_dir: &Path, file: &str) -> Result<Vec<Job>, SystemError> {
+        Ok(Self::from_str_with_base(text, base_dir, file)?.1)
+    }
+
+    /// Parses run-set text: its base system and its jobs.
+    pub fn from_str_with_base(
+        text: &str,
+        base_dir: &Path,
+        file: &str,
+    ) -> Result<(LoadedSystem, Vec<Job>), SystemError> {
         let rs: RunSet = serde_json::from_str(text).map_err(|e| SystemError::Json {
             file: file.to_string(),
             line: e.line(),
@@ -140,7 +156,8 @@ impl RunSet {
                 ))
             }
         };
-        rs.expand(&base, file)
+        let jobs = rs.expand(&base, file)?;
+        Ok((base, jobs))
     }
 
     /// Expands into jobs with resolved (absolute-path) system descriptions.
@@ -210,18 +227,40 @@ impl RunSet {
     }
 }
 
-/// Runs one job with real FMUs: validates, simulates, returns the output.
-pub fn run_job_fmu(job: &Job, cancel: &AtomicBool) -> Result<SimOutput, String> {
-    let sys = LoadedSystem::from_description(
-        job.system.clone(),
-        Path::new("/"),
-        &format!("run '{}'", job.name),
-    );
+/// Runs one job of `system`'s run set (a job from [`RunSet::expand`] of that system: the same
+/// instances, FMUs and timing; only start values and the stop time differ) on the prepared
+/// FMUs: validates its start values, simulates, returns the output.
+pub fn run_job(
+    system: &PreparedSystem,
+    job: &Job,
+    cancel: &AtomicBool,
+) -> Result<SimOutput, String> {
+    let run = format!("run '{}'", job.name);
+    let base = &system.system().desc;
+    let same_fmus = job.system.instances.len() == base.instances.len()
+        && job
+            .system
+            .instances
+            .iter()
+            .zip(&base.instances)
+            .zip(system.fmu_paths())
+            .all(|((j, b), p)| {
+                j.name == b.name && j.fmu == *p && j.step_multiple == b.step_multiple
+            });
+    if !same_fmus || job.system.step != base.step || job.system.start_time != base.start_time {
+        return Err(format!(
+            "{run}: not a run of the prepared system '{}' (instances, FMUs or timing differ)",
+            system.system().file
+        ));
+    }
+    let changes = system
+        .changes(&job.parameters, Some(job.system.stop_time), &run)
+        .map_err(|e| e.to_string())?;
     let opts = RunOptions {
         cancel: Some(cancel),
         progress: None,
     };
-    sys.run(&opts).map_err(|e| e.to_string())
+    system.run(&changes, &opts).map_err(|e| e.to_string())
 }
 
 /// Runs all jobs on `threads` workers with `runner`, writing each run's folder and

@@ -18,8 +18,9 @@ use std::time::Instant;
 
 use fmu_examples::{MassSpring, SpringDamperMass};
 use master::coupling::RunOptions;
-use master::runset::{execute, run_job_fmu, RunSet};
+use master::runset::{execute, run_job, RunSet};
 use master::system::LoadedSystem;
+use master::system::PreparedSystem;
 use model_description::{Diagnostics, FmuModel, InstanceContext};
 
 const STOP: f64 = 10.0;
@@ -192,14 +193,15 @@ fn runset_wall(dist: &Path, threads: usize) -> (f64, f64) {
         "system": base,
         "product": {"ms.stiffness": [60.0, 70.0, 80.0, 90.0, 100.0, 110.0, 120.0, 130.0]}
     });
-    let jobs = RunSet::jobs_from_str(&set.to_string(), dist, "bench-runset").unwrap();
+    let (base, jobs) = RunSet::from_str_with_base(&set.to_string(), dist, "bench-runset").unwrap();
     assert_eq!(jobs.len(), 8);
     let out = tempfile::tempdir().unwrap();
     let cancel = std::sync::atomic::AtomicBool::new(false);
     let started = Instant::now();
     let cpu0 = cpu_seconds();
+    let system = PreparedSystem::prepare(&base).unwrap();
     let reports = execute(&jobs, out.path(), threads, false, |job| {
-        run_job_fmu(job, &cancel)
+        run_job(&system, job, &cancel)
     })
     .unwrap();
     let wall = started.elapsed().as_secs_f64();

@@ -3,7 +3,8 @@
 use std::path::PathBuf;
 
 use super::{CommandError, Context};
-use crate::runset::{execute as run_all, run_job_fmu, RunSet};
+use crate::runset::{execute as run_all, run_job, RunSet};
+use crate::system::PreparedSystem;
 
 /// Run a base system with parameter variations (cartesian product and/or list) in parallel.
 #[derive(Debug, clap::Args)]
@@ -19,13 +20,14 @@ pub struct Args {
 }
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
-    let jobs = RunSet::load_jobs(&args.runset)?;
+    let (base, jobs) = RunSet::load(&args.runset)?;
+    let system = PreparedSystem::prepare(&base)?;
     let threads = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let cancel = ctx.cancel;
     let reports = run_all(&jobs, &args.output, threads, ctx.progress, |job| {
-        run_job_fmu(job, cancel)
+        run_job(&system, job, cancel)
     })?;
     let failed: Vec<&str> = reports
         .iter()

@@ -337,9 +337,9 @@ impl RunRequest {
         p
     }
 
-    /// The self-contained job (resolved FMU paths, stop time set).
-    pub fn job(&self, sources: &Sources) -> Result<Job, SystemError> {
-        let base = sources.system(self.config)?;
+    /// The self-contained job (resolved FMU paths, stop time set) from the configuration's
+    /// system (`Sources::system` of `self.config`).
+    pub fn job(&self, base: &LoadedSystem) -> Result<Job, SystemError> {
         let set = RunSet {
             base: None,
             system: None,
@@ -349,7 +349,7 @@ impl RunRequest {
                 parameters: self.parameters(),
             }],
         };
-        let mut jobs = set.expand(&base, &base.file)?;
+        let mut jobs = set.expand(base, &base.file)?;
         let mut job = jobs.pop().ok_or_else(|| SystemError::Invalid {
             file: base.file.clone(),
             line: None,
@@ -433,7 +433,7 @@ mod tests {
         let r = RunRequest::new("sweep-", c, 287.5, Some(3), 12.0)
             .with(var::MPPT_INITIAL_LEFT, Value::from(8.0));
         assert_eq!(r.name, "sweep-mppt2_v287.5_s3");
-        let j = r.job(&src).unwrap();
+        let j = r.job(&src.system(c).unwrap()).unwrap();
         assert_eq!(j.name, "sweep-mppt2_v287.5_s3");
         assert!((j.system.stop_time - 12.0).abs() < 1e-12);
         let bogie = j

@@ -1,8 +1,11 @@
-//! Running the study: every batch of runs goes through the master's run sets
+//! Running the study: each configuration's system is prepared once for the whole study
+//! ([`PreparedSystem`]: its FMUs opened, checked, unpacked and loaded once, its plan built
+//! once), and every batch of runs goes through the master's run sets
 //! ([`master::runset::execute`]: parallel on a rayon pool, one folder per run with
-//! system.json / results.csv / summary.json, failures kept), the numbers of each run are
-//! computed from its full-rate output inside the worker, and the stored results.csv is
-//! decimated to [`StudySettings::stored_rate_hz`].
+//! system.json / results.csv / summary.json, failures kept); a run is its start values and
+//! stop time ([`master::runset::run_job`]). The numbers of each run are computed from its
+//! full-rate output inside the worker, and the stored results.csv is decimated to
+//! [`StudySettings::stored_rate_hz`].
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -19,8 +22,8 @@ use crate::study::critical::{Critical, CurvePoint};
 use crate::study::metrics::{decimate, run_metrics, MetricSpec, RunMetrics, BOGIE_MASS_T};
 use crate::study::settings::StudySettings;
 use master::coupling::SimOutput;
-use master::runset::{execute, run_job_fmu, Job, SweepError};
-use master::system::SystemError;
+use master::runset::{execute, run_job, Job, SweepError};
+use master::system::{PreparedSystem, RunError, SystemError};
 
 /// Why the study stopped.
 #[derive(Debug, thiserror::Error)]
@@ -31,6 +34,8 @@ pub enum StudyError {
     MissingFmu { path: PathBuf, hint: String },
     #[error(transparent)]
     System(#[from] SystemError),
+    #[error(transparent)]
+    Prepare(#[from] RunError),
     #[error(transparent)]
     Sweep(#[from] SweepError),
     #[error(transparent)]
@@ -168,6 +173,8 @@ struct Collected {
 struct Executor<'a> {
     settings: &'a StudySettings,
     opts: &'a StudyOptions<'a>,
+    /// Each configuration's system, prepared on its first run.
+    prepared: HashMap<&'static str, PreparedSystem>,
     collected: Collected,
 }
 
@@ -176,15 +183,32 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
 }
 
 impl Executor<'_> {
+    /// Prepares the configuration's system unless done before.
+    fn prepare(&mut self, c: &'static Configuration) -> Result<(), StudyError> {
+        if !self.prepared.contains_key(c.id) {
+            let system = self.opts.sources.system(c)?;
+            self.prepared
+                .insert(c.id, PreparedSystem::prepare(&system)?);
+        }
+        Ok(())
+    }
+
     /// Runs one batch in `<out>/runs/<batch>` and collects its numbers.
     fn run_batch(&mut self, batch: &str, planned: Vec<Planned>) -> Result<(), StudyError> {
         if planned.is_empty() {
             return Ok(());
         }
-        let mut jobs: Vec<Job> = Vec::with_capacity(planned.len());
-        let mut specs: HashMap<String, (MetricSpec, bool)> = HashMap::new();
         for p in &planned {
-            jobs.push(p.request.job(&self.opts.sources)?);
+            self.prepare(p.request.config)?;
+        }
+        let prepared = &self.prepared;
+        let mut jobs: Vec<Job> = Vec::with_capacity(planned.len());
+        let mut specs: HashMap<String, (MetricSpec, bool, &PreparedSystem)> = HashMap::new();
+        for p in &planned {
+            let Some(system) = prepared.get(p.request.config.id) else {
+                return Err(StudyError::UnknownConfiguration(p.request.config.id.into()));
+            };
+            jobs.push(p.request.job(system.system())?);
             specs.insert(
                 p.request.name.clone(),
                 (
@@ -194,6 +218,7 @@ impl Executor<'_> {
                         speed_kmh: p.request.speed_kmh,
                     },
                     p.keep,
+                    system,
                 ),
             );
         }
@@ -210,10 +235,10 @@ impl Executor<'_> {
         let cancel = self.opts.cancel;
         let rate = self.settings.stored_rate_hz;
         let runner = |job: &Job| -> Result<SimOutput, String> {
-            let out = run_job_fmu(job, cancel)?;
-            let Some((spec, keep)) = specs.get(&job.name) else {
+            let Some((spec, keep, system)) = specs.get(&job.name) else {
                 return Err(format!("internal: no metric spec for run '{}'", job.name));
             };
+            let out = run_job(system, job, cancel)?;
             let m = run_metrics(&out, spec).map_err(|e| e.to_string());
             lock(&metrics).insert(job.name.clone(), m);
             let factor = crate::study::metrics::sample_rate(&out)
@@ -360,6 +385,28 @@ pub fn check_fmus(sources: &Sources, configs: &[&Configuration]) -> Result<(), S
     Ok(())
 }
 
+/// Every configuration the study runs: the swept ones and those of the perturbation, c_v and
+/// scenario runs.
+pub fn configurations_used(
+    settings: &StudySettings,
+) -> Result<Vec<&'static Configuration>, StudyError> {
+    let mut used: Vec<&'static Configuration> = Vec::new();
+    for id in settings
+        .configurations
+        .iter()
+        .copied()
+        .chain(["passive", "full_active", "mppt1", "mppt2"])
+        .chain(HISTORY_CONFIGS.iter().copied())
+        .chain(HIL_CONFIGS.iter().copied())
+    {
+        let c = config_or_err(id)?;
+        if !used.contains(&c) {
+            used.push(c);
+        }
+    }
+    Ok(used)
+}
+
 /// Runs the whole study (sweep, bisection, perturbation, c_v, scenarios).
 pub fn run_study(
     settings: &StudySettings,
@@ -370,23 +417,13 @@ pub fn run_study(
         .iter()
         .map(|id| config_or_err(id))
         .collect::<Result<_, _>>()?;
-    let mut needed = configs.clone();
-    for id in ["passive", "full_active", "mppt1", "mppt2"]
-        .iter()
-        .chain(HISTORY_CONFIGS)
-        .chain(HIL_CONFIGS)
-    {
-        let c = config_or_err(id)?;
-        if !needed.contains(&c) {
-            needed.push(c);
-        }
-    }
-    check_fmus(&opts.sources, &needed)?;
+    check_fmus(&opts.sources, &configurations_used(settings)?)?;
     let s = settings;
     let first_seed = s.seeds.first().copied().unwrap_or(1);
     let mut ex = Executor {
         settings,
         opts,
+        prepared: HashMap::new(),
         collected: Collected::default(),
     };
 

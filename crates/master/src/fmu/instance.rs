@@ -1,0 +1,269 @@
+//! One FMI 2.0 co-simulation instance driven through the C functions of its [`PreparedFmu`].
+
+use std::ffi::CString;
+use std::sync::Arc;
+
+use fmi_sys::fmi2 as ffi;
+
+use super::library::{callbacks, Fmi2Library};
+use super::{FmuError, PreparedFmu};
+use crate::slave::{FailStatus, ScalarType, Slave, SlaveError, StepStatus, VarRef};
+
+/// Instance names must be non-empty C strings.
+pub(crate) fn check_instance_name(name: &str) -> Result<(), FmuError> {
+    if name.is_empty() || name.contains('\0') {
+        return Err(FmuError::InstanceName {
+            name: name.replace('\0', "\\0"),
+            reason: "must be non-empty and contain no NUL".into(),
+        });
+    }
+    Ok(())
+}
+
+/// One instantiated FMU. Dropping it frees its saved FMU state and calls fmi2FreeInstance; the
+/// unpacked folder and the library go when the last instance of its [`PreparedFmu`] is gone.
+pub struct FmuSlave {
+    component: ffi::fmi2Component,
+    /// The single state slot for step retry (null until first saved).
+    saved: ffi::fmi2FMUstate,
+    name: String,
+    can_state: bool,
+    can_vary_step: bool,
+    // The FMU may keep the pointer to its callbacks for its whole life.
+    _callbacks: Box<ffi::fmi2CallbackFunctions>,
+    fmu: Arc<PreparedFmu>,
+}
+
+impl std::fmt::Debug for FmuSlave {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "FmuSlave({})", self.name)
+    }
+}
+
+/// fmi2OK and fmi2Warning are success; anything else names the status.
+fn status(s: ffi::fmi2Status) -> Result<(), FailStatus> {
+    match s {
+        ffi::fmi2Status_fmi2OK | ffi::fmi2Status_fmi2Warning => Ok(()),
+        ffi::fmi2Status_fmi2Discard => Err(FailStatus::Discard),
+        ffi::fmi2Status_fmi2Error => Err(FailStatus::Error),
+        ffi::fmi2Status_fmi2Fatal => Err(FailStatus::Fatal),
+        ffi::fmi2Status_fmi2Pending => Err(FailStatus::Other("fmi2Pending".into())),
+        other => Err(FailStatus::Other(format!("unknown status {other}"))),
+    }
+}
+
+impl FmuSlave {
+    /// fmi2Instantiate of a co-simulation instance of `fmu`.
+    pub(crate) fn new(
+        fmu: Arc<PreparedFmu>,
+        instance_name: &str,
+        logging_on: bool,
+    ) -> Result<Self, FmuError> {
+        check_instance_name(instance_name)?;
+        let load_err = |reason: String| FmuError::Load {
+            path: fmu.archive().path.clone(),
+            instance: instance_name.to_string(),
+            reason,
+        };
+        let model = &fmu.archive().model;
+        let name = CString::new(instance_name).map_err(|e| load_err(e.to_string()))?;
+        let guid = CString::new(model.guid.as_str()).map_err(|e| load_err(e.to_string()))?;
+        let callbacks = Box::new(callbacks());
+        let lib = fmu.library();
+        // SAFETY: all strings are NUL-terminated and outlive the call; the callbacks live as
+        // long as the instance (boxed, freed after fmi2FreeInstance).
+        let component = unsafe {
+            (lib.instantiate)(
+                name.as_ptr(),
+                ffi::fmi2Type_fmi2CoSimulation,
+                guid.as_ptr(),
+                fmu.resource_url().as_ptr(),
+                &*callbacks,
+                0,
+                i32::from(logging_on),
+            )
+        };
+        if component.is_null() {
+            return Err(load_err("fmi2Instantiate returned NULL".into()));
+        }
+        let caps = model.co_simulation.as_ref();
+        Ok(FmuSlave {
+            component,
+            saved: std::ptr::null_mut(),
+            name: instance_name.to_string(),
+            can_state: caps.is_some_and(|c| c.can_get_and_set_fmu_state) && lib.fmu_state.is_some(),
+            can_vary_step: caps.is_some_and(|c| c.can_handle_variable_communication_step_size),
+            _callbacks: callbacks,
+            fmu,
+        })
+    }
+
+    fn lib(&self) -> &Fmi2Library {
+        self.fmu.library()
+    }
+
+    fn check(&self, call: &'static str, s: ffi::fmi2Status) -> Result<(), SlaveError> {
+        status(s).map_err(|status| SlaveError {
+            instance: self.name.clone(),
+            call,
+            status,
+        })
+    }
+
+    fn missing(&self, call: &'static str) -> SlaveError {
+        SlaveError {
+            instance: self.name.clone(),
+            call,
+            status: FailStatus::Other("the FMU does not support FMU state".into()),
+        }
+    }
+}
+
+impl Drop for FmuSlave {
+    fn drop(&mut self) {
+        let lib = self.fmu.library();
+        // SAFETY: the component came from fmi2Instantiate of this library and is freed once;
+        // a saved state belongs to it. Freeing is allowed in every state.
+        unsafe {
+            if let (Some(f), false) = (lib.fmu_state, self.saved.is_null()) {
+                (f.free)(self.component, &mut self.saved);
+            }
+            (lib.free_instance)(self.component);
+        }
+    }
+}
+
+impl Slave for FmuSlave {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn setup_experiment(&mut self, start_time: f64, stop_time: f64) -> Result<(), SlaveError> {
+        // SAFETY (every call below): `component` is a live instance of this library; pointers
+        // and lengths come from slices of matching length.
+        let s = unsafe {
+            (self.lib().setup_experiment)(self.component, 0, 0.0, start_time, 1, stop_time)
+        };
+        self.check("fmi2SetupExperiment", s)
+    }
+    fn enter_initialization_mode(&mut self) -> Result<(), SlaveError> {
+        let s = unsafe { (self.lib().enter_initialization_mode)(self.component) };
+        self.check("fmi2EnterInitializationMode", s)
+    }
+    fn exit_initialization_mode(&mut self) -> Result<(), SlaveError> {
+        let s = unsafe { (self.lib().exit_initialization_mode)(self.component) };
+        self.check("fmi2ExitInitializationMode", s)
+    }
+    fn get(&mut self, vars: &[VarRef], out: &mut [f64]) -> Result<(), SlaveError> {
+        for (v, o) in vars.iter().zip(out.iter_mut()) {
+            let vr = [v.vr];
+            match v.ty {
+                ScalarType::Real => {
+                    let mut x = [0.0];
+                    let s = unsafe {
+                        (self.lib().get_real)(self.component, vr.as_ptr(), 1, x.as_mut_ptr())
+                    };
+                    self.check("fmi2GetReal", s)?;
+                    *o = x[0];
+                }
+                ScalarType::Integer => {
+                    let mut x = [0];
+                    let s = unsafe {
+                        (self.lib().get_integer)(self.component, vr.as_ptr(), 1, x.as_mut_ptr())
+                    };
+                    self.check("fmi2GetInteger", s)?;
+                    *o = f64::from(x[0]);
+                }
+                ScalarType::Boolean => {
+                    let mut x = [0];
+                    let s = unsafe {
+                        (self.lib().get_boolean)(self.component, vr.as_ptr(), 1, x.as_mut_ptr())
+                    };
+                    self.check("fmi2GetBoolean", s)?;
+                    *o = if x[0] != 0 { 1.0 } else { 0.0 };
+                }
+            }
+        }
+        Ok(())
+    }
+    fn set(&mut self, vars: &[VarRef], values: &[f64]) -> Result<(), SlaveError> {
+        for (v, &x) in vars.iter().zip(values) {
+            let vr = [v.vr];
+            match v.ty {
+                ScalarType::Real => {
+                    let s = unsafe {
+                        (self.lib().set_real)(self.component, vr.as_ptr(), 1, [x].as_ptr())
+                    };
+                    self.check("fmi2SetReal", s)?;
+                }
+                ScalarType::Integer => {
+                    // values come from Integer outputs or validated parameters: exact
+                    let s = unsafe {
+                        (self.lib().set_integer)(
+                            self.component,
+                            vr.as_ptr(),
+                            1,
+                            [x.round() as i32].as_ptr(),
+                        )
+                    };
+                    self.check("fmi2SetInteger", s)?;
+                }
+                ScalarType::Boolean => {
+                    let s = unsafe {
+                        (self.lib().set_boolean)(
+                            self.component,
+                            vr.as_ptr(),
+                            1,
+                            [i32::from(x != 0.0)].as_ptr(),
+                        )
+                    };
+                    self.check("fmi2SetBoolean", s)?;
+                }
+            }
+        }
+        Ok(())
+    }
+    fn do_step(&mut self, t: f64, h: f64) -> Result<StepStatus, SlaveError> {
+        let s = unsafe { (self.lib().do_step)(self.component, t, h, 1) };
+        match status(s) {
+            Ok(()) => Ok(StepStatus::Ok),
+            Err(FailStatus::Discard) => Ok(StepStatus::Discard),
+            Err(status) => Err(SlaveError {
+                instance: self.name.clone(),
+                call: "fmi2DoStep",
+                status,
+            }),
+        }
+    }
+    fn can_save_state(&self) -> bool {
+        self.can_state
+    }
+    fn can_vary_step(&self) -> bool {
+        self.can_vary_step
+    }
+    fn save_state(&mut self) -> Result<(), SlaveError> {
+        let Some(f) = self.lib().fmu_state else {
+            return Err(self.missing("fmi2GetFMUstate"));
+        };
+        // a non-null slot is overwritten in place (FMI 2.0 section 2.1.8)
+        let s = unsafe { (f.get)(self.component, &mut self.saved) };
+        self.check("fmi2GetFMUstate", s)
+    }
+    fn restore_state(&mut self) -> Result<(), SlaveError> {
+        let Some(f) = self.lib().fmu_state else {
+            return Err(self.missing("fmi2SetFMUstate"));
+        };
+        if self.saved.is_null() {
+            return Err(SlaveError {
+                instance: self.name.clone(),
+                call: "fmi2SetFMUstate",
+                status: FailStatus::Other("no saved state".into()),
+            });
+        }
+        let s = unsafe { (f.set)(self.component, self.saved) };
+        self.check("fmi2SetFMUstate", s)
+    }
+    fn terminate(&mut self) -> Result<(), SlaveError> {
+        let s = unsafe { (self.lib().terminate)(self.component) };
+        self.check("fmi2Terminate", s)
+    }
+}

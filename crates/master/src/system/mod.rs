@@ -1,0 +1,362 @@
+//! System description (JSON): FMU instances, parameters, connections, timing, coupling,
+//! recording; validated against the FMUs' model descriptions into a [`CouplingPlan`].
+//!
+//! ```json
+//! {
+//!   "instances": [
+//!     {"name": "ms",  "fmu": "dist/MassSpring.fmu", "parameters": {"m": 1.0, "k": 100.0}},
+//!     {"name": "sdm", "fmu": "dist/SpringDamperMass.fmu", "step_multiple": 1}
+//!   ],
+//!   "connections": [
+//!     {"from": "ms.position", "to": "sdm.input_position"},
+//!     {"from": "sdm.coupling_force", "to": "ms.force"}
+//!   ],
+//!   "start_time": 0.0, "stop_time": 1.0, "step": 0.001,
+//!   "algorithm": "gauss-seidel",          // or "jacobi"; default gauss-seidel
+//!   "order": ["ms", "sdm"],               // optional; default derived from feedthrough
+//!   "record": ["ms.position"],            // optional; default all outputs + connected inputs
+//!   "init_sweeps": 3, "max_step_halvings": 0
+//! }
+//! ```
+//! FMU paths are relative to the JSON file's folder. Variables are `instance.variable`, split at
+//! the first dot (instance names may not contain dots; variable names may).
+//!
+//! Interpretations: a unit mismatch is an error only when both variables declare a unit
+//! (an FMU that declares none is taken as "unknown", not "dimensionless"). The Gauss-Seidel
+//! order is a topological order of the graph with an edge A -> B for each connection A.y -> B.u
+//! where u feeds directly through to an output of B (ModelStructure/Outputs): such a B must see
+//! A's new outputs. Cycles (algebraic loops) are broken in declaration order with a warning.
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use crate::coupling::{Algorithm, RunOptions, SimError, SimOutput};
+use crate::fmu::{FmuArchive, FmuError};
+use crate::model_description::{ModelDescription, VarType};
+use crate::slave::ScalarType;
+
+fn default_alg() -> Algorithm {
+    Algorithm::GaussSeidel
+}
+fn default_sweeps() -> usize {
+    3
+}
+fn one() -> u32 {
+    1
+}
+
+/// The JSON system description.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SystemDescription {
+    pub instances: Vec<InstanceSpec>,
+    #[serde(default)]
+    pub connections: Vec<ConnectionSpec>,
+    #[serde(default)]
+    pub start_time: f64,
+    pub stop_time: f64,
+    /// Communication step [s].
+    pub step: f64,
+    #[serde(default = "default_alg")]
+    pub algorithm: Algorithm,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub order: Option<Vec<String>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub record: Option<Vec<String>>,
+    #[serde(default = "default_sweeps")]
+    pub init_sweeps: usize,
+    #[serde(default)]
+    pub max_step_halvings: u32,
+}
+
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InstanceSpec {
+    pub name: String,
+    pub fmu: PathBuf,
+    /// Start values by variable name (numbers for Real/Integer, true/false for Boolean).
+    #[serde(default)]
+    pub parameters: BTreeMap<String, Value>,
+    /// This instance steps every `step_multiple` communication steps.
+    #[serde(default = "one")]
+    pub step_multiple: u32,
+    /// Passed to fmi2Instantiate as loggingOn.
+    #[serde(default)]
+    pub logging: bool,
+}
+
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConnectionSpec {
+    pub from: String,
+    pub to: String,
+}
+
+/// A problem with a system description; always names the file and field.
+#[derive(Debug, thiserror::Error)]
+pub enum SystemError {
+    #[error("cannot read '{path}': {source}")]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{file}: line {line}, column {column}: {message}")]
+    Json {
+        file: String,
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    #[error("{file}{}: {field}: {reason}", .line.map(|l| format!(" line {l}")).unwrap_or_default())]
+    Invalid {
+        file: String,
+        line: Option<usize>,
+        field: String,
+        reason: String,
+    },
+    #[error("{file}: {field}: {source}")]
+    Fmu {
+        file: String,
+        field: String,
+        #[source]
+        source: Box<FmuError>,
+    },
+}
+
+/// Anything that stops `master run`.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error(transparent)]
+    System(#[from] SystemError),
+    #[error(transparent)]
+    Fmu(#[from] FmuError),
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+}
+
+/// A system description together with where it came from (for paths and error lines).
+#[derive(Debug, Clone)]
+pub struct LoadedSystem {
+    pub desc: SystemDescription,
+    /// Name used in messages (the file path, or a label).
+    pub file: String,
+    /// Folder FMU paths are relative to.
+    pub base_dir: PathBuf,
+    /// JSON text, if any, for line numbers in messages.
+    pub text: Option<String>,
+}
+
+/// Splits `instance.variable` at the first dot.
+pub fn split_ref(s: &str) -> Option<(&str, &str)> {
+    let (a, b) = s.split_once('.')?;
+    (!a.is_empty() && !b.is_empty()).then_some((a, b))
+}
+
+fn type_of(t: VarType) -> Option<ScalarType> {
+    match t {
+        VarType::Real => Some(ScalarType::Real),
+        // An Enumeration's value is an Integer (FMI 2.0: fmi2SetInteger / fmi2GetInteger).
+        VarType::Integer | VarType::Enumeration => Some(ScalarType::Integer),
+        VarType::Boolean => Some(ScalarType::Boolean),
+        VarType::String => None,
+    }
+}
+
+/// Converts a JSON start value to the variable's type; `Err` is the reason.
+pub fn json_value_for(t: VarType, v: &Value) -> Result<f64, String> {
+    match (t, v) {
+        (VarType::Real, Value::Number(n)) => n
+            .as_f64()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("{n} is not a finite number")),
+        (VarType::Integer | VarType::Enumeration, Value::Number(n)) => n
+            .as_i64()
+            .filter(|x| i32::try_from(*x).is_ok())
+            .map(|x| x as f64)
+            .ok_or_else(|| format!("{n} is not a 32-bit integer (variable is {t})")),
+        (VarType::Boolean, Value::Bool(b)) => Ok(if *b { 1.0 } else { 0.0 }),
+        (t, v) => Err(format!("a {t} variable cannot take the value {v}")),
+    }
+}
+
+impl LoadedSystem {
+    /// Reads and parses a JSON file; FMU paths are relative to its folder.
+    pub fn load(path: &Path) -> Result<Self, SystemError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SystemError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Self::from_json_str(&text, &base, &path.display().to_string())
+    }
+
+    /// Parses JSON text. `file` names it in messages.
+    pub fn from_json_str(text: &str, base_dir: &Path, file: &str) -> Result<Self, SystemError> {
+        let desc: SystemDescription =
+            serde_json::from_str(text).map_err(|e| SystemError::Json {
+                file: file.to_string(),
+                line: e.line(),
+                column: e.column(),
+                message: e
+                    .to_string()
+                    .split(" at line ")
+                    .next()
+                    .unwrap_or("")
+                    .to_string(),
+            })?;
+        Ok(LoadedSystem {
+            desc,
+            file: file.to_string(),
+            base_dir: base_dir.to_path_buf(),
+            text: Some(text.to_string()),
+        })
+    }
+
+    /// Wraps an in-memory description (e.g. one run of a sweep).
+    pub fn from_description(desc: SystemDescription, base_dir: &Path, file: &str) -> Self {
+        LoadedSystem {
+            desc,
+            file: file.to_string(),
+            base_dir: base_dir.to_path_buf(),
+            text: None,
+        }
+    }
+
+    /// Line of the first occurrence of `"needle"` in the JSON text.
+    fn line_of(&self, needle: &str) -> Option<usize> {
+        let text = self.text.as_ref()?;
+        let quoted = format!("\"{needle}\"");
+        let pos = text.find(&quoted)?;
+        Some(text[..pos].matches('\n').count() + 1)
+    }
+
+    fn invalid(
+        &self,
+        field: impl Into<String>,
+        needle: &str,
+        reason: impl Into<String>,
+    ) -> SystemError {
+        SystemError::Invalid {
+            file: self.file.clone(),
+            line: self.line_of(needle),
+            field: field.into(),
+            reason: reason.into(),
+        }
+    }
+
+    /// Absolute (or base-relative) path of instance `i`'s FMU.
+    pub fn fmu_path(&self, i: usize) -> PathBuf {
+        let p = &self.desc.instances[i].fmu;
+        if p.is_absolute() {
+            p.clone()
+        } else {
+            self.base_dir.join(p)
+        }
+    }
+
+    /// The description with FMU paths made absolute (self-contained, e.g. for sweep jobs).
+    pub fn resolved(&self) -> SystemDescription {
+        let mut d = self.desc.clone();
+        for (i, inst) in d.instances.iter_mut().enumerate() {
+            let p = self.fmu_path(i);
+            inst.fmu = std::path::absolute(&p).unwrap_or(p);
+        }
+        d
+    }
+
+    /// Opens and checks every instance's FMU (no binary is loaded).
+    pub fn open_fmus(&self) -> Result<Vec<FmuArchive>, SystemError> {
+        let mut cache: HashMap<PathBuf, FmuArchive> = HashMap::new();
+        let mut out = Vec::new();
+        for i in 0..self.desc.instances.len() {
+            let p = self.fmu_path(i);
+            let a = match cache.get(&p) {
+                Some(a) => a.clone(),
+                None => {
+                    let a = FmuArchive::open(&p).map_err(|source| SystemError::Fmu {
+                        file: self.file.clone(),
+                        field: format!("instances[{i}].fmu"),
+                        source: Box::new(source),
+                    })?;
+                    cache.insert(p, a.clone());
+                    a
+                }
+            };
+            out.push(a);
+        }
+        Ok(out)
+    }
+
+    fn instance_index(&self, name: &str) -> Option<usize> {
+        self.desc.instances.iter().position(|i| i.name == name)
+    }
+
+    /// Resolves `instance.variable` (for messages: `field`).
+    fn resolve<'m>(
+        &self,
+        field: &str,
+        s: &str,
+        models: &[&'m ModelDescription],
+    ) -> Result<(usize, usize, &'m crate::model_description::Variable), SystemError> {
+        let Some((inst, var)) = split_ref(s) else {
+            return Err(self.invalid(
+                field,
+                s,
+                format!("'{s}' is not of the form 'instance.variable'"),
+            ));
+        };
+        let Some(i) = self.instance_index(inst) else {
+            let names: Vec<&str> = self
+                .desc
+                .instances
+                .iter()
+                .map(|i| i.name.as_str())
+                .collect();
+            let hint = names
+                .iter()
+                .filter(|n| crate::model_description::edit_distance(n, inst) <= 2)
+                .map(|n| format!(" (did you mean '{n}'?)"))
+                .next()
+                .unwrap_or_else(|| format!(" (instances: {})", names.join(", ")));
+            return Err(self.invalid(field, s, format!("unknown instance '{inst}'{hint}")));
+        };
+        let md = models[i];
+        match md.variable(var) {
+            Some((vi, v)) => Ok((i, vi, v)),
+            None => {
+                let hint = md
+                    .suggest(var)
+                    .map(|n| format!(" (did you mean '{inst}.{n}'?)"))
+                    .unwrap_or_default();
+                Err(self.invalid(
+                    field,
+                    s,
+                    format!(
+                        "unknown variable '{s}' in instance '{inst}' (model '{}'){hint}",
+                        md.model_name
+                    ),
+                ))
+            }
+        }
+    }
+
+    /// Opens the FMUs, validates, instantiates one instance per entry, simulates, and frees
+    /// everything (also on error). For many runs of one system, prepare it once
+    /// ([`PreparedSystem`]).
+    pub fn run(&self, opts: &RunOptions) -> Result<SimOutput, RunError> {
+        PreparedSystem::prepare(self)?.run(&RunChanges::default(), opts)
+    }
+}
+
+mod plan;
+mod prepared;
+
+pub use prepared::{PreparedSystem, RunChanges};
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,356 @@
+//! Validation of a system description against the FMUs' model descriptions into a
+//! [`CouplingPlan`].
+
+use std::collections::HashMap;
+
+use serde_json::Value;
+
+use super::{json_value_for, type_of, LoadedSystem, SystemError};
+use crate::coupling::{
+    topological_order, Algorithm, CouplingPlan, PlanConnection, PlanInstance, Recorded,
+};
+use crate::model_description::{Causality, ModelDescription};
+use crate::slave::VarRef;
+
+impl LoadedSystem {
+    /// Validates against the model descriptions (one per instance, same order) and builds the
+    /// coupling plan. No FMU binary is needed.
+    pub fn plan(&self, models: &[&ModelDescription]) -> Result<CouplingPlan, SystemError> {
+        let d = &self.desc;
+        if d.instances.is_empty() {
+            return Err(self.invalid("instances", "instances", "at least one instance is needed"));
+        }
+        if models.len() != d.instances.len() {
+            return Err(self.invalid(
+                "instances",
+                "instances",
+                "internal: one model description per instance expected",
+            ));
+        }
+        if !(d.step.is_finite() && d.step > 0.0) {
+            return Err(self.invalid(
+                "step",
+                "step",
+                format!("must be a positive number, got {}", d.step),
+            ));
+        }
+        self.check_stop_time(d.stop_time)?;
+        let mut instances = Vec::new();
+        for (i, inst) in d.instances.iter().enumerate() {
+            let f = format!("instances[{i}].name");
+            if inst.name.is_empty() || inst.name.contains('.') || inst.name.contains('\0') {
+                return Err(self.invalid(
+                    f,
+                    &inst.name,
+                    format!(
+                        "'{}' is not a valid instance name (non-empty, no '.')",
+                        inst.name
+                    ),
+                ));
+            }
+            if d.instances[..i].iter().any(|o| o.name == inst.name) {
+                return Err(self.invalid(
+                    f,
+                    &inst.name,
+                    format!("instance name '{}' is used twice", inst.name),
+                ));
+            }
+            if inst.step_multiple == 0 {
+                return Err(self.invalid(
+                    format!("instances[{i}].step_multiple"),
+                    "step_multiple",
+                    "must be >= 1",
+                ));
+            }
+            let md = models[i];
+            let mut params = Vec::new();
+            let mut parameter_names = Vec::new();
+            let invalid = |f: String, needle: &str, r: String| self.invalid(f, needle, r);
+            for (name, value) in &inst.parameters {
+                params.push(start_value(i, md, name, value, &invalid)?);
+                parameter_names.push(name.clone());
+            }
+            instances.push(PlanInstance {
+                name: inst.name.clone(),
+                step_multiple: inst.step_multiple,
+                parameters: params,
+                parameter_names,
+            });
+        }
+
+        let mut connections = Vec::new();
+        let mut inputs_taken: HashMap<(usize, usize), usize> = HashMap::new();
+        let mut feedthrough_edges = Vec::new();
+        for (ci, c) in d.connections.iter().enumerate() {
+            let ff = format!("connections[{ci}].from");
+            let tf = format!("connections[{ci}].to");
+            let (fi, fvi, fv) = self.resolve(&ff, &c.from, models)?;
+            let (ti, tvi, tv) = self.resolve(&tf, &c.to, models)?;
+            if fv.causality != Causality::Output {
+                return Err(self.invalid(
+                    ff,
+                    &c.from,
+                    format!(
+                        "'{}' has causality '{}', only outputs can be connection sources",
+                        c.from, fv.causality
+                    ),
+                ));
+            }
+            if tv.causality != Causality::Input {
+                return Err(self.invalid(
+                    tf,
+                    &c.to,
+                    format!(
+                        "'{}' has causality '{}', only inputs can be connection targets",
+                        c.to, tv.causality
+                    ),
+                ));
+            }
+            if fi == ti {
+                return Err(self.invalid(tf, &c.to, "connects an instance to itself"));
+            }
+            if fv.var_type != tv.var_type {
+                return Err(self.invalid(
+                    format!("connections[{ci}]"),
+                    &c.to,
+                    format!(
+                        "type mismatch: '{}' is {} but '{}' is {}",
+                        c.from, fv.var_type, c.to, tv.var_type
+                    ),
+                ));
+            }
+            let Some(ty) = type_of(fv.var_type) else {
+                return Err(self.invalid(
+                    format!("connections[{ci}]"),
+                    &c.from,
+                    format!("{} connections are not supported", fv.var_type),
+                ));
+            };
+            if let (Some(uf), Some(ut)) = (&fv.unit, &tv.unit) {
+                if uf != ut {
+                    return Err(self.invalid(
+                        format!("connections[{ci}]"),
+                        &c.to,
+                        format!(
+                            "unit mismatch: '{}' is in [{uf}] but '{}' is in [{ut}]",
+                            c.from, c.to
+                        ),
+                    ));
+                }
+            }
+            if let Some(prev) = inputs_taken.insert((ti, tvi), ci) {
+                return Err(self.invalid(
+                    tf,
+                    &c.to,
+                    format!("input '{}' is already driven by connections[{prev}]", c.to),
+                ));
+            }
+            if models[ti].has_direct_feedthrough(tvi) {
+                feedthrough_edges.push((fi, ti));
+            }
+            let _ = fvi;
+            connections.push(PlanConnection {
+                from_instance: fi,
+                from: VarRef {
+                    vr: fv.value_reference,
+                    ty,
+                },
+                to_instance: ti,
+                to: VarRef {
+                    vr: tv.value_reference,
+                    ty,
+                },
+                label: c.from.clone(),
+            });
+        }
+
+        let order = match &d.order {
+            Some(names) => {
+                let mut order = Vec::new();
+                for (k, n) in names.iter().enumerate() {
+                    let Some(i) = self.instance_index(n) else {
+                        return Err(self.invalid(
+                            format!("order[{k}]"),
+                            n,
+                            format!("unknown instance '{n}'"),
+                        ));
+                    };
+                    if order.contains(&i) {
+                        return Err(self.invalid(
+                            format!("order[{k}]"),
+                            n,
+                            format!("instance '{n}' appears twice"),
+                        ));
+                    }
+                    order.push(i);
+                }
+                if order.len() != d.instances.len() {
+                    let missing: Vec<&str> = (0..d.instances.len())
+                        .filter(|i| !order.contains(i))
+                        .map(|i| d.instances[i].name.as_str())
+                        .collect();
+                    return Err(self.invalid(
+                        "order",
+                        "order",
+                        format!("must list every instance; missing: {}", missing.join(", ")),
+                    ));
+                }
+                order
+            }
+            None => {
+                let (order, broken) = topological_order(d.instances.len(), &feedthrough_edges);
+                if !broken.is_empty() && d.algorithm == Algorithm::GaussSeidel {
+                    let names: Vec<&str> = broken
+                        .iter()
+                        .map(|&i| d.instances[i].name.as_str())
+                        .collect();
+                    log::warn!(target: "master", "{}: algebraic loop through direct feedthrough; Gauss-Seidel order breaks it at {}", self.file, names.join(", "));
+                }
+                order
+            }
+        };
+
+        let label = |i: usize, v: &crate::model_description::Variable| match &v.unit {
+            Some(u) => format!("{}.{} [{u}]", d.instances[i].name, v.name),
+            None => format!("{}.{}", d.instances[i].name, v.name),
+        };
+        let mut record = Vec::new();
+        match &d.record {
+            Some(list) => {
+                for (k, s) in list.iter().enumerate() {
+                    let (i, _, v) = self.resolve(&format!("record[{k}]"), s, models)?;
+                    let Some(ty) = type_of(v.var_type) else {
+                        return Err(self.invalid(
+                            format!("record[{k}]"),
+                            s,
+                            format!("{} variables cannot be recorded", v.var_type),
+                        ));
+                    };
+                    record.push(Recorded {
+                        instance: i,
+                        var: VarRef {
+                            vr: v.value_reference,
+                            ty,
+                        },
+                        label: label(i, v),
+                    });
+                }
+            }
+            None => {
+                for (i, md) in models.iter().enumerate() {
+                    for (vi, v) in md.variables.iter().enumerate() {
+                        let connected_input =
+                            v.causality == Causality::Input && inputs_taken.contains_key(&(i, vi));
+                        if v.causality == Causality::Output || connected_input {
+                            if let Some(ty) = type_of(v.var_type) {
+                                record.push(Recorded {
+                                    instance: i,
+                                    var: VarRef {
+                                        vr: v.value_reference,
+                                        ty,
+                                    },
+                                    label: label(i, v),
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+        }
+
+        Ok(CouplingPlan {
+            start_time: d.start_time,
+            stop_time: d.stop_time,
+            step: d.step,
+            instances,
+            connections,
+            algorithm: d.algorithm,
+            order,
+            record,
+            init_sweeps: d.init_sweeps,
+            max_step_halvings: d.max_step_halvings,
+        })
+    }
+
+    /// The stop time is after the start time and a whole number of steps away from it.
+    pub(super) fn check_stop_time(&self, stop_time: f64) -> Result<(), SystemError> {
+        let d = &self.desc;
+        if !(d.start_time.is_finite() && stop_time.is_finite() && stop_time > d.start_time) {
+            return Err(self.invalid(
+                "stop_time",
+                "stop_time",
+                format!(
+                    "must be greater than start_time ({}), got {stop_time}",
+                    d.start_time
+                ),
+            ));
+        }
+        let span = stop_time - d.start_time;
+        let n = (span / d.step).round();
+        if (n * d.step - span).abs() > 1e-9 * span.max(d.step) {
+            return Err(self.invalid(
+                "step",
+                "step",
+                format!(
+                    "stop_time - start_time = {span} s is not an integer multiple of step = {} s",
+                    d.step
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Builds the error of a field: (field, text to find the line by, reason).
+pub(super) type Invalid<'a> = dyn Fn(String, &str, String) -> SystemError + 'a;
+
+/// The start value `name = value` of instance `i` (model `md`): a settable variable of a
+/// supported type, the value converted to that type.
+pub(super) fn start_value(
+    i: usize,
+    md: &ModelDescription,
+    name: &str,
+    value: &Value,
+    invalid: &Invalid,
+) -> Result<(VarRef, f64), SystemError> {
+    let field = format!("instances[{i}].parameters.{name}");
+    let Some((_, v)) = md.variable(name) else {
+        let hint = md
+            .suggest(name)
+            .map(|n| format!(" (did you mean '{n}'?)"))
+            .unwrap_or_default();
+        return Err(invalid(
+            field,
+            name,
+            format!(
+                "unknown variable '{name}' in model '{}'{hint}",
+                md.model_name
+            ),
+        ));
+    };
+    if !v.is_settable() {
+        return Err(invalid(
+            field,
+            name,
+            format!(
+                "'{name}' has causality '{}' and variability '{}' and cannot be given a start value",
+                v.causality, v.variability
+            ),
+        ));
+    }
+    let Some(ty) = type_of(v.var_type) else {
+        return Err(invalid(
+            field,
+            name,
+            format!("{} variables are not supported", v.var_type),
+        ));
+    };
+    let x = json_value_for(v.var_type, value).map_err(|r| invalid(field.clone(), name, r))?;
+    Ok((
+        VarRef {
+            vr: v.value_reference,
+            ty,
+        },
+        x,
+    ))
+}

@@ -1,0 +1,204 @@
+use super::*;
+use crate::coupling::CouplingPlan;
+use crate::model_description::tests::MASS_SPRING;
+use crate::slave::VarRef;
+
+/// SpringDamperMass as the example FMU will declare it.
+pub const SDM: &str = r#"<fmiModelDescription fmiVersion="2.0" modelName="SpringDamperMass" guid="g2">
+  <CoSimulation modelIdentifier="SpringDamperMass" canGetAndSetFMUstate="true"/>
+  <ModelVariables>
+<ScalarVariable name="m" valueReference="0" causality="parameter" variability="fixed"><Real start="1" unit="kg"/></ScalarVariable>
+<ScalarVariable name="k" valueReference="1" causality="parameter" variability="fixed"><Real start="1" unit="N/m"/></ScalarVariable>
+<ScalarVariable name="d" valueReference="2" causality="parameter" variability="fixed"><Real start="1" unit="N.s/m"/></ScalarVariable>
+<ScalarVariable name="input_position" valueReference="3" causality="input"><Real start="0" unit="m"/></ScalarVariable>
+<ScalarVariable name="input_velocity" valueReference="4" causality="input"><Real start="0" unit="m/s"/></ScalarVariable>
+<ScalarVariable name="coupling_force" valueReference="5" causality="output"><Real unit="N"/></ScalarVariable>
+<ScalarVariable name="position" valueReference="6" causality="output"><Real unit="m"/></ScalarVariable>
+<ScalarVariable name="velocity" valueReference="7" causality="output"><Real unit="m/s"/></ScalarVariable>
+<ScalarVariable name="mode" valueReference="8" causality="parameter" variability="fixed"><Integer start="0"/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure><Outputs>
+<Unknown index="6" dependencies="4 5"/>
+<Unknown index="7" dependencies=""/>
+<Unknown index="8" dependencies=""/>
+  </Outputs></ModelStructure>
+</fmiModelDescription>"#;
+
+const SYS: &str = r#"{
+  "instances": [
+{"name": "sdm", "fmu": "SpringDamperMass.fmu", "parameters": {"k": 200.0, "mode": 1}},
+{"name": "ms", "fmu": "MassSpring.fmu", "parameters": {"m": 1.0, "k": 100.0}}
+  ],
+  "connections": [
+{"from": "ms.position", "to": "sdm.input_position"},
+{"from": "ms.velocity", "to": "sdm.input_velocity"},
+{"from": "sdm.coupling_force", "to": "ms.force"}
+  ],
+  "stop_time": 1.0,
+  "step": 0.001
+}"#;
+
+fn models() -> (ModelDescription, ModelDescription) {
+    (
+        ModelDescription::parse(SDM).unwrap(),
+        ModelDescription::parse(MASS_SPRING).unwrap(),
+    )
+}
+
+fn plan_of(text: &str) -> Result<CouplingPlan, SystemError> {
+    let (a, b) = models();
+    let s = LoadedSystem::from_json_str(text, Path::new("/x"), "sys.json")?;
+    s.plan(&[&a, &b])
+}
+
+fn err_of(text: &str) -> String {
+    plan_of(text).unwrap_err().to_string()
+}
+
+#[test]
+fn valid_system_gives_feedthrough_order_and_default_record() {
+    let p = plan_of(SYS).unwrap();
+    // sdm's coupling_force feeds through from its inputs: ms must step first
+    assert_eq!(p.order, vec![1, 0]);
+    assert_eq!(p.algorithm, Algorithm::GaussSeidel);
+    assert_eq!(p.connections.len(), 3);
+    assert_eq!(
+        p.instances[0].parameters,
+        vec![
+            (
+                VarRef {
+                    vr: 1,
+                    ty: ScalarType::Real
+                },
+                200.0
+            ),
+            (
+                VarRef {
+                    vr: 8,
+                    ty: ScalarType::Integer
+                },
+                1.0
+            ),
+        ]
+    );
+    let labels: Vec<&str> = p.record.iter().map(|r| r.label.as_str()).collect();
+    assert_eq!(
+        labels,
+        vec![
+            "sdm.input_position [m]",
+            "sdm.input_velocity [m/s]",
+            "sdm.coupling_force [N]",
+            "sdm.position [m]",
+            "sdm.velocity [m/s]",
+            "ms.force [N]",
+            "ms.position [m]",
+            "ms.velocity [m/s]",
+        ]
+    );
+}
+
+#[test]
+fn explicit_order_and_record() {
+    let t = SYS.replace("\"step\": 0.001", "\"step\": 0.001, \"order\": [\"sdm\", \"ms\"], \"record\": [\"ms.position\"], \"algorithm\": \"jacobi\"");
+    let p = plan_of(&t).unwrap();
+    assert_eq!(p.order, vec![0, 1]);
+    assert_eq!(p.algorithm, Algorithm::Jacobi);
+    assert_eq!(p.record.len(), 1);
+    let t = SYS.replace("\"step\": 0.001", "\"step\": 0.001, \"order\": [\"sdm\"]");
+    assert!(err_of(&t).contains("missing: ms"));
+}
+
+#[test]
+fn unknown_variable_names_field_line_and_suggestion() {
+    let t = SYS.replace("\"sdm.coupling_force\"", "\"sdm.coupling_forse\"");
+    let e = err_of(&t);
+    assert_eq!(
+        e,
+        "sys.json line 9: connections[2].from: unknown variable 'sdm.coupling_forse' in instance 'sdm' (model 'SpringDamperMass') (did you mean 'sdm.coupling_force'?)"
+    );
+    let t = SYS.replace("\"to\": \"ms.force\"", "\"to\": \"mss.force\"");
+    assert!(err_of(&t).contains("connections[2].to: unknown instance 'mss' (did you mean 'ms'?)"));
+    let t = SYS.replace("\"k\": 100.0", "\"kk\": 100.0");
+    let e = err_of(&t);
+    assert!(
+        e.contains("instances[1].parameters.kk: unknown variable 'kk'")
+            && e.contains("did you mean 'k'"),
+        "{e}"
+    );
+}
+
+#[test]
+fn causality_type_and_unit_checks() {
+    let t = SYS.replace("\"from\": \"ms.position\"", "\"from\": \"ms.force\"");
+    assert!(err_of(&t).contains("connections[0].from: 'ms.force' has causality 'input'"));
+    let t = SYS.replace("\"to\": \"ms.force\"", "\"to\": \"ms.velocity\"");
+    assert!(err_of(&t).contains("only inputs can be connection targets"));
+    // unit mismatch: position [m] -> input_velocity [m/s]
+    let t = SYS.replace(
+        "{\"from\": \"ms.velocity\", \"to\": \"sdm.input_velocity\"}",
+        "{\"from\": \"ms.position\", \"to\": \"sdm.input_velocity\"}",
+    );
+    let e = err_of(&t);
+    assert!(e.contains("connections[1]: unit mismatch: 'ms.position' is in [m] but 'sdm.input_velocity' is in [m/s]"), "{e}");
+    // type mismatch needs an Integer output: make ms.velocity Integer
+    let (a, _) = models();
+    let ms_int = MASS_SPRING.replace("<Real unit=\"m/s\"/>", "<Integer/>");
+    let b = ModelDescription::parse(&ms_int).unwrap();
+    let s = LoadedSystem::from_json_str(SYS, Path::new("/x"), "sys.json").unwrap();
+    let e = s.plan(&[&a, &b]).unwrap_err().to_string();
+    assert!(
+        e.contains("type mismatch: 'ms.velocity' is Integer but 'sdm.input_velocity' is Real"),
+        "{e}"
+    );
+    // the same input twice
+    let t = SYS.replace(
+        "{\"from\": \"ms.velocity\", \"to\": \"sdm.input_velocity\"}",
+        "{\"from\": \"ms.position\", \"to\": \"sdm.input_position\"}",
+    );
+    assert!(err_of(&t).contains(
+        "connections[1].to: input 'sdm.input_position' is already driven by connections[0]"
+    ));
+}
+
+#[test]
+fn parameter_value_checks() {
+    let t = SYS.replace("\"mode\": 1", "\"mode\": 1.5");
+    assert!(err_of(&t).contains("instances[0].parameters.mode: 1.5 is not a 32-bit integer"));
+    let t = SYS.replace("\"mode\": 1", "\"mode\": true");
+    assert!(err_of(&t).contains("Integer variable cannot take the value true"));
+    let t = SYS.replace("\"k\": 200.0", "\"coupling_force\": 2.0");
+    assert!(err_of(&t).contains("causality 'output'"));
+}
+
+#[test]
+fn malformed_json_and_timing() {
+    let e = err_of("{\n  \"instances\": [\n  }");
+    assert!(e.starts_with("sys.json: line 3, column 3:"), "{e}");
+    let e = err_of(&SYS.replace("\"step\"", "\"stpe\""));
+    assert!(e.contains("unknown field `stpe`"), "{e}");
+    assert!(err_of(&SYS.replace("0.001", "-1")).contains("step: must be a positive number"));
+    assert!(err_of(&SYS.replace("0.001", "0.3")).contains("not an integer multiple"));
+    assert!(err_of(&SYS.replace("\"stop_time\": 1.0", "\"stop_time\": 0.0")).contains("stop_time"));
+    let e = err_of(&SYS.replace("\"name\": \"ms\"", "\"name\": \"sdm\""));
+    assert!(
+        e.contains("instances[1].name: instance name 'sdm' is used twice"),
+        "{e}"
+    );
+    let e = err_of(&SYS.replace("\"name\": \"ms\"", "\"name\": \"m.s\""));
+    assert!(e.contains("not a valid instance name"), "{e}");
+}
+
+#[test]
+fn missing_fmu_names_the_field() {
+    let s = LoadedSystem::from_json_str(SYS, Path::new("/nonexistent"), "sys.json").unwrap();
+    let e = s.open_fmus().unwrap_err().to_string();
+    assert!(
+        e.contains("instances[0].fmu") && e.contains("/nonexistent/SpringDamperMass.fmu"),
+        "{e}"
+    );
+    let r = s.resolved();
+    assert_eq!(
+        r.instances[1].fmu,
+        PathBuf::from("/nonexistent/MassSpring.fmu")
+    );
+}
