@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use master::coupling::{Algorithm, RunOptions};
 use master::fmu::FmuArchive;
-use master::slave::{Slave, VarRef};
+use master::slave::{Slave, VarBatch, VarRef};
 use master::system::LoadedSystem;
 
 fn dist() -> PathBuf {
@@ -117,7 +117,7 @@ fn coupled_fmus_converge_to_the_monolithic_solution_and_gs_beats_jacobi() {
 fn fmu_state_save_and_restore_round_trip() {
     let a = FmuArchive::open(&dist().join("MassSpring.fmu")).unwrap();
     let (_, pos) = a.model.variable("position").unwrap();
-    let pos = VarRef::real(pos.value_reference);
+    let pos = VarBatch::new(vec![VarRef::real(pos.value_reference)]);
     let mut s = a.instantiate("ms", false).unwrap();
     s.setup_experiment(0.0, 1.0).unwrap();
     s.enter_initialization_mode().unwrap();
@@ -126,11 +126,11 @@ fn fmu_state_save_and_restore_round_trip() {
     s.save_state().unwrap();
     s.do_step(0.01, 0.01).unwrap();
     let mut first = [0.0];
-    s.get(&[pos], &mut first).unwrap();
+    s.get(&pos, &mut first).unwrap();
     s.restore_state().unwrap();
     s.do_step(0.01, 0.01).unwrap();
     let mut again = [0.0];
-    s.get(&[pos], &mut again).unwrap();
+    s.get(&pos, &mut again).unwrap();
     assert_eq!(first, again);
     assert!(first[0] != 0.1, "the mass moved");
     s.terminate().unwrap();

@@ -24,7 +24,11 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use crate::slave::{FailStatus, Slave, SlaveError, StepStatus, VarRef};
+use crate::slave::{FailStatus, Slave, SlaveError, StepStatus, VarBatch, VarRef};
+
+use exchange::{Dest, Exchange};
+
+mod exchange;
 
 /// Coupling algorithm.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -208,13 +212,20 @@ pub struct RunOptions<'a> {
 
 struct Engine<'p, 's, 'd, 'o> {
     plan: &'p CouplingPlan,
+    exchange: &'p Exchange,
     slaves: &'s mut [&'d mut dyn Slave],
     opts: &'o RunOptions<'o>,
     n_steps: u64,
     rejected: u64,
     initialised: Vec<bool>,
     fatal: Vec<bool>,
-    jacobi_buf: Vec<f64>,
+    /// Latest connected outputs of each instance (in its `Source::outputs` order).
+    outputs: Vec<Vec<f64>>,
+    /// Scratch: the inputs of one destination, and their previous values.
+    inputs: Vec<f64>,
+    previous: Vec<f64>,
+    /// Scratch: the recorded variables of one instance.
+    recorded: Vec<f64>,
 }
 
 impl Engine<'_, '_, '_, '_> {
@@ -233,62 +244,93 @@ impl Engine<'_, '_, '_, '_> {
         SimError::Slave { time, source: e }
     }
 
-    fn get1(&mut self, time: f64, i: usize, v: VarRef, label: &str) -> Result<f64, SimError> {
-        let mut x = [0.0];
-        self.slaves[i]
-            .get(&[v], &mut x)
-            .map_err(|e| self.slave_err(time, i, e))?;
-        if !x[0].is_finite() {
-            return Err(SimError::NonFinite {
-                time,
-                label: label.to_string(),
-                value: x[0],
-            });
+    /// Reads the connected outputs of instance `i` (one call per type).
+    fn read_outputs(&mut self, time: f64, i: usize) -> Result<(), SimError> {
+        let src = &self.exchange.sources[i];
+        if src.outputs.is_empty() {
+            return Ok(());
         }
-        Ok(x[0])
+        let mut values = std::mem::take(&mut self.outputs[i]);
+        values.resize(src.outputs.len(), 0.0);
+        let r = self.slaves[i].get(&src.outputs, &mut values);
+        self.outputs[i] = values;
+        r.map_err(|e| self.slave_err(time, i, e))
     }
 
-    fn set1(&mut self, time: f64, i: usize, v: VarRef, x: f64) -> Result<(), SimError> {
-        self.slaves[i]
-            .set(&[v], &[x])
-            .map_err(|e| self.slave_err(time, i, e))
-    }
-
-    /// Copies the outputs of instance `from` to their connected inputs; returns the largest
-    /// change of an input value (for the initialisation fixed point).
-    fn propagate_from(&mut self, time: f64, from: usize) -> Result<f64, SimError> {
-        let plan = self.plan;
-        let mut change: f64 = 0.0;
-        for c in plan.connections.iter().filter(|c| c.from_instance == from) {
-            let x = self.get1(time, c.from_instance, c.from, &c.label)?;
-            let mut old = [f64::NAN];
-            // reading the input back is allowed in FMI 2.0; if it fails, count as changed
-            let before = self.slaves[c.to_instance].get(&[c.to], &mut old).is_ok();
-            if !before || (old[0] - x).abs() > 0.0 || old[0].is_nan() {
-                change = change.max(if before {
-                    (old[0] - x).abs()
-                } else {
-                    f64::INFINITY
-                });
+    /// The connected outputs of instance `i` must be finite (first offender in plan order).
+    fn check_outputs(&self, time: f64, i: usize) -> Result<(), SimError> {
+        let src = &self.exchange.sources[i];
+        for (&x, &ci) in self.outputs[i].iter().zip(&src.connections) {
+            if !x.is_finite() {
+                return Err(self.non_finite(time, ci, x));
             }
-            self.set1(time, c.to_instance, c.to, x)?;
+        }
+        Ok(())
+    }
+
+    fn non_finite(&self, time: f64, connection: usize, value: f64) -> SimError {
+        SimError::NonFinite {
+            time,
+            label: self.plan.connections[connection].label.clone(),
+            value,
+        }
+    }
+
+    /// Writes the inputs of one destination from the latest outputs (one call per type). With
+    /// `compare`, first reads the inputs back and returns the largest change (initialisation
+    /// fixed point; reading an input is allowed in FMI 2.0, a failed read counts as changed).
+    fn write_inputs(&mut self, time: f64, dest: &Dest, compare: bool) -> Result<f64, SimError> {
+        let j = dest.instance;
+        let mut inputs = std::mem::take(&mut self.inputs);
+        inputs.clear();
+        inputs.extend(dest.from.iter().map(|&(i, k)| self.outputs[i][k]));
+        let mut change: f64 = 0.0;
+        if compare {
+            let mut old = std::mem::take(&mut self.previous);
+            old.clear();
+            old.resize(inputs.len(), f64::NAN);
+            let before = self.slaves[j].get(&dest.inputs, &mut old).is_ok();
+            for (&o, &x) in old.iter().zip(&inputs) {
+                if !before || (o - x).abs() > 0.0 || o.is_nan() {
+                    change = change.max(if before { (o - x).abs() } else { f64::INFINITY });
+                }
+            }
+            self.previous = old;
+        }
+        let r = self.slaves[j].set(&dest.inputs, &inputs);
+        self.inputs = inputs;
+        r.map_err(|e| self.slave_err(time, j, e))?;
+        Ok(change)
+    }
+
+    /// Copies the outputs of instance `from` to their connected inputs; with `compare`, returns
+    /// the largest change of an input value (for the initialisation fixed point).
+    fn propagate_from(&mut self, time: f64, from: usize, compare: bool) -> Result<f64, SimError> {
+        self.read_outputs(time, from)?;
+        self.check_outputs(time, from)?;
+        let exchange = self.exchange;
+        let mut change: f64 = 0.0;
+        for dest in &exchange.sources[from].dests {
+            change = change.max(self.write_inputs(time, dest, compare)?);
         }
         Ok(change)
     }
 
     /// Jacobi exchange: read all connected outputs first, then set all inputs.
     fn exchange_all_jacobi(&mut self, time: f64) -> Result<(), SimError> {
-        let plan = self.plan;
-        let mut buf = std::mem::take(&mut self.jacobi_buf);
-        buf.clear();
-        for c in &plan.connections {
-            let x = self.get1(time, c.from_instance, c.from, &c.label)?;
-            buf.push(x);
+        for i in 0..self.slaves.len() {
+            self.read_outputs(time, i)?;
         }
-        for (c, &x) in plan.connections.iter().zip(&buf) {
-            self.set1(time, c.to_instance, c.to, x)?;
+        for (ci, &(i, k)) in self.exchange.connection_at.iter().enumerate() {
+            let x = self.outputs[i][k];
+            if !x.is_finite() {
+                return Err(self.non_finite(time, ci, x));
+            }
         }
-        self.jacobi_buf = buf;
+        let exchange = self.exchange;
+        for dest in &exchange.jacobi {
+            self.write_inputs(time, dest, false)?;
+        }
         Ok(())
     }
 
@@ -298,19 +340,40 @@ impl Engine<'_, '_, '_, '_> {
             Algorithm::GaussSeidel => {
                 for idx in 0..self.plan.order.len() {
                     let i = self.plan.order[idx];
-                    self.propagate_from(time, i)?;
+                    self.propagate_from(time, i, false)?;
                 }
                 Ok(())
             }
         }
     }
 
+    /// Appends one result row: time, then the recorded variables (one call per instance and
+    /// type), which must be finite.
     fn record(&mut self, time: f64, out: &mut Vec<f64>) -> Result<(), SimError> {
+        let row = out.len();
         out.push(time);
-        let plan = self.plan;
-        for r in &plan.record {
-            let x = self.get1(time, r.instance, r.var, &r.label)?;
-            out.push(x);
+        out.resize(row + 1 + self.plan.record.len(), f64::NAN);
+        let exchange = self.exchange;
+        let mut values = std::mem::take(&mut self.recorded);
+        for g in &exchange.record {
+            values.resize(g.vars.len(), 0.0);
+            if let Err(e) = self.slaves[g.instance].get(&g.vars, &mut values) {
+                self.recorded = values;
+                return Err(self.slave_err(time, g.instance, e));
+            }
+            for (&c, &x) in g.columns.iter().zip(&values) {
+                out[row + 1 + c] = x;
+            }
+        }
+        self.recorded = values;
+        for (r, &x) in self.plan.record.iter().zip(&out[row + 1..]) {
+            if !x.is_finite() {
+                return Err(SimError::NonFinite {
+                    time,
+                    label: r.label.clone(),
+                    value: x,
+                });
+            }
         }
         Ok(())
     }
@@ -323,9 +386,10 @@ impl Engine<'_, '_, '_, '_> {
                 .setup_experiment(t0, plan.stop_time)
                 .map_err(|e| self.slave_err(t0, i, e))?;
             let inst = &plan.instances[i];
+            // one call per start value, so that a refused one is named
             for (k, &(v, x)) in inst.parameters.iter().enumerate() {
                 self.slaves[i]
-                    .set(&[v], &[x])
+                    .set(&VarBatch::new(vec![v]), &[x])
                     .map_err(|source| SimError::StartValue {
                         instance: inst.name.clone(),
                         name: inst
@@ -345,7 +409,7 @@ impl Engine<'_, '_, '_, '_> {
             let mut change: f64 = 0.0;
             for idx in 0..plan.order.len() {
                 let i = plan.order[idx];
-                change = change.max(self.propagate_from(t0, i)?);
+                change = change.max(self.propagate_from(t0, i, true)?);
             }
             if change == 0.0 {
                 break;
@@ -413,7 +477,7 @@ impl Engine<'_, '_, '_, '_> {
                                 Ok(StepStatus::Discard) => return Ok(Some(i)),
                                 Err(e) => return Err(self.slave_err(ts, i, e)),
                             }
-                            self.propagate_from(ts + h, i)?;
+                            self.propagate_from(ts + h, i, false)?;
                         }
                     }
                 }
@@ -607,15 +671,20 @@ pub fn simulate(
     check_step_sizes(plan, slaves, n_steps)?;
     let started = Instant::now();
     let n = slaves.len();
+    let exchange = Exchange::new(plan);
     let mut eng = Engine {
         plan,
+        exchange: &exchange,
         slaves,
         opts,
         n_steps,
         rejected: 0,
         initialised: vec![false; n],
         fatal: vec![false; n],
-        jacobi_buf: Vec::new(),
+        outputs: vec![Vec::new(); n],
+        inputs: Vec::new(),
+        previous: Vec::new(),
+        recorded: Vec::new(),
     };
     let res = eng.run();
     let term = eng.terminate_all();

@@ -2,7 +2,7 @@
 //! `MassSpring` and `SpringDamperMass` will implement.
 
 use super::*;
-use crate::slave::{ScalarType, VarRef};
+use crate::slave::{ScalarType, VarBatch, VarRef};
 use std::cell::RefCell;
 use std::rc::Rc;
 use std::sync::Arc;
@@ -20,6 +20,9 @@ pub struct Hooks {
     pub cancel_after: Option<(usize, Arc<AtomicBool>)>,
     pub step_times: Vec<(f64, f64)>,
     pub fail_set_vr: Option<u32>,
+    /// Number of get and set calls (each a batch).
+    pub gets: usize,
+    pub sets: usize,
 }
 
 /// Dynamics: state (x, v), values by value reference.
@@ -155,15 +158,17 @@ impl<M: Model + Clone> Slave for Mock<M> {
         self.note("exit");
         Ok(())
     }
-    fn get(&mut self, vars: &[VarRef], out: &mut [f64]) -> Result<(), SlaveError> {
+    fn get(&mut self, batch: &VarBatch, out: &mut [f64]) -> Result<(), SlaveError> {
+        self.hooks.gets += 1;
         self.m.outputs();
-        for (v, o) in vars.iter().zip(out) {
+        for (v, o) in batch.vars().iter().zip(out) {
             *o = self.m.values()[v.vr as usize];
         }
         Ok(())
     }
-    fn set(&mut self, vars: &[VarRef], values: &[f64]) -> Result<(), SlaveError> {
-        for (v, x) in vars.iter().zip(values) {
+    fn set(&mut self, batch: &VarBatch, values: &[f64]) -> Result<(), SlaveError> {
+        self.hooks.sets += 1;
+        for (v, x) in batch.vars().iter().zip(values) {
             if self.hooks.fail_set_vr == Some(v.vr) {
                 return Err(SlaveError {
                     instance: self.name.clone(),
@@ -573,4 +578,20 @@ fn fixed_step_slave_is_not_retried_with_smaller_steps() {
         .step_times
         .iter()
         .all(|&(_, h)| (h - 4e-3).abs() < 1e-15));
+}
+
+#[test]
+fn every_step_makes_one_get_and_one_set_call_per_slave() {
+    // ms: 2 outputs to sdm, 2 recorded; sdm: 1 output to ms, 1 recorded. Per macro step each
+    // slave is read once for its connected outputs and once for its recorded variables and
+    // written once, whatever the number of connections (the calls of N more steps).
+    for alg in [Algorithm::GaussSeidel, Algorithm::Jacobi] {
+        let calls = |stop: f64| {
+            let (_, a, b) = run(&two_mass_plan(alg, vec![0, 1], 0.01, stop));
+            [a.hooks.gets, a.hooks.sets, b.hooks.gets, b.hooks.sets]
+        };
+        let (short, long) = (calls(0.1), calls(0.2));
+        let per_10_steps: Vec<usize> = long.iter().zip(&short).map(|(l, s)| l - s).collect();
+        assert_eq!(per_10_steps, [20, 10, 20, 10], "{alg:?}");
+    }
 }

@@ -7,7 +7,7 @@ use fmi_sys::fmi2 as ffi;
 
 use super::library::{callbacks, Fmi2Library};
 use super::{FmuError, PreparedFmu};
-use crate::slave::{FailStatus, ScalarType, Slave, SlaveError, StepStatus, VarRef};
+use crate::slave::{FailStatus, ScalarType, Slave, SlaveError, StepStatus, VarBatch};
 
 /// Instance names must be non-empty C strings.
 pub(crate) fn check_instance_name(name: &str) -> Result<(), FmuError> {
@@ -29,6 +29,9 @@ pub struct FmuSlave {
     name: String,
     can_state: bool,
     can_vary_step: bool,
+    /// Scratch buffers of mixed-type batches (reused: no allocation per step).
+    reals: Vec<f64>,
+    ints: Vec<i32>,
     // The FMU may keep the pointer to its callbacks for its whole life.
     _callbacks: Box<ffi::fmi2CallbackFunctions>,
     fmu: Arc<PreparedFmu>,
@@ -93,6 +96,8 @@ impl FmuSlave {
             name: instance_name.to_string(),
             can_state: caps.is_some_and(|c| c.can_get_and_set_fmu_state) && lib.fmu_state.is_some(),
             can_vary_step: caps.is_some_and(|c| c.can_handle_variable_communication_step_size),
+            reals: Vec::new(),
+            ints: Vec::new(),
             _callbacks: callbacks,
             fmu,
         })
@@ -108,6 +113,14 @@ impl FmuSlave {
             call,
             status,
         })
+    }
+
+    fn internal(&self, call: &'static str, reason: &str) -> SlaveError {
+        SlaveError {
+            instance: self.name.clone(),
+            call,
+            status: FailStatus::Other(format!("internal: {reason}")),
+        }
     }
 
     fn missing(&self, call: &'static str) -> SlaveError {
@@ -153,72 +166,93 @@ impl Slave for FmuSlave {
         let s = unsafe { (self.lib().exit_initialization_mode)(self.component) };
         self.check("fmi2ExitInitializationMode", s)
     }
-    fn get(&mut self, vars: &[VarRef], out: &mut [f64]) -> Result<(), SlaveError> {
-        for (v, o) in vars.iter().zip(out.iter_mut()) {
-            let vr = [v.vr];
-            match v.ty {
-                ScalarType::Real => {
-                    let mut x = [0.0];
-                    let s = unsafe {
-                        (self.lib().get_real)(self.component, vr.as_ptr(), 1, x.as_mut_ptr())
-                    };
-                    self.check("fmi2GetReal", s)?;
-                    *o = x[0];
-                }
-                ScalarType::Integer => {
-                    let mut x = [0];
-                    let s = unsafe {
-                        (self.lib().get_integer)(self.component, vr.as_ptr(), 1, x.as_mut_ptr())
-                    };
-                    self.check("fmi2GetInteger", s)?;
-                    *o = f64::from(x[0]);
-                }
-                ScalarType::Boolean => {
-                    let mut x = [0];
-                    let s = unsafe {
-                        (self.lib().get_boolean)(self.component, vr.as_ptr(), 1, x.as_mut_ptr())
-                    };
-                    self.check("fmi2GetBoolean", s)?;
-                    *o = if x[0] != 0 { 1.0 } else { 0.0 };
-                }
+    fn get(&mut self, batch: &VarBatch, out: &mut [f64]) -> Result<(), SlaveError> {
+        if out.len() != batch.len() {
+            return Err(self.internal("fmi2GetReal", "batch and value lengths differ"));
+        }
+        let (c, lib) = (self.component, self.fmu.library());
+        if batch.all_real() {
+            if !out.is_empty() {
+                let vrs = &batch.group(ScalarType::Real).vrs;
+                let s = unsafe { (lib.get_real)(c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
+                self.check("fmi2GetReal", s)?;
+            }
+            return Ok(());
+        }
+        let g = batch.group(ScalarType::Real);
+        if !g.vrs.is_empty() {
+            self.reals.resize(g.vrs.len(), 0.0);
+            let s =
+                unsafe { (lib.get_real)(c, g.vrs.as_ptr(), g.vrs.len(), self.reals.as_mut_ptr()) };
+            self.check("fmi2GetReal", s)?;
+            for (&k, &x) in g.positions.iter().zip(&self.reals) {
+                out[k] = x;
+            }
+        }
+        for (ty, call) in [
+            (ScalarType::Integer, "fmi2GetInteger"),
+            (ScalarType::Boolean, "fmi2GetBoolean"),
+        ] {
+            let g = batch.group(ty);
+            if g.vrs.is_empty() {
+                continue;
+            }
+            self.ints.resize(g.vrs.len(), 0);
+            let get = if ty == ScalarType::Integer {
+                lib.get_integer
+            } else {
+                lib.get_boolean
+            };
+            let s = unsafe { get(c, g.vrs.as_ptr(), g.vrs.len(), self.ints.as_mut_ptr()) };
+            self.check(call, s)?;
+            for (&k, &x) in g.positions.iter().zip(&self.ints) {
+                // an fmi2Boolean is any non-zero integer for true
+                out[k] = match ty {
+                    ScalarType::Boolean if x != 0 => 1.0,
+                    ScalarType::Boolean => 0.0,
+                    _ => f64::from(x),
+                };
             }
         }
         Ok(())
     }
-    fn set(&mut self, vars: &[VarRef], values: &[f64]) -> Result<(), SlaveError> {
-        for (v, &x) in vars.iter().zip(values) {
-            let vr = [v.vr];
-            match v.ty {
-                ScalarType::Real => {
-                    let s = unsafe {
-                        (self.lib().set_real)(self.component, vr.as_ptr(), 1, [x].as_ptr())
-                    };
-                    self.check("fmi2SetReal", s)?;
-                }
-                ScalarType::Integer => {
-                    // values come from Integer outputs or validated parameters: exact
-                    let s = unsafe {
-                        (self.lib().set_integer)(
-                            self.component,
-                            vr.as_ptr(),
-                            1,
-                            [x.round() as i32].as_ptr(),
-                        )
-                    };
-                    self.check("fmi2SetInteger", s)?;
-                }
-                ScalarType::Boolean => {
-                    let s = unsafe {
-                        (self.lib().set_boolean)(
-                            self.component,
-                            vr.as_ptr(),
-                            1,
-                            [i32::from(x != 0.0)].as_ptr(),
-                        )
-                    };
-                    self.check("fmi2SetBoolean", s)?;
-                }
+    fn set(&mut self, batch: &VarBatch, values: &[f64]) -> Result<(), SlaveError> {
+        if values.len() != batch.len() {
+            return Err(self.internal("fmi2SetReal", "batch and value lengths differ"));
+        }
+        let (c, lib) = (self.component, self.fmu.library());
+        let g = batch.group(ScalarType::Real);
+        if !g.vrs.is_empty() {
+            let s = if batch.all_real() {
+                unsafe { (lib.set_real)(c, g.vrs.as_ptr(), g.vrs.len(), values.as_ptr()) }
+            } else {
+                self.reals.clear();
+                self.reals.extend(g.positions.iter().map(|&k| values[k]));
+                unsafe { (lib.set_real)(c, g.vrs.as_ptr(), g.vrs.len(), self.reals.as_ptr()) }
+            };
+            self.check("fmi2SetReal", s)?;
+        }
+        for (ty, call) in [
+            (ScalarType::Integer, "fmi2SetInteger"),
+            (ScalarType::Boolean, "fmi2SetBoolean"),
+        ] {
+            let g = batch.group(ty);
+            if g.vrs.is_empty() {
+                continue;
             }
+            self.ints.clear();
+            self.ints.extend(g.positions.iter().map(|&k| match ty {
+                ScalarType::Boolean => i32::from(values[k] != 0.0),
+                // values come from Integer outputs or validated parameters: exact
+                _ => values[k].round() as i32,
+            }));
+            let set = if ty == ScalarType::Integer {
+                lib.set_integer
+            } else {
+                lib.set_boolean
+            };
+            let s = unsafe { set(c, g.vrs.as_ptr(), g.vrs.len(), self.ints.as_ptr()) };
+            self.check(call, s)?;
         }
         Ok(())
     }

@@ -1,0 +1,140 @@
+//! The data exchange of a plan, arranged once per run for batched calls: every slave's
+//! connected outputs are read with one call per type, every slave's connected inputs written
+//! with one call per type, every slave's recorded variables read with one call per type.
+
+use super::CouplingPlan;
+use crate::slave::{VarBatch, VarRef};
+
+/// The connected outputs of one instance and where they go.
+#[derive(Debug, Default)]
+pub(super) struct Source {
+    /// One entry per connection from this instance, in plan order.
+    pub outputs: VarBatch,
+    /// The connection (index into the plan's) of each output.
+    pub connections: Vec<usize>,
+    /// The instances its outputs feed, in order of first connection.
+    pub dests: Vec<Dest>,
+}
+
+/// Inputs of one instance written together.
+#[derive(Debug)]
+pub(super) struct Dest {
+    pub instance: usize,
+    pub inputs: VarBatch,
+    /// For each input: (source instance, position in that source's outputs).
+    pub from: Vec<(usize, usize)>,
+}
+
+/// Recorded variables of one instance.
+#[derive(Debug)]
+pub(super) struct RecordGroup {
+    pub instance: usize,
+    pub vars: VarBatch,
+    /// Result column (0-based, after time) of each variable.
+    pub columns: Vec<usize>,
+}
+
+/// The whole exchange of a plan.
+#[derive(Debug, Default)]
+pub(super) struct Exchange {
+    /// Indexed by instance.
+    pub sources: Vec<Source>,
+    /// Per plan connection: (source instance, position in its outputs).
+    pub connection_at: Vec<(usize, usize)>,
+    /// All connected inputs per destination instance (Jacobi writes them after all reads).
+    pub jacobi: Vec<Dest>,
+    pub record: Vec<RecordGroup>,
+}
+
+/// Variables of one instance with a value per variable.
+struct Grouped<T> {
+    instance: usize,
+    vars: VarBatch,
+    payload: Vec<T>,
+}
+
+/// Groups `(instance, variable, payload)` by instance, in order of first appearance.
+fn group<T>(items: impl Iterator<Item = (usize, VarRef, T)>) -> Vec<Grouped<T>> {
+    let mut groups: Vec<(usize, Vec<VarRef>, Vec<T>)> = Vec::new();
+    for (instance, var, payload) in items {
+        match groups.iter_mut().find(|g| g.0 == instance) {
+            Some(g) => {
+                g.1.push(var);
+                g.2.push(payload);
+            }
+            None => groups.push((instance, vec![var], vec![payload])),
+        }
+    }
+    groups
+        .into_iter()
+        .map(|(instance, vars, payload)| Grouped {
+            instance,
+            vars: VarBatch::new(vars),
+            payload,
+        })
+        .collect()
+}
+
+fn dests(groups: Vec<Grouped<(usize, usize)>>) -> Vec<Dest> {
+    groups
+        .into_iter()
+        .map(|g| Dest {
+            instance: g.instance,
+            inputs: g.vars,
+            from: g.payload,
+        })
+        .collect()
+}
+
+impl Exchange {
+    /// Arranges `plan`'s connections and records (instances assumed valid: see `check_plan`).
+    pub fn new(plan: &CouplingPlan) -> Self {
+        let n = plan.instances.len();
+        // position of each connection in its source's outputs
+        let mut count = vec![0usize; n];
+        let connection_at: Vec<(usize, usize)> = plan
+            .connections
+            .iter()
+            .map(|c| {
+                let i = c.from_instance;
+                count[i] += 1;
+                (i, count[i] - 1)
+            })
+            .collect();
+        let links = || plan.connections.iter().zip(connection_at.iter().copied());
+        let sources = (0..n)
+            .map(|i| {
+                let mine = || {
+                    links()
+                        .enumerate()
+                        .filter(move |(_, (c, _))| c.from_instance == i)
+                };
+                Source {
+                    outputs: VarBatch::new(mine().map(|(_, (c, _))| c.from).collect()),
+                    connections: mine().map(|(ci, _)| ci).collect(),
+                    dests: dests(group(mine().map(|(_, (c, at))| (c.to_instance, c.to, at)))),
+                }
+            })
+            .collect();
+        let jacobi = dests(group(links().map(|(c, at)| (c.to_instance, c.to, at))));
+        let record = group(
+            plan.record
+                .iter()
+                .enumerate()
+                .map(|(col, r)| (r.instance, r.var, col)),
+        )
+        .into_iter()
+        .map(|g| RecordGroup {
+            instance: g.instance,
+            vars: g.vars,
+            columns: g.payload,
+        })
+        .collect();
+        Exchange {
+            sources,
+            connection_at,
+            jacobi,
+            record,
+        }
+    }
+}
