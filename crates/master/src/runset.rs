@@ -134,17 +134,7 @@ impl RunSet {
         base_dir: &Path,
         file: &str,
     ) -> Result<(LoadedSystem, Vec<Job>), SystemError> {
-        let rs: RunSet = serde_json::from_str(text).map_err(|e| SystemError::Json {
-            file: file.to_string(),
-            line: e.line(),
-            column: e.column(),
-            message: e
-                .to_string()
-                .split(" at line ")
-                .next()
-                .unwrap_or("")
-                .to_string(),
-        })?;
+        let rs: RunSet = serde_json::from_str(text).map_err(|e| SystemError::json(file, &e))?;
         let base = match (&rs.base, &rs.system) {
             (Some(p), None) => LoadedSystem::load(&base_dir.join(p))?,
             (None, Some(s)) => LoadedSystem::from_description(s.clone(), base_dir, file),

@@ -13,9 +13,12 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // benchmark code
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use common::cpu_seconds;
 use fmu_examples::{MassSpring, SpringDamperMass};
 use master::coupling::RunOptions;
 use master::runset::{execute, run_job, RunSet};
@@ -171,21 +174,6 @@ fn fmpy_run(dist: &Path) -> Result<(f64, (f64, f64)), String> {
     Ok((wall[0], (fin[0], fin[1])))
 }
 
-/// CPU time (user + system) of this process so far [s], from /proc/self/stat (Linux; 0 elsewhere).
-fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    // fields after the ")" closing the command name: utime and stime are the 12th and 13th
-    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
-    let f: Vec<f64> = rest
-        .split_whitespace()
-        .skip(11)
-        .take(2)
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    // clock ticks are 100 per second on Linux x86_64/aarch64
-    f.iter().sum::<f64>() / 100.0
-}
-
 /// A run set of 8 runs (RUNSET_STOP s simulated each, stiffness varied) on `threads` workers: wall time.
 fn runset_wall(dist: &Path, threads: usize) -> (f64, f64) {
     let base: serde_json::Value = serde_json::from_str(&system_json(dist, RUNSET_STOP)).unwrap();
@@ -198,14 +186,14 @@ fn runset_wall(dist: &Path, threads: usize) -> (f64, f64) {
     let out = tempfile::tempdir().unwrap();
     let cancel = std::sync::atomic::AtomicBool::new(false);
     let started = Instant::now();
-    let cpu0 = cpu_seconds();
+    let cpu0 = cpu_seconds(false);
     let system = PreparedSystem::prepare(&base).unwrap();
     let reports = execute(&jobs, out.path(), threads, false, |job| {
         run_job(&system, job, &cancel)
     })
     .unwrap();
     let wall = started.elapsed().as_secs_f64();
-    let cpu = cpu_seconds() - cpu0;
+    let cpu = cpu_seconds(false) - cpu0;
     assert!(reports.iter().all(|r| r.ok), "a run failed: {reports:?}");
     (wall, cpu)
 }

@@ -16,7 +16,7 @@
 
 use signal_processing::BandPass;
 
-use crate::signal::{dominant_frequency, sliding_rms_distance, SignalError};
+use crate::signal::{check, dominant_frequency, sliding_rms_distance, SignalError};
 
 /// EN 14363 lateral-acceleration limit [m/s^2] for a bogie mass in tonnes: (12 - m/5)/2.
 pub fn acceleration_limit(bogie_mass_t: f64) -> f64 {
@@ -65,12 +65,6 @@ impl Default for StabilitySettings {
 /// Why an assessment could not be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum AssessError {
-    #[error("parameter '{name}' = {value}: {reason}")]
-    InvalidParameter {
-        name: &'static str,
-        value: f64,
-        reason: &'static str,
-    },
     #[error(transparent)]
     Signal(#[from] SignalError),
 }
@@ -88,21 +82,14 @@ pub struct Assessment {
     pub stable: bool,
 }
 
+/// A parameter check: `ok` and finite, or an error naming the parameter.
 fn param(
     name: &'static str,
     value: f64,
     ok: bool,
     reason: &'static str,
 ) -> Result<(), AssessError> {
-    if ok && value.is_finite() {
-        Ok(())
-    } else {
-        Err(AssessError::InvalidParameter {
-            name,
-            value,
-            reason,
-        })
-    }
+    Ok(check(name, value, ok, reason)?)
 }
 
 /// Filtered sliding-window rms of a signal sampled at `fs` [Hz] at constant `speed_mps`,

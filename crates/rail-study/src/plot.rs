@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use plotters::coord::ranged1d::{AsRangedCoord, Ranged, ValueFormatter};
 use plotters::prelude::*;
 
 use master::output::{write_bytes_atomic, OutputError};
@@ -20,6 +21,118 @@ pub enum PlotError {
 
 /// (min, max) of an axis.
 type Range = (f64, f64);
+
+/// A drawing area with axes, as [`render_svg`] hands it to the chart's own drawing.
+pub(crate) type Frame<'a, 'b, X, Y> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>;
+
+pub(crate) fn draw_err(title: &str, e: &dyn std::fmt::Display) -> PlotError {
+    PlotError::Draw {
+        title: title.to_string(),
+        reason: e.to_string(),
+    }
+}
+
+/// Renders what every chart shares (white background, caption, axes with their descriptions,
+/// the legend box last, at its default place unless `legend`) into an SVG string; `body`
+/// draws the data.
+pub(crate) fn render_svg<XR, YR, F>(
+    title: &str,
+    size: (u32, u32),
+    (x_label, y_label): (&str, &str),
+    (xr, yr): (XR, YR),
+    legend: Option<SeriesLabelPosition>,
+    body: F,
+) -> Result<String, PlotError>
+where
+    XR: AsRangedCoord<Value = f64>,
+    YR: AsRangedCoord<Value = f64>,
+    XR::CoordDescType: ValueFormatter<f64>,
+    YR::CoordDescType: ValueFormatter<f64>,
+    F: FnOnce(&mut Frame<'_, '_, XR::CoordDescType, YR::CoordDescType>) -> Result<(), PlotError>,
+{
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| draw_err(title, &e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(xr, yr)
+            .map_err(|e| draw_err(title, &e))?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .draw()
+            .map_err(|e| draw_err(title, &e))?;
+        body(&mut chart)?;
+        let mut labels = chart.configure_series_labels();
+        if let Some(p) = legend {
+            labels.position(p);
+        }
+        labels
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| draw_err(title, &e))?;
+        root.present().map_err(|e| draw_err(title, &e))?;
+    }
+    Ok(svg)
+}
+
+/// Each series as a line in its palette colour with a legend entry; points failing `keep` are
+/// left out.
+pub(crate) fn draw_lines<X, Y>(
+    chart: &mut Frame<'_, '_, X, Y>,
+    title: &str,
+    series: &[Series],
+    keep: impl Fn((f64, f64)) -> bool,
+) -> Result<(), PlotError>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    for (i, s) in series.iter().enumerate() {
+        let color = Palette99::pick(i).to_rgba();
+        let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(|&p| keep(p)).collect();
+        chart
+            .draw_series(LineSeries::new(pts, color.stroke_width(2)))
+            .map_err(|e| draw_err(title, &e))?
+            .label(&s.name)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            });
+    }
+    Ok(())
+}
+
+/// A dashed red horizontal line at `value` across `x_span`, with a legend entry.
+pub(crate) fn draw_limit<X, Y>(
+    chart: &mut Frame<'_, '_, X, Y>,
+    title: &str,
+    x_span: (f64, f64),
+    value: f64,
+    label: &str,
+) -> Result<(), PlotError>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let style = RED.stroke_width(1);
+    chart
+        .draw_series(DashedLineSeries::new(
+            vec![(x_span.0, value), (x_span.1, value)],
+            8,
+            5,
+            style,
+        ))
+        .map_err(|e| draw_err(title, &e))?
+        .label(label)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+    Ok(())
+}
 
 /// One named series of (x, y) points.
 #[derive(Debug, Clone, PartialEq)]
@@ -105,68 +218,29 @@ impl Chart {
     /// Renders to an SVG string; `scatter` draws points instead of lines.
     pub fn to_svg(&self, scatter: bool) -> Result<String, PlotError> {
         let ((x0, x1), (y0, y1)) = self.ranges()?;
-        let draw = |e: &dyn std::fmt::Display| PlotError::Draw {
-            title: self.title.clone(),
-            reason: e.to_string(),
-        };
-        let mut svg = String::new();
-        {
-            let root =
-                SVGBackend::with_string(&mut svg, (self.width, self.height)).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| draw(&e))?;
-            let mut chart = ChartBuilder::on(&root)
-                .caption(&self.title, ("sans-serif", 20))
-                .margin(12)
-                .x_label_area_size(45)
-                .y_label_area_size(70)
-                .build_cartesian_2d(x0..x1, y0..y1)
-                .map_err(|e| draw(&e))?;
-            chart
-                .configure_mesh()
-                .x_desc(&self.x_label)
-                .y_desc(&self.y_label)
-                .draw()
-                .map_err(|e| draw(&e))?;
-            for (i, s) in self.series.iter().enumerate() {
-                let color = Palette99::pick(i).to_rgba();
-                let pts = s
-                    .points
-                    .iter()
-                    .copied()
-                    .filter(|(x, y)| x.is_finite() && y.is_finite());
-                if scatter {
+        let t = self.title.as_str();
+        let labels = (self.x_label.as_str(), self.y_label.as_str());
+        let size = (self.width, self.height);
+        render_svg(t, size, labels, (x0..x1, y0..y1), None, |chart| {
+            let finite = |(x, y): (f64, f64)| x.is_finite() && y.is_finite();
+            if scatter {
+                for (i, s) in self.series.iter().enumerate() {
+                    let color = Palette99::pick(i).to_rgba();
+                    let pts = s.points.iter().copied().filter(|&p| finite(p));
                     chart
                         .draw_series(pts.map(|p| Circle::new(p, 3, color.filled())))
-                        .map_err(|e| draw(&e))?
+                        .map_err(|e| draw_err(t, &e))?
                         .label(&s.name)
                         .legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled()));
-                } else {
-                    chart
-                        .draw_series(LineSeries::new(pts, color.stroke_width(2)))
-                        .map_err(|e| draw(&e))?
-                        .label(&s.name)
-                        .legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                        });
                 }
+            } else {
+                draw_lines(chart, t, &self.series, finite)?;
             }
-            if let Some((v, label)) = &self.limit {
-                let style = RED.stroke_width(1);
-                chart
-                    .draw_series(DashedLineSeries::new(vec![(x0, *v), (x1, *v)], 8, 5, style))
-                    .map_err(|e| draw(&e))?
-                    .label(label)
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            match &self.limit {
+                Some((v, label)) => draw_limit(chart, t, (x0, x1), *v, label),
+                None => Ok(()),
             }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()
-                .map_err(|e| draw(&e))?;
-            root.present().map_err(|e| draw(&e))?;
-        }
-        Ok(svg)
+        })
     }
 
     /// Line chart to an SVG file (atomic).

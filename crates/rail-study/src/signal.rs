@@ -4,6 +4,7 @@
 
 use std::f64::consts::PI;
 
+pub use signal_processing::rms;
 use signal_processing::{Complex64, DesignError};
 
 /// A signal-processing input problem, naming the parameter.
@@ -29,7 +30,8 @@ pub enum SignalError {
     Design(#[from] DesignError),
 }
 
-fn check(
+/// A parameter check: `ok` and finite, or an error naming the parameter.
+pub(crate) fn check(
     name: &'static str,
     value: f64,
     ok: bool,
@@ -157,14 +159,6 @@ pub fn dominant_frequency(x: &[f64], fs: f64, f_min: f64, f_max: f64) -> Result<
     Ok(f[best] + shift * (f[1] - f[0]))
 }
 
-/// Root mean square.
-pub fn rms(x: &[f64]) -> f64 {
-    if x.is_empty() {
-        return 0.0;
-    }
-    (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt()
-}
-
 /// RMS over sliding windows of `window_m` metres advanced by `step_m` metres, for a signal
 /// sampled at `fs` while running at constant `speed_mps`. Returns (window centre [m], rms).
 pub fn sliding_rms_distance(
@@ -226,9 +220,7 @@ mod tests {
     use approx::assert_relative_eq;
 
     fn sine(a: f64, f: f64, fs: f64, secs: f64, phase: f64) -> Vec<f64> {
-        (0..(secs * fs) as usize)
-            .map(|i| a * (2.0 * PI * f * i as f64 / fs + phase).sin())
-            .collect()
+        signal_processing::sampled(|t| a * (2.0 * PI * f * t + phase).sin(), fs, secs)
     }
 
     #[test]

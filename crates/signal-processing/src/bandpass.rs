@@ -207,14 +207,10 @@ mod tests {
     use super::*;
     use approx::assert_relative_eq;
 
-    fn sine(a: f64, f: f64, fs: f64, secs: f64, phase: f64) -> Vec<f64> {
-        (0..(secs * fs) as usize)
-            .map(|i| a * (2.0 * PI * f * i as f64 / fs + phase).sin())
-            .collect()
-    }
+    use crate::{rms, sampled};
 
-    fn rms(x: &[f64]) -> f64 {
-        (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt()
+    fn sine(a: f64, f: f64, fs: f64, secs: f64, phase: f64) -> Vec<f64> {
+        sampled(|t| a * (2.0 * PI * f * t + phase).sin(), fs, secs)
     }
 
     #[test]

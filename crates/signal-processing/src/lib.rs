@@ -7,7 +7,8 @@
 //!   analogue prototype and the bilinear (Tustin) transform with pre-warped edges, as a cascade
 //!   of biquads each scaled to unit gain at the centre; streaming ([`BandPass::process`]),
 //!   causal over a slice ([`BandPass::filter`]) and zero-phase ([`BandPass::filtfilt`]).
-//! * [`principal_sqrt`]: the complex square root the design uses.
+//! * [`principal_sqrt`]: the complex square root the design uses; [`rms`]; [`sampled`] (test
+//!   signals).
 //!
 //! The crate knows no model and no FMI: plain functions of numbers, so a model crate may
 //! depend on it.
@@ -18,6 +19,21 @@ mod biquad;
 pub use bandpass::{BandPass, DesignError, DesignParameter};
 pub use biquad::Biquad;
 pub use num_complex::Complex64;
+
+/// Root mean square (0 for an empty signal).
+pub fn rms(x: &[f64]) -> f64 {
+    if x.is_empty() {
+        return 0.0;
+    }
+    (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt()
+}
+
+/// `signal(t)` sampled at `fs` [Hz] for `secs` seconds, `t = i / fs` (test signals).
+pub fn sampled(signal: impl Fn(f64) -> f64, fs: f64, secs: f64) -> Vec<f64> {
+    (0..(secs * fs) as usize)
+        .map(|i| signal(i as f64 / fs))
+        .collect()
+}
 
 /// Principal square root by the algebraic formula
 /// `sqrt(z) = sqrt((|z| + re)/2) + i sign(im) sqrt((|z| - re)/2)`.
@@ -35,6 +51,18 @@ pub fn principal_sqrt(z: Complex64) -> Complex64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rms_of_a_sampled_sine() {
+        let x = sampled(
+            |t| 3.0 * (2.0 * std::f64::consts::PI * 5.0 * t).sin(),
+            1000.0,
+            2.0,
+        );
+        assert_eq!(x.len(), 2000);
+        assert!((rms(&x) - 3.0 / 2f64.sqrt()).abs() < 1e-12);
+        assert_eq!(rms(&[]), 0.0);
+    }
 
     #[test]
     fn principal_sqrt_squares_back_and_takes_the_right_half_plane() {

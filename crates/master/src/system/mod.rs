@@ -126,6 +126,23 @@ pub enum SystemError {
     },
 }
 
+impl SystemError {
+    /// A JSON syntax or schema error of `file`, with its line and column.
+    pub fn json(file: &str, e: &serde_json::Error) -> Self {
+        SystemError::Json {
+            file: file.to_string(),
+            line: e.line(),
+            column: e.column(),
+            message: e
+                .to_string()
+                .split(" at line ")
+                .next()
+                .unwrap_or("")
+                .to_string(),
+        }
+    }
+}
+
 /// Anything that stops `master run`.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
@@ -198,17 +215,7 @@ impl LoadedSystem {
     /// Parses JSON text. `file` names it in messages.
     pub fn from_json_str(text: &str, base_dir: &Path, file: &str) -> Result<Self, SystemError> {
         let desc: SystemDescription =
-            serde_json::from_str(text).map_err(|e| SystemError::Json {
-                file: file.to_string(),
-                line: e.line(),
-                column: e.column(),
-                message: e
-                    .to_string()
-                    .split(" at line ")
-                    .next()
-                    .unwrap_or("")
-                    .to_string(),
-            })?;
+            serde_json::from_str(text).map_err(|e| SystemError::json(file, &e))?;
         Ok(LoadedSystem {
             desc,
             file: file.to_string(),

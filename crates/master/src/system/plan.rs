@@ -214,6 +214,14 @@ impl LoadedSystem {
             Some(u) => format!("{}.{} [{u}]", d.instances[i].name, v.name),
             None => format!("{}.{}", d.instances[i].name, v.name),
         };
+        let recorded = |i: usize, v: &crate::model_description::Variable, ty| Recorded {
+            instance: i,
+            var: VarRef {
+                vr: v.value_reference,
+                ty,
+            },
+            label: label(i, v),
+        };
         let mut record = Vec::new();
         match &d.record {
             Some(list) => {
@@ -226,14 +234,7 @@ impl LoadedSystem {
                             format!("{} variables cannot be recorded", v.var_type),
                         ));
                     };
-                    record.push(Recorded {
-                        instance: i,
-                        var: VarRef {
-                            vr: v.value_reference,
-                            ty,
-                        },
-                        label: label(i, v),
-                    });
+                    record.push(recorded(i, v, ty));
                 }
             }
             None => {
@@ -243,14 +244,7 @@ impl LoadedSystem {
                             v.causality == Causality::Input && inputs_taken.contains_key(&(i, vi));
                         if v.causality == Causality::Output || connected_input {
                             if let Some(ty) = type_of(v.var_type) {
-                                record.push(Recorded {
-                                    instance: i,
-                                    var: VarRef {
-                                        vr: v.value_reference,
-                                        ty,
-                                    },
-                                    label: label(i, v),
-                                });
+                                record.push(recorded(i, v, ty));
                             }
                         }
                     }

@@ -7,7 +7,7 @@ use std::ops::Range;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 
-use crate::plot::{Chart, PlotError};
+use crate::plot::{draw_err, draw_limit, draw_lines, render_svg, Chart, PlotError};
 
 /// Axis scale.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -21,13 +21,6 @@ fn data_err(title: &str, reason: &str) -> PlotError {
     PlotError::Data {
         title: title.to_string(),
         reason: reason.to_string(),
-    }
-}
-
-fn draw_err(title: &str, e: &dyn std::fmt::Display) -> PlotError {
-    PlotError::Draw {
-        title: title.to_string(),
-        reason: e.to_string(),
     }
 }
 
@@ -115,60 +108,17 @@ where
     Y::CoordDescType: ValueFormatter<f64>,
 {
     let t = chart.title.as_str();
-    let mut svg = String::new();
-    {
-        let root =
-            SVGBackend::with_string(&mut svg, (chart.width, chart.height)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| draw_err(t, &e))?;
-        let mut ctx = ChartBuilder::on(&root)
-            .caption(t, ("sans-serif", 20))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d(xr, yr)
-            .map_err(|e| draw_err(t, &e))?;
-        ctx.configure_mesh()
-            .x_desc(&chart.x_label)
-            .y_desc(&chart.y_label)
-            .draw()
-            .map_err(|e| draw_err(t, &e))?;
-        for (i, s) in chart.series.iter().enumerate() {
-            let color = Palette99::pick(i).to_rgba();
-            let pts: Vec<(f64, f64)> = s
-                .points
-                .iter()
-                .copied()
-                .filter(|&p| usable(p, xs, ys))
-                .collect();
-            ctx.draw_series(LineSeries::new(pts, color.stroke_width(2)))
-                .map_err(|e| draw_err(t, &e))?
-                .label(&s.name)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
-        }
-        if let Some((v, label)) = &chart.limit {
-            if ys == Scale::Linear || *v > 0.0 {
-                let style = RED.stroke_width(1);
-                ctx.draw_series(DashedLineSeries::new(
-                    vec![(x_span.0, *v), (x_span.1, *v)],
-                    8,
-                    5,
-                    style,
-                ))
-                .map_err(|e| draw_err(t, &e))?
-                .label(label)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+    let labels = (chart.x_label.as_str(), chart.y_label.as_str());
+    let size = (chart.width, chart.height);
+    render_svg(t, size, labels, (xr, yr), None, |ctx| {
+        draw_lines(ctx, t, &chart.series, |p| usable(p, xs, ys))?;
+        match &chart.limit {
+            Some((v, label)) if ys == Scale::Linear || *v > 0.0 => {
+                draw_limit(ctx, t, x_span, *v, label)
             }
+            _ => Ok(()),
         }
-        ctx.configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| draw_err(t, &e))?;
-        root.present().map_err(|e| draw_err(t, &e))?;
-    }
-    Ok(svg)
+    })
 }
 
 /// Viridis-like colour ramp, `u` in 0..1 (dark blue -> teal -> green -> yellow).
@@ -256,23 +206,10 @@ impl ColourScatter {
         let xr = axis_range(x0, x1, Scale::Linear, true);
         let yr = axis_range(y0, y1, Scale::Linear, true);
         let cu = |c: f64| if c1 > c0 { (c - c0) / (c1 - c0) } else { 0.5 };
-        let mut svg = String::new();
-        {
-            let root =
-                SVGBackend::with_string(&mut svg, (self.width, self.height)).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| draw_err(t, &e))?;
-            let mut ctx = ChartBuilder::on(&root)
-                .caption(t, ("sans-serif", 20))
-                .margin(12)
-                .x_label_area_size(45)
-                .y_label_area_size(70)
-                .build_cartesian_2d(xr.clone(), yr.clone())
-                .map_err(|e| draw_err(t, &e))?;
-            ctx.configure_mesh()
-                .x_desc(&self.x_label)
-                .y_desc(&self.y_label)
-                .draw()
-                .map_err(|e| draw_err(t, &e))?;
+        let labels = (self.x_label.as_str(), self.y_label.as_str());
+        let size = (self.width, self.height);
+        let legend = Some(SeriesLabelPosition::UpperLeft);
+        render_svg(t, size, labels, (xr.clone(), yr.clone()), legend, |ctx| {
             if self.zero_line_x {
                 let style = BLACK.mix(0.6).stroke_width(1);
                 ctx.draw_series(DashedLineSeries::new(
@@ -312,15 +249,8 @@ impl ColourScatter {
                     .label(format!("{c:.0} {}", self.c_unit))
                     .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled()));
             }
-            ctx.configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()
-                .map_err(|e| draw_err(t, &e))?;
-            root.present().map_err(|e| draw_err(t, &e))?;
-        }
-        Ok(svg)
+            Ok(())
+        })
     }
 }
 

@@ -3,8 +3,8 @@
 
 use std::path::PathBuf;
 
+use super::{failed, write_analysis};
 use crate::analysis::assess::{assess_table, Criterion, ResultsTable};
-use crate::analysis::{print_report, Artefacts};
 use crate::en14363::StabilitySettings;
 use master::cli::{CommandError, Context};
 
@@ -52,8 +52,7 @@ pub struct Args {
     pub out: PathBuf,
 }
 
-pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
-    let failed = |e| CommandError::Failed(format!("{e}"));
+pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     let criterion = match args.quantity {
         Quantity::Acceleration => Criterion::LateralAcceleration {
             bogie_mass_t: args.bogie_mass,
@@ -70,9 +69,7 @@ pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
     let table = ResultsTable::load(&args.table).map_err(failed)?;
     let report =
         assess_table(&table, &args.signals, args.speed, criterion, &settings).map_err(failed)?;
-    let mut files = Artefacts::default();
-    report.add_artefacts(&mut files).map_err(failed)?;
-    files.write_all(&args.out)?;
-    print_report(&report.summary(), &files, &args.out);
-    Ok(())
+    write_analysis(&args.out, ctx.cancel, &report.summary(), |f| {
+        report.add_artefacts(f)
+    })
 }

@@ -6,10 +6,10 @@ use std::path::PathBuf;
 
 use fmu_damper::{ActuatorParams, SemiActiveParams};
 
+use super::{failed, write_analysis};
 use crate::analysis::damper::{
     characterise_actuator, characterise_damper, ActuatorOptions, DamperOptions,
 };
-use crate::analysis::{print_report, AnalysisError, Artefacts};
 use master::cli::{CommandError, Context};
 
 /// Which model to characterise.
@@ -57,23 +57,17 @@ pub struct Args {
     pub actuator_f_max: f64,
 }
 
-fn failed(e: AnalysisError) -> CommandError {
-    CommandError::Failed(e.to_string())
-}
-
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
-    let mut files = Artefacts::default();
-    let mut summary = String::new();
+    let (mut damper, mut actuator) = (None, None);
     if matches!(args.target, Target::Damper | Target::All) {
         let opts = DamperOptions {
             frf_points: args.damper_freqs,
             frf_band_hz: (args.damper_f_min, args.damper_f_max),
             ..DamperOptions::default()
         };
-        let r =
-            characterise_damper(&SemiActiveParams::default(), &opts, ctx.cancel).map_err(failed)?;
-        r.add_artefacts(&mut files).map_err(failed)?;
-        summary.push_str(&r.summary());
+        damper = Some(
+            characterise_damper(&SemiActiveParams::default(), &opts, ctx.cancel).map_err(failed)?,
+        );
     }
     if matches!(args.target, Target::Actuator | Target::All) {
         let opts = ActuatorOptions {
@@ -81,12 +75,22 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             band_hz: (args.actuator_f_min, args.actuator_f_max),
             ..ActuatorOptions::default()
         };
-        let r =
-            characterise_actuator(&ActuatorParams::default(), &opts, ctx.cancel).map_err(failed)?;
-        r.add_artefacts(&mut files).map_err(failed)?;
-        summary.push_str(&r.summary());
+        actuator = Some(
+            characterise_actuator(&ActuatorParams::default(), &opts, ctx.cancel).map_err(failed)?,
+        );
     }
-    files.write_all(&args.out)?;
-    print_report(&summary, &files, &args.out);
-    Ok(())
+    let summary = damper
+        .iter()
+        .map(|r| r.summary())
+        .chain(actuator.iter().map(|r| r.summary()));
+    let summary: String = summary.collect();
+    write_analysis(&args.out, ctx.cancel, &summary, |f| {
+        if let Some(r) = &damper {
+            r.add_artefacts(f)?;
+        }
+        match &actuator {
+            Some(r) => r.add_artefacts(f),
+            None => Ok(()),
+        }
+    })
 }

@@ -5,11 +5,11 @@ use std::path::PathBuf;
 
 use wheel_rail::RadiusConvention;
 
+use super::{failed, write_analysis};
 use crate::analysis::geometry::fleet::{fleet, profiles_in};
 use crate::analysis::geometry::{
     contact_geometry, parse_inclination, GeometryInputs, ProfileSource,
 };
-use crate::analysis::{check_cancel, print_report, Artefacts};
 use master::cli::{CommandError, Context};
 
 /// How unequal wheel radii enter (`--radius-convention`).
@@ -104,7 +104,6 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         radius_convention: args.radius_convention.into(),
         ..d
     };
-    let failed = |e| CommandError::Failed(format!("{e}"));
     if !args.wheels.is_empty() || args.wheel_dir.is_some() {
         let mut wheels: Vec<ProfileSource> = args
             .wheels
@@ -118,18 +117,9 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             skipped = other;
         }
         let r = fleet(&inputs, &wheels, ctx.cancel).map_err(failed)?;
-        check_cancel(ctx.cancel).map_err(failed)?;
-        let mut files = Artefacts::default();
-        r.add_artefacts(&mut files).map_err(failed)?;
-        files.write_all(&args.out)?;
-        print_report(&r.summary(&skipped), &files, &args.out);
-        return Ok(());
+        let summary = r.summary(&skipped);
+        return write_analysis(&args.out, ctx.cancel, &summary, |f| r.add_artefacts(f));
     }
     let r = contact_geometry(&inputs).map_err(failed)?;
-    check_cancel(ctx.cancel).map_err(failed)?;
-    let mut files = Artefacts::default();
-    r.add_artefacts(&mut files).map_err(failed)?;
-    files.write_all(&args.out)?;
-    print_report(&r.summary(), &files, &args.out);
-    Ok(())
+    write_analysis(&args.out, ctx.cancel, &r.summary(), |f| r.add_artefacts(f))
 }

@@ -3,7 +3,12 @@
 //! an `execute(&Args, &Context) -> Result<(), CommandError>`, declare it here and add a variant
 //! to `Command` in `src/main.rs`.
 
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
 use master::cli::CommandError;
+
+use crate::analysis::{check_cancel, print_report, AnalysisError, Artefacts};
 
 pub mod assess;
 pub mod characterise;
@@ -16,4 +21,25 @@ impl From<crate::plot::PlotError> for CommandError {
     fn from(e: crate::plot::PlotError) -> Self {
         CommandError::Other(Box::new(e))
     }
+}
+
+/// An analysis failure as a command error (the message names the model, file or option).
+pub(crate) fn failed(e: AnalysisError) -> CommandError {
+    CommandError::Failed(e.to_string())
+}
+
+/// Ends an analysis command: unless interrupted, collects its files (`add`), writes them into
+/// `out` (only now, after everything is computed) and prints `summary` with the file list.
+pub(crate) fn write_analysis(
+    out: &Path,
+    cancel: &AtomicBool,
+    summary: &str,
+    add: impl FnOnce(&mut Artefacts) -> Result<(), AnalysisError>,
+) -> Result<(), CommandError> {
+    check_cancel(cancel).map_err(failed)?;
+    let mut files = Artefacts::default();
+    add(&mut files).map_err(failed)?;
+    files.write_all(out)?;
+    print_report(summary, &files, out);
+    Ok(())
 }

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use fmu_bogie2dof::Params;
 
+use super::{failed, write_analysis};
 use crate::analysis::locus::{parse_damper, root_locus, speed_grid_kmh, DamperSpec};
-use crate::analysis::{check_cancel, print_report, Artefacts};
 use master::cli::{CommandError, Context};
 
 /// Options of `master root-locus` (the description shown by `--help` is the `after_help`).
@@ -38,17 +38,11 @@ pub struct Args {
 }
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
-    let failed = |e| CommandError::Failed(format!("{e}"));
     let speeds = speed_grid_kmh(args.from, args.to, args.step).map_err(failed)?;
     let mut params = Params::default();
     if let Some(c) = args.conicity {
         params.conicity = c;
     }
     let r = root_locus(&params, args.damper, &speeds).map_err(failed)?;
-    check_cancel(ctx.cancel).map_err(failed)?;
-    let mut files = Artefacts::default();
-    r.add_artefacts(&mut files).map_err(failed)?;
-    files.write_all(&args.out)?;
-    print_report(&r.summary(), &files, &args.out);
-    Ok(())
+    write_analysis(&args.out, ctx.cancel, &r.summary(), |f| r.add_artefacts(f))
 }

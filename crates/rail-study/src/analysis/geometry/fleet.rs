@@ -16,8 +16,8 @@ use wheel_rail::{compute_table, DeltaR};
 
 use super::{check_options, conicity_at, setup_of, ConicityPoint, GeometryInputs, ProfileSource};
 use crate::analysis::{AnalysisError, Artefacts};
-use master::output::csv_field;
 use crate::plot::PlotError;
+use master::output::csv_field;
 
 /// File name endings read from a `--wheel-dir` folder (case-insensitive).
 pub const PROFILE_EXTENSIONS: [&str; 4] = ["dat", "txt", "csv", "prf"];
