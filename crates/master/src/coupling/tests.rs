@@ -2,9 +2,10 @@
 //! `MassSpring` and `SpringDamperMass` will implement.
 
 use super::*;
-use crate::slave::{ScalarType, VarBatch, VarRef};
+use crate::slave::{ScalarType, Slave, SlaveError, StepStatus, VarBatch, VarRef};
 use std::cell::RefCell;
 use std::rc::Rc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 pub type CallLog = Rc<RefCell<Vec<String>>>;

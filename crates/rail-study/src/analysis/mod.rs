@@ -6,7 +6,8 @@
 //!
 //! * [`figures`]: line charts with logarithmic axes and scatter plots coloured by a third
 //!   variable (the plain linear charts come from [`crate::plot`]).
-//! * [`damper`]: hysteresis loops, damper FRFs, actuator FRFs (crate `fmu-damper`).
+//! * [`damper`], [`actuator`]: hysteresis loops and damper FRFs, actuator FRFs (crate
+//!   `fmu-damper`).
 //! * [`geometry`]: wheel/rail contact tables and equivalent conicity (crate `wheel-rail`).
 //! * [`locus`]: eigenvalues of the linear bogie over speed (crate `fmu-bogie2dof`).
 //! * [`assess`]: EN 14363 assessment of recorded signals (ours or a host's export).
@@ -16,6 +17,7 @@ use std::path::{Path, PathBuf};
 use crate::plot::{Chart, PlotError};
 use master::output::{csv_field, write_bytes_atomic, OutputError};
 
+pub mod actuator;
 pub mod assess;
 pub mod damper;
 pub mod figures;

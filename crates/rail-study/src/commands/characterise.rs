@@ -1,15 +1,15 @@
 //! `master characterise [damper|actuator|all]`: hysteresis loops, FRFs and equivalent
 //! stiffness/damping of the semi-active yaw damper, FRFs of the full-active actuator
-//! (seed 3.3.4, 3.4.4; computation in [`crate::analysis::damper`]).
+//! (seed 3.3.4, 3.4.4; computation in [`crate::analysis::damper`] and
+//! [`crate::analysis::actuator`]).
 
 use std::path::PathBuf;
 
 use fmu_damper::{ActuatorParams, SemiActiveParams};
 
 use super::{failed, write_analysis};
-use crate::analysis::damper::{
-    characterise_actuator, characterise_damper, ActuatorOptions, DamperOptions,
-};
+use crate::analysis::actuator::{characterise_actuator, ActuatorOptions};
+use crate::analysis::damper::{characterise_damper, DamperOptions};
 use master::cli::{CommandError, Context};
 
 /// Which model to characterise.

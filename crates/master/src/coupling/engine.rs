@@ -1,0 +1,412 @@
+//! The fixed-step co-simulation engine: initialisation, macro steps with retry, data exchange
+//! in batches, recording, termination (see [`super`] for the semantics).
+
+use std::sync::atomic::Ordering;
+
+use super::exchange::{Dest, Exchange};
+use super::{Algorithm, CouplingPlan, RunOptions, SimError};
+use crate::slave::{FailStatus, Slave, SlaveError, StepStatus, VarBatch};
+
+pub(super) struct Engine<'p, 's, 'd, 'o> {
+    plan: &'p CouplingPlan,
+    exchange: &'p Exchange,
+    slaves: &'s mut [&'d mut dyn Slave],
+    opts: &'o RunOptions<'o>,
+    n_steps: u64,
+    rejected: u64,
+    initialised: Vec<bool>,
+    fatal: Vec<bool>,
+    /// Latest connected outputs of each instance (in its `Source::outputs` order).
+    outputs: Vec<Vec<f64>>,
+    /// Scratch: the inputs of one destination, and their previous values.
+    inputs: Vec<f64>,
+    previous: Vec<f64>,
+    /// Scratch: the recorded variables of one instance.
+    recorded: Vec<f64>,
+}
+
+impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
+    pub(super) fn new(
+        plan: &'p CouplingPlan,
+        exchange: &'p Exchange,
+        slaves: &'s mut [&'d mut dyn Slave],
+        opts: &'o RunOptions<'o>,
+        n_steps: u64,
+    ) -> Self {
+        let n = slaves.len();
+        Engine {
+            plan,
+            exchange,
+            slaves,
+            opts,
+            n_steps,
+            rejected: 0,
+            initialised: vec![false; n],
+            fatal: vec![false; n],
+            outputs: vec![Vec::new(); n],
+            inputs: Vec::new(),
+            previous: Vec::new(),
+            recorded: Vec::new(),
+        }
+    }
+
+    /// Macro steps redone with sub-steps after a discard.
+    pub(super) fn rejected(&self) -> u64 {
+        self.rejected
+    }
+
+    fn t(&self, k: u64) -> f64 {
+        if k >= self.n_steps {
+            self.plan.stop_time
+        } else {
+            self.plan.start_time + k as f64 * self.plan.step
+        }
+    }
+
+    fn slave_err(&mut self, time: f64, i: usize, e: SlaveError) -> SimError {
+        if e.status == FailStatus::Fatal {
+            self.fatal[i] = true;
+        }
+        SimError::Slave { time, source: e }
+    }
+
+    /// Reads the connected outputs of instance `i` (one call per type).
+    fn read_outputs(&mut self, time: f64, i: usize) -> Result<(), SimError> {
+        let src = &self.exchange.sources[i];
+        if src.outputs.is_empty() {
+            return Ok(());
+        }
+        let mut values = std::mem::take(&mut self.outputs[i]);
+        values.resize(src.outputs.len(), 0.0);
+        let r = self.slaves[i].get(&src.outputs, &mut values);
+        self.outputs[i] = values;
+        r.map_err(|e| self.slave_err(time, i, e))
+    }
+
+    /// The connected outputs of instance `i` must be finite (first offender in plan order).
+    fn check_outputs(&self, time: f64, i: usize) -> Result<(), SimError> {
+        let src = &self.exchange.sources[i];
+        for (&x, &ci) in self.outputs[i].iter().zip(&src.connections) {
+            if !x.is_finite() {
+                return Err(self.non_finite(time, ci, x));
+            }
+        }
+        Ok(())
+    }
+
+    fn non_finite(&self, time: f64, connection: usize, value: f64) -> SimError {
+        SimError::NonFinite {
+            time,
+            label: self.plan.connections[connection].label.clone(),
+            value,
+        }
+    }
+
+    /// Writes the inputs of one destination from the latest outputs (one call per type). With
+    /// `compare`, first reads the inputs back and returns the largest change (initialisation
+    /// fixed point; reading an input is allowed in FMI 2.0, a failed read counts as changed).
+    fn write_inputs(&mut self, time: f64, dest: &Dest, compare: bool) -> Result<f64, SimError> {
+        let j = dest.instance;
+        let mut inputs = std::mem::take(&mut self.inputs);
+        inputs.clear();
+        inputs.extend(dest.from.iter().map(|&(i, k)| self.outputs[i][k]));
+        let mut change: f64 = 0.0;
+        if compare {
+            let mut old = std::mem::take(&mut self.previous);
+            old.clear();
+            old.resize(inputs.len(), f64::NAN);
+            let before = self.slaves[j].get(&dest.inputs, &mut old).is_ok();
+            for (&o, &x) in old.iter().zip(&inputs) {
+                if !before || (o - x).abs() > 0.0 || o.is_nan() {
+                    change = change.max(if before { (o - x).abs() } else { f64::INFINITY });
+                }
+            }
+            self.previous = old;
+        }
+        let r = self.slaves[j].set(&dest.inputs, &inputs);
+        self.inputs = inputs;
+        r.map_err(|e| self.slave_err(time, j, e))?;
+        Ok(change)
+    }
+
+    /// Copies the outputs of instance `from` to their connected inputs; with `compare`, returns
+    /// the largest change of an input value (for the initialisation fixed point).
+    fn propagate_from(&mut self, time: f64, from: usize, compare: bool) -> Result<f64, SimError> {
+        self.read_outputs(time, from)?;
+        self.check_outputs(time, from)?;
+        let exchange = self.exchange;
+        let mut change: f64 = 0.0;
+        for dest in &exchange.sources[from].dests {
+            change = change.max(self.write_inputs(time, dest, compare)?);
+        }
+        Ok(change)
+    }
+
+    /// Jacobi exchange: read all connected outputs first, then set all inputs.
+    fn exchange_all_jacobi(&mut self, time: f64) -> Result<(), SimError> {
+        for i in 0..self.slaves.len() {
+            self.read_outputs(time, i)?;
+        }
+        for (ci, &(i, k)) in self.exchange.connection_at.iter().enumerate() {
+            let x = self.outputs[i][k];
+            if !x.is_finite() {
+                return Err(self.non_finite(time, ci, x));
+            }
+        }
+        let exchange = self.exchange;
+        for dest in &exchange.jacobi {
+            self.write_inputs(time, dest, false)?;
+        }
+        Ok(())
+    }
+
+    fn exchange_all(&mut self, time: f64) -> Result<(), SimError> {
+        match self.plan.algorithm {
+            Algorithm::Jacobi => self.exchange_all_jacobi(time),
+            Algorithm::GaussSeidel => {
+                for idx in 0..self.plan.order.len() {
+                    let i = self.plan.order[idx];
+                    self.propagate_from(time, i, false)?;
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// Appends one result row: time, then the recorded variables (one call per instance and
+    /// type), which must be finite.
+    fn record(&mut self, time: f64, out: &mut Vec<f64>) -> Result<(), SimError> {
+        let row = out.len();
+        out.push(time);
+        out.resize(row + 1 + self.plan.record.len(), f64::NAN);
+        let exchange = self.exchange;
+        let mut values = std::mem::take(&mut self.recorded);
+        for g in &exchange.record {
+            values.resize(g.vars.len(), 0.0);
+            if let Err(e) = self.slaves[g.instance].get(&g.vars, &mut values) {
+                self.recorded = values;
+                return Err(self.slave_err(time, g.instance, e));
+            }
+            for (&c, &x) in g.columns.iter().zip(&values) {
+                out[row + 1 + c] = x;
+            }
+        }
+        self.recorded = values;
+        for (r, &x) in self.plan.record.iter().zip(&out[row + 1..]) {
+            if !x.is_finite() {
+                return Err(SimError::NonFinite {
+                    time,
+                    label: r.label.clone(),
+                    value: x,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn initialise(&mut self) -> Result<(), SimError> {
+        let plan = self.plan;
+        let t0 = plan.start_time;
+        for i in 0..self.slaves.len() {
+            self.slaves[i]
+                .setup_experiment(t0, plan.stop_time)
+                .map_err(|e| self.slave_err(t0, i, e))?;
+            let inst = &plan.instances[i];
+            // one call per start value, so that a refused one is named
+            for (k, &(v, x)) in inst.parameters.iter().enumerate() {
+                self.slaves[i]
+                    .set(&VarBatch::new(vec![v]), &[x])
+                    .map_err(|source| SimError::StartValue {
+                        instance: inst.name.clone(),
+                        name: inst
+                            .parameter_names
+                            .get(k)
+                            .cloned()
+                            .unwrap_or_else(|| format!("vr {}", v.vr)),
+                        value: x,
+                        source,
+                    })?;
+            }
+            self.slaves[i]
+                .enter_initialization_mode()
+                .map_err(|e| self.slave_err(t0, i, e))?;
+        }
+        for _ in 0..plan.init_sweeps.max(1) {
+            let mut change: f64 = 0.0;
+            for idx in 0..plan.order.len() {
+                let i = plan.order[idx];
+                change = change.max(self.propagate_from(t0, i, true)?);
+            }
+            if change == 0.0 {
+                break;
+            }
+        }
+        for i in 0..self.slaves.len() {
+            self.slaves[i]
+                .exit_initialization_mode()
+                .map_err(|e| self.slave_err(t0, i, e))?;
+            // fmi2Terminate is allowed only from step mode (FMI 2.0 CS state machine); a slave
+            // stopped earlier is only freed
+            self.initialised[i] = true;
+        }
+        self.exchange_all(t0)
+    }
+
+    /// Tries macro step `k` split into `parts` sub-steps; returns the index of a slave that
+    /// discarded, if any.
+    fn try_macro_step(&mut self, k: u64, parts: u64) -> Result<Option<usize>, SimError> {
+        let plan = self.plan;
+        let n = self.slaves.len();
+        let t = self.t(k);
+        // (start, end) of each active slave's window
+        let windows: Vec<Option<(f64, f64)>> = plan
+            .instances
+            .iter()
+            .map(|inst| {
+                let m = u64::from(inst.step_multiple.max(1));
+                k.is_multiple_of(m)
+                    .then(|| (t, self.t((k + m).min(self.n_steps))))
+            })
+            .collect();
+        let sub = |(a, b): (f64, f64), j: u64| -> (f64, f64) {
+            let s = a + (b - a) * (j as f64) / (parts as f64);
+            let e = if j + 1 == parts {
+                b
+            } else {
+                a + (b - a) * ((j + 1) as f64) / (parts as f64)
+            };
+            (s, e - s)
+        };
+        for j in 0..parts {
+            match plan.algorithm {
+                Algorithm::Jacobi => {
+                    for (i, w) in windows.iter().enumerate().take(n) {
+                        if let Some(w) = *w {
+                            let (ts, h) = sub(w, j);
+                            match self.slaves[i].do_step(ts, h) {
+                                Ok(StepStatus::Ok) => {}
+                                Ok(StepStatus::Discard) => return Ok(Some(i)),
+                                Err(e) => return Err(self.slave_err(ts, i, e)),
+                            }
+                        }
+                    }
+                    let te = sub((t, self.t(k + 1)), j);
+                    self.exchange_all_jacobi(te.0 + te.1)?;
+                }
+                Algorithm::GaussSeidel => {
+                    for idx in 0..plan.order.len() {
+                        let i = plan.order[idx];
+                        if let Some(w) = windows[i] {
+                            let (ts, h) = sub(w, j);
+                            match self.slaves[i].do_step(ts, h) {
+                                Ok(StepStatus::Ok) => {}
+                                Ok(StepStatus::Discard) => return Ok(Some(i)),
+                                Err(e) => return Err(self.slave_err(ts, i, e)),
+                            }
+                            self.propagate_from(ts + h, i, false)?;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(None)
+    }
+
+    fn macro_step(&mut self, k: u64) -> Result<(), SimError> {
+        let t = self.t(k);
+        let h = self.t(k + 1) - t;
+        let retry = self.plan.max_step_halvings > 0;
+        let lacking = self.slaves.iter().position(|s| !s.can_save_state());
+        // sub-steps change every active slave's step size
+        let fixed = self.slaves.iter().position(|s| !s.can_vary_step());
+        let can_retry = retry && lacking.is_none() && fixed.is_none();
+        if can_retry {
+            for i in 0..self.slaves.len() {
+                self.slaves[i]
+                    .save_state()
+                    .map_err(|e| self.slave_err(t, i, e))?;
+            }
+        }
+        let mut parts = 1u64;
+        let mut halvings = 0u32;
+        loop {
+            let Some(i) = self.try_macro_step(k, parts)? else {
+                return Ok(());
+            };
+            let name = self.slaves[i].name().to_string();
+            let refusal = if !retry {
+                Some("step retry is off (max_step_halvings = 0)".to_string())
+            } else if let Some(l) = lacking {
+                Some(format!(
+                    "cannot retry: instance '{}' does not support canGetAndSetFMUstate",
+                    self.slaves[l].name()
+                ))
+            } else if let Some(l) = fixed {
+                Some(format!(
+                    "cannot retry with smaller steps: instance '{}' does not support \
+                     canHandleVariableCommunicationStepSize",
+                    self.slaves[l].name()
+                ))
+            } else if halvings >= self.plan.max_step_halvings {
+                Some(format!("still discarded after {halvings} halvings"))
+            } else {
+                None
+            };
+            if let Some(reason) = refusal {
+                return Err(SimError::Discarded {
+                    time: t,
+                    instance: name,
+                    step: h / parts as f64,
+                    reason,
+                });
+            }
+            for j in 0..self.slaves.len() {
+                self.slaves[j]
+                    .restore_state()
+                    .map_err(|e| self.slave_err(t, j, e))?;
+            }
+            self.rejected += 1;
+            halvings += 1;
+            parts *= 2;
+            log::debug!(target: "master", "t = {t}: '{name}' discarded, retrying with {parts} sub-steps");
+        }
+    }
+
+    pub(super) fn run(&mut self) -> Result<Vec<f64>, SimError> {
+        let mut data =
+            Vec::with_capacity((self.n_steps as usize + 1) * (self.plan.record.len() + 1));
+        self.initialise()?;
+        self.record(self.plan.start_time, &mut data)?;
+        for k in 0..self.n_steps {
+            if let Some(c) = self.opts.cancel {
+                if c.load(Ordering::Relaxed) {
+                    return Err(SimError::Cancelled { time: self.t(k) });
+                }
+            }
+            self.macro_step(k)?;
+            let t = self.t(k + 1);
+            self.record(t, &mut data)?;
+            if let Some(p) = self.opts.progress {
+                p(k + 1, self.n_steps);
+            }
+        }
+        Ok(data)
+    }
+
+    /// fmi2Terminate on every slave that reached step mode and did not fail fatally.
+    pub(super) fn terminate_all(&mut self) -> Result<(), SimError> {
+        let mut first = None;
+        for i in 0..self.slaves.len() {
+            if self.initialised[i] && !self.fatal[i] {
+                self.initialised[i] = false;
+                if let Err(e) = self.slaves[i].terminate() {
+                    first.get_or_insert(SimError::Slave {
+                        time: self.plan.stop_time,
+                        source: e,
+                    });
+                }
+            }
+        }
+        first.map_or(Ok(()), Err)
+    }
+}

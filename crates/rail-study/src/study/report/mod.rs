@@ -1,0 +1,425 @@
+//! Study outputs: CSVs behind every plot, SVG charts, `study.json` and `REPORT.md`.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use crate::plot::Chart;
+use crate::study::config::{configuration, var};
+use crate::study::critical::Critical;
+use crate::study::run::{
+    scenario, ConfigResult, StudyError, StudyResults, HIL_CONFIGS, HISTORY_CONFIGS,
+};
+use master::output::{write_bytes_atomic, write_csv_atomic, write_json_atomic};
+
+/// Timing of the whole study, measured by the caller.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Timing {
+    pub wall_s: f64,
+    pub threads: usize,
+}
+
+impl Timing {
+    /// Simulated seconds per wall-clock second over the whole study.
+    pub fn sim_per_wall(&self, r: &StudyResults) -> f64 {
+        if self.wall_s > 0.0 {
+            r.simulated_s / self.wall_s
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The seed's Table 4-3 (R14): c_v [kNs/m], rms acc [m/s^2], F_max [kN], rms power [kW].
+pub const SEED_TABLE_4_3: [(f64, f64, f64, f64); 4] = [
+    (210.0, 7.08, 20.369, 0.357),
+    (270.0, 5.98, 23.491, 0.280),
+    (330.0, 3.91, 23.100, 0.242),
+    (390.0, 2.63, 24.570, 0.194),
+];
+
+fn label_of(id: &str) -> &'static str {
+    configuration(id).map_or("?", |c| c.label)
+}
+
+/// (time, value) series of a column of a kept run, in display units via `scale`.
+fn series(r: &StudyResults, run: &str, column: &str, scale: f64) -> Option<Vec<(f64, f64)>> {
+    let out = r.kept.get(run)?;
+    let t = out.column("time")?;
+    let y = out.column(column)?;
+    Some(t.into_iter().zip(y).map(|(t, y)| (t, y * scale)).collect())
+}
+
+/// Writes a CSV of several equally sampled series side by side (time from the first).
+fn write_series_csv(path: &Path, columns: &[(String, Vec<(f64, f64)>)]) -> Result<(), StudyError> {
+    let Some(n) = columns.iter().map(|c| c.1.len()).min() else {
+        return Ok(());
+    };
+    let mut header = vec!["time [s]".to_string()];
+    header.extend(columns.iter().map(|c| c.0.clone()));
+    let rows: Vec<Vec<f64>> = (0..n)
+        .map(|i| {
+            let mut row = vec![columns[0].1[i].0];
+            row.extend(columns.iter().map(|c| c.1[i].1));
+            row
+        })
+        .collect();
+    write_csv_atomic(path, &header, rows.iter().map(Vec::as_slice))?;
+    Ok(())
+}
+
+/// A time-history chart + CSV of one column across several runs.
+#[allow(clippy::too_many_arguments)]
+fn history_chart(
+    r: &StudyResults,
+    dir: &Path,
+    stem: &str,
+    title: &str,
+    y_label: &str,
+    runs: &[(&str, String)],
+    column: &str,
+    scale: f64,
+) -> Result<Option<String>, StudyError> {
+    let mut cols = Vec::new();
+    let mut chart = Chart::new(title, "time [s]", y_label);
+    for (label, run) in runs {
+        if let Some(s) = series(r, run, column, scale) {
+            chart = chart.with_series(label, s.clone());
+            cols.push((format!("{label}: {y_label}"), s));
+        }
+    }
+    if cols.is_empty() {
+        return Ok(None);
+    }
+    write_series_csv(&dir.join(format!("{stem}.csv")), &cols)?;
+    chart.write_lines(&dir.join(format!("{stem}.svg")))?;
+    Ok(Some(stem.to_string()))
+}
+
+fn fmt_opt(v: Option<f64>, scale: f64, prec: usize) -> String {
+    v.map_or("failed".to_string(), |x| format!("{:.*}", prec, x * scale))
+}
+
+/// Writes every output file and REPORT.md into `out`; returns the report text.
+pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<String, StudyError> {
+    std::fs::create_dir_all(out).map_err(|source| master::output::OutputError::Io {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    // the numbers first: a plotting problem must not lose them
+    write_json_atomic(&out.join("study.json"), r)?;
+    let mut figures: Vec<(String, &str)> = Vec::new();
+
+    // ---- rms vs speed (Fig. 4.24)
+    let mut rows: Vec<Vec<String>> = Vec::new();
+    let mut chart = Chart::new(
+        "EN 14363 rms of the wheelset lateral acceleration vs speed",
+        "speed [km/h]",
+        "max sliding rms, band-passed [m/s^2]",
+    )
+    .with_limit(r.limit_mps2, &format!("a_lim = {:.2} m/s^2", r.limit_mps2));
+    for c in &r.configs {
+        let pts: Vec<(f64, f64)> = c
+            .curve()
+            .iter()
+            .filter_map(|p| p.rms.map(|v| (p.speed_kmh, v)))
+            .collect();
+        if !pts.is_empty() {
+            chart = chart.with_series(c.label, pts);
+        }
+        for (kind, pts) in [("sweep", &c.sweep), ("bisection", &c.bisection)] {
+            for p in pts.iter() {
+                let mut row = vec![
+                    c.id.to_string(),
+                    kind.to_string(),
+                    format!("{}", p.speed_kmh),
+                    p.rms().map_or("failed".into(), |v| format!("{v:.4}")),
+                ];
+                row.extend(
+                    p.per_seed
+                        .iter()
+                        .map(|v| v.map_or("failed".into(), |v| format!("{v:.4}"))),
+                );
+                rows.push(row);
+            }
+        }
+    }
+    let mut header: Vec<String> = ["configuration", "kind", "speed [km/h]", "rms max [m/s2]"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    header.extend(
+        r.settings
+            .seeds
+            .iter()
+            .map(|s| format!("rms seed {s} [m/s2]")),
+    );
+    master::output::write_atomic(&out.join("rms_vs_speed.csv"), |w| {
+        let line = |w: &mut dyn std::io::Write, f: &[String]| {
+            let l: Vec<String> = f.iter().map(|x| master::output::csv_field(x)).collect();
+            writeln!(w, "{}", l.join(",")).map_err(|source| master::output::OutputError::Io {
+                path: out.join("rms_vs_speed.csv"),
+                source,
+            })
+        };
+        line(w, &header)?;
+        for row in &rows {
+            line(w, row)?;
+        }
+        Ok(())
+    })?;
+    if !r.configs.is_empty() {
+        chart.write_lines(&out.join("rms_vs_speed.svg"))?;
+        figures.push((
+            "rms_vs_speed".into(),
+            "rms vs speed, all configurations, a_lim dashed (Figs. 4.13, 4.23, 4.24)",
+        ));
+    }
+
+    // ---- time histories at the history speed (Figs. 4.18, 4.21, 4.25, 4.26)
+    let v_hist = r.settings.history_speed_kmh;
+    let hist_runs: Vec<(&str, String)> = HISTORY_CONFIGS
+        .iter()
+        .map(|id| (label_of(id), scenario::history(id)))
+        .collect();
+    let semi_runs: Vec<(&str, String)> = hist_runs
+        .iter()
+        .filter(|(_, n)| !n.ends_with("full_active"))
+        .cloned()
+        .collect();
+    let title = |what: &str| format!("{what} at {v_hist:.0} km/h, irregular track");
+    for (stem, what, ylab, col, scale, runs, caption) in [
+        ("history_displacement", "front wheelset lateral displacement relative to the track", "displacement [mm]", var::WS_FRONT_Y, 1e3, &hist_runs, "wheelset displacement, passive / MPPT2 / sky-hook / full-active (Figs. 4.18, 4.21, 4.25)"),
+        ("history_acceleration", "front wheelset lateral acceleration", "acceleration [m/s^2]", var::WS_FRONT_ACC, 1.0, &hist_runs, "wheelset acceleration (Figs. 4.18, 4.21, 4.26)"),
+        ("history_force", "left yaw damper force", "force [kN]", var::FORCE_LEFT_DAMPER, 1e-3, &semi_runs, "damper force (Figs. 4.18, 4.21)"),
+        ("history_command", "left valve command", "command [V]", var::COMMAND_LEFT, 1.0, &semi_runs, "valve command MPPT2 vs sky-hook (Figs. 4.18, 4.21)"),
+    ] {
+        if let Some(s) = history_chart(r, out, stem, &title(what), ylab, runs, col, scale)? {
+            figures.push((s, caption));
+        }
+    }
+    // full-active force tracking (Fig. 4.27)
+    let fa = scenario::history("full_active");
+    if let (Some(f), Some(fr)) = (
+        series(r, &fa, var::FORCE_LEFT_ACTUATOR, 1e-3),
+        series(r, &fa, var::FORCE_REFERENCE_LEFT, 1e-3),
+    ) {
+        let t_end = f.last().map_or(0.0, |p| p.0);
+        let zoom = |s: &[(f64, f64)]| from_time(s, t_end - 2.0);
+        write_series_csv(
+            &out.join("full_active_force.csv"),
+            &[
+                ("actuator force [kN]".into(), f.clone()),
+                ("reference c_v v [kN]".into(), fr.clone()),
+            ],
+        )?;
+        Chart::new(
+            &format!(
+                "full-active: actuator force and IDF reference at {v_hist:.0} km/h (last 2 s)"
+            ),
+            "time [s]",
+            "force [kN]",
+        )
+        .with_series("actuator force", zoom(&f))
+        .with_series("reference c_v v", zoom(&fr))
+        .write_lines(&out.join("full_active_force.svg"))?;
+        figures.push((
+            "full_active_force".into(),
+            "full-active force vs IDF reference (Fig. 4.27)",
+        ));
+    }
+
+    // ---- perturbation (Figs. 4.4-4.6, 5.11-5.13, 5.16-5.18; R7)
+    let mut pert_cols = Vec::new();
+    let mut chart = Chart::new(
+        "passive, ideal track, initial lateral displacement",
+        "time [s]",
+        "front wheelset lateral displacement relative to the track [mm]",
+    );
+    for p in &r.perturbation {
+        if let Some(s) = series(r, &p.name, var::WS_FRONT_Y, 1e3) {
+            let label = format!("{:.0} km/h", p.speed_kmh);
+            chart = chart.with_series(&label, s.clone());
+            pert_cols.push((format!("{label}: displacement [mm]"), s));
+        }
+    }
+    if !pert_cols.is_empty() {
+        write_series_csv(&out.join("perturbation.csv"), &pert_cols)?;
+        chart.write_lines(&out.join("perturbation.svg"))?;
+        figures.push((
+            "perturbation".into(),
+            "initial-perturbation runs, passive, 220/285/320 km/h (Figs. 5.11-5.13, R7)",
+        ));
+    }
+
+    // ---- MPPT valve commands (Figs. 4.16, 5.22) and the HIL runs (5.19-5.24)
+    let v_low = r.settings.mppt_low_speed_kmh;
+    let v_hil = r.settings.hil_speed_kmh;
+    let low_runs: Vec<(&str, String)> = ["mppt1", "mppt2"]
+        .iter()
+        .map(|id| (label_of(id), scenario::mppt_low(id)))
+        .collect();
+    if let Some(s) = history_chart(
+        r,
+        out,
+        "mppt_command_closed_start",
+        &format!("MPPT valve command from a closed valve at {v_low:.0} km/h"),
+        "command [V]",
+        &low_runs,
+        var::COMMAND_LEFT,
+        1.0,
+    )? {
+        figures.push((
+            s,
+            "MPPT1 vs MPPT2 valve command, closed start (Fig. 4.16, R10)",
+        ));
+    }
+    let hil_runs: Vec<(&str, String)> = HIL_CONFIGS
+        .iter()
+        .map(|id| (label_of(id), scenario::hil(id)))
+        .collect();
+    let mppt_hil: Vec<(&str, String)> = hil_runs
+        .iter()
+        .filter(|(_, n)| n.contains("mppt"))
+        .cloned()
+        .collect();
+    if let Some(s) = history_chart(
+        r,
+        out,
+        "mppt_command_open_start",
+        &format!(
+            "MPPT valve command from {:.0} V, slow valve, {v_hil:.0} km/h",
+            r.settings.hil_initial_command_v
+        ),
+        "command [V]",
+        &mppt_hil,
+        var::COMMAND_LEFT,
+        1.0,
+    )? {
+        figures.push((
+            s,
+            "MPPT1 vs MPPT2 valve command, open start, slow valve (Figs. 5.19, 5.21, 5.22, R10)",
+        ));
+    }
+    if let Some(s) = history_chart(
+        r,
+        out,
+        "slow_valve_displacement",
+        &format!(
+            "slow valve at {v_hil:.0} km/h: front wheelset displacement relative to the track"
+        ),
+        "displacement [mm]",
+        &hil_runs,
+        var::WS_FRONT_Y,
+        1e3,
+    )? {
+        figures.push((
+            s,
+            "slow valve: sky-hook vs MPPT wheelset displacement (Figs. 5.19-5.24, R12)",
+        ));
+    }
+    if let Some(s) = history_chart(
+        r,
+        out,
+        "slow_valve_opening",
+        &format!("slow valve at {v_hil:.0} km/h: actual valve opening (left)"),
+        "opening [-]",
+        &hil_runs,
+        var::OPENING_LEFT,
+        1.0,
+    )? {
+        figures.push((
+            s,
+            "slow valve: actual opening lagging the command (Fig. 5.25)",
+        ));
+    }
+
+    // Fig. 5.25: zoom on the on/off sky-hook's command and the valve's actual opening
+    let slow = scenario::hil("skyhook_onoff_slow");
+    if let (Some(cmd), Some(open)) = (
+        series(r, &slow, var::COMMAND_LEFT, 0.1),
+        series(r, &slow, var::OPENING_LEFT, 1.0),
+    ) {
+        let t_end = cmd.last().map_or(0.0, |p| p.0);
+        let zoom = |s: &[(f64, f64)]| from_time(s, t_end - 1.0);
+        write_series_csv(
+            &out.join("skyhook_valve_zoom.csv"),
+            &[
+                ("slow valve: command / 10 V [-]".into(), cmd.clone()),
+                ("slow valve: actual opening [-]".into(), open.clone()),
+            ],
+        )?;
+        Chart::new(
+            &format!(
+                "on/off sky-hook, slow valve, {v_hil:.0} km/h: command and actual opening, last 1 s ({:.0} Hz samples)",
+                r.settings.stored_rate_hz
+            ),
+            "time [s]",
+            "opening [-]",
+        )
+        .with_series("slow valve: command", zoom(&cmd))
+        .with_series("slow valve: actual opening", zoom(&open))
+        .write_lines(&out.join("skyhook_valve_zoom.svg"))?;
+        figures.push((
+            "skyhook_valve_zoom".into(),
+            "on/off sky-hook: the slow valve cannot follow the switching command (Fig. 5.25, R12)",
+        ));
+    }
+
+    // ---- c_v sensitivity (Table 4-3)
+    let cv_header: Vec<String> = [
+        "c_v [kNs/m]",
+        "rms acc [m/s2]",
+        "F_max [kN]",
+        "rms power F v [kW]",
+        "rms hydraulic power [kW]",
+        "seed rms acc [m/s2]",
+        "seed F_max [kN]",
+        "seed rms power [kW]",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let cv_rows: Vec<Vec<f64>> =
+        r.cv.iter()
+            .map(|c| {
+                let cv = c.c_v_nspm.unwrap_or(f64::NAN) / 1e3;
+                let m = c.metrics.as_ref();
+                let seed = SEED_TABLE_4_3
+                    .iter()
+                    .find(|s| (s.0 - cv).abs() < 0.5)
+                    .copied()
+                    .unwrap_or((cv, f64::NAN, f64::NAN, f64::NAN));
+                vec![
+                    cv,
+                    m.map_or(f64::NAN, |m| m.rms()),
+                    m.map_or(f64::NAN, |m| m.peak_force_n / 1e3),
+                    m.and_then(|m| m.rms_power_w).map_or(f64::NAN, |p| p / 1e3),
+                    m.and_then(|m| m.rms_hydraulic_power_w)
+                        .map_or(f64::NAN, |p| p / 1e3),
+                    seed.1,
+                    seed.2,
+                    seed.3,
+                ]
+            })
+            .collect();
+    write_csv_atomic(
+        &out.join("cv_sensitivity.csv"),
+        &cv_header,
+        cv_rows.iter().map(Vec::as_slice),
+    )?;
+
+    let text = report_markdown(r, timing, &figures);
+    write_bytes_atomic(&out.join("REPORT.md"), text.as_bytes())?;
+    Ok(text)
+}
+
+/// The points of a time series from `t0` on (zoomed figures).
+fn from_time(s: &[(f64, f64)], t0: f64) -> Vec<(f64, f64)> {
+    s.iter().filter(|p| p.0 >= t0).copied().collect()
+}
+
+mod markdown;
+#[cfg(test)]
+mod tests;
+
+pub use markdown::{gain_over_passive, report_markdown, within_limit_above, DIFFERENCES};

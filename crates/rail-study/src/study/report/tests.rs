@@ -1,0 +1,183 @@
+use super::*;
+use crate::study::critical::Critical;
+use crate::study::metrics::RunMetrics;
+use crate::study::run::{ConfigResult, NamedRun, SpeedPoint};
+use crate::study::settings::StudySettings;
+use std::collections::BTreeMap;
+
+fn metrics(rms: f64, amp: f64, cmd: Option<f64>) -> RunMetrics {
+    RunMetrics {
+        rms_front: rms,
+        rms_rear: rms * 0.9,
+        frequency_hz: 4.0,
+        tail_amplitude_m: amp,
+        max_displacement_m: amp * 1.2,
+        peak_force_n: 20e3,
+        rms_power_w: Some(250.0),
+        rms_hydraulic_power_w: Some(8000.0),
+        tail_command_v: cmd,
+    }
+}
+
+fn results() -> StudyResults {
+    let cfg = |id: &'static str, k: Critical| {
+        let c = configuration(id).unwrap();
+        ConfigResult {
+            id: c.id,
+            label: c.label,
+            seed_value: c.seed_value,
+            reference: c.reference,
+            sweep: vec![
+                SpeedPoint {
+                    speed_kmh: 280.0,
+                    per_seed: vec![Some(3.0), Some(2.0)],
+                },
+                SpeedPoint {
+                    speed_kmh: 290.0,
+                    per_seed: vec![Some(6.0), None],
+                },
+            ],
+            bisection: vec![],
+            critical: Some(k),
+        }
+    };
+    let named =
+        |name: &str, config: &'static str, v: f64, cv: Option<f64>, m: Option<RunMetrics>| {
+            NamedRun {
+                name: name.into(),
+                config,
+                speed_kmh: v,
+                c_v_nspm: cv,
+                error: m.is_none().then(|| "boom".to_string()),
+                metrics: m,
+            }
+        };
+    StudyResults {
+        settings: StudySettings::quick(),
+        limit_mps2: 5.39,
+        configs: vec![
+            cfg(
+                "passive",
+                Critical::Between {
+                    stable_kmh: 280.0,
+                    unstable_kmh: 290.0,
+                },
+            ),
+            cfg("mppt2", Critical::Above { max_kmh: 400.0 }),
+        ],
+        perturbation: vec![named(
+            "perturbation-passive_v220_ideal",
+            "passive",
+            220.0,
+            None,
+            Some(metrics(0.1, 1e-4, None)),
+        )],
+        cv: vec![
+            named(
+                "cv-210",
+                "full_active",
+                380.0,
+                Some(210e3),
+                Some(metrics(7.0, 5e-3, None)),
+            ),
+            named("cv-270", "full_active", 380.0, Some(270e3), None),
+        ],
+        scenarios: vec![named(
+            "hil-mppt2_slow",
+            "mppt2_slow",
+            260.0,
+            None,
+            Some(metrics(1.0, 1e-3, Some(3.5))),
+        )],
+        failures: vec![("cv-270".into(), "boom".into())],
+        runs: 7,
+        simulated_s: 70.0,
+        run_wall_s: 10.0,
+        kept: BTreeMap::new(),
+    }
+}
+
+#[test]
+fn report_has_the_tables_the_timing_and_the_failures() {
+    let r = results();
+    let t = Timing {
+        wall_s: 7.0,
+        threads: 2,
+    };
+    assert!((t.sim_per_wall(&r) - 10.0).abs() < 1e-12);
+    assert_eq!(gain_over_passive(&r, "mppt2"), Some(110.0));
+    let md = report_markdown(&r, &t, &[("rms_vs_speed".into(), "caption")]);
+    for s in [
+        "| passive (30 %) | 290.0 (stable at 280.0) | - | - | 280-300 km/h | R8 |",
+        "| MPPT2, ideal valve | > 400 | - | >= +110 |",
+        "**10.0 simulated seconds per wall-clock second**",
+        "| 210 | 7.00 | 20.0 | 0.250 | 8.00 | 7.08 | 20.4 | 0.357 |",
+        "| 270 | failed | failed | failed | failed | 5.98 |",
+        "| hil-mppt2_slow (MPPT2, slow valve) | 260 | 3.50 | 1.00 |",
+        "`cv-270`: boom",
+        "`rms_vs_speed.svg`",
+    ] {
+        assert!(md.contains(s), "missing {s:?} in\n{md}");
+    }
+}
+
+#[test]
+fn speeds_within_the_limit_above_a_burst_are_listed_as_ranges() {
+    let point = |v: f64, rms: Option<f64>| SpeedPoint {
+        speed_kmh: v,
+        per_seed: vec![rms],
+    };
+    let mut c = results().configs.remove(0);
+    c.sweep = vec![
+        point(290.0, Some(3.0)),
+        point(300.0, Some(6.0)), // burst: first exceedance
+        point(310.0, Some(4.0)),
+        point(320.0, Some(5.0)),
+        point(330.0, Some(5.5)),
+        point(340.0, Some(2.0)),
+        point(350.0, None), // failed run: not counted as within the limit
+    ];
+    c.critical = Some(Critical::Between {
+        stable_kmh: 295.0,
+        unstable_kmh: 297.5,
+    });
+    assert_eq!(within_limit_above(&c, 5.39), "310-320, 340");
+    c.critical = Some(Critical::Above { max_kmh: 350.0 });
+    assert_eq!(within_limit_above(&c, 5.39), "-");
+    c.critical = Some(Critical::Between {
+        stable_kmh: 335.0,
+        unstable_kmh: 345.0,
+    });
+    assert_eq!(within_limit_above(&c, 5.39), "-");
+}
+
+#[test]
+fn outputs_are_written_even_without_time_histories() {
+    let r = results();
+    let d = tempfile::tempdir().unwrap();
+    let text = write_outputs(
+        &r,
+        d.path(),
+        &Timing {
+            wall_s: 1.0,
+            threads: 1,
+        },
+    )
+    .unwrap();
+    assert!(text.contains("Critical speeds"));
+    for f in [
+        "REPORT.md",
+        "rms_vs_speed.csv",
+        "rms_vs_speed.svg",
+        "cv_sensitivity.csv",
+        "study.json",
+    ] {
+        assert!(d.path().join(f).exists(), "{f}");
+    }
+    let csv = std::fs::read_to_string(d.path().join("rms_vs_speed.csv")).unwrap();
+    assert!(
+        csv.contains("passive,sweep,290,failed,6.0000,failed"),
+        "{csv}"
+    );
+    assert!(!d.path().join("history_displacement.svg").exists());
+}
