@@ -466,7 +466,7 @@ mod tests {
         let m = analyse(
             &p,
             60.0,
-            &YawDamperModel::rigid(DamperRepresentation::Maxwell { k: 1e12, c: 1e5 }),
+            &YawDamperModel::rigid(DamperRepresentation::Maxwell { k: 1e9, c: 1e5 }),
         )
         .unwrap();
         let (a, b) = (v.least_stable.unwrap(), m.least_stable.unwrap());

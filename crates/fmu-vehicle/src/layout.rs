@@ -346,6 +346,18 @@ impl SparseSuspension {
         }
     }
 
+    /// Gershgorin bound of the largest eigenvalue of M^-1 K: max_i sum_j |K_ij| / M_i.
+    pub fn gershgorin_bound(&self, minv: &[f64; N_DOF]) -> f64 {
+        let mut rows = [0.0; N_DOF];
+        for &(i, _, k, _) in &self.entries {
+            rows[i] += k.abs();
+        }
+        rows.iter()
+            .zip(minv)
+            .map(|(r, m)| r * m)
+            .fold(0.0, f64::max)
+    }
+
     /// Number of non-zero entries.
     pub fn len(&self) -> usize {
         self.entries.len()

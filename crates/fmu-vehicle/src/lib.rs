@@ -14,9 +14,14 @@
 //! [`linear`] (linear matrices), [`eigen`] (state matrix, modes, critical speed, root locus),
 //! [`calibration`].
 pub mod calibration;
+pub mod dynamics;
 pub mod eigen;
 pub mod layout;
 pub mod linear;
+pub mod model;
 pub mod params;
+pub mod sim;
+pub mod track;
 
+pub use model::{Inputs, ModelError, Outputs, StepError, Vehicle};
 pub use params::{ModelKind, ParamError, PsdLevel, TrackSource, VehicleParams};

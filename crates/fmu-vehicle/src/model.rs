@@ -1,0 +1,542 @@
+//! Time-domain coach for co-simulation: [`Vehicle`] with [`Inputs`] and [`Outputs`].
+//!
+//! Integration: classical RK4 with a fixed internal sub-step (at most
+//! [`VehicleParams::solver_substep_s`], chosen by the convergence study in
+//! [`crate::calibration`]); the communication step is split into n = ceil(h / h_sub) equal
+//! sub-steps. Fixed cost per communication step, no allocation, deterministic. Damper forces
+//! and the external track input are held over a communication step; the trailing wheelsets'
+//! alignment is interpolated linearly between its values at the step ends.
+//!
+//! Direct feedthrough: the yaw-damper forces act on frame and car-body yaw, so the
+//! accelerations of frame and car-body points away from their centres (frame over the axle
+//! boxes, car body over the bogies, damper ends) depend on them at the same instant; the track
+//! input reaches the leading wheelset's relative displacement, guiding force, Y/Q and
+//! acceleration at once. [`Vehicle::outputs`] evaluates them without stepping.
+
+use serde::{Deserialize, Serialize};
+use wheel_rail::{GeometryTable, SegmentHint, TableError};
+
+use crate::dynamics::{rhs, Consts, Eval, N_STATES, RATES, SPIN};
+use crate::layout::{
+    damper_bogie, damper_side, frame_roll, frame_y, frame_yaw, wheelset_y, wheelset_yaw, Positions,
+    CARBODY_ROLL, CARBODY_Y, CARBODY_YAW, N_BOGIES, N_DAMPERS, N_DOF, N_WHEELSETS,
+};
+use crate::params::{ContactSource, ParamError, TrackSource, VehicleParams};
+use crate::track::TrackRecord;
+
+/// The worn-profile surrogate table shipped with the crate (the 2-dof bogie's default table:
+/// EN 15302 A/A with a 0.25 cone on the central +-3.5 mm of the tread, A/A flange).
+pub const WORN_SURROGATE_CSV: &str = include_str!("../resources/wheel_rail_worn_surrogate.csv");
+
+/// The shipped default table.
+pub fn worn_surrogate_table() -> Result<GeometryTable, TableError> {
+    GeometryTable::parse_csv(WORN_SURROGATE_CSV, "built-in wheel_rail_worn_surrogate.csv")
+}
+
+/// tan(gamma) a table must reach on each side to cover the flange.
+pub const FLANGE_TAN_GAMMA: f64 = 1.0;
+
+/// Errors when building the model.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ModelError {
+    /// Invalid parameter.
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    /// The contact table could not be read.
+    #[error(transparent)]
+    Table(#[from] TableError),
+    /// The contact table does not reach flange contact on one side.
+    #[error(
+        "contact table does not cover the flange: on the {side} wheel tan(gamma) reaches only \
+         {max_tan_gamma:.3} within the table's range ({range_mm:.2} mm), flange contact needs \
+         at least {FLANGE_TAN_GAMMA}"
+    )]
+    FlangeNotCovered {
+        /// "left" or "right".
+        side: &'static str,
+        /// Largest tan(gamma) of that side.
+        max_tan_gamma: f64,
+        /// Range end on that side [mm].
+        range_mm: f64,
+    },
+}
+
+/// Errors of a step or an output evaluation; the model is unchanged after any of them.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StepError {
+    /// An input is NaN or infinite.
+    #[error("input `{name}` is not finite ({value})")]
+    NonFiniteInput {
+        /// Input name (physics field).
+        name: &'static str,
+        /// Value.
+        value: f64,
+    },
+    /// Step size not usable.
+    #[error("invalid communication step {h} s (must be finite, > 0 and <= 1 s)")]
+    InvalidStep {
+        /// Step [s].
+        h: f64,
+    },
+    /// The state became NaN or infinite.
+    #[error("state diverged at t = {time_s} s")]
+    Diverged {
+        /// Time [s].
+        time_s: f64,
+    },
+    /// A wheelset left the contact table's range: it has climbed the flange (derailment).
+    #[error(
+        "derailment at t = {time_s:.4} s: wheelset {wheelset} displaced {y_rel_mm:.2} mm \
+         relative to the track, beyond the contact table's range ({limit_mm:.2} mm)"
+    )]
+    Derailed {
+        /// Time [s].
+        time_s: f64,
+        /// Wheelset number, 1 = leading.
+        wheelset: usize,
+        /// Displacement relative to the track [mm].
+        y_rel_mm: f64,
+        /// Table range on that side [mm].
+        limit_mm: f64,
+    },
+}
+
+/// Inputs of one communication step.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Inputs {
+    /// Yaw damper forces, tension positive [N]: front left, front right, rear left, rear right.
+    pub damper_force_n: [f64; N_DAMPERS],
+    /// Track lateral alignment under the leading wheelset, positive right [m] (used when the
+    /// track source is External).
+    pub track_lateral_m: f64,
+}
+
+impl Inputs {
+    fn check(&self) -> Result<(), StepError> {
+        const NAMES: [&str; N_DAMPERS] = [
+            "damper_force_n[0]",
+            "damper_force_n[1]",
+            "damper_force_n[2]",
+            "damper_force_n[3]",
+        ];
+        for (name, &value) in NAMES.iter().zip(&self.damper_force_n) {
+            if !value.is_finite() {
+                return Err(StepError::NonFiniteInput { name, value });
+            }
+        }
+        if !self.track_lateral_m.is_finite() {
+            return Err(StepError::NonFiniteInput {
+                name: "track_lateral_m",
+                value: self.track_lateral_m,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Outputs of one wheelset.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct WheelsetOutputs {
+    /// Lateral displacement (absolute) [m].
+    pub lateral_m: f64,
+    /// Lateral displacement relative to the track [m].
+    pub lateral_rel_track_m: f64,
+    /// Lateral velocity [m/s].
+    pub lateral_velocity_mps: f64,
+    /// Lateral acceleration [m/s^2].
+    pub lateral_acc_mps2: f64,
+    /// Yaw angle, nose-left [rad].
+    pub yaw_rad: f64,
+    /// Guiding force: sum of the lateral forces of the rails on the wheelset, positive right [N].
+    pub guiding_force_n: f64,
+    /// Y/Q of the wheel with the larger lateral force: max(|Y_L|, |Y_R|) / P [-].
+    pub y_over_q: f64,
+    /// Track alignment under the wheelset [m].
+    pub track_m: f64,
+}
+
+/// Outputs of one bogie frame.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct FrameOutputs {
+    /// Lateral displacement of the centre [m].
+    pub lateral_m: f64,
+    /// Yaw angle, nose-left [rad].
+    pub yaw_rad: f64,
+    /// Roll angle [rad].
+    pub roll_rad: f64,
+    /// Lateral acceleration of the frame over its leading axle box, at the frame's centre
+    /// height (EN 14363 stability quantity) [m/s^2].
+    pub lateral_acc_leading_axle_mps2: f64,
+    /// Same over the trailing axle box [m/s^2].
+    pub lateral_acc_trailing_axle_mps2: f64,
+}
+
+/// Outputs of the car body (accelerations at floor height, kinematic, without the gravity
+/// component g phi an accelerometer tilting with the body would add).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct CarBodyOutputs {
+    /// Lateral displacement of the centre of gravity [m].
+    pub lateral_m: f64,
+    /// Yaw angle, nose-left [rad].
+    pub yaw_rad: f64,
+    /// Roll angle [rad].
+    pub roll_rad: f64,
+    /// Lateral acceleration at floor height above the front bogie centre [m/s^2].
+    pub lateral_acc_front_mps2: f64,
+    /// Same at mid-length [m/s^2].
+    pub lateral_acc_mid_mps2: f64,
+    /// Same above the rear bogie centre [m/s^2].
+    pub lateral_acc_rear_mps2: f64,
+}
+
+/// Outputs of one yaw damper. Velocities and accelerations of the attachment points are
+/// absolute, along the damper axis (longitudinal), positive forward (from the frame end
+/// towards the car-body end); elongation velocity = car-body end - frame end.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct DamperOutputs {
+    /// Elongation, extension positive [m].
+    pub elongation_m: f64,
+    /// Elongation velocity [m/s].
+    pub elongation_velocity_mps: f64,
+    /// Velocity of the car-body end [m/s].
+    pub carbody_end_velocity_mps: f64,
+    /// Acceleration of the car-body end [m/s^2].
+    pub carbody_end_acc_mps2: f64,
+    /// Velocity of the frame end [m/s].
+    pub frame_end_velocity_mps: f64,
+    /// Acceleration of the frame end [m/s^2].
+    pub frame_end_acc_mps2: f64,
+}
+
+/// All outputs at one instant.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Outputs {
+    /// Time [s].
+    pub time_s: f64,
+    /// Wheelsets, leading first.
+    pub wheelset: [WheelsetOutputs; N_WHEELSETS],
+    /// Frames, front first.
+    pub frame: [FrameOutputs; N_BOGIES],
+    /// Car body.
+    pub carbody: CarBodyOutputs,
+    /// Yaw dampers: front left, front right, rear left, rear right.
+    pub damper: [DamperOutputs; N_DAMPERS],
+}
+
+/// The coach: plain data, clonable and serialisable (FMU state).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Vehicle {
+    params: VehicleParams,
+    consts: Consts,
+    table: GeometryTable,
+    table_range_m: (f64, f64),
+    hints: [SegmentHint; N_WHEELSETS],
+    positions: Positions,
+    #[serde(with = "state_serde")]
+    state: [f64; N_STATES],
+    time_s: f64,
+    /// Distance travelled [m].
+    position_m: f64,
+    record: TrackRecord,
+    /// Largest sub-step used [s]: the parameter, or less where stability needs it.
+    substep_s: f64,
+}
+
+/// Checks that the table reaches flange contact on both sides.
+fn check_flange(table: &GeometryTable) -> Result<(), ModelError> {
+    let (lo, hi) = table.y_range();
+    let (mut left, mut right) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+    for [_, _, _, tl, tr] in table.rows() {
+        left = left.max(tl);
+        right = right.max(tr);
+    }
+    for (side, max_tan_gamma, range) in [("left", left, lo), ("right", right, hi)] {
+        if max_tan_gamma < FLANGE_TAN_GAMMA {
+            return Err(ModelError::FlangeNotCovered {
+                side,
+                max_tan_gamma,
+                range_mm: range * 1e3,
+            });
+        }
+    }
+    Ok(())
+}
+
+impl Vehicle {
+    /// Validates the parameters and loads the contact table.
+    pub fn new(params: VehicleParams) -> Result<Self, ModelError> {
+        let table = match &params.contact {
+            ContactSource::WornSurrogate => worn_surrogate_table()?,
+            ContactSource::File(path) => GeometryTable::load(path)?,
+        };
+        Self::with_table(params, table)
+    }
+
+    /// As [`Self::new`] with an explicit contact table (`params.contact` is ignored).
+    pub fn with_table(params: VehicleParams, table: GeometryTable) -> Result<Self, ModelError> {
+        params.validate()?;
+        check_flange(&table)?;
+        let consts = Consts::new(&params, &table);
+        let positions = Positions::new(&params);
+        let mut state = [0.0; N_STATES];
+        for i in 0..N_BOGIES {
+            state[frame_y(i)] = params.initial.lateral_m;
+            state[frame_yaw(i)] = params.initial.yaw_rad;
+        }
+        for j in 0..N_WHEELSETS {
+            let arm = positions.wheelset_x_m[j] - positions.bogie_x_m[j / 2];
+            state[wheelset_y(j)] = params.initial.lateral_m - arm * params.initial.yaw_rad;
+            state[wheelset_yaw(j)] = params.initial.yaw_rad;
+        }
+        let record = TrackRecord::new(positions.wheelset_delay_m[N_WHEELSETS - 1]);
+        let substep_s = params
+            .solver_substep_s
+            .min(consts.stable_substep_s(&params, &table));
+        Ok(Self {
+            substep_s,
+            table_range_m: table.y_range(),
+            params,
+            consts,
+            table,
+            hints: [SegmentHint::default(); N_WHEELSETS],
+            positions,
+            state,
+            time_s: 0.0,
+            position_m: 0.0,
+            record,
+        })
+    }
+
+    /// Parameters in use.
+    pub fn params(&self) -> &VehicleParams {
+        &self.params
+    }
+
+    /// Contact table in use.
+    pub fn contact_table(&self) -> &GeometryTable {
+        &self.table
+    }
+
+    /// Current time [s].
+    pub fn time_s(&self) -> f64 {
+        self.time_s
+    }
+
+    /// The state (q, q', spin rates).
+    pub fn state(&self) -> &[f64; N_STATES] {
+        &self.state
+    }
+
+    /// Overwrites the state (must be finite).
+    pub fn set_state(&mut self, state: [f64; N_STATES]) -> Result<(), StepError> {
+        if state.iter().any(|v| !v.is_finite()) {
+            return Err(StepError::Diverged {
+                time_s: self.time_s,
+            });
+        }
+        self.state = state;
+        Ok(())
+    }
+
+    /// Largest internal sub-step [s] (the parameter, lowered where stability needs it).
+    pub fn substep_s(&self) -> f64 {
+        self.substep_s
+    }
+
+    /// Number of internal sub-steps for a communication step h.
+    pub fn substeps(&self, h: f64) -> usize {
+        (h / self.substep_s - 1e-9).ceil().max(1.0) as usize
+    }
+
+    /// Alignment under each wheelset when the leading one is at `x` and the input is `input`.
+    fn track_at(&self, x: f64, input: f64) -> [f64; N_WHEELSETS] {
+        match self.params.track {
+            TrackSource::None => [0.0; N_WHEELSETS],
+            TrackSource::External | TrackSource::Internal { .. } => {
+                let pending = (self.position_m, input);
+                let d = &self.positions.wheelset_delay_m;
+                [
+                    input,
+                    self.record.at(x - d[1], pending),
+                    self.record.at(x - d[2], pending),
+                    self.record.at(x - d[3], pending),
+                ]
+            }
+        }
+    }
+
+    /// Outputs at the current time for the given inputs (no stepping).
+    pub fn outputs(&self, inputs: &Inputs) -> Result<Outputs, StepError> {
+        inputs.check()?;
+        let yt = self.track_at(self.position_m, inputs.track_lateral_m);
+        let mut hints = self.hints;
+        Ok(self.outputs_with(&self.state, &mut hints, &yt, inputs))
+    }
+
+    fn outputs_with(
+        &self,
+        x: &[f64; N_STATES],
+        hints: &mut [SegmentHint; N_WHEELSETS],
+        yt: &[f64; N_WHEELSETS],
+        inputs: &Inputs,
+    ) -> Outputs {
+        let c = &self.consts;
+        let e: Eval = rhs(c, &self.table, hints, x, yt, &inputs.damper_force_n);
+        let acc = |i: usize| e.dx[RATES + i];
+        let p = &self.params;
+        let pos = &self.positions;
+        let mut o = Outputs {
+            time_s: self.time_s,
+            ..Outputs::default()
+        };
+        for (j, (w, &track_m)) in e.wheelsets.iter().zip(yt).enumerate() {
+            let (iy, ip) = (wheelset_y(j), wheelset_yaw(j));
+            o.wheelset[j] = WheelsetOutputs {
+                lateral_m: x[iy],
+                lateral_rel_track_m: x[iy] - track_m,
+                lateral_velocity_mps: x[RATES + iy],
+                lateral_acc_mps2: acc(iy),
+                yaw_rad: x[ip],
+                guiding_force_n: w.lateral_n,
+                y_over_q: w.left_n.abs().max(w.right_n.abs()) / c.load,
+                track_m,
+            };
+        }
+        let arm = p.geometry.half_wheelbase_m;
+        for i in 0..N_BOGIES {
+            let (iy, ip) = (frame_y(i), frame_yaw(i));
+            o.frame[i] = FrameOutputs {
+                lateral_m: x[iy],
+                yaw_rad: x[ip],
+                roll_rad: x[frame_roll(i)],
+                // point at +p (leading axle) moves laterally by -p psi
+                lateral_acc_leading_axle_mps2: acc(iy) - arm * acc(ip),
+                lateral_acc_trailing_axle_mps2: acc(iy) + arm * acc(ip),
+            };
+        }
+        let dz = p.carbody.floor_height_m - p.carbody.cg_height_m;
+        let cb = |xp: f64| acc(CARBODY_Y) - xp * acc(CARBODY_YAW) + dz * acc(CARBODY_ROLL);
+        o.carbody = CarBodyOutputs {
+            lateral_m: x[CARBODY_Y],
+            yaw_rad: x[CARBODY_YAW],
+            roll_rad: x[CARBODY_ROLL],
+            lateral_acc_front_mps2: cb(pos.bogie_x_m[0]),
+            lateral_acc_mid_mps2: cb(0.0),
+            lateral_acc_rear_mps2: cb(pos.bogie_x_m[1]),
+        };
+        let b = p.geometry.damper_arm_m;
+        for d in 0..N_DAMPERS {
+            // attachment at lateral coordinate Y = side b: longitudinal u_x = psi Y
+            let arm_y = damper_side(d) * b;
+            let fy = frame_yaw(damper_bogie(d));
+            let (cb_v, fr_v) = (arm_y * x[RATES + CARBODY_YAW], arm_y * x[RATES + fy]);
+            let (cb_a, fr_a) = (arm_y * acc(CARBODY_YAW), arm_y * acc(fy));
+            o.damper[d] = DamperOutputs {
+                elongation_m: arm_y * (x[CARBODY_YAW] - x[fy]),
+                elongation_velocity_mps: cb_v - fr_v,
+                carbody_end_velocity_mps: cb_v,
+                carbody_end_acc_mps2: cb_a,
+                frame_end_velocity_mps: fr_v,
+                frame_end_acc_mps2: fr_a,
+            };
+        }
+        o
+    }
+
+    /// Advances over one communication step h with the inputs held; returns the outputs at the
+    /// end of the step. On error the model is unchanged.
+    pub fn step(&mut self, h: f64, inputs: &Inputs) -> Result<Outputs, StepError> {
+        inputs.check()?;
+        if !(h.is_finite() && h > 0.0 && h <= 1.0) {
+            return Err(StepError::InvalidStep { h });
+        }
+        let c = &self.consts;
+        let x0 = self.position_m;
+        let x1 = x0 + c.v * h;
+        let input = inputs.track_lateral_m;
+        let yt0 = self.track_at(x0, input);
+        let yt1 = self.track_at(x1, input);
+        let n = self.substeps(h);
+        let hs = h / n as f64;
+        let forces = &inputs.damper_force_n;
+        let table = &self.table;
+        let mut hints = self.hints;
+        let mut f = |x: &[f64; N_STATES], tau: f64| {
+            let u = tau / h;
+            let yt = [0, 1, 2, 3].map(|j| yt0[j] + u * (yt1[j] - yt0[j]));
+            rhs(c, table, &mut hints, x, &yt, forces).dx
+        };
+        let mut x = self.state;
+        for k in 0..n {
+            let t0 = k as f64 * hs;
+            let k1 = f(&x, t0);
+            let k2 = f(&axpy(&x, 0.5 * hs, &k1), t0 + 0.5 * hs);
+            let k3 = f(&axpy(&x, 0.5 * hs, &k2), t0 + 0.5 * hs);
+            let k4 = f(&axpy(&x, hs, &k3), t0 + hs);
+            for i in 0..N_STATES {
+                x[i] += hs / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+        }
+        if x.iter().any(|v| !v.is_finite()) {
+            return Err(StepError::Diverged {
+                time_s: self.time_s + h,
+            });
+        }
+        let (lo, hi) = self.table_range_m;
+        for j in 0..N_WHEELSETS {
+            let y_rel = x[wheelset_y(j)] - yt1[j];
+            if y_rel < lo || y_rel > hi {
+                return Err(StepError::Derailed {
+                    time_s: self.time_s + h,
+                    wheelset: j + 1,
+                    y_rel_mm: y_rel * 1e3,
+                    limit_mm: if y_rel < lo { lo } else { hi } * 1e3,
+                });
+            }
+        }
+        self.state = x;
+        self.hints = hints;
+        self.time_s += h;
+        if !matches!(self.params.track, TrackSource::None) {
+            self.record.push(x0, input);
+        }
+        self.position_m = x1;
+        let mut hints = self.hints;
+        Ok(self.outputs_with(&self.state, &mut hints, &yt1, inputs))
+    }
+}
+
+#[inline]
+fn axpy(x: &[f64; N_STATES], a: f64, d: &[f64; N_STATES]) -> [f64; N_STATES] {
+    let mut r = *x;
+    for i in 0..N_STATES {
+        r[i] += a * d[i];
+    }
+    r
+}
+
+/// Index of the spin perturbation rate of wheelset j in the state.
+pub const fn spin_index(j: usize) -> usize {
+    SPIN + j
+}
+
+/// Number of mechanical dofs (re-export for tools).
+pub const DOFS: usize = N_DOF;
+
+/// Serde for the state array (serde derives arrays up to 32 elements only).
+mod state_serde {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    use super::N_STATES;
+
+    pub fn serialize<S: Serializer>(x: &[f64; N_STATES], s: S) -> Result<S::Ok, S::Error> {
+        x.as_slice().serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; N_STATES], D::Error> {
+        let v = Vec::<f64>::deserialize(d)?;
+        v.try_into().map_err(|v: Vec<f64>| {
+            serde::de::Error::invalid_length(v.len(), &"the vehicle state length")
+        })
+    }
+}
