@@ -21,7 +21,6 @@ pub mod linear;
 pub mod model;
 pub mod params;
 pub mod sim;
-pub mod track;
 
 pub use model::{Inputs, ModelError, Outputs, StepError, Vehicle};
 pub use params::{ModelKind, ParamError, PsdLevel, TrackSource, VehicleParams};

@@ -5,7 +5,10 @@
 //! [`crate::calibration`]); the communication step is split into n = ceil(h / h_sub) equal
 //! sub-steps. Fixed cost per communication step, no allocation, deterministic. Damper forces
 //! and the external track input are held over a communication step; the trailing wheelsets'
-//! alignment is interpolated linearly between its values at the step ends.
+//! external alignment is interpolated linearly between its values at the step ends, the
+//! internal generator (wheel-rail's ERRI B176 realisation) is evaluated at every RK4 stage.
+//! Every wheelset sees the same track, delayed by its distance behind the leading wheelset
+//! over the speed (external input: through a spatial delay line).
 //!
 //! Direct feedthrough: the yaw-damper forces act on frame and car-body yaw, so the
 //! accelerations of frame and car-body points away from their centres (frame over the axle
@@ -16,13 +19,13 @@
 use serde::{Deserialize, Serialize};
 use wheel_rail::{GeometryTable, SegmentHint, TableError};
 
-use crate::dynamics::{rhs, Consts, Eval, N_STATES, RATES, SPIN};
+use crate::dynamics::{rhs, Consts, Eval, N_STATES, RATES};
 use crate::layout::{
     damper_bogie, damper_side, frame_roll, frame_y, frame_yaw, wheelset_y, wheelset_yaw, Positions,
-    CARBODY_ROLL, CARBODY_Y, CARBODY_YAW, N_BOGIES, N_DAMPERS, N_DOF, N_WHEELSETS,
+    CARBODY_ROLL, CARBODY_Y, CARBODY_YAW, N_BOGIES, N_DAMPERS, N_WHEELSETS,
 };
 use crate::params::{ContactSource, ParamError, TrackSource, VehicleParams};
-use crate::track::TrackRecord;
+use wheel_rail::track::{DelayLine, TrackGenerator};
 
 /// The worn-profile surrogate table shipped with the crate (the 2-dof bogie's default table:
 /// EN 15302 A/A with a 0.25 cone on the central +-3.5 mm of the tread, A/A flange).
@@ -237,9 +240,20 @@ pub struct Vehicle {
     time_s: f64,
     /// Distance travelled [m].
     position_m: f64,
-    record: TrackRecord,
+    track: Track,
     /// Largest sub-step used [s]: the parameter, or less where stability needs it.
     substep_s: f64,
+}
+
+/// Where the alignment under the wheelsets comes from, with its memory.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+enum Track {
+    /// Straight ideal track.
+    None,
+    /// External input under the leading wheelset, recorded for the trailing ones.
+    External(DelayLine),
+    /// Internal generator (synthesised once on a grid, interpolated).
+    Internal(TrackGenerator),
 }
 
 /// Checks that the table reaches flange contact on both sides.
@@ -288,7 +302,14 @@ impl Vehicle {
             state[wheelset_y(j)] = params.initial.lateral_m - arm * params.initial.yaw_rad;
             state[wheelset_yaw(j)] = params.initial.yaw_rad;
         }
-        let record = TrackRecord::new(positions.wheelset_delay_m[N_WHEELSETS - 1]);
+        let longest = positions.wheelset_delay_m[N_WHEELSETS - 1];
+        let track = match params.track {
+            TrackSource::None => Track::None,
+            TrackSource::External => Track::External(DelayLine::new(longest)),
+            TrackSource::Internal { level, seed } => {
+                Track::Internal(TrackGenerator::new(level, seed))
+            }
+        };
         let substep_s = params
             .solver_substep_s
             .min(consts.stable_substep_s(&params, &table));
@@ -303,7 +324,7 @@ impl Vehicle {
             state,
             time_s: 0.0,
             position_m: 0.0,
-            record,
+            track,
         })
     }
 
@@ -348,20 +369,17 @@ impl Vehicle {
         (h / self.substep_s - 1e-9).ceil().max(1.0) as usize
     }
 
-    /// Alignment under each wheelset when the leading one is at `x` and the input is `input`.
+    /// Alignment under each wheelset when the leading one is at `x` and the external input
+    /// is `input` (External: the trailing ones read the record, the leading one sees the input).
     fn track_at(&self, x: f64, input: f64) -> [f64; N_WHEELSETS] {
-        match self.params.track {
-            TrackSource::None => [0.0; N_WHEELSETS],
-            TrackSource::External | TrackSource::Internal { .. } => {
-                let pending = (self.position_m, input);
-                let d = &self.positions.wheelset_delay_m;
-                [
-                    input,
-                    self.record.at(x - d[1], pending),
-                    self.record.at(x - d[2], pending),
-                    self.record.at(x - d[3], pending),
-                ]
+        let d = &self.positions.wheelset_delay_m;
+        match &self.track {
+            Track::None => [0.0; N_WHEELSETS],
+            Track::External(line) => {
+                let at = |k: usize| line.at(x - d[k]).unwrap_or(input);
+                [input, at(1), at(2), at(3)]
             }
+            Track::Internal(g) => g.eval_behind(x, *d),
         }
     }
 
@@ -450,10 +468,36 @@ impl Vehicle {
         if !(h.is_finite() && h > 0.0 && h <= 1.0) {
             return Err(StepError::InvalidStep { h });
         }
-        let c = &self.consts;
         let x0 = self.position_m;
-        let x1 = x0 + c.v * h;
+        let x1 = x0 + self.consts.v * h;
         let input = inputs.track_lateral_m;
+        // Record the input before reading (a trailing wheelset less than a step's travel
+        // behind reads it); taken back if the step fails.
+        let undo = match &mut self.track {
+            Track::External(line) => Some(line.push_undoable(x0, input)),
+            Track::Internal(_) | Track::None => None,
+        };
+        let result = self.integrate(h, x0, x1, input, inputs);
+        match result {
+            Ok(o) => Ok(o),
+            Err(e) => {
+                if let (Some(u), Track::External(line)) = (undo, &mut self.track) {
+                    line.undo(u);
+                }
+                Err(e)
+            }
+        }
+    }
+
+    fn integrate(
+        &mut self,
+        h: f64,
+        x0: f64,
+        x1: f64,
+        input: f64,
+        inputs: &Inputs,
+    ) -> Result<Outputs, StepError> {
+        let c = &self.consts;
         let yt0 = self.track_at(x0, input);
         let yt1 = self.track_at(x1, input);
         let n = self.substeps(h);
@@ -461,9 +505,21 @@ impl Vehicle {
         let forces = &inputs.damper_force_n;
         let table = &self.table;
         let mut hints = self.hints;
+        let generator = match &self.track {
+            Track::Internal(g) => Some(g),
+            _ => None,
+        };
+        let delays = self.positions.wheelset_delay_m;
         let mut f = |x: &[f64; N_STATES], tau: f64| {
-            let u = tau / h;
-            let yt = [0, 1, 2, 3].map(|j| yt0[j] + u * (yt1[j] - yt0[j]));
+            // the generated track at each stage's position (independent of the step); the
+            // external input's record between its values at the step ends
+            let yt = match generator {
+                Some(g) => g.eval_behind(x0 + c.v * tau, delays),
+                None => {
+                    let u = tau / h;
+                    [0, 1, 2, 3].map(|j| yt0[j] + u * (yt1[j] - yt0[j]))
+                }
+            };
             rhs(c, table, &mut hints, x, &yt, forces).dx
         };
         let mut x = self.state;
@@ -497,9 +553,6 @@ impl Vehicle {
         self.state = x;
         self.hints = hints;
         self.time_s += h;
-        if !matches!(self.params.track, TrackSource::None) {
-            self.record.push(x0, input);
-        }
         self.position_m = x1;
         let mut hints = self.hints;
         Ok(self.outputs_with(&self.state, &mut hints, &yt1, inputs))
@@ -514,14 +567,6 @@ fn axpy(x: &[f64; N_STATES], a: f64, d: &[f64; N_STATES]) -> [f64; N_STATES] {
     }
     r
 }
-
-/// Index of the spin perturbation rate of wheelset j in the state.
-pub const fn spin_index(j: usize) -> usize {
-    SPIN + j
-}
-
-/// Number of mechanical dofs (re-export for tools).
-pub const DOFS: usize = N_DOF;
 
 /// Serde for the state array (serde derives arrays up to 32 elements only).
 mod state_serde {

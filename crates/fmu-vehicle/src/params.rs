@@ -70,15 +70,7 @@ pub enum ModelKind {
     NonLinear,
 }
 
-/// Level of the ERRI B176 lateral alignment spectrum.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-pub enum PsdLevel {
-    /// A = 2.119e-7 m rad.
-    #[default]
-    Low,
-    /// A = 6.125e-7 m rad.
-    High,
-}
+pub use wheel_rail::track::PsdLevel;
 
 /// Where the lateral track alignment comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -590,12 +582,6 @@ impl VehicleParams {
             1e-2,
             "RK4 sub-step",
         )?;
-        if let TrackSource::Internal { .. } = self.track {
-            return Err(ParamError::new(
-                "track",
-                "the internal track generator is not available yet; use External",
-            ));
-        }
         if let ContactSource::File(path) = &self.contact {
             if path.trim().is_empty() {
                 return Err(ParamError::new("contact", "empty contact table path"));
