@@ -20,34 +20,44 @@
 //! per axle box) belongs to a conventional passenger bogie. The primary longitudinal and
 //! lateral stiffnesses are therefore scaled together by one factor, found by
 //! [`calibrate_primary_stiffness_factor`] for 285 km/h (the middle of R15):
-//! [`PRIMARY_STIFFNESS_FACTOR`] = 3.08, i.e. 96.7 MN/m longitudinal and 12.0 MN/m lateral per
+//! [`PRIMARY_STIFFNESS_FACTOR`] = 3.15, i.e. 98.9 MN/m longitudinal and 12.2 MN/m lateral per
 //! axle box (high-speed bogies: 10-150 MN/m and 5-20 MN/m). Sensitivities measured on the way
-//! (linear critical speed, km/h): factor 1 / 1.5 / 2 / 3 / 5 / 10 / 100: 334 / 314 / 301 / 287 /
-//! 273 / 262 / 252; rigid primary: 250; conicity 0.30 / 0.35 at factor 1: 305 / 284; without the
-//! secondary lateral dampers: 275; yaw-damper c 60 / 104 / 200 kNs/m: 282 / 334 / 528. In the
-//! coach, unlike the 2-dof bogie, the yaw dampers' damping matters more than their stiffness.
-//! Vertical primary stiffness, secondary suspension, masses and heights stay as published.
+//! (linear critical speed, km/h, other values as published): factor 1 / 1.5 / 2 / 3 / 5 / 10 /
+//! 100: 334 / 314 / 301 / 287 / 273 / 262 / 252; rigid primary in all directions: 250;
+//! conicity 0.30 / 0.35 at factor 1: 305 / 284; without the secondary lateral dampers: 275;
+//! yaw-damper c 60 / 104 / 200 kNs/m: 282 / 334 / 528; creep reduction 0.5 / 0.6 / 1.0: 341 /
+//! 334 / 348. In the coach, unlike the 2-dof bogie, the yaw dampers' damping matters more than
+//! their stiffness (a mounting stiffness in series makes the Maxwell element stiffer at 4-5 Hz
+//! and RAISES the critical speed here: 5 MN/m: 366 km/h). Vertical primary stiffness, secondary
+//! suspension, masses and heights stay as published.
 //!
 //! # Results (tests: `tests/calibration.rs` in this crate, `tests/tests/vehicle_*.rs`)
-//! * R15: 285.0 km/h at 4.0 Hz, both bogies hunting (kinetic-energy shares front/rear
-//!   bogie about 0.5/0.4, car body 0.1).
+//! * R15: 285.0 km/h at 4.03 Hz (Im 25.3 rad/s), both bogies hunting (kinetic-energy shares:
+//!   front bogie 0.50, rear bogie 0.40, car body 0.10). Seed R6 (2-dof bogie): about 3-4 Hz.
 //! * R16 with the passive reference damper itself (the hydraulic model of fmu-damper at 30 %,
 //!   the seed's passive damper, coupled co-simulation style at 1 ms), 3 mm initial lateral
-//!   displacement of both bogies: decays at 240 and 260 km/h; 280 km/h: a 3.9 mm limit cycle on
-//!   the tread, Y/Q 0.2 (no flange contact); 300 km/h: 6.6 mm flange-contact limit cycle
-//!   (Y/Q 0.8). With the linear Maxwell stand-in instead the damping does not fall with the
-//!   stroke, and the limit cycles stay smaller (280: 0.6 mm, 300: 3.5 mm, 320: 4.6 mm): R16's
-//!   flange contact at 300 km/h needs the real damper's falling equivalent damping at large
-//!   strokes (1 mm: 96 kNs/m, 3 mm: 61 kNs/m at 4 Hz).
+//!   displacement of both bogies: decays at 240 km/h (and 260); 280 km/h: a 4.3 mm limit cycle
+//!   on the tread, Y/Q 0.23, never on the flange; 300 km/h: a 6.57 mm limit cycle up the flange
+//!   root (tan gamma 0.8; the flank starts at 6.65 mm), Y/Q 0.80; 320 km/h: 6.60 mm, Y/Q 0.88.
+//!   With the linear Maxwell stand-in instead the damping does not fall with the stroke and the
+//!   limit cycles stay smaller (280: 0.6 mm, 300: 3.55 mm, 320: 4.69 mm, all on the tread):
+//!   R16's flange contact at 300 km/h needs the real damper's falling equivalent damping at
+//!   large strokes (1 mm: 96 kNs/m, 3 mm: 61 kNs/m at 4 Hz).
+//! * Reduction (tests/tests/vehicle_vs_bogie.rs): car body 1000 times heavier, rigid primary,
+//!   the bogie's data: 270.22 km/h at 4.411 Hz against the 2-dof bogie's 270.03 km/h at
+//!   4.409 Hz.
 //!
-//! # Integrator sub-step (convergence study, tests `convergence_*`)
-//! RK4 with one sub-step per 1 ms communication step: the limit-cycle amplitude at 320 km/h
-//! with hard flange contact (Y/Q 2.1) differs from a 0.1 ms sub-step by 0.001 mm, the
-//! time-domain critical speed of the linear model by less than 0.01 km/h. With a 10 ms
-//! communication step, sub-steps of 1 / 2 / 5 / 10 ms give 6.573 / 6.544 / 6.650 mm / unstable
-//! against 6.567 mm at 0.1 ms, and Y/Q 0.78 / 0.73 / 1.16 against 0.77, so [`SOLVER_SUBSTEP_S`]
-//! = 1 ms. Below that bound the model lowers the sub-step where creep damping (which grows as
-//! 1/V) or the stiffest contact or suspension frequency would need it.
+//! # Integrator sub-step (convergence study, `tests/convergence.rs`)
+//! RK4 with one sub-step per 1 ms communication step: the limit cycle at 320 km/h with the
+//! yaw dampers at 30 % of the passive damping (hard flange contact, Y/Q 2.05) is 6.6944 mm
+//! against 6.6937 mm with a 0.1 ms sub-step, Y/Q 2.053 against 2.039, and the time-domain
+//! critical speed of the linear model 287.27 km/h for both. With a 10 ms communication step
+//! (where the sub-step constant itself limits the internal step): 1 ms sub-step 6.5912 mm /
+//! Y/Q 0.841 / 302.26 km/h against 6.5836 mm / 0.828 / 302.31 km/h at 0.1 ms; a 2 ms sub-step
+//! gives Y/Q 0.879 (6 % off, the test fails), 5 ms 1.16, 10 ms diverges. Hence
+//! [`SOLVER_SUBSTEP_S`] = 1 ms. Below that bound the model lowers the sub-step where the
+//! creep damping (growing as 1/V: at 10 km/h the non-linear model takes 0.19 ms) or the
+//! stiffest contact or suspension frequency needs it (`dynamics::Consts::stable_substep_s`).
 
 use crate::eigen::{
     critical_speed, CriticalSpeed, DamperRepresentation, EigenError, YawDamperModel,

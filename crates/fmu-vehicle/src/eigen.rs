@@ -317,6 +317,14 @@ fn shares_of(p: &VehicleParams, v: &DVector<Complex<f64>>) -> EnergyShares {
     }
 }
 
+impl ModeKind {
+    /// Name by the shares: car body if it holds at least half the kinetic energy, else the
+    /// bogie holding at least twice the other's share, else both bogies.
+    pub fn from_shares(s: &EnergyShares) -> Self {
+        kind_of(s)
+    }
+}
+
 fn kind_of(s: &EnergyShares) -> ModeKind {
     if s.carbody >= 0.5 {
         ModeKind::CarBody

@@ -149,3 +149,38 @@ fn time_domain_linear_growth_matches_the_eigenvalue() {
     assert!(re > 0.3);
     assert!((rate - re).abs() < 0.03 * re, "{rate} vs {re}");
 }
+
+#[test]
+fn root_locus_names_the_modes() {
+    let p = VehicleParams::default();
+    let speeds: Vec<f64> = [100.0, 200.0, 285.0].iter().map(|k| k / 3.6).collect();
+    let rl = fmu_vehicle::eigen::root_locus(&p, &passive_damper(), &speeds).unwrap();
+    assert_eq!(rl.len(), 3);
+    // at 100 km/h the slowest-decaying oscillation is the car body's (about 0.6 Hz; by damping
+    // ratio a wheelset mode near 90 Hz is the least damped one)
+    let low = rl[0].least_stable.unwrap();
+    assert_eq!(low.kind, ModeKind::CarBody, "{low:?}");
+    assert!(low.shares.carbody > 0.9 && low.freq_hz < 1.5, "{low:?}");
+    // at the critical speed it is the bogies' hunting at about 4 Hz
+    let hunt = rl[2].least_stable.unwrap();
+    assert_ne!(hunt.kind, ModeKind::CarBody);
+    assert!(hunt.freq_hz > 3.0 && hunt.freq_hz < 5.0, "{hunt:?}");
+    for r in &rl {
+        assert_eq!(r.eigenvalues.len(), 2 * 17 + 4);
+        let s = r.least_damped.unwrap().shares;
+        assert!((s.carbody + s.front_bogie + s.rear_bogie - 1.0).abs() < 1e-9);
+    }
+    // the naming rule
+    use fmu_vehicle::eigen::EnergyShares;
+    let k = |c: f64, f: f64, r: f64| {
+        ModeKind::from_shares(&EnergyShares {
+            carbody: c,
+            front_bogie: f,
+            rear_bogie: r,
+        })
+    };
+    assert_eq!(k(0.6, 0.2, 0.2), ModeKind::CarBody);
+    assert_eq!(k(0.1, 0.7, 0.2), ModeKind::FrontBogie);
+    assert_eq!(k(0.1, 0.2, 0.7), ModeKind::RearBogie);
+    assert_eq!(k(0.1, 0.5, 0.4), ModeKind::BothBogies);
+}
