@@ -1,0 +1,75 @@
+//! R17 for the passive coach: on ERRI B176 low-level track (seeds 1 and 2), with four
+//! hydraulic passive dampers (fmu-damper at 30 % opening, coupled co-simulation style at
+//! 1 ms), the EN 14363 rms of the frame lateral acceleration over the leading axle boxes of
+//! both bogies (band-pass +-2 Hz around the dominant frequency, 100 m windows in 10 m steps,
+//! a_lim = 5.39 m/s^2 for the 6.1 t bogie; the master's assessment) stays below the limit at
+//! 290 km/h and exceeds it at 320 km/h. Seed R8/R17: the limit is exceeded at about
+//! 280-300 km/h (measured here: met up to 300 km/h, first exceeded at 310 km/h on seed 1).
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use fmu_damper::{SemiActiveDamper, SemiActiveInputs};
+use fmu_vehicle::{Inputs, PsdLevel, TrackSource, Vehicle, VehicleParams};
+use master::en14363::{acceleration_limit, assess_lateral_acceleration, StabilitySettings};
+
+/// Largest EN 14363 rms over the two frames [m/s^2] for a 20 s run (the first 5 s skipped).
+fn max_rms(kmh: f64, seed: u64) -> f64 {
+    let p = VehicleParams {
+        speed_mps: kmh / 3.6,
+        track: TrackSource::Internal {
+            level: PsdLevel::Low,
+            seed,
+        },
+        ..VehicleParams::default()
+    };
+    let bogie_t = p.bogie_mass_kg() / 1000.0;
+    let mut v = Vehicle::new(p).unwrap();
+    let mut dampers: Vec<SemiActiveDamper> = (0..4)
+        .map(|_| SemiActiveDamper::passive_reference().unwrap())
+        .collect();
+    let h = 1e-3;
+    let mut inputs = Inputs::default();
+    let mut out = v.outputs(&inputs).unwrap();
+    let (mut front, mut rear) = (Vec::new(), Vec::new());
+    for _ in 0..20_000 {
+        for (d, damper) in dampers.iter_mut().enumerate() {
+            let o = damper
+                .step(
+                    h,
+                    &SemiActiveInputs {
+                        elongation_m: out.damper[d].elongation_m,
+                        elongation_velocity_mps: out.damper[d].elongation_velocity_mps,
+                        valve_command_v: 0.0,
+                    },
+                )
+                .unwrap();
+            inputs.damper_force_n[d] = o.force_n;
+        }
+        out = v.step(h, &inputs).unwrap();
+        front.push(out.frame[0].lateral_acc_leading_axle_mps2);
+        rear.push(out.frame[1].lateral_acc_leading_axle_mps2);
+    }
+    let s = StabilitySettings {
+        skip_s: 5.0,
+        ..StabilitySettings::default()
+    };
+    let a = |x: &[f64]| {
+        assess_lateral_acceleration(x, 1.0 / h, kmh / 3.6, bogie_t, &s)
+            .unwrap()
+            .max_rms
+    };
+    let m = a(&front).max(a(&rear));
+    eprintln!("{kmh} km/h, seed {seed}: max rms {m:.2} m/s^2");
+    m
+}
+
+#[test]
+fn r17_passive_coach_meets_en14363_at_290_and_exceeds_it_at_320_kmh() {
+    let limit = acceleration_limit(VehicleParams::default().bogie_mass_kg() / 1000.0);
+    assert!((limit - 5.39).abs() < 0.01);
+    for seed in [1, 2] {
+        let below = max_rms(290.0, seed);
+        assert!(below < limit, "seed {seed}: {below} at 290 km/h");
+        let above = max_rms(320.0, seed);
+        assert!(above > limit, "seed {seed}: {above} at 320 km/h");
+    }
+}
