@@ -1,8 +1,9 @@
 //! Real-time factor of the coach: one simulated second (1000 communication steps of 1 ms, the
-//! default RK4 sub-step) at 300 km/h (linear model: 280 km/h) on ERRI B176 high-level irregular track (internal
-//! generator), non-linear model, the four yaw dampers as Maxwell elements evaluated beside the
-//! model like a co-simulated damper. Simulated seconds per wall second = 1 / (time per iter);
-//! the target is at least 200 (time per iter below 5 ms).
+//! default RK4 sub-step) on ERRI B176 irregular track (internal generator): the non-linear
+//! model at 300 km/h on high-level track, the linear model at 250 km/h on low-level track, the
+//! four yaw dampers as Maxwell elements evaluated beside the model like co-simulated dampers.
+//! Simulated seconds per wall second = 1 / (time per iter); the target is at least 200 (time
+//! per iter below 5 ms).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 use criterion::{criterion_group, criterion_main, Criterion};
 use fmu_vehicle::calibration::{PASSIVE_MAXWELL_C_NS_PER_M, PASSIVE_MAXWELL_K_N_PER_M};
@@ -15,25 +16,27 @@ fn bench(c: &mut Criterion) {
         c: PASSIVE_MAXWELL_C_NS_PER_M,
     };
     // the linear model at 280 km/h (stable; above its critical speed it grows without bound)
-    for (name, model, kmh) in [
+    // The linear model runs at 250 km/h on low-level track: it has no flange, and on the
+    // high-level track its lightly damped response leaves the table's range (as the 2-dof
+    // bogie's linear model does, 14 mm at 250 km/h).
+    for (name, model, kmh, level) in [
         (
             "nonlinear_1s_sim_h1ms_irregular_track",
             ModelKind::NonLinear,
             300.0,
+            PsdLevel::High,
         ),
         (
             "linear_1s_sim_h1ms_irregular_track",
             ModelKind::Linear,
-            280.0,
+            250.0,
+            PsdLevel::Low,
         ),
     ] {
         let p = VehicleParams {
             speed_mps: kmh / 3.6,
             model,
-            track: TrackSource::Internal {
-                level: PsdLevel::High,
-                seed: 1,
-            },
+            track: TrackSource::Internal { level, seed: 1 },
             ..VehicleParams::default()
         };
         // start from a vehicle that has run 2 s (hunting established)
