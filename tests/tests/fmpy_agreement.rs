@@ -114,3 +114,8 @@ fn ideal_damper_force_controller() {
 fn bogie_2dof() {
     check::<fmu_bogie2dof::fmu::Bogie2Dof>();
 }
+
+#[test]
+fn rail_vehicle() {
+    check::<fmu_vehicle::fmu::RailVehicle>();
+}

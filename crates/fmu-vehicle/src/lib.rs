@@ -12,10 +12,13 @@
 //!
 //! Modules: [`params`] (data set, sources, validation), [`layout`] (dofs, suspension assembly),
 //! [`linear`] (linear matrices), [`eigen`] (state matrix, modes, critical speed, root locus),
-//! [`calibration`].
+//! [`calibration`], [`dynamics`] (right-hand side), [`model`] (time-domain [`Vehicle`]),
+//! [`track`], [`sim`] (closed loop with linear dampers), [`fmu`] (FMU shell `RailVehicle`,
+//! exported with feature `fmi-export`).
 pub mod calibration;
 pub mod dynamics;
 pub mod eigen;
+pub mod fmu;
 pub mod layout;
 pub mod linear;
 pub mod model;

@@ -1,0 +1,262 @@
+//! The RailVehicle FMU driven through the glue's state machine (the same checks as the C API).
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use fmu_vehicle::fmu::{RailVehicle, FMU_DEFAULT_INITIAL_LATERAL_M, FMU_DEFAULT_SPEED_MPS};
+use fmu_vehicle::params::Initial;
+use fmu_vehicle::{Inputs, PsdLevel, TrackSource, Vehicle, VehicleParams};
+use model_description::{
+    rust_component, value_reference, Causality, CollectLog, Component, FmuModel, InstanceContext,
+    Status, VarType,
+};
+
+type M = RailVehicle;
+
+fn vr(name: &str) -> u32 {
+    value_reference::<M>(name).unwrap_or_else(|| panic!("no variable {name}"))
+}
+
+fn new() -> (Component, CollectLog) {
+    let (mut c, log) = rust_component::<M>(InstanceContext::default()).unwrap();
+    assert_eq!(c.setup_experiment(0.0, None), Status::Ok);
+    assert_eq!(c.enter_initialization_mode(), Status::Ok);
+    (c, log)
+}
+
+fn set(c: &mut Component, name: &str, x: f64) -> Status {
+    c.set_real(&[vr(name)], &[x])
+}
+
+fn get(c: &mut Component, name: &str) -> f64 {
+    let mut out = [f64::NAN];
+    let s = c.get_real(&[vr(name)], &mut out);
+    assert!(s <= Status::Warning, "get {name}: {s:?}");
+    out[0]
+}
+
+fn logged(log: &[(Status, String, String)], status: Status, needle: &str) -> bool {
+    log.iter()
+        .any(|(s, _, m)| *s == status && m.contains(needle))
+}
+
+fn real_outputs() -> Vec<String> {
+    M::variables()
+        .iter()
+        .filter(|v| v.meta.causality == Causality::Output && v.meta.var_type == VarType::Real)
+        .map(|v| v.meta.name.clone())
+        .collect()
+}
+
+#[test]
+fn names_are_structured() {
+    for v in M::variables() {
+        let n = &v.meta.name;
+        assert!(n.contains('.'), "bare name {n}");
+        assert!(!n.starts_with("model"), "{n}");
+    }
+    for name in [
+        "damper_front_left.force",
+        "damper_rear_right.carbody_end_velocity",
+        "carbody.lateral_acceleration_mid",
+        "frame_rear.lateral_acceleration_trailing_axle",
+        "wheelset_4.y_over_q",
+    ] {
+        vr(name);
+    }
+}
+
+#[test]
+fn default_experiment_is_finite_and_hunts() {
+    let e = M::INFO.default_experiment;
+    let (mut c, log) = rust_component::<M>(InstanceContext::default()).unwrap();
+    assert_eq!(
+        c.setup_experiment(e.start_time, Some(e.stop_time)),
+        Status::Ok
+    );
+    assert_eq!(c.enter_initialization_mode(), Status::Ok);
+    assert_eq!(c.exit_initialization_mode(), Status::Ok);
+    let names = real_outputs();
+    let n = ((e.stop_time - e.start_time) / e.step_size).round() as usize;
+    let mut t = e.start_time;
+    let (mut peak, mut yq): (f64, f64) = (0.0, 0.0);
+    for k in 0..n {
+        let target = e.start_time + (k + 1) as f64 * e.step_size;
+        assert_eq!(c.do_step(t, target - t), Status::Ok, "{:?}", log.take());
+        t = target;
+        if k % 10 == 0 {
+            for name in &names {
+                let x = get(&mut c, name);
+                assert!(x.is_finite(), "{name} = {x} at t = {t}");
+            }
+        }
+        if t > 2.0 {
+            peak = peak.max(get(&mut c, "wheelset_1.lateral_displacement").abs());
+            yq = yq.max(get(&mut c, "wheelset_1.y_over_q"));
+        }
+    }
+    assert!(log.take().is_empty());
+    // hunting into flange contact without yaw dampers
+    assert!(peak > 6e-3 && peak < 8e-3, "{peak}");
+    assert!(yq > 1.0, "{yq}");
+}
+
+/// Same parameters, same inputs: the FMU outputs equal the physics bit for bit.
+#[test]
+fn fmu_equals_plain_physics_bit_for_bit() {
+    let (mut c, log) = new();
+    assert_eq!(set(&mut c, "vehicle.speed", 280.0 / 3.6), Status::Ok);
+    assert_eq!(
+        c.set_integer(&[vr("track.source")], &[2]),
+        Status::Ok,
+        "{:?}",
+        log.take()
+    );
+    assert_eq!(c.set_integer(&[vr("track.level")], &[1]), Status::Ok);
+    assert_eq!(c.set_integer(&[vr("track.seed")], &[7]), Status::Ok);
+    assert_eq!(c.exit_initialization_mode(), Status::Ok);
+    let p = VehicleParams {
+        speed_mps: 280.0 / 3.6,
+        initial: Initial {
+            lateral_m: FMU_DEFAULT_INITIAL_LATERAL_M,
+            yaw_rad: 0.0,
+        },
+        track: TrackSource::Internal {
+            level: PsdLevel::High,
+            seed: 7,
+        },
+        ..VehicleParams::default()
+    };
+    let mut v = Vehicle::new(p).unwrap();
+    let forces = [
+        "damper_front_left.force",
+        "damper_front_right.force",
+        "damper_rear_left.force",
+        "damper_rear_right.force",
+    ]
+    .map(vr);
+    let h = 1e-3;
+    let mut t = 0.0;
+    for k in 0..1000 {
+        let f = 3e3 * ((k as f64) * 0.05).sin();
+        let i = Inputs {
+            damper_force_n: [f, -0.5 * f, 0.3 * f, -f],
+            track_lateral_m: 0.0,
+        };
+        assert_eq!(c.set_real(&forces, &i.damper_force_n), Status::Ok);
+        assert_eq!(c.do_step(t, h), Status::Ok);
+        // the glue steps from its own time to t + h: the same effective step here
+        let o = v.step((t + h) - t, &i).unwrap();
+        t += h;
+        assert_eq!(
+            get(&mut c, "wheelset_3.lateral_displacement"),
+            o.wheelset[2].lateral_m
+        );
+        assert_eq!(
+            get(&mut c, "frame_rear.lateral_acceleration_leading_axle"),
+            o.frame[1].lateral_acc_leading_axle_mps2
+        );
+        assert_eq!(
+            get(&mut c, "carbody.lateral_acceleration_mid"),
+            o.carbody.lateral_acc_mid_mps2
+        );
+        assert_eq!(
+            get(&mut c, "damper_rear_right.carbody_end_acceleration"),
+            o.damper[3].carbody_end_acc_mps2
+        );
+        assert_eq!(
+            get(&mut c, "wheelset_4.track_alignment"),
+            o.wheelset[3].track_m
+        );
+    }
+}
+
+#[test]
+fn impossible_parameters_are_named() {
+    // the glue refuses values outside the declared range at once
+    let (mut c, log) = new();
+    assert_eq!(set(&mut c, "carbody.mass", -1.0), Status::Error);
+    assert!(logged(&log.take(), Status::Error, "carbody.mass"));
+    // the physics' own checks at fmi2ExitInitializationMode, under the FMI names
+    for (name, value, needle) in [
+        ("geometry.half_wheelbase", 5.0, "do not fit"),
+        ("primary.longitudinal_stiffness", 0.0, "> 0"),
+        ("frame.yaw_inertia", 0.0, "> 0"),
+    ] {
+        let (mut c, log) = new();
+        assert_eq!(set(&mut c, name, value), Status::Ok);
+        assert_eq!(c.exit_initialization_mode(), Status::Error, "{name}");
+        let l = log.take();
+        assert!(logged(&l, Status::Error, name), "{name}: {l:?}");
+        assert!(logged(&l, Status::Error, needle), "{name}: {l:?}");
+    }
+}
+
+#[test]
+fn a_contact_table_without_flange_is_refused() {
+    let dir = std::env::temp_dir().join(format!("rail_vehicle_table_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("tread_only.csv");
+    let t = wheel_rail::GeometryTable::synthetic(0.2, 7e-3, 5e-4, 0.5).unwrap();
+    std::fs::write(&file, t.to_csv(wheel_rail::CsvNumbers::Scientific)).unwrap();
+    let (mut c, log) = new();
+    let path = file.to_string_lossy().into_owned();
+    assert_eq!(
+        c.set_string(&[vr("contact.table")], &[path.as_str()]),
+        Status::Ok
+    );
+    assert_eq!(c.exit_initialization_mode(), Status::Error);
+    let l = log.take();
+    assert!(logged(&l, Status::Error, "contact.table"), "{l:?}");
+    assert!(logged(&l, Status::Error, "flange"), "{l:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_input_and_derailment_are_errors_naming_the_cause() {
+    let (mut c, log) = new();
+    assert_eq!(c.exit_initialization_mode(), Status::Ok);
+    // NaN is refused by the glue at fmi2SetReal
+    assert_eq!(
+        set(&mut c, "damper_front_right.force", f64::NAN),
+        Status::Error
+    );
+    assert!(logged(
+        &log.take(),
+        Status::Error,
+        "damper_front_right.force"
+    ));
+    // linear model far above its critical speed without dampers: derails
+    let (mut c, log) = new();
+    assert_eq!(
+        c.set_integer(&[vr("wheel_rail.force_law")], &[0]),
+        Status::Ok
+    );
+    assert_eq!(set(&mut c, "vehicle.speed", 90.0), Status::Ok);
+    assert_eq!(c.exit_initialization_mode(), Status::Ok);
+    let mut t = 0.0;
+    let mut status = Status::Ok;
+    for _ in 0..20_000 {
+        status = c.do_step(t, 1e-3);
+        if status != Status::Ok {
+            break;
+        }
+        t += 1e-3;
+        assert!(get(&mut c, "wheelset_1.lateral_displacement").is_finite());
+    }
+    assert_eq!(status, Status::Error);
+    let l = log.take();
+    assert!(logged(&l, Status::Error, "derailment"), "{l:?}");
+}
+
+#[test]
+fn start_values_are_the_fmu_defaults() {
+    let (mut c, _log) = new();
+    assert_eq!(get(&mut c, "vehicle.speed"), FMU_DEFAULT_SPEED_MPS);
+    assert_eq!(
+        get(&mut c, "initial.lateral_displacement"),
+        FMU_DEFAULT_INITIAL_LATERAL_M
+    );
+    assert_eq!(
+        get(&mut c, "primary.longitudinal_stiffness"),
+        VehicleParams::default().primary.kx_n_per_m
+    );
+}
