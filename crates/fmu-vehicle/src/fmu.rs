@@ -216,11 +216,11 @@ impl FmuModel for RailVehicle {
         let mut v: Vec<Variable<Self>> = Vec::new();
         model_description::declare! { v;
             /// Running speed V (> 0: the creepages divide by V)
-            parameter "vehicle.speed" [unit = "m/s", display_unit = "km/h", range = 1.0..=200.0] => params.speed_mps;
+            parameter "running.speed" [unit = "m/s", display_unit = "km/h", range = 1.0..=200.0] => params.speed_mps;
             /// Wheel/rail force law: linear (Kalker, constant conicity and gravitational stiffness, the
             /// seed's (5.1)-(5.18) per wheelset) or non-linear (contact table, Vermeulen-Johnson
             /// saturation, wheelset spin dofs, (5.19)-(5.27) per wheelset)
-            parameter "wheel_rail.force_law" => params.model;
+            parameter "contact.model" => params.model;
             /// Car-body mass (Manchester Benchmark: 32 t)
             parameter "carbody.mass" [unit = "kg", display_unit = "t", min = 0.0] => params.carbody.mass_kg;
             /// Car-body roll inertia about its centre of gravity (Manchester: 56 800 kg m2)
@@ -297,10 +297,10 @@ impl FmuModel for RailVehicle {
             /// b: lateral arm of the four yaw dampers (MPE 2019: 1.35 m, as the 2-dof bogie)
             parameter "damper.lateral_arm" [unit = "m", min = 0.0] => params.geometry.damper_arm_m;
             /// Equivalent conicity of the linear model (default: the default table at 1 mm)
-            parameter "wheel_rail.conicity" [unit = "1", range = 0.0..=1.0] => params.wheel_rail.conicity;
+            parameter "linear.conicity" [unit = "1", range = 0.0..=1.0] => params.wheel_rail.conicity;
             /// Lateral contact-angle (gravitational) stiffness per wheelset of the linear model (default:
             /// the default table at 1 mm, at the default wheel load)
-            parameter "wheel_rail.gravitational_stiffness" [unit = "N/m", display_unit = "MN/m", min = 0.0] => params.wheel_rail.gravity_stiffness_n_per_m;
+            parameter "linear.gravitational_stiffness" [unit = "N/m", display_unit = "MN/m", min = 0.0] => params.wheel_rail.gravity_stiffness_n_per_m;
             /// f11: Kalker longitudinal creep coefficient per wheel (Hertz + Kalker, 11.5 MN at 70 kN,
             /// scaled as P^(2/3) to the wheel load)
             parameter "creep.f11" [unit = "N", min = 0.0] => params.wheel_rail.f11_n;
