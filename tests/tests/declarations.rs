@@ -18,7 +18,7 @@ fn metas<M: FmuModel>() -> Vec<model_description::variable::VarMeta> {
     M::variables().into_iter().map(|v| v.meta).collect()
 }
 
-/// Runs `f` for each of the nine models.
+/// Runs `f` for each of the ten models.
 macro_rules! for_each_model {
     ($f:ident) => {
         $f::<fmu_examples::MassSpring>();
@@ -30,6 +30,7 @@ macro_rules! for_each_model {
         $f::<fmu_controller::fmu::SkyHookController>();
         $f::<fmu_controller::fmu::IdealDamperForceController>();
         $f::<fmu_bogie2dof::fmu::Bogie2Dof>();
+        $f::<fmu_vehicle::fmu::RailVehicle>();
     };
 }
 
@@ -301,6 +302,7 @@ fn every_parameter_error_names_a_declared_variable() {
     use fmu_controller::fmu::{IdealDamperForceController, MpptController, SkyHookController};
     use fmu_damper::fmu::{FullActiveActuator, PassiveYawDamper, SemiActiveDamper};
     use fmu_examples::{MassSpring, SpringDamperMass};
+    use fmu_vehicle::fmu::RailVehicle;
     // How many parameters have a validation path reachable with one value (at least; the
     // examples' declared bounds already refuse every bad value).
     let counts = [
@@ -341,6 +343,7 @@ fn every_parameter_error_names_a_declared_variable() {
             3,
         ),
         ("Bogie2Dof", single_parameter_errors::<Bogie2Dof>(), 14),
+        ("RailVehicle", single_parameter_errors::<RailVehicle>(), 20),
     ];
     for (model, n, at_least) in counts {
         eprintln!("{model}: {n} parameters with a reachable validation error");
@@ -380,6 +383,10 @@ fn every_parameter_error_names_a_declared_variable() {
         &["table.opening[3]"],
     );
     cross_parameter_error::<SkyHookController>(&[("table.damping[4]", 5e5)], &["table.damping[4]"]);
+    cross_parameter_error::<RailVehicle>(
+        &[("geometry.half_wheelbase", 5.0)],
+        &["geometry.half_wheelbase"],
+    );
 }
 
 fn state_round_trip<M: FmuModel>() {

@@ -467,8 +467,8 @@ impl VehicleParams {
             return Err(ParamError::new(
                 "geometry.half_wheelbase_m",
                 format!(
-                    "the wheelsets do not fit the bogies: half wheelbase {} m must be at most \
-                     half of the half bogie spacing {} m (the bogies would overlap)",
+                    "the wheelsets do not fit the bogies: {} m must be at most half of \
+                     geometry.half_bogie_spacing_m = {} m (the bogies would overlap)",
                     g.half_wheelbase_m, g.half_bogie_spacing_m
                 ),
             ));
@@ -528,7 +528,7 @@ impl VehicleParams {
         if s.kx_n_per_m == 0.0 && s.yaw_stiffness_nm_per_rad == 0.0 {
             return Err(ParamError::new(
                 "secondary.kx_n_per_m",
-                "must be > 0 (or the air-spring yaw stiffness): otherwise the car body yaw is free",
+                "must be > 0 (or secondary.yaw_stiffness_nm_per_rad): otherwise the car body yaw is free",
             ));
         }
         let r = &self.wheel_rail;
