@@ -1,4 +1,4 @@
-//! Every FMU's declaration, checked the same way for all nine models (driven from Rust through
+//! Every FMU's declaration, checked the same way for all ten models (driven from Rust through
 //! the glue's state machine, the same path as the C API):
 //! - the default experiment is a whole number of steps in floating point (strict hosts refuse
 //!   0.3 s / 1e-4 s);
