@@ -10,7 +10,7 @@
 
 use fmu_damper::{SemiActiveDamper, SemiActiveInputs};
 use fmu_vehicle::{Inputs, PsdLevel, TrackSource, Vehicle, VehicleParams};
-use master::en14363::{acceleration_limit, assess_lateral_acceleration, StabilitySettings};
+use rail_study::en14363::{acceleration_limit, assess_lateral_acceleration, StabilitySettings};
 
 /// Largest EN 14363 rms over the two frames [m/s^2] for a 20 s run (the first 5 s skipped).
 fn max_rms(kmh: f64, seed: u64) -> f64 {
