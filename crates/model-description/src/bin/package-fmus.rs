@@ -352,7 +352,13 @@ fn cargo_build(root: &Path, build: &Build, crates: &[String]) -> Result<(), Stri
             c
         }
     };
-    cmd.current_dir(root)
+    // zig reports its own include folders relative to the working directory when they lie
+    // below it (a project-local .venv does), and cargo-zigbuild hands them to bindgen, whose
+    // build scripts run elsewhere: build from outside the workspace so every path is absolute.
+    let manifest = root.join("Cargo.toml");
+    cmd.current_dir(std::env::temp_dir())
+        .arg("--manifest-path")
+        .arg(&manifest)
         .args(["--release", "--lib", "--features", "fmi-export"]);
     for c in crates {
         cmd.args(["-p", c]);
