@@ -109,7 +109,7 @@ fn eigenvalue_critical_speed_matches_coupled_onset_with_the_damper_fmu() {
     // Initial lateral displacements of 3 and 8 mm give damper strokes of about 1.3 and 3.2 mm
     // near onset. (From 1 mm the stroke is only 0.1 mm; there the damper's first-harmonic
     // characterisation, dominated by the laminar orifice region, predicts 387 km/h while the
-    // coupled run starts hunting at 286 km/h: an open point recorded on issue 4.)
+    // coupled run starts hunting at 286 km/h: an open point, see docs/VALIDATION.md.)
     for initial_m in [0.003, 0.008] {
         check_onset(initial_m);
     }

@@ -38,7 +38,7 @@
 //! (`ContactSource::ProfilesAA`, FMU `contact.table = "AA"`). Shipped as
 //! `resources/wheel_rail_worn_surrogate.csv` (`examples/write_surrogate.rs`).
 //! The A/A table under both is the wheel-rail crate's E1 output with the closest-point contact
-//! of session 1; wheel-rail now reports the centroid of the contact zone (E1 delta r within
+//! of the first release; wheel-rail now reports the centroid of the contact zone (E1 delta r within
 //! 0.1 mm to 6 mm), which would change this table by up to 0.24 mm / 0.046 in tan gamma near the
 //! flange root and the gravitational stiffness at 1 mm by -8 %. The calibration below rests on
 //! the shipped table; regenerating it means re-running this calibration.

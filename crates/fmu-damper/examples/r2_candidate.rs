@@ -1,4 +1,4 @@
-//! R2 exploration (issue 3), companion of `r2_peak`: for a given laminar core dP_t, find the
+//! R2 exploration, companion of `r2_peak`: for a given laminar core dP_t, find the
 //! (Q_ref, C_f) whose 0 % k_eq peak (1 mm) sits at a target frequency while the 0 % peak forces
 //! at 4 Hz are centred in R1 (sqrt(F1 F3) = sqrt(12 kN 20 kN)), then A_v centring the 100 %
 //! peaks in 0.5-1 kN; prints R1, the phases, the c_eq table the sky-hook controller uses

@@ -1,4 +1,4 @@
-//! R2 exploration (issue 3): can a plausible calibration put the 0 % k_eq peak (1 mm) at
+//! R2 exploration: can a plausible calibration put the 0 % k_eq peak (1 mm) at
 //! 5.5-6.5 Hz while R1 keeps a margin? Does NOT change the defaults.
 //!
 //! At 0 % opening only `K Q_ref / V0` and `K C_f / V0` matter (dP' = K/V0 (f(v) - C_f g(dP))),

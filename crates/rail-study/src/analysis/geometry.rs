@@ -1,4 +1,4 @@
-//! Wheel/rail contact geometry from profiles (issue 8 item 4), through crate `wheel-rail`:
+//! Wheel/rail contact geometry from profiles, through crate `wheel-rail`:
 //! the contact table in the bogie's CSV format, a detailed table, Δr(y), tanγ(y) and the
 //! EN 15302 equivalent conicity over amplitude.
 //!
