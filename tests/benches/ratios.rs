@@ -1,0 +1,425 @@
+//! The project's benchmark: every speed figure and ratio, measured in one run on this machine,
+//! with the load average beside each (speed is never asserted; tests do not time anything).
+//!
+//! 1. Each model alone, physics called directly, 1 ms communication steps: Bogie2Dof
+//!    non-linear on the internal irregular track, the damper and actuator cases, the
+//!    controller boards, RailVehicle non-linear.
+//! 2. The coupled passive system (`systems/passive.json`: Bogie2Dof + two PassiveYawDamper
+//!    FMUs from dist/, Gauss-Seidel, 1 ms) in our master, against the same physics stepped in
+//!    the same order in plain Rust (no FMI); both must end in the same state to rounding
+//!    (checked).
+//! 3. fmpy driving the same three FMUs in a Python loop, same order and step.
+//! 4. A run set of 4 runs of that system on 2 worker threads against 1.
+//! 5. The studies' wall time (`master study` on 2 cores), when `BENCH_STUDY` names the study
+//!    options (scripts/bench.sh sets it).
+//!
+//! `bash scripts/bench.sh` builds what it needs and runs this; it writes docs/BENCHMARKS.md.
+//! By hand: `cargo bench -p tests --bench ratios` (needs dist/).
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // benchmark code
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use fmu_bogie2dof::model::{Bogie, Inputs};
+use fmu_bogie2dof::params::{Params, PsdLevel, TrackSource};
+use fmu_bogie2dof::perf::ReferenceTrack;
+use fmu_damper::perf::DamperCase;
+use fmu_damper::semi_active::{SemiActiveDamper, SemiActiveInputs, SemiActiveParams};
+use master::coupling::RunOptions;
+use master::runset::{execute, run_job, RunSet};
+use master::system::{LoadedSystem, PreparedSystem};
+
+/// Simulated time of the coupled runs [s].
+const COUPLED_STOP_S: f64 = 10.0;
+const STEP_S: f64 = 1e-3;
+const REPEATS: usize = 5;
+/// Simulated time of fmpy's loop [s] (Python is slow; the figure is per simulated second).
+const FMPY_STOP_S: f64 = 2.0;
+
+fn repo() -> PathBuf {
+    std::path::absolute(Path::new(env!("CARGO_MANIFEST_DIR")).join("..")).unwrap()
+}
+
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "unknown".into())
+}
+
+/// CPU time (user + system) of this process [s], from /proc/self/stat.
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
+    rest.split_whitespace()
+        .skip(11)
+        .take(2)
+        .filter_map(|x| x.parse::<f64>().ok())
+        .sum::<f64>()
+        / 100.0
+}
+
+struct Report {
+    lines: Vec<String>,
+}
+
+impl Report {
+    fn line(&mut self, text: String) {
+        println!("{text}");
+        self.lines.push(text);
+    }
+}
+
+/// The passive system with its stop time replaced.
+fn passive_system(stop_s: f64) -> LoadedSystem {
+    let path = repo().join("systems/passive.json");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    v["stop_time"] = serde_json::json!(stop_s);
+    LoadedSystem::from_json_str(&v.to_string(), &repo().join("systems"), "passive.json").unwrap()
+}
+
+/// Master: best wall time of the simulation loop per simulated second (preparation, i.e.
+/// unpacking and loading the FMUs, not timed), and the final front wheelset displacement.
+fn master_passive() -> (f64, f64) {
+    let system = PreparedSystem::prepare(&passive_system(COUPLED_STOP_S)).unwrap();
+    let changes = system
+        .changes(&std::collections::BTreeMap::new(), None, "bench")
+        .unwrap();
+    let mut best = f64::INFINITY;
+    let mut last = f64::NAN;
+    for _ in 0..REPEATS {
+        let started = Instant::now();
+        let out = system.run(&changes, &RunOptions::default()).unwrap();
+        best = best.min(started.elapsed().as_secs_f64());
+        last = *out
+            .column("bogie.wheelset_front.lateral_displacement_relative")
+            .unwrap()
+            .last()
+            .unwrap();
+    }
+    (best / COUPLED_STOP_S, last)
+}
+
+/// The same physics, parameters, order and step without FMI; records the same 7 values per
+/// step as the system's record list.
+fn direct_passive() -> (f64, f64) {
+    let n = (COUPLED_STOP_S / STEP_S).round() as usize;
+    let mut best = f64::INFINITY;
+    let mut last = f64::NAN;
+    let mut rec: Vec<f64> = Vec::with_capacity((n + 1) * 8);
+    for _ in 0..REPEATS {
+        rec.clear();
+        let params = Params {
+            speed_mps: 83.333_333_333_333_33,
+            track: TrackSource::Internal {
+                level: PsdLevel::Low,
+                seed: 1,
+            },
+            initial_lateral_m: 0.0,
+            initial_yaw_rad: 0.0,
+            ..Params::default()
+        };
+        let started = Instant::now();
+        let mut bogie = Bogie::new(params).unwrap();
+        let mut left = SemiActiveDamper::new(SemiActiveParams::passive_reference()).unwrap();
+        let mut right = SemiActiveDamper::new(SemiActiveParams::passive_reference()).unwrap();
+        let mut inputs = Inputs::default();
+        let mut out = bogie.outputs(&inputs).unwrap();
+        for k in 0..n {
+            let _t = k as f64 * STEP_S;
+            out = bogie.step(STEP_S, &inputs).unwrap();
+            let l = left
+                .step(
+                    STEP_S,
+                    &SemiActiveInputs {
+                        elongation_m: out.damper_left_elongation_m,
+                        elongation_velocity_mps: out.damper_left_velocity_mps,
+                        ..SemiActiveInputs::default()
+                    },
+                )
+                .unwrap();
+            let r = right
+                .step(
+                    STEP_S,
+                    &SemiActiveInputs {
+                        elongation_m: out.damper_right_elongation_m,
+                        elongation_velocity_mps: out.damper_right_velocity_mps,
+                        ..SemiActiveInputs::default()
+                    },
+                )
+                .unwrap();
+            inputs.damper_left_force_n = l.force_n;
+            inputs.damper_right_force_n = r.force_n;
+            rec.extend_from_slice(&[
+                out.time_s,
+                out.wheelset_front_rel_track_m,
+                out.wheelset_rear_rel_track_m,
+                out.wheelset_front_acc_mps2,
+                out.wheelset_rear_acc_mps2,
+                out.guiding_force_front_n,
+                l.force_n,
+                r.force_n,
+            ]);
+        }
+        best = best.min(started.elapsed().as_secs_f64());
+        last = out.wheelset_front_rel_track_m;
+        std::hint::black_box(&rec);
+    }
+    (best / COUPLED_STOP_S, last)
+}
+
+fn python() -> Option<PathBuf> {
+    let p = std::env::var_os("RAIL_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join(".venv/bin/python"));
+    p.exists().then_some(p)
+}
+
+/// fmpy's loop over the passive system: wall per simulated second, or why not measured.
+fn fmpy_passive() -> Result<f64, String> {
+    let py = python().ok_or("no python with fmpy (set RAIL_PYTHON or create .venv)")?;
+    let out = Command::new(&py)
+        .arg(repo().join("tests/fmpy/bench_fmpy_system.py"))
+        .arg(repo().join("systems/passive.json"))
+        .arg(FMPY_STOP_S.to_string())
+        .arg("2")
+        .output()
+        .map_err(|e| format!("{}: {e}", py.display()))?;
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    if !out.status.success() {
+        return Err(format!(
+            "bench_fmpy_system.py failed: {text}{}",
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
+    text.lines()
+        .find_map(|l| l.strip_prefix("fmpy_wall_per_sim_s "))
+        .and_then(|x| x.trim().parse().ok())
+        .ok_or_else(|| format!("unexpected output: {text}"))
+}
+
+/// A run set of 4 speeds of the passive system on `threads` workers: (wall [s], CPU [s]).
+fn runset_wall(threads: usize) -> (f64, f64) {
+    let path = repo().join("systems/passive.json");
+    let mut base: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    base["stop_time"] = serde_json::json!(COUPLED_STOP_S);
+    let set = serde_json::json!({
+        "system": base,
+        "product": {"bogie.vehicle.speed": [69.4, 75.0, 80.6, 86.1]}
+    });
+    let (base, jobs) =
+        RunSet::from_str_with_base(&set.to_string(), &repo().join("systems"), "bench").unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    let started = Instant::now();
+    let cpu0 = cpu_seconds();
+    let system = PreparedSystem::prepare(&base).unwrap();
+    let reports = execute(&jobs, out.path(), threads, false, |job| {
+        run_job(&system, job, &cancel)
+    })
+    .unwrap();
+    let wall = started.elapsed().as_secs_f64();
+    assert!(reports.iter().all(|r| r.ok), "a run failed: {reports:?}");
+    (wall, cpu_seconds() - cpu0)
+}
+
+/// `master study OPTIONS` into a temporary folder: (wall [s], its last line).
+fn study_wall(options: &str) -> Result<(f64, String), String> {
+    let master = repo().join("target/release/master");
+    if !master.exists() {
+        return Err(format!("{} not built", master.display()));
+    }
+    let out = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let started = Instant::now();
+    let run = Command::new(&master)
+        .arg("--quiet")
+        .arg("study")
+        .args(options.split_whitespace())
+        .arg("--fmus")
+        .arg(repo().join("dist"))
+        .arg("--out")
+        .arg(out.path())
+        .output()
+        .map_err(|e| e.to_string())?;
+    let wall = started.elapsed().as_secs_f64();
+    if !run.status.success() {
+        return Err(String::from_utf8_lossy(&run.stderr).into_owned());
+    }
+    let text = String::from_utf8_lossy(&run.stdout);
+    Ok((wall, text.lines().last().unwrap_or("").to_string()))
+}
+
+fn main() {
+    if std::env::args().any(|a| a == "--list") {
+        return;
+    }
+    let dist = repo().join("dist");
+    if !dist.join("Bogie2Dof.fmu").exists() || !dist.join("PassiveYawDamper.fmu").exists() {
+        eprintln!("dist/ has no Bogie2Dof.fmu / PassiveYawDamper.fmu: run `bash scripts/bench.sh`");
+        std::process::exit(1);
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let mut r = Report { lines: Vec::new() };
+    r.line(format!(
+        "machine: {cores} cores; load average (1/5/15 min) at the start: {}",
+        load_average()
+    ));
+    r.line(String::new());
+    r.line("## Each model alone (physics called directly, 1 ms steps, one core)".into());
+    r.line(String::new());
+    r.line("| model | real-time factor | load average |".into());
+    r.line("|---|---|---|".into());
+    let rtf = fmu_bogie2dof::perf::realtime_factor(ReferenceTrack::InternalIrregular, 10.0, 5)
+        .unwrap();
+    r.line(format!(
+        "| Bogie2Dof non-linear, 320 km/h, internal irregular track (target >= 500) | {rtf:.0} x | {} |",
+        load_average()
+    ));
+    for case in DamperCase::ALL {
+        let ns = fmu_damper::perf::ns_per_step(case, 5000, 7).unwrap();
+        r.line(format!(
+            "| damper: {} | {:.0} x ({ns:.0} ns per step) | {} |",
+            case.name(),
+            1e6 / ns,
+            load_average()
+        ));
+    }
+    for case in fmu_controller::perf::ControllerCase::ALL {
+        let ns = fmu_controller::perf::ns_per_step(case, 5000, 7).unwrap();
+        r.line(format!(
+            "| controller: {} | {:.0} x ({ns:.0} ns per step) | {} |",
+            case.name(),
+            1e6 / ns,
+            load_average()
+        ));
+    }
+    let vehicle = vehicle_rtf();
+    r.line(format!(
+        "| RailVehicle non-linear, 300 km/h, high-level irregular track, 4 Maxwell dampers | {vehicle:.0} x | {} |",
+        load_average()
+    ));
+
+    r.line(String::new());
+    r.line(format!(
+        "## Coupled passive system (Bogie2Dof + 2 PassiveYawDamper, Gauss-Seidel, 1 ms, {COUPLED_STOP_S} s simulated, best of {REPEATS})"
+    ));
+    r.line(String::new());
+    let load = load_average();
+    let (t_direct, fin_direct) = direct_passive();
+    let (t_master, fin_master) = master_passive();
+    // The FMUs' binaries are built against glibc 2.17, whose libm may round exp/pow in the
+    // last bit differently from the build machine's: the two agree to rounding, not bit for bit.
+    let relative = (fin_direct - fin_master).abs() / fin_direct.abs().max(1e-9);
+    assert!(
+        relative <= 1e-6,
+        "direct {fin_direct} vs master {fin_master}: not the same computation"
+    );
+    r.line(format!(
+        "- our master: {:.0} x real time ({:.2} ms per simulated second; target >= 300 x)",
+        1.0 / t_master,
+        t_master * 1e3
+    ));
+    r.line(format!(
+        "- the same physics in plain Rust: {:.0} x real time ({:.2} ms per simulated second)",
+        1.0 / t_direct,
+        t_direct * 1e3
+    ));
+    r.line(format!(
+        "- ratio master / direct Rust: {:.2} (target <= 1.1); both end at the same state \
+         ({fin_master:.6e} m, relative difference {relative:.1e})",
+        t_master / t_direct
+    ));
+    match fmpy_passive() {
+        Ok(t_fmpy) => r.line(format!(
+            "- fmpy Python loop: {:.1} x real time; ratio fmpy / master: {:.1}",
+            1.0 / t_fmpy,
+            t_fmpy / t_master
+        )),
+        Err(why) => r.line(format!("- fmpy loop: not measured ({why})")),
+    }
+    r.line(format!(
+        "- load average before / after: {load} / {}",
+        load_average()
+    ));
+    let (w1, c1) = runset_wall(1);
+    let (w2, c2) = runset_wall(2);
+    r.line(format!(
+        "- run set of 4 runs of {COUPLED_STOP_S} s: --jobs 1 {w1:.2} s, --jobs 2 {w2:.2} s, speed-up {:.2} (cores used {:.2} / {:.2}; load {})",
+        w1 / w2,
+        c1 / w1,
+        c2 / w2,
+        load_average()
+    ));
+
+    if let Ok(studies) = std::env::var("BENCH_STUDY") {
+        r.line(String::new());
+        r.line("## Studies (the `master` binary, all cores)".into());
+        r.line(String::new());
+        for options in studies.split(';').filter(|s| !s.trim().is_empty()) {
+            let load = load_average();
+            match study_wall(options) {
+                Ok((wall, last)) => r.line(format!(
+                    "- `master study {}`: {wall:.1} s wall (load before {load}); {last}",
+                    options.trim()
+                )),
+                Err(why) => r.line(format!(
+                    "- `master study {}`: failed: {why}",
+                    options.trim()
+                )),
+            }
+        }
+    }
+
+    let mut md = String::from(
+        "# Benchmarks\n\nWritten by `bash scripts/bench.sh` (tests/benches/ratios.rs); every figure \
+         below comes from one run on one machine, with the load average beside it.\n\n",
+    );
+    for l in &r.lines {
+        let _ = writeln!(md, "{l}");
+    }
+    let path = std::env::var_os("BENCH_OUT")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join("target/BENCHMARKS.md"));
+    match std::fs::write(&path, md) {
+        Ok(()) => println!("written to {}", path.display()),
+        Err(e) => eprintln!("cannot write {}: {e}", path.display()),
+    }
+}
+
+/// RailVehicle non-linear at 300 km/h on high-level track with four Maxwell dampers, 1 ms:
+/// median real-time factor of 5 runs of 5 s from a vehicle that has run 2 s.
+fn vehicle_rtf() -> f64 {
+    use fmu_vehicle::calibration::{PASSIVE_MAXWELL_C_NS_PER_M, PASSIVE_MAXWELL_K_N_PER_M};
+    use fmu_vehicle::sim::{run_closed_loop, LoopDamper};
+    use fmu_vehicle::{ModelKind, Vehicle, VehicleParams};
+    let damper = LoopDamper::Maxwell {
+        k: PASSIVE_MAXWELL_K_N_PER_M,
+        c: PASSIVE_MAXWELL_C_NS_PER_M,
+    };
+    let p = VehicleParams {
+        speed_mps: 300.0 / 3.6,
+        model: ModelKind::NonLinear,
+        track: fmu_vehicle::TrackSource::Internal {
+            level: fmu_vehicle::PsdLevel::High,
+            seed: 1,
+        },
+        ..VehicleParams::default()
+    };
+    let mut warm = Vehicle::new(p).unwrap();
+    run_closed_loop(&mut warm, damper, STEP_S, 2.0, &|_| 0.0, &mut |_| {}).unwrap();
+    let mut f: Vec<f64> = (0..5)
+        .map(|_| {
+            let mut m = warm.clone();
+            let started = Instant::now();
+            run_closed_loop(&mut m, damper, STEP_S, 5.0, &|_| 0.0, &mut |_| {}).unwrap();
+            std::hint::black_box(m.state()[0]);
+            5.0 / started.elapsed().as_secs_f64()
+        })
+        .collect();
+    f.sort_by(f64::total_cmp);
+    f[2]
+}
