@@ -250,7 +250,10 @@ fn study_wall(options: &str) -> Result<(f64, String), String> {
         return Err(String::from_utf8_lossy(&run.stderr).into_owned());
     }
     let text = String::from_utf8_lossy(&run.stdout);
-    Ok((wall, text.lines().last().unwrap_or("").to_string()))
+    // the summary line without the temporary report path
+    let last = text.lines().last().unwrap_or("");
+    let last = last.split("; report:").next().unwrap_or(last);
+    Ok((wall, last.to_string()))
 }
 
 fn main() {
@@ -273,8 +276,8 @@ fn main() {
     r.line(String::new());
     r.line("| model | real-time factor | load average |".into());
     r.line("|---|---|---|".into());
-    let rtf = fmu_bogie2dof::perf::realtime_factor(ReferenceTrack::InternalIrregular, 10.0, 5)
-        .unwrap();
+    let rtf =
+        fmu_bogie2dof::perf::realtime_factor(ReferenceTrack::InternalIrregular, 10.0, 5).unwrap();
     r.line(format!(
         "| Bogie2Dof non-linear, 320 km/h, internal irregular track (target >= 500) | {rtf:.0} x | {} |",
         load_average()
