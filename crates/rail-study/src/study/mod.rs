@@ -1,4 +1,4 @@
-//! The stability study of the seed's chapter 4 (issue 7): passive, semi-active (MPPT1/2,
+//! The stability study of the seed's chapter 4: passive, semi-active (MPPT1/2,
 //! sky-hook on/off and continuous, each with an ideal and a slow valve) and full-active (IDF)
 //! yaw dampers on the non-linear 2-dof bogie, assessed by the EN 14363 rms criterion.
 //!
