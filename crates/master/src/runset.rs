@@ -51,16 +51,16 @@ pub struct RunSpec {
     pub parameters: BTreeMap<String, Value>,
 }
 
-/// One self-contained run.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+/// One self-contained run (serialisable both ways: a job can be sent to another process).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Job {
     pub name: String,
     pub parameters: BTreeMap<String, Value>,
     pub system: SystemDescription,
 }
 
-/// Outcome of one job.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+/// Outcome of one job (also each run's `summary.json`, which reads back into it).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RunReport {
     pub name: String,
     pub parameters: BTreeMap<String, Value>,
@@ -308,7 +308,11 @@ where
     Ok(reports)
 }
 
-fn run_one<F>(job: &Job, outdir: &Path, runner: &F) -> RunReport
+/// Runs one job with `runner` and writes its folder `<outdir>/<job>/`: `system.json` first,
+/// then `results.csv` and last `summary.json` (each atomically), so a run whose
+/// `summary.json` says ok has all its files. A runner may also hand over results computed
+/// elsewhere (another process or machine).
+pub fn run_one<F>(job: &Job, outdir: &Path, runner: &F) -> RunReport
 where
     F: Fn(&Job) -> Result<SimOutput, String>,
 {
