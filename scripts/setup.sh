@@ -30,6 +30,14 @@ if ! "$VENV/bin/python" -c "import pythonfmu" 2>/dev/null; then
   "$VENV/bin/pip" install -q "pythonfmu==0.7.0" >/dev/null
 fi
 
+# The Python package railfmu (python/): maturin builds its wheel from the binding crate; pandas,
+# dask.distributed, tqdm and pytest are what it and its tests use.
+if ! "$VENV/bin/python" -c "import maturin, pandas, distributed, tqdm, pytest" 2>/dev/null; then
+  step "installing maturin, pandas, dask.distributed, tqdm, pytest into $VENV"
+  "$VENV/bin/pip" install -q "maturin==1.16.0" "pandas==3.1.1" "dask==2026.8.0" "distributed==2026.8.0" \
+    "tqdm==4.67.1" "pytest==9.2.0" >/dev/null
+fi
+
 # Portable Linux binaries: cargo-zigbuild builds the FMUs against glibc 2.17 (manylinux2014)
 # with zig as C compiler and linker. Both are pinned: cargo-zigbuild from crates.io into
 # target/tools/bin (where package-fmus looks first), zig from PyPI's ziglang package in the venv,
@@ -51,4 +59,15 @@ export CARGO_ZIGBUILD_PYTHON_PATH="$VENV/bin/python"
 # Builds the FMU libraries with cargo-zigbuild (glibc 2.17) and writes dist/*.fmu.
 package_fmus() {
   cargo run --release -q -p model-description --bin package-fmus
+}
+
+# pyo3 (python/) builds against the venv's interpreter, the same for maturin and clippy.
+export PYO3_PYTHON="$VENV/bin/python"
+
+# Builds the railfmu wheel (python/, maturin, release) into target/wheels and installs it into
+# the venv.
+python_package() {
+  rm -f target/wheels/railfmu-*.whl
+  "$VENV/bin/maturin" build --release --quiet -m python/Cargo.toml -i "$VENV/bin/python" -o target/wheels
+  "$VENV/bin/pip" install -q --force-reinstall --no-deps target/wheels/railfmu-*.whl
 }

@@ -71,6 +71,14 @@ cargo test --release --workspace
 # The glue's no-allocation test calls the exported C functions in-process (feature fmi-export).
 cargo test --release -p fmu-examples --features fmi-export
 
+step "Python package railfmu: wheel built with maturin into target/wheels, installed into the venv, pytest"
+# The binding crate is a workspace member whose pyo3 module is behind its feature `python`
+# (maturin sets it), so the workspace builds and lints without Python; lint the module here.
+cargo clippy -q -p railfmu-python --features python --all-targets -- -D warnings
+cargo build --release -q -p rail-study --bin master
+python_package
+"$VENV/bin/python" -m pytest -q python/tests
+
 step "reproducible packaging: the same build gives the same .fmu bytes"
 sha256sum dist/*.fmu > target/fmu.sha256
 cargo run --release -q -p model-description --bin package-fmus -- --no-build >/dev/null

@@ -1,0 +1,34 @@
+"""railfmu: the co-simulation master from Python.
+
+Load a system of FMI 2.0 co-simulation FMUs (the master's JSON system description), set start
+values, run it, and get the results as NumPy or pandas with their units; run a run set (a base
+system plus parameter variations) on local threads or on a Dask cluster; read result folders
+back. Every run is the master's own (the same Rust code as the ``master`` command, bit for bit);
+the GIL is released while FMUs run. Errors are exceptions carrying the master's messages.
+
+>>> import railfmu
+>>> sys = railfmu.System.load("systems/passive.json")
+>>> df = sys.run({"bogie.vehicle.speed": 70.0}, stop_time=2.0).to_pandas()
+>>> df.attrs["units"]["bogie.wheelset_front.lateral_displacement_relative"]
+'m'
+"""
+
+from ._railfmu import Error, FmuError, OutputError, SimulationError, SystemDescriptionError
+from ._results import Results, RunSetResults, read_results, split_label
+from ._runset import RunSet, run_set
+from ._system import System
+
+__all__ = [
+    "Error",
+    "FmuError",
+    "OutputError",
+    "Results",
+    "RunSet",
+    "RunSetResults",
+    "SimulationError",
+    "System",
+    "SystemDescriptionError",
+    "read_results",
+    "run_set",
+    "split_label",
+]

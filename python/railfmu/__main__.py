@@ -1,0 +1,74 @@
+"""``python -m railfmu`` (also the ``railfmu`` command): run sets from the command line, on
+local threads or on a Dask cluster.
+
+    railfmu sweep RUNSET.json -o OUTDIR [--jobs N] [--dask-scheduler ADDRESS] [--resume]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import List, Optional
+
+from . import Error, RunSet
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    rs = RunSet.load(args.runset)
+    client = None
+    if args.dask_scheduler:
+        from distributed import Client
+
+        client = Client(args.dask_scheduler)
+    try:
+        res = rs.run(
+            args.output,
+            threads=args.jobs,
+            client=client,
+            progress=not args.quiet and sys.stderr.isatty(),
+            resume=args.resume,
+            ship_fmus=not args.shared_fmus,
+        )
+    finally:
+        if client is not None:
+            client.close()
+    for r in res.reports:
+        if r["ok"]:
+            s = r["summary"]
+            print(f"{r['name']}: ok, {s['steps']} steps, {s['wall_time_s']:.3f} s wall time")
+        else:
+            print(f"{r['name']}: FAILED: {r['error']}")
+    ok = sum(1 for r in res.reports if r["ok"])
+    print(f"{ok} of {len(res.reports)} runs ok; see {res.folder / 'sweep.json'}")
+    if res.failed:
+        print(f"error: {len(res.failed)} run(s) failed: {', '.join(res.failed)}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    p = argparse.ArgumentParser(prog="railfmu", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True)
+    s = sub.add_parser("sweep", help="run a run set (parameter variations) into a run-set folder")
+    s.add_argument("runset", help="run-set description (JSON)")
+    s.add_argument("-o", "--output", default="sweep-out", help="output folder (default: sweep-out)")
+    s.add_argument("-j", "--jobs", type=int, default=None, help="local threads (default: all cores)")
+    s.add_argument("--dask-scheduler", metavar="ADDRESS", help="run on this Dask scheduler (e.g. tcp://host:8786)")
+    s.add_argument("--resume", action="store_true", help="keep runs already complete in the output folder")
+    s.add_argument(
+        "--shared-fmus", action="store_true", help="workers read the FMUs from their paths (shared file system) instead of receiving copies"
+    )
+    s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    args = p.parse_args(argv)
+    try:
+        return _sweep(args)
+    except Error as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,138 @@
+"""Run sets: a base system plus parameter variations (the master's run-set JSON), run on local
+threads or as Dask tasks, into the master's run-set folder."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any, Callable, Dict, List, Mapping, Optional, Union
+
+from . import _railfmu
+from ._progress import bar
+from ._results import RunSetResults
+
+PathLike = Union[str, "os.PathLike[str]"]
+DoneCallback = Callable[[int, int, str, Optional[str]], Any]
+
+
+class RunSet:
+    """A run set expanded into self-contained jobs: each job is its name, its parameters and
+    its resolved system description (FMU paths absolute), exactly as ``master sweep`` runs it.
+
+    >>> rs = RunSet.load("study/speeds.json")
+    >>> [j["name"] for j in rs.jobs]
+    """
+
+    def __init__(self, base_json: str, label: str, jobs_json: List[str]):
+        self._base_json = base_json
+        self._label = label
+        self._jobs_json = list(jobs_json)
+        self._names = [json.loads(j)["name"] for j in self._jobs_json]
+
+    @classmethod
+    def load(cls, path: PathLike) -> "RunSet":
+        """Reads a run-set file (``base`` or inline ``system``, ``product``, ``runs``)."""
+        return cls(*_railfmu.load_run_set(os.fspath(path)))
+
+    @classmethod
+    def from_dict(cls, runset: Mapping[str, Any], base_dir: PathLike = ".", label: str = "<dict>") -> "RunSet":
+        """A run set given as a dict; paths relative to ``base_dir``."""
+        return cls(*_railfmu.run_set_from_json(json.dumps(runset), os.fspath(base_dir), label))
+
+    @property
+    def base(self) -> Dict[str, Any]:
+        """The base system description (FMU paths absolute)."""
+        return json.loads(self._base_json)
+
+    @property
+    def jobs(self) -> List[Dict[str, Any]]:
+        """Each job: ``name``, ``parameters`` (``instance.variable`` -> value), ``system``."""
+        return [json.loads(j) for j in self._jobs_json]
+
+    @property
+    def names(self) -> List[str]:
+        """The run names (also their folder names), in job order."""
+        return list(self._names)
+
+    def __len__(self) -> int:
+        return len(self._jobs_json)
+
+    def __repr__(self) -> str:
+        return f"<RunSet {self._label}: {len(self)} runs>"
+
+    def run(
+        self,
+        output_dir: PathLike,
+        *,
+        threads: Optional[int] = None,
+        client: Any = None,
+        progress: Union[None, bool, DoneCallback] = None,
+        resume: bool = False,
+        ship_fmus: bool = True,
+        retries: int = 3,
+    ) -> RunSetResults:
+        """Runs every job and writes the run-set folder: ``<output_dir>/<run>/`` with
+        ``system.json``, ``results.csv`` and ``summary.json``, and ``<output_dir>/sweep.json``
+        with every run's report in job order. A failed run is reported in its own summary and
+        the others go on.
+
+        * ``client=None``: on ``threads`` local threads (default: all cores), the GIL released.
+        * ``client=dask.distributed.Client(...)``: one Dask task per run (see
+          :mod:`railfmu.dask`); the results come back to this process, which writes the folder.
+        * ``resume=True``: runs already complete in ``output_dir`` (ok, results present, same
+          resolved system) are kept and not run again.
+        * ``progress``: True for a bar, or ``f(done, total, run_name, error_or_None)``.
+        """
+        out = Path(output_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        reports: List[Optional[str]] = [None] * len(self)
+        if resume:
+            for i, j in enumerate(self._jobs_json):
+                reports[i] = _railfmu.completed_report(os.fspath(out), j)
+        todo = [i for i, r in enumerate(reports) if r is None]
+        total, done = len(self), len(self) - len(todo)
+        with bar(progress, "runs") as cb:
+            if cb is not None and done:
+                cb(done, total, "", None)
+
+            def on_done(name: str, error: Optional[str]) -> None:
+                nonlocal done
+                done += 1
+                if cb is not None:
+                    cb(done, total, name, error)
+
+            if todo:
+                jobs = [self._jobs_json[i] for i in todo]
+                if client is None:
+                    system = _railfmu.PreparedSystem.from_json(self._base_json, "", self._label)
+                    threads = threads or os.cpu_count() or 1
+                    new = system.run_jobs(jobs, os.fspath(out), threads, on_done)
+                else:
+                    from .dask import run_jobs_on_cluster
+
+                    new = run_jobs_on_cluster(
+                        client, self._base_json, self._label, jobs, out, on_done, ship_fmus=ship_fmus, retries=retries
+                    )
+                for i, r in zip(todo, new):
+                    reports[i] = r
+        final = [r for r in reports if r is not None]
+        _railfmu.write_sweep(os.fspath(out), final)
+        return RunSetResults(out, [json.loads(r) for r in final])
+
+
+def run_set(
+    runset: Union[PathLike, Mapping[str, Any], RunSet],
+    output_dir: PathLike,
+    **options: Any,
+) -> RunSetResults:
+    """Loads a run set (a file, a dict or a :class:`RunSet`) and runs it (see
+    :meth:`RunSet.run` for the options: threads, client, progress, resume, ship_fmus,
+    retries)."""
+    if isinstance(runset, RunSet):
+        rs = runset
+    elif isinstance(runset, Mapping):
+        rs = RunSet.from_dict(runset)
+    else:
+        rs = RunSet.load(runset)
+    return rs.run(output_dir, **options)

@@ -1,0 +1,149 @@
+"""A system of coupled FMUs, prepared once, run many times."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any, Callable, Dict, List, Mapping, Optional, Union
+
+from . import _railfmu
+from ._results import Results
+
+PathLike = Union[str, "os.PathLike[str]"]
+Value = Union[bool, int, float, str]
+ProgressArg = Union[None, bool, Callable[[int, int], Any]]
+
+
+def _plain(value: Any) -> Any:
+    """NumPy scalars as the Python bool/int/float they stand for."""
+    try:
+        import numpy as np
+    except ImportError:  # pragma: no cover
+        return value
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return float(value)
+    return value
+
+
+def _plain_dict(parameters: Optional[Mapping[str, Any]]) -> Dict[str, Any]:
+    return {k: _plain(v) for k, v in (parameters or {}).items()}
+
+
+class System:
+    """A system description (JSON: FMU instances, parameters, connections, timing, coupling,
+    recording) with its FMUs opened, checked, unpacked and loaded once.
+
+    Start values set here (:meth:`set_parameter`) and the stop time apply to every later
+    :meth:`run`; each run instantiates its own FMU instances, so runs never see each other's
+    state. Invalid names or values raise :class:`SystemDescriptionError` at once, with the
+    master's message.
+
+    >>> sys = System.load("systems/passive.json")
+    >>> sys.set_parameter("bogie.vehicle.speed", 70.0)
+    >>> df = sys.run(stop_time=2.0).to_pandas()
+    """
+
+    def __init__(self, prepared: "_railfmu.PreparedSystem"):
+        self._prepared = prepared
+        self._parameters: Dict[str, Value] = {}
+        self._stop_time: Optional[float] = None
+
+    @classmethod
+    def load(cls, path: PathLike) -> "System":
+        """Loads a system description file (FMU paths relative to its folder)."""
+        return cls(_railfmu.PreparedSystem.load(os.fspath(path)))
+
+    @classmethod
+    def from_dict(cls, description: Mapping[str, Any], base_dir: PathLike = ".", label: str = "<dict>") -> "System":
+        """A system from a description given as a dict (FMU paths relative to ``base_dir``)."""
+        return cls(_railfmu.PreparedSystem.from_json(json.dumps(description), os.fspath(base_dir), label))
+
+    @property
+    def file(self) -> str:
+        """The description's file (or label), as named in messages."""
+        return self._prepared.file
+
+    @property
+    def description(self) -> Dict[str, Any]:
+        """The description as loaded, FMU paths absolute (without this object's changes)."""
+        return json.loads(self._prepared.description_json())
+
+    @property
+    def instances(self) -> List[str]:
+        """Instance names in declaration order."""
+        return [i["name"] for i in self.description["instances"]]
+
+    @property
+    def columns(self) -> List[str]:
+        """The header of a run's results: ``time [s]``, then ``instance.variable [unit]``."""
+        return self._prepared.header()
+
+    def variables(self, instance: str) -> List[Dict[str, Any]]:
+        """The variables of one instance's FMU (name, causality, variability, type, unit,
+        start, description, ...), from its modelDescription.xml."""
+        names = self.instances
+        if instance not in names:
+            raise KeyError(f"no instance '{instance}' (instances: {', '.join(names)})")
+        models = json.loads(self._prepared.models_json())
+        return list(models[names.index(instance)]["variables"])
+
+    @property
+    def parameters(self) -> Dict[str, Value]:
+        """The start values set on this object (``instance.variable`` -> value), a copy."""
+        return dict(self._parameters)
+
+    def set_parameter(self, name: str, value: Value) -> None:
+        """Sets the start value of ``instance.variable`` for later runs; checked against the
+        FMU's model description at once (name, type, range as the master checks them)."""
+        self.set_parameters({name: value})
+
+    def set_parameters(self, parameters: Mapping[str, Value]) -> None:
+        """Sets several start values (see :meth:`set_parameter`); all or none."""
+        merged = {**self._parameters, **_plain_dict(parameters)}
+        self._prepared.check(merged, self._stop_time)
+        self._parameters = merged
+
+    @property
+    def stop_time(self) -> float:
+        """Stop time [s] of later runs (the description's unless set)."""
+        return self._stop_time if self._stop_time is not None else float(self.description["stop_time"])
+
+    @stop_time.setter
+    def stop_time(self, value: Optional[float]) -> None:
+        if value is not None:
+            self._prepared.check(self._parameters, float(value))
+        self._stop_time = None if value is None else float(value)
+
+    def run(
+        self,
+        parameters: Optional[Mapping[str, Value]] = None,
+        stop_time: Optional[float] = None,
+        progress: ProgressArg = None,
+    ) -> Results:
+        """Runs the system once and returns its :class:`Results`.
+
+        ``parameters`` and ``stop_time`` apply to this run only, on top of those set on the
+        object. The GIL is released while the FMUs run, so other Python threads go on.
+        ``progress``: True for a progress bar (tqdm when installed), or a callable
+        ``f(steps_done, steps_total)``. Ctrl-C stops the run at its next communication point
+        and raises KeyboardInterrupt.
+
+        Raises :class:`SystemDescriptionError` for an invalid name or value,
+        :class:`FmuError` when an FMU cannot be instantiated, :class:`SimulationError` when
+        the simulation fails.
+        """
+        merged = {**self._parameters, **_plain_dict(parameters)}
+        stop = float(stop_time) if stop_time is not None else self._stop_time
+        from ._progress import bar
+
+        with bar(progress, "steps") as cb:
+            header, data, summary = self._prepared.run(merged, stop, cb)
+        return Results._from_bytes(header, data, json.loads(summary))
+
+    def __repr__(self) -> str:
+        return f"<System {self.file}: {', '.join(self.instances)}>"

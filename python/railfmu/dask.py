@@ -1,0 +1,161 @@
+"""Run sets on a Dask cluster (``dask.distributed``): one task per run.
+
+Each task is self-contained: the base system's resolved description and one job (its name,
+parameters and resolved system) go in, the run's table (or its error) comes out. The client
+writes the run's folder with the master's own writer, so a run-set folder made on a cluster is
+the one ``master sweep`` makes, value for value, and the workers need no access to the output
+folder.
+
+FMUs reach the workers in one of two ways:
+
+* ``ship_fmus=True`` (default): the client reads each FMU file once, scatters its bytes to every
+  worker (``Client.scatter(..., broadcast=True)``, once per run set, not once per task) and each
+  worker keeps a copy under its temporary folder, named by the file's SHA-256. This works on any
+  deployment (LocalCluster, dask-jobqueue on Slurm/PBS, cloud clusters) without a shared file
+  system, and the workers run exactly the bytes the client has.
+* ``ship_fmus=False``: the workers open the FMU paths of the description as they are (absolute
+  paths on the client). Use it when all nodes see the FMUs on one shared file system (typical on
+  HPC): nothing is copied.
+
+A worker prepares a system (unpacks and loads its FMUs) once and keeps it for the later tasks of
+the same run set. A simulation that fails is the run's result (its error is kept in its
+``summary.json``), not a task failure; a task whose worker dies is run again by Dask
+(``retries``, and Dask's own rescheduling of a lost worker's tasks).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+import threading
+import uuid
+from pathlib import Path
+from typing import Any, Callable, Dict, List, Optional, Tuple
+
+from . import _railfmu
+
+_PREPARED: Dict[str, "_railfmu.PreparedSystem"] = {}
+_PREPARED_LOCK = threading.Lock()
+_KEEP_PREPARED = 4
+
+
+def _fmu_cache_dir() -> Path:
+    return Path(tempfile.gettempdir()) / f"railfmu-fmus-{os.getuid() if hasattr(os, 'getuid') else 'user'}"
+
+
+def _local_copy(digest: str, name: str, data: bytes) -> str:
+    """Path of this worker's copy of an FMU (written once, atomically)."""
+    folder = _fmu_cache_dir() / digest[:32]
+    path = folder / name
+    if path.is_file() and path.stat().st_size == len(data):
+        return str(path)
+    if hashlib.sha256(data).hexdigest() != digest:
+        raise RuntimeError(f"FMU '{name}' arrived damaged (SHA-256 differs)")
+    folder.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".tmp-")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return str(path)
+
+
+def _localise(description: Dict[str, Any], paths: Dict[str, str]) -> Dict[str, Any]:
+    d = dict(description)
+    d["instances"] = [dict(i, fmu=paths.get(i["fmu"], i["fmu"])) for i in d["instances"]]
+    return d
+
+
+def _prepared(base_json: str, label: str) -> "_railfmu.PreparedSystem":
+    with _PREPARED_LOCK:
+        system = _PREPARED.get(base_json)
+        if system is None:
+            system = _railfmu.PreparedSystem.from_json(base_json, "", label)
+            if len(_PREPARED) >= _KEEP_PREPARED:
+                _PREPARED.pop(next(iter(_PREPARED)))
+            _PREPARED[base_json] = system
+        return system
+
+
+def run_task(base_json: str, label: str, job_json: str, fmus: Optional[Dict[str, Tuple[str, str, bytes]]] = None) -> Dict[str, Any]:
+    """The task a worker runs: one job of a run set. ``fmus`` maps each FMU path of the
+    description to (SHA-256, file name, bytes) when the FMUs are shipped. Returns the run's
+    ``header``, ``data`` (float64 bytes) and ``summary_json``, or its ``error``."""
+    if fmus:
+        paths = {p: _local_copy(digest, name, data) for p, (digest, name, data) in fmus.items()}
+        base_json = json.dumps(_localise(json.loads(base_json), paths))
+        job = json.loads(job_json)
+        job["system"] = _localise(job["system"], paths)
+        job_json = json.dumps(job)
+    header, data, summary_json, error = _prepared(base_json, label).run_job(job_json)
+    return {"header": header, "data": data, "summary_json": summary_json, "error": error}
+
+
+def _read_fmus(base_json: str) -> Dict[str, Tuple[str, str, bytes]]:
+    out: Dict[str, Tuple[str, str, bytes]] = {}
+    for inst in json.loads(base_json)["instances"]:
+        p = inst["fmu"]
+        if p in out:
+            continue
+        try:
+            data = Path(p).read_bytes()
+        except OSError as e:
+            raise _railfmu.FmuError(f"cannot read '{p}': {e}") from None
+        out[p] = (hashlib.sha256(data).hexdigest(), Path(p).name, data)
+    return out
+
+
+def run_jobs_on_cluster(
+    client: Any,
+    base_json: str,
+    label: str,
+    jobs_json: List[str],
+    outdir: Path,
+    on_done: Callable[[str, Optional[str]], Any],
+    *,
+    ship_fmus: bool = True,
+    retries: int = 3,
+) -> List[str]:
+    """Submits one task per job to ``client``, writes each run's folder as its result arrives
+    and returns the reports (JSON) in job order. A task that raises (even after its retries,
+    e.g. every worker running it died) gives a failed run carrying the exception's message."""
+    from distributed import as_completed
+
+    fmus_arg: Any = None
+    if ship_fmus:
+        fmus = _read_fmus(base_json)
+        scattered = client.scatter({f"railfmu-fmu-{v[0]}": v[2] for v in fmus.values()}, broadcast=True)
+        fmus_arg = {p: (digest, name, scattered[f"railfmu-fmu-{digest}"]) for p, (digest, name, _) in fmus.items()}
+    # keys unique per submission: a key resubmitted while the scheduler still releases it from
+    # an earlier set would be cancelled
+    token = uuid.uuid4().hex[:16]
+    futures = {}
+    for i, job_json in enumerate(jobs_json):
+        name = json.loads(job_json)["name"]
+        fut = client.submit(
+            run_task, base_json, label, job_json, fmus_arg, key=f"railfmu-{name}-{token}", retries=retries, pure=False
+        )
+        futures[fut] = (i, name, job_json)
+    reports: List[Optional[str]] = [None] * len(jobs_json)
+    try:
+        for fut in as_completed(list(futures)):
+            i, name, job_json = futures[fut]
+            try:
+                r = fut.result()
+                report = _railfmu.write_run(os.fspath(outdir), job_json, r["header"], r["data"], r["summary_json"], r["error"])
+                error = r["error"]
+            except Exception as e:  # the task failed: the run's error, the set goes on
+                error = f"run '{name}' failed on the cluster: {type(e).__name__}: {e}"
+                report = _railfmu.write_run(os.fspath(outdir), job_json, error=error)
+            reports[i] = report
+            on_done(name, error)
+    finally:
+        for fut in futures:
+            fut.cancel()
+    return [r for r in reports if r is not None]

@@ -1,0 +1,535 @@
+//! The pyo3 layer: classes and functions of `railfmu._railfmu`. Data crosses as JSON text
+//! (system descriptions, jobs, reports: the master's own serde formats) and as native-endian
+//! `f64` bytes (result tables, read by NumPy without a copy per value). Every run happens on a
+//! thread of its own with the GIL released; the calling thread waits for it with the GIL
+//! released too, waking every 50 ms to deliver progress to Python and to check for Ctrl-C
+//! (which cancels the run at its next communication point and raises `KeyboardInterrupt`).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, RecvTimeoutError, Sender};
+use std::sync::Mutex;
+use std::time::Duration;
+
+use pyo3::exceptions::{PyException, PyTypeError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyString};
+use serde_json::Value;
+
+use master::coupling::{RunOptions, SimError, SimOutput, Summary};
+use master::output::write_csv_atomic;
+use master::runset::{execute, run_job, Job, RunReport, RunSet, SweepError};
+use master::system::{LoadedSystem, PreparedSystem, RunError, SystemError};
+
+use crate::{error_message, f64_bytes, f64_from_bytes, results, runs};
+
+pyo3::create_exception!(
+    _railfmu,
+    Error,
+    PyException,
+    "Base class of every error of railfmu; the message is the master's."
+);
+pyo3::create_exception!(
+    _railfmu,
+    SystemDescriptionError,
+    Error,
+    "A system or run-set description, a parameter name or a parameter value is invalid."
+);
+pyo3::create_exception!(
+    _railfmu,
+    FmuError,
+    Error,
+    "An FMU cannot be opened, checked, loaded or instantiated."
+);
+pyo3::create_exception!(
+    _railfmu,
+    SimulationError,
+    Error,
+    "A simulation stopped: an FMU failed or discarded a step, or a value is not finite."
+);
+pyo3::create_exception!(
+    _railfmu,
+    OutputError,
+    Error,
+    "A result file or folder cannot be written or read."
+);
+
+fn system_err(e: &SystemError) -> PyErr {
+    match e {
+        SystemError::Fmu { .. } => FmuError::new_err(error_message(e)),
+        _ => SystemDescriptionError::new_err(error_message(e)),
+    }
+}
+
+fn run_err(e: &RunError) -> PyErr {
+    match e {
+        RunError::System(s) => system_err(s),
+        RunError::Fmu(_) => FmuError::new_err(error_message(e)),
+        RunError::Sim(SimError::Cancelled { .. }) => {
+            pyo3::exceptions::PyKeyboardInterrupt::new_err(error_message(e))
+        }
+        RunError::Sim(_) => SimulationError::new_err(error_message(e)),
+        RunError::Output(_) => OutputError::new_err(error_message(e)),
+    }
+}
+
+fn sweep_err(e: &SweepError) -> PyErr {
+    match e {
+        SweepError::System(s) => system_err(s),
+        SweepError::Output(_) | SweepError::Dir { .. } => OutputError::new_err(error_message(e)),
+        SweepError::Pool { .. } => Error::new_err(error_message(e)),
+    }
+}
+
+fn json_err(what: &str, e: &serde_json::Error) -> PyErr {
+    SystemDescriptionError::new_err(format!("{what}: {e}"))
+}
+
+/// A Python value as the JSON value a system description would hold.
+fn json_value(key: &str, ob: &Bound<'_, PyAny>) -> PyResult<Value> {
+    if ob.is_instance_of::<PyBool>() {
+        return Ok(Value::Bool(ob.extract::<bool>()?));
+    }
+    if ob.is_instance_of::<PyInt>() {
+        return match ob.extract::<i64>() {
+            Ok(i) => Ok(Value::from(i)),
+            Err(_) => Err(SystemDescriptionError::new_err(format!(
+                "{key}: {ob} is not a 64-bit integer"
+            ))),
+        };
+    }
+    if ob.is_instance_of::<PyFloat>() {
+        let x: f64 = ob.extract()?;
+        return serde_json::Number::from_f64(x)
+            .map(Value::Number)
+            .ok_or_else(|| {
+                SystemDescriptionError::new_err(format!("{key}: {x} is not a finite number"))
+            });
+    }
+    if ob.is_instance_of::<PyString>() {
+        return Ok(Value::String(ob.extract()?));
+    }
+    let ty = ob.get_type().name()?;
+    Err(PyTypeError::new_err(format!(
+        "{key}: a start value is a bool, int, float or str, not {ty}"
+    )))
+}
+
+/// `{"instance.variable": value}` from a Python dict.
+fn json_parameters(parameters: Option<&Bound<'_, PyDict>>) -> PyResult<BTreeMap<String, Value>> {
+    let mut out = BTreeMap::new();
+    if let Some(d) = parameters {
+        for (k, v) in d.iter() {
+            let key: String = k.extract().map_err(|_| {
+                PyTypeError::new_err(format!("parameter names are str, not {}", k.get_type()))
+            })?;
+            let value = json_value(&key, &v)?;
+            out.insert(key, value);
+        }
+    }
+    Ok(out)
+}
+
+/// What a background run tells the waiting Python thread.
+enum Event {
+    /// (macro steps done, total) of a single run.
+    Steps(u64, u64),
+    /// A run of a set finished: its name and its error, if it failed.
+    Done(String, Option<String>),
+}
+
+/// Runs `work` on a scoped thread while this thread waits with the GIL released, handing each
+/// event to `on_event` (with the GIL) and checking for signals. An exception of `on_event` or a
+/// signal (Ctrl-C) sets `cancel`, waits for `work` to stop and is raised.
+fn in_background<'s, T: Send>(
+    py: Python<'_>,
+    cancel: &'s AtomicBool,
+    work: impl FnOnce(&Sender<Event>) -> T + Send + 's,
+    mut on_event: impl FnMut(Python<'_>, Event) -> PyResult<()>,
+) -> PyResult<T> {
+    let (tx, rx) = mpsc::channel::<Event>();
+    let rx = Mutex::new(rx);
+    std::thread::scope(|s| {
+        let handle = s.spawn(move || work(&tx));
+        let mut failure: Option<PyErr> = None;
+        loop {
+            let got = py.detach(|| {
+                rx.lock()
+                    .map(|r| r.recv_timeout(Duration::from_millis(50)))
+                    .unwrap_or(Err(RecvTimeoutError::Disconnected))
+            });
+            match got {
+                Ok(ev) => {
+                    if failure.is_none() {
+                        if let Err(e) = on_event(py, ev) {
+                            cancel.store(true, Ordering::SeqCst);
+                            failure = Some(e);
+                        }
+                    }
+                }
+                Err(RecvTimeoutError::Timeout) => {}
+                Err(RecvTimeoutError::Disconnected) => break,
+            }
+            if failure.is_none() {
+                if let Err(e) = py.check_signals() {
+                    cancel.store(true, Ordering::SeqCst);
+                    failure = Some(e);
+                }
+            }
+        }
+        let joined = py.detach(move || handle.join());
+        match (failure, joined) {
+            (Some(e), _) => Err(e),
+            (None, Ok(v)) => Ok(v),
+            (None, Err(_)) => Err(Error::new_err("internal: the run thread panicked")),
+        }
+    })
+}
+
+/// Results as (header, data bytes, summary JSON).
+type Table<'py> = (Vec<String>, Bound<'py, PyBytes>, String);
+
+fn table<'py>(py: Python<'py>, out: &SimOutput) -> PyResult<Table<'py>> {
+    let summary = serde_json::to_string(&out.summary)
+        .map_err(|e| Error::new_err(format!("internal: summary: {e}")))?;
+    Ok((
+        out.header.clone(),
+        PyBytes::new(py, &f64_bytes(&out.data)),
+        summary,
+    ))
+}
+
+/// A system description with its FMUs opened, checked, unpacked and loaded once, and its
+/// coupling plan built: many runs of it cost only their simulation. Immutable and shared by
+/// threads.
+#[pyclass(frozen, module = "railfmu._railfmu", name = "PreparedSystem")]
+pub struct PySystem {
+    prepared: PreparedSystem,
+    models_json: String,
+}
+
+impl PySystem {
+    fn prepare(py: Python<'_>, system: LoadedSystem) -> PyResult<Self> {
+        let prepared = py
+            .detach(|| PreparedSystem::prepare(&system))
+            .map_err(|e| run_err(&e))?;
+        let archives = system.open_fmus().map_err(|e| system_err(&e))?;
+        let models: Vec<_> = archives.iter().map(|a| &a.model).collect();
+        let models_json = serde_json::to_string(&models)
+            .map_err(|e| Error::new_err(format!("internal: model descriptions: {e}")))?;
+        Ok(PySystem {
+            prepared,
+            models_json,
+        })
+    }
+}
+
+#[pymethods]
+impl PySystem {
+    /// Loads a system description (JSON file; FMU paths relative to its folder) and prepares it.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let system = LoadedSystem::load(&path).map_err(|e| system_err(&e))?;
+        Self::prepare(py, system)
+    }
+
+    /// Parses JSON text (FMU paths relative to `base_dir`; `label` names it in messages).
+    #[staticmethod]
+    fn from_json(py: Python<'_>, text: &str, base_dir: PathBuf, label: &str) -> PyResult<Self> {
+        let system =
+            LoadedSystem::from_json_str(text, &base_dir, label).map_err(|e| system_err(&e))?;
+        Self::prepare(py, system)
+    }
+
+    /// The name used in messages (the file path or label).
+    #[getter]
+    fn file(&self) -> String {
+        self.prepared.system().file.clone()
+    }
+
+    /// The description as JSON, FMU paths made absolute.
+    fn description_json(&self) -> PyResult<String> {
+        serde_json::to_string(&self.prepared.system().resolved())
+            .map_err(|e| Error::new_err(format!("internal: description: {e}")))
+    }
+
+    /// The model description of each instance's FMU (same order) as a JSON list.
+    fn models_json(&self) -> String {
+        self.models_json.clone()
+    }
+
+    /// The CSV header of a run: `time [s]` and each recorded variable's `name [unit]`.
+    fn header(&self) -> Vec<String> {
+        let mut h = vec!["time [s]".to_string()];
+        h.extend(self.prepared.plan().record.iter().map(|r| r.label.clone()));
+        h
+    }
+
+    /// Validates start values (`{"instance.variable": value}`) and a stop time without running.
+    #[pyo3(signature = (parameters=None, stop_time=None))]
+    fn check(
+        &self,
+        parameters: Option<&Bound<'_, PyDict>>,
+        stop_time: Option<f64>,
+    ) -> PyResult<()> {
+        let params = json_parameters(parameters)?;
+        self.prepared
+            .changes(&params, stop_time, &self.prepared.system().file)
+            .map(|_| ())
+            .map_err(|e| system_err(&e))
+    }
+
+    /// One run with the given start values and stop time; returns (header, data bytes, summary
+    /// JSON). `progress(steps_done, steps_total)` is called about a hundred times.
+    #[pyo3(signature = (parameters=None, stop_time=None, progress=None))]
+    fn run<'py>(
+        &self,
+        py: Python<'py>,
+        parameters: Option<&Bound<'py, PyDict>>,
+        stop_time: Option<f64>,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<Table<'py>> {
+        let params = json_parameters(parameters)?;
+        let changes = self
+            .prepared
+            .changes(&params, stop_time, &self.prepared.system().file)
+            .map_err(|e| system_err(&e))?;
+        let cancel = AtomicBool::new(false);
+        let want_progress = progress.is_some();
+        let prepared = &self.prepared;
+        let cancel_ref = &cancel;
+        let out = in_background(
+            py,
+            &cancel,
+            move |tx| {
+                let report = |k: u64, n: u64| {
+                    let stride = (n / 100).max(1);
+                    if want_progress && (k == n || k.is_multiple_of(stride)) {
+                        let _ = tx.send(Event::Steps(k, n));
+                    }
+                };
+                let opts = RunOptions {
+                    cancel: Some(cancel_ref),
+                    progress: Some(&report),
+                };
+                prepared.run(&changes, &opts)
+            },
+            |py, ev| match (&progress, ev) {
+                (Some(cb), Event::Steps(k, n)) => cb.call1(py, (k, n)).map(|_| ()),
+                _ => Ok(()),
+            },
+        )?;
+        let out = out.map_err(|e| run_err(&e))?;
+        table(py, &out)
+    }
+
+    /// Runs one job of this system's run set (JSON, as from `load_run_set`), as a run set's
+    /// worker does; returns (header, data bytes, summary JSON, None) or (None, None, None,
+    /// error): a failed simulation is the run's result, not an exception.
+    #[allow(clippy::type_complexity)]
+    fn run_job<'py>(
+        &self,
+        py: Python<'py>,
+        job_json: &str,
+    ) -> PyResult<(
+        Option<Vec<String>>,
+        Option<Bound<'py, PyBytes>>,
+        Option<String>,
+        Option<String>,
+    )> {
+        let job: Job = serde_json::from_str(job_json).map_err(|e| json_err("job", &e))?;
+        let cancel = AtomicBool::new(false);
+        let prepared = &self.prepared;
+        let cancel_ref = &cancel;
+        let job_ref = &job;
+        let out = in_background(
+            py,
+            &cancel,
+            move |_| run_job(prepared, job_ref, cancel_ref),
+            |_, _| Ok(()),
+        )?;
+        match out {
+            Ok(out) => {
+                let (h, d, s) = table(py, &out)?;
+                Ok((Some(h), Some(d), Some(s), None))
+            }
+            Err(e) => Ok((None, None, None, Some(e))),
+        }
+    }
+
+    /// Runs jobs of this system's run set on `threads` threads, writing `<outdir>/<run>/` per
+    /// job and `<outdir>/sweep.json` (the master's run-set folder); `on_done(name, error)` is
+    /// called as each run finishes. Returns each job's report as JSON, in job order.
+    #[pyo3(signature = (jobs_json, outdir, threads, on_done=None))]
+    fn run_jobs(
+        &self,
+        py: Python<'_>,
+        jobs_json: Vec<String>,
+        outdir: PathBuf,
+        threads: usize,
+        on_done: Option<Py<PyAny>>,
+    ) -> PyResult<Vec<String>> {
+        let jobs = jobs_json
+            .iter()
+            .map(|j| serde_json::from_str::<Job>(j).map_err(|e| json_err("job", &e)))
+            .collect::<PyResult<Vec<Job>>>()?;
+        let cancel = AtomicBool::new(false);
+        let prepared = &self.prepared;
+        let cancel_ref = &cancel;
+        let (jobs_ref, outdir_ref) = (&jobs, &outdir);
+        let reports = in_background(
+            py,
+            &cancel,
+            move |tx| {
+                let tx = Mutex::new(tx.clone());
+                execute(jobs_ref, outdir_ref, threads, false, |job| {
+                    let r = run_job(prepared, job, cancel_ref);
+                    if let Ok(tx) = tx.lock() {
+                        let _ = tx.send(Event::Done(job.name.clone(), r.as_ref().err().cloned()));
+                    }
+                    r
+                })
+            },
+            |py, ev| match (&on_done, ev) {
+                (Some(cb), Event::Done(name, error)) => cb.call1(py, (name, error)).map(|_| ()),
+                _ => Ok(()),
+            },
+        )?;
+        let reports = reports.map_err(|e| sweep_err(&e))?;
+        reports.iter().map(report_json).collect()
+    }
+}
+
+fn report_json(r: &RunReport) -> PyResult<String> {
+    serde_json::to_string(r).map_err(|e| Error::new_err(format!("internal: report: {e}")))
+}
+
+/// Reads a run-set file: (resolved base system JSON, base label, each job as JSON).
+#[pyfunction]
+fn load_run_set(path: PathBuf) -> PyResult<(String, String, Vec<String>)> {
+    let (base, jobs) = RunSet::load(&path).map_err(|e| system_err(&e))?;
+    run_set_parts(&base, &jobs)
+}
+
+/// Parses run-set JSON text (paths relative to `base_dir`, `label` names it in messages).
+#[pyfunction]
+fn run_set_from_json(
+    text: &str,
+    base_dir: PathBuf,
+    label: &str,
+) -> PyResult<(String, String, Vec<String>)> {
+    let (base, jobs) =
+        RunSet::from_str_with_base(text, &base_dir, label).map_err(|e| system_err(&e))?;
+    run_set_parts(&base, &jobs)
+}
+
+fn run_set_parts(base: &LoadedSystem, jobs: &[Job]) -> PyResult<(String, String, Vec<String>)> {
+    let desc = serde_json::to_string(&base.resolved())
+        .map_err(|e| Error::new_err(format!("internal: base system: {e}")))?;
+    let jobs = jobs
+        .iter()
+        .map(|j| serde_json::to_string(j).map_err(|e| Error::new_err(format!("internal: {e}"))))
+        .collect::<PyResult<Vec<_>>>()?;
+    Ok((desc, base.file.clone(), jobs))
+}
+
+/// The report (JSON) of a job whose run is complete in `outdir`, else None.
+#[pyfunction]
+fn completed_report(outdir: PathBuf, job_json: &str) -> PyResult<Option<String>> {
+    let job: Job = serde_json::from_str(job_json).map_err(|e| json_err("job", &e))?;
+    runs::completed(&outdir, &job)
+        .as_ref()
+        .map(report_json)
+        .transpose()
+}
+
+/// Writes `<outdir>/sweep.json` from reports (JSON) in job order.
+#[pyfunction]
+fn write_sweep(outdir: PathBuf, reports_json: Vec<String>) -> PyResult<()> {
+    let reports = reports_json
+        .iter()
+        .map(|r| serde_json::from_str::<RunReport>(r).map_err(|e| json_err("report", &e)))
+        .collect::<PyResult<Vec<_>>>()?;
+    runs::write_sweep(&outdir, &reports).map_err(|e| OutputError::new_err(error_message(&e)))
+}
+
+/// Writes the folder of a job from results computed elsewhere (header, data bytes, summary
+/// JSON) or from its error; returns the report as JSON.
+#[pyfunction]
+#[pyo3(signature = (outdir, job_json, header=None, data=None, summary_json=None, error=None))]
+fn write_run(
+    outdir: PathBuf,
+    job_json: &str,
+    header: Option<Vec<String>>,
+    data: Option<&[u8]>,
+    summary_json: Option<&str>,
+    error: Option<String>,
+) -> PyResult<String> {
+    let job: Job = serde_json::from_str(job_json).map_err(|e| json_err("job", &e))?;
+    let result = match (error, header, data, summary_json) {
+        (Some(e), ..) => Err(e),
+        (None, Some(header), Some(data), Some(summary)) => {
+            let data = f64_from_bytes(data).map_err(OutputError::new_err)?;
+            let summary: Summary =
+                serde_json::from_str(summary).map_err(|e| json_err("summary", &e))?;
+            Ok(SimOutput {
+                header,
+                data,
+                summary,
+            })
+        }
+        _ => Err("internal: a run came back with neither results nor an error".to_string()),
+    };
+    std::fs::create_dir_all(&outdir)
+        .map_err(|e| OutputError::new_err(format!("cannot create '{}': {e}", outdir.display())))?;
+    report_json(&runs::write_run(&outdir, &job, result))
+}
+
+/// Reads a results CSV: (header, data bytes), every value exactly as written.
+#[pyfunction]
+fn read_csv<'py>(py: Python<'py>, path: PathBuf) -> PyResult<(Vec<String>, Bound<'py, PyBytes>)> {
+    let t = py
+        .detach(|| results::read_csv(&path))
+        .map_err(OutputError::new_err)?;
+    Ok((t.header, PyBytes::new(py, &f64_bytes(&t.data))))
+}
+
+/// Writes a results CSV atomically, exactly as `master run` does.
+#[pyfunction]
+fn write_csv(path: PathBuf, header: Vec<String>, data: &[u8]) -> PyResult<()> {
+    let data = f64_from_bytes(data).map_err(OutputError::new_err)?;
+    let cols = header.len().max(1);
+    if !data.len().is_multiple_of(cols) {
+        return Err(OutputError::new_err(format!(
+            "{} values do not fill rows of {cols} columns",
+            data.len()
+        )));
+    }
+    write_csv_atomic(Path::new(&path), &header, data.chunks(cols))
+        .map_err(|e| OutputError::new_err(error_message(&e)))
+}
+
+#[pymodule]
+fn _railfmu(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // FMU logger messages and the master's warnings go to stderr, as in the command line.
+    master::fmu::install_logger(log::LevelFilter::Warn);
+    let py = m.py();
+    m.add("Error", py.get_type::<Error>())?;
+    m.add(
+        "SystemDescriptionError",
+        py.get_type::<SystemDescriptionError>(),
+    )?;
+    m.add("FmuError", py.get_type::<FmuError>())?;
+    m.add("SimulationError", py.get_type::<SimulationError>())?;
+    m.add("OutputError", py.get_type::<OutputError>())?;
+    m.add_class::<PySystem>()?;
+    m.add_function(wrap_pyfunction!(load_run_set, m)?)?;
+    m.add_function(wrap_pyfunction!(run_set_from_json, m)?)?;
+    m.add_function(wrap_pyfunction!(completed_report, m)?)?;
+    m.add_function(wrap_pyfunction!(write_sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(write_run, m)?)?;
+    m.add_function(wrap_pyfunction!(read_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(write_csv, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,131 @@
+"""Run sets on a dask.distributed LocalCluster of 2 worker processes: the same results as the
+local run set bit for bit, a killed worker does not lose the set, bad input fails its own run
+only, and the command line reaches the cluster too."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import railfmu
+from conftest import ROOT, speed_set
+
+distributed = pytest.importorskip("distributed")
+
+
+@pytest.fixture(scope="module")
+def client():
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+    c = distributed.Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def csv_bytes(folder: Path) -> dict:
+    return {p.parent.name: p.read_bytes() for p in sorted(folder.glob("*/results.csv"))}
+
+
+def eight_runs(dist, stop_time=0.5):
+    return railfmu.RunSet.from_dict(speed_set(dist, [50.0, 60.0, 70.0, 80.0], seeds=[1, 2], stop_time=stop_time))
+
+
+def test_a_cluster_run_set_equals_the_local_one_bit_for_bit(dist, client, tmp_path):
+    rs = eight_runs(dist)
+    local = rs.run(tmp_path / "local", threads=2)
+    calls = []
+    remote = rs.run(tmp_path / "dask", client=client, progress=lambda *a: calls.append(a))
+    assert remote.ok and len(remote) == 8
+    assert csv_bytes(tmp_path / "dask") == csv_bytes(tmp_path / "local")
+    for name in remote:
+        assert (tmp_path / "dask" / name / "system.json").read_bytes() == (tmp_path / "local" / name / "system.json").read_bytes()
+    assert sorted(c[0] for c in calls) == list(range(1, 9))
+    # both workers took part
+    assert len({r["summary"]["wall_time_s"] for r in remote.reports}) == 8
+    assert [r["parameters"] for r in remote.reports] == [r["parameters"] for r in local.reports]
+    # the FMUs were shipped: each worker has its own copy of each, named by content
+    from railfmu.dask import _fmu_cache_dir
+
+    for folder in client.run(_fmu_cache_dir).values():
+        copies = {p.name for p in Path(folder).glob("*/*.fmu")}
+        assert {"Bogie2Dof.fmu", "PassiveYawDamper.fmu"} <= copies
+    # the same with the FMUs read from their (shared) paths
+    rs.run(tmp_path / "shared", client=client, ship_fmus=False)
+    assert csv_bytes(tmp_path / "shared") == csv_bytes(tmp_path / "local")
+
+
+def test_bad_input_fails_its_own_run_and_no_worker(dist, client, tmp_path):
+    pids = set(client.run(os.getpid).values())
+    rs = speed_set(dist, [60.0], stop_time=0.2)
+    rs["runs"] = [
+        {"name": "typo", "parameters": {"bogie.vehicle.sped": 70.0}},
+        {"name": "wrong_type", "parameters": {"bogie.track.seed": 1.5}},
+        {"name": "negative", "parameters": {"bogie.vehicle.speed": -5.0}},
+    ]
+    res = railfmu.run_set(rs, tmp_path / "out", client=client)
+    assert set(res) == {"run-000"}
+    assert "unknown variable 'vehicle.sped'" in res.failed["typo"]
+    assert "is not a 32-bit integer" in res.failed["wrong_type"]
+    assert "negative" in res.failed
+    assert set(client.run(os.getpid).values()) == pids  # no worker crashed
+
+
+def test_a_killed_worker_does_not_lose_the_set_and_a_resumed_set_skips_finished_runs(dist, client, tmp_path):
+    rs = eight_runs(dist, stop_time=1.0)
+    local = rs.run(tmp_path / "local", threads=2)
+    pids = client.run(os.getpid)
+    victim = sorted(pids.values())[0]
+    killed = []
+
+    def kill_once(done, total, name, error):
+        if not killed:
+            os.kill(victim, signal.SIGKILL)
+            killed.append(name)
+
+    res = rs.run(tmp_path / "dask", client=client, progress=kill_once)
+    assert killed and res.ok and len(res) == 8
+    assert csv_bytes(tmp_path / "dask") == csv_bytes(tmp_path / "local")
+    client.wait_for_workers(2, timeout=60)
+    assert victim not in client.run(os.getpid).values()
+    # resumed on the cluster: only the removed runs run again
+    for name in ("run-002", "run-007"):
+        (tmp_path / "dask" / name / "results.csv").unlink()
+    ran = []
+    again = rs.run(tmp_path / "dask", client=client, resume=True, progress=lambda d, t, n, e: ran.append(n))
+    assert sorted(n for n in ran if n) == ["run-002", "run-007"]
+    assert again.ok and csv_bytes(tmp_path / "dask") == csv_bytes(tmp_path / "local")
+
+
+def test_the_command_line_runs_a_set_on_the_cluster(dist, client, master_cmd, tmp_path):
+    set_file = tmp_path / "set.json"
+    set_file.write_text(json.dumps(speed_set(dist, [50.0, 70.0], stop_time=0.2)))
+    local = railfmu.run_set(set_file, tmp_path / "local", threads=1)
+    addr = client.scheduler.address
+    r = subprocess.run(
+        [sys.executable, "-m", "railfmu", "sweep", str(set_file), "-o", str(tmp_path / "cli"), "--dask-scheduler", addr, "-q"],
+        capture_output=True, text=True, check=False,
+    )
+    assert r.returncode == 0, r.stderr
+    assert "2 of 2 runs ok" in r.stdout
+    assert csv_bytes(tmp_path / "cli") == csv_bytes(tmp_path / "local")
+    assert local.ok
+    # `master sweep --dask-scheduler` hands the set to the Python package
+    env = dict(os.environ, RAILFMU_PYTHON=sys.executable)
+    r = subprocess.run(
+        [str(master_cmd), "sweep", str(set_file), "-o", str(tmp_path / "master"), "--dask-scheduler", addr],
+        capture_output=True, text=True, check=False, env=env,
+    )
+    assert r.returncode == 0, r.stderr
+    assert csv_bytes(tmp_path / "master") == csv_bytes(tmp_path / "local")
+    env["RAILFMU_PYTHON"] = str(tmp_path / "no-python")
+    r = subprocess.run(
+        [str(master_cmd), "sweep", str(set_file), "-o", str(tmp_path / "none"), "--dask-scheduler", addr],
+        capture_output=True, text=True, check=False, env=env,
+    )
+    assert r.returncode == 1 and "needs the Python package railfmu" in r.stderr

@@ -1,0 +1,95 @@
+"""Run sets on local threads: the same folders as `master sweep`, a progress callback, failures
+kept per run, resuming skips finished runs, and the folder reads back."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import railfmu
+from conftest import bits, run_master, speed_set
+
+
+def csv_bytes(folder: Path) -> dict:
+    return {p.parent.name: p.read_bytes() for p in sorted(folder.glob("*/results.csv"))}
+
+
+def test_a_local_run_set_equals_master_sweep(dist, master_cmd, tmp_path):
+    set_file = tmp_path / "set.json"
+    set_file.write_text(json.dumps(speed_set(dist, [50.0, 60.0, 70.0, 80.0], seeds=[1, 2], stop_time=0.5)))
+    r = run_master(master_cmd, "sweep", set_file, "-o", tmp_path / "cli", "--jobs", "2")
+    assert r.returncode == 0, r.stderr
+    calls = []
+    res = railfmu.run_set(set_file, tmp_path / "py", threads=2, progress=lambda *a: calls.append(a))
+    assert res.ok and len(res) == 8
+    cli, py = csv_bytes(tmp_path / "cli"), csv_bytes(tmp_path / "py")
+    assert len(py) == 8 and py == cli
+    for name in res:
+        assert (tmp_path / "py" / name / "system.json").read_bytes() == (tmp_path / "cli" / name / "system.json").read_bytes()
+    assert sorted(c[0] for c in calls) == list(range(1, 9))
+    assert {c[2] for c in calls} == set(res)
+    assert all(c[1] == 8 and c[3] is None for c in calls)
+    # the eight runs differ from each other (speeds and seeds reach the FMU)
+    finals = {n: res[n].values[-1, 1] for n in res}
+    assert len(set(finals.values())) == 8
+    # read back: reports, per-run tables, one long DataFrame
+    back = railfmu.read_results(tmp_path / "cli")
+    assert isinstance(back, railfmu.RunSetResults) and back.ok
+    assert np.array_equal(bits(back["run-005"].values), bits(res["run-005"].values))
+    assert back["run-005"].summary["steps"] == 500
+    table = back.summary_frame()
+    assert list(table["bogie.vehicle.speed"]) == [50.0, 60.0, 70.0, 80.0] * 2  # keys in alphabetical order: seed outer
+    long = back.to_pandas()
+    assert long.index.names == ["run", "time"] and len(long) == 8 * 501
+    assert long.attrs["units"]["damper_left.damper.force"] == "N"
+    one = railfmu.read_results(tmp_path / "cli" / "run-005")
+    assert one.summary["steps"] == 500
+
+
+def test_a_failed_run_is_kept_and_the_others_go_on(dist, tmp_path):
+    rs = speed_set(dist, [60.0], stop_time=0.2)
+    rs["runs"] = [{"name": "typo", "parameters": {"bogie.vehicle.sped": 70.0}}, {"name": "slow", "parameters": {"bogie.vehicle.speed": 40.0}}]
+    res = railfmu.run_set(rs, tmp_path / "out", threads=2)
+    assert not res.ok
+    assert set(res) == {"run-000", "slow"}
+    assert "unknown variable 'vehicle.sped'" in res.failed["typo"]
+    with pytest.raises(KeyError, match="failed"):
+        res["typo"]
+    sweep = json.loads((tmp_path / "out" / "sweep.json").read_text())
+    assert [r["name"] for r in sweep] == ["run-000", "typo", "slow"]
+    assert not (tmp_path / "out" / "typo" / "results.csv").exists()
+
+
+def test_a_resumed_set_skips_finished_runs(dist, tmp_path):
+    rs = railfmu.RunSet.from_dict(speed_set(dist, [50.0, 60.0, 70.0, 80.0], stop_time=0.3))
+    out = tmp_path / "out"
+    first = rs.run(out, threads=2)
+    before = csv_bytes(out)
+    # one run lost, one interrupted before its summary, one whose inputs changed
+    shutil.rmtree(out / "run-001")
+    (out / "run-002" / "summary.json").unlink()
+    sys2 = json.loads((out / "run-003" / "system.json").read_text())
+    sys2["stop_time"] = 0.2
+    (out / "run-003" / "system.json").write_text(json.dumps(sys2))
+    ran = []
+    again = rs.run(out, threads=2, resume=True, progress=lambda d, t, n, e: ran.append(n))
+    assert sorted(n for n in ran if n) == ["run-001", "run-002", "run-003"]
+    assert again.ok and csv_bytes(out) == before
+    assert [r["name"] for r in again.reports] == [r["name"] for r in first.reports]
+    # nothing left to do
+    ran.clear()
+    rs.run(out, resume=True, progress=lambda d, t, n, e: ran.append(n))
+    assert [n for n in ran if n] == []
+
+
+def test_the_readme_run_set_expands_to_eight_resolved_runs():
+    rs = railfmu.RunSet.load(Path(__file__).parents[1] / "examples" / "passive_speeds.json")
+    assert len(rs) == 8 and rs.names[0] == "run-000"
+    job = rs.jobs[5]
+    assert job["parameters"] == {"bogie.track.seed": 2, "bogie.vehicle.speed": 66.67}
+    assert job["system"]["instances"][0]["parameters"]["vehicle.speed"] == 66.67
+    assert all(Path(i["fmu"]).is_absolute() for i in job["system"]["instances"])

@@ -1,0 +1,152 @@
+"""One system from Python: the same bits as `master run`, results with units, parameters,
+progress, the GIL released during runs, errors as exceptions with the master's messages."""
+
+from __future__ import annotations
+
+import json
+import threading
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import railfmu
+from conftest import bits, passive, run_master
+
+
+def test_a_run_from_python_equals_the_command_line_bit_for_bit(passive_file, master_cmd, tmp_path):
+    cli_csv = tmp_path / "cli.csv"
+    r = run_master(master_cmd, "run", passive_file, "-o", cli_csv)
+    assert r.returncode == 0, r.stderr
+    res = railfmu.System.load(passive_file).run()
+    assert len(res) == 1001  # 1 s at 1 ms, both ends
+    cli = railfmu.read_results(cli_csv)
+    assert cli.header == res.header
+    assert np.array_equal(bits(cli.values), bits(res.values))
+    # written from Python, the file is the command line's byte for byte
+    py_csv = tmp_path / "py.csv"
+    res.to_csv(py_csv)
+    assert py_csv.read_bytes() == cli_csv.read_bytes()
+    # the bogie moves: the comparison is not one of empty tables
+    assert np.max(np.abs(res["bogie.wheelset_front.lateral_displacement_relative"])) > 1e-6
+
+
+def test_start_values_from_python_equal_a_description_holding_them(dist, master_cmd, tmp_path):
+    changed = tmp_path / "changed.json"
+    changed.write_text(json.dumps(passive(dist, 0.5, **{"vehicle.speed": 55.0, "track.seed": 7})))
+    cli_csv = tmp_path / "cli.csv"
+    assert run_master(master_cmd, "run", changed, "-o", cli_csv).returncode == 0
+    base = tmp_path / "base.json"
+    base.write_text(json.dumps(passive(dist, 2.0)))
+    sys = railfmu.System.load(base)
+    sys.set_parameter("bogie.vehicle.speed", np.float64(55.0))  # NumPy scalars are accepted
+    sys.set_parameters({"bogie.track.seed": np.int64(7)})
+    sys.stop_time = 0.5
+    res = sys.run()
+    assert np.array_equal(bits(res.values), bits(railfmu.read_results(cli_csv).values))
+    # run-only values do not stick; another seed gives another track
+    other = sys.run({"bogie.track.seed": 8})
+    assert sys.parameters["bogie.track.seed"] == 7
+    assert not np.array_equal(other.values, res.values)
+    assert np.array_equal(bits(sys.run().values), bits(res.values))
+
+
+def test_results_carry_units_into_pandas_and_numpy(passive_file):
+    res = railfmu.System.load(passive_file).run(stop_time=0.2)
+    df = res.to_pandas()
+    assert df.index.name == "time"
+    assert df.index[-1] == pytest.approx(0.2)
+    assert list(df.columns) == res.names[1:]
+    assert df.attrs["units"]["time"] == "s"
+    assert df.attrs["units"]["bogie.wheelset_front.lateral_displacement_relative"] == "m"
+    assert df.attrs["units"]["damper_left.damper.force"] == "N"
+    assert df.attrs["summary"]["steps"] == 200
+    assert np.array_equal(df["damper_left.damper.force"].to_numpy(), res["damper_left.damper.force [N]"])
+    arr = res.to_numpy()
+    assert arr.dtype.names[0] == "time"
+    assert arr.dtype["damper_left.damper.force"].metadata == {"unit": "N"}
+    assert np.array_equal(arr["time"], res.time)
+
+
+def test_progress_and_the_gil_released_during_a_run(passive_file):
+    sys = railfmu.System.load(passive_file)
+    seen = []
+    sys.run(progress=lambda k, n: seen.append((k, n)))
+    assert seen[-1] == (1000, 1000)
+    assert all(a[0] < b[0] for a, b in zip(seen, seen[1:]))
+    assert len(seen) >= 50
+    # The GIL is released while the FMUs run: this thread's Python loop goes on between the
+    # progress calls of a run on another thread (which would all see the same count if the
+    # run held the GIL).
+    ticks = [0]
+    at = []
+    done = threading.Event()
+
+    def run():
+        try:
+            sys.run(stop_time=3.0, progress=lambda k, n: at.append(ticks[0]))
+        finally:
+            done.set()
+
+    t = threading.Thread(target=run)
+    t.start()
+    while not done.is_set():
+        ticks[0] += 1
+    t.join()
+    assert len(at) >= 100 and at[-1] > at[0]
+
+
+def test_bad_input_raises_with_the_masters_message_and_changes_nothing(passive_file, dist, tmp_path):
+    sys = railfmu.System.load(passive_file)
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"unknown variable 'vehicle.sped'.*did you mean 'vehicle.speed'"):
+        sys.set_parameter("bogie.vehicle.sped", 70.0)
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"unknown instance 'bogey'"):
+        sys.run({"bogey.vehicle.speed": 70.0})
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"1.5 is not a 32-bit integer"):
+        sys.set_parameter("bogie.track.seed", 1.5)
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"cannot take the value \"fast\""):
+        sys.run({"bogie.vehicle.speed": "fast"})
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"not a finite number"):
+        sys.run({"bogie.vehicle.speed": float("nan")})
+    with pytest.raises(TypeError, match=r"not list"):
+        sys.run({"bogie.vehicle.speed": [1.0]})
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"stop_time"):
+        sys.stop_time = -1.0
+    assert sys.parameters == {} and sys.stop_time == 1.0
+    assert len(sys.run(stop_time=0.01)) == 11  # still usable
+    # files: missing, malformed JSON (line and column), broken FMU
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"cannot read"):
+        railfmu.System.load(tmp_path / "nope.json")
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"instances": [\n  {"name": "a", "fmu": 3}\n]}')
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"line 2"):
+        railfmu.System.load(bad)
+    broken = tmp_path / "Broken.fmu"
+    broken.write_bytes(b"PK\x03\x04 this is not a zip archive")
+    d = passive(dist, 1.0)
+    d["instances"][1]["fmu"] = str(broken)
+    with pytest.raises(railfmu.FmuError, match=r"Broken.fmu"):
+        railfmu.System.from_dict(d)
+    # an FMU whose zip lacks its binary
+    nobin = tmp_path / "NoBinary.fmu"
+    with zipfile.ZipFile(dist / "PassiveYawDamper.fmu") as src, zipfile.ZipFile(nobin, "w") as dst:
+        for item in src.infolist():
+            if not item.filename.startswith("binaries/"):
+                dst.writestr(item, src.read(item))
+    d["instances"][1]["fmu"] = str(nobin)
+    with pytest.raises(railfmu.FmuError) as e:
+        railfmu.System.from_dict(d)
+    assert "NoBinary.fmu" in str(e.value)
+    assert issubclass(railfmu.FmuError, railfmu.Error)
+
+
+def test_variables_and_description(passive_file):
+    sys = railfmu.System.load(passive_file)
+    assert sys.instances == ["bogie", "damper_left", "damper_right"]
+    speed = [v for v in sys.variables("bogie") if v["name"] == "vehicle.speed"]
+    assert len(speed) == 1 and speed[0]["unit"] == "m/s"
+    assert sys.columns[0] == "time [s]"
+    assert Path(sys.description["instances"][0]["fmu"]).is_absolute()
+    with pytest.raises(KeyError, match="bogey"):
+        sys.variables("bogey")
