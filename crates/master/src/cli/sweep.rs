@@ -17,9 +17,17 @@ pub struct Args {
     /// Number of parallel runs (default: all cores).
     #[arg(short, long)]
     pub jobs: Option<usize>,
+    /// Run on a Dask cluster: one task per run, sent to this scheduler (e.g. tcp://host:8786).
+    /// Done by the Python package railfmu (`python -m railfmu sweep`), which must be installed
+    /// for the Python in $RAILFMU_PYTHON (default: python3), with dask.distributed.
+    #[arg(long, value_name = "ADDRESS")]
+    pub dask_scheduler: Option<String>,
 }
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
+    if let Some(address) = &args.dask_scheduler {
+        return on_dask(args, address, ctx);
+    }
     let (base, jobs) = RunSet::load(&args.runset)?;
     let system = PreparedSystem::prepare(&base)?;
     let threads = args
@@ -54,6 +62,34 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             "{} run(s) failed: {}",
             failed.len(),
             failed.join(", ")
+        )))
+    }
+}
+
+/// `--dask-scheduler`: the same run set through the Python package, which writes the same
+/// run-set folder; its output and exit status are this command's.
+fn on_dask(args: &Args, address: &str, ctx: &Context) -> Result<(), CommandError> {
+    let python = std::env::var_os("RAILFMU_PYTHON").unwrap_or_else(|| "python3".into());
+    let mut cmd = std::process::Command::new(&python);
+    cmd.args(["-m", "railfmu", "sweep"])
+        .arg(&args.runset)
+        .arg("-o")
+        .arg(&args.output)
+        .args(["--dask-scheduler", address]);
+    if !ctx.progress {
+        cmd.arg("--quiet");
+    }
+    let status = cmd.status().map_err(|e| {
+        CommandError::Failed(format!(
+            "--dask-scheduler needs the Python package railfmu: cannot start '{}': {e}",
+            std::path::Path::new(&python).display()
+        ))
+    })?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(CommandError::Failed(format!(
+            "the run set on the Dask cluster {address} did not complete ({status})"
         )))
     }
 }
