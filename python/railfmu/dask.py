@@ -130,8 +130,12 @@ def run_jobs_on_cluster(
     fmus_arg: Any = None
     if ship_fmus:
         fmus = _read_fmus(base_json)
-        scattered = client.scatter({f"railfmu-fmu-{v[0]}": v[2] for v in fmus.values()}, broadcast=True)
-        fmus_arg = {p: (digest, name, scattered[f"railfmu-fmu-{digest}"]) for p, (digest, name, _) in fmus.items()}
+        # hash=False: keys new to this set. A key derived from the content would be the one an
+        # earlier set scattered, which the scheduler may still be releasing (its tasks would
+        # then fail with "lost dependencies").
+        paths = list(fmus)
+        scattered = client.scatter([fmus[p][2] for p in paths], broadcast=True, hash=False)
+        fmus_arg = {p: (fmus[p][0], fmus[p][1], f) for p, f in zip(paths, scattered)}
     # keys unique per submission: a key resubmitted while the scheduler still releases it from
     # an earlier set would be cancelled
     token = uuid.uuid4().hex[:16]

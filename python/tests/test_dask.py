@@ -55,6 +55,11 @@ def test_a_cluster_run_set_equals_the_local_one_bit_for_bit(dist, client, tmp_pa
     for folder in client.run(_fmu_cache_dir).values():
         copies = {p.name for p in Path(folder).glob("*/*.fmu")}
         assert {"Bogie2Dof.fmu", "PassiveYawDamper.fmu"} <= copies
+    # the same set again at once: its FMUs are scattered anew while the scheduler may still be
+    # releasing the first set's copies
+    again = rs.run(tmp_path / "again", client=client)
+    assert again.ok, again.failed
+    assert csv_bytes(tmp_path / "again") == csv_bytes(tmp_path / "local")
     # the same with the FMUs read from their (shared) paths
     rs.run(tmp_path / "shared", client=client, ship_fmus=False)
     assert csv_bytes(tmp_path / "shared") == csv_bytes(tmp_path / "local")
