@@ -78,6 +78,14 @@ def test_bad_input_fails_its_own_run_and_no_worker(dist, client, tmp_path):
     assert "unknown variable 'vehicle.sped'" in res.failed["typo"]
     assert "is not a 32-bit integer" in res.failed["wrong_type"]
     assert "negative" in res.failed
+    # a broken FMU fails every run of the set, with the master's message, on the workers
+    broken = tmp_path / "Broken.fmu"
+    broken.write_bytes(b"PK\x03\x04 not a zip archive")
+    rs = speed_set(dist, [60.0, 70.0], stop_time=0.2)
+    rs["system"]["instances"][1]["fmu"] = str(broken)
+    res = railfmu.run_set(rs, tmp_path / "broken", client=client, retries=0)
+    assert len(res) == 0 and len(res.failed) == 2
+    assert all("FmuError" in e and "Broken.fmu" in e for e in res.failed.values()), res.failed
     assert set(client.run(os.getpid).values()) == pids  # no worker crashed
 
 

@@ -4,6 +4,9 @@ progress, the GIL released during runs, errors as exceptions with the master's m
 from __future__ import annotations
 
 import json
+import signal
+import subprocess
+import sys
 import threading
 import zipfile
 from pathlib import Path
@@ -150,3 +153,24 @@ def test_variables_and_description(passive_file):
     assert Path(sys.description["instances"][0]["fmu"]).is_absolute()
     with pytest.raises(KeyError, match="bogey"):
         sys.variables("bogey")
+
+
+def test_ctrl_c_stops_a_run_and_raises_keyboard_interrupt(passive_file):
+    script = f"""
+import sys, railfmu
+s = railfmu.System.load({str(passive_file)!r})
+def started(k, n):
+    if k == n // 100:
+        print("started", flush=True)
+try:
+    s.run(stop_time=3000.0, progress=started)
+except KeyboardInterrupt:
+    print("interrupted", flush=True)
+    sys.exit(3)
+"""
+    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "started"
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=120)
+    assert p.returncode == 3, err
+    assert out.strip() == "interrupted"
