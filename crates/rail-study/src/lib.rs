@@ -5,6 +5,7 @@
 //!
 //! * [`signal`], [`en14363`]: spectrum, sliding rms, EN 14363 stability assessment (the
 //!   band-pass is `signal-processing`'s).
+//! * [`en12299`]: lateral ride comfort of the car body (W_d weighting, N_y).
 //! * [`plot`]: SVG charts.
 //! * [`analysis`]: damper characterisation, root locus, contact geometry, assessment of
 //!   recorded signals.
@@ -13,6 +14,7 @@
 
 pub mod analysis;
 pub mod commands;
+pub mod en12299;
 pub mod en14363;
 pub mod plot;
 pub mod signal;
