@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The project's main job: build and package every FMU into dist/, then run the built-in default
-# study (passive, semi-active and full-active yaw dampers on the bogie, coupled by our master)
-# and write the report, plots and CSVs into results/.
+# study (passive, semi-active and full-active yaw dampers on the coach, coupled by our master)
+# into results/, and the same study on the 2-dof bogie (the seed's HIL configuration) into
+# results/bogie2dof/: reports, plots and CSVs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
@@ -9,6 +10,8 @@ source scripts/setup.sh
 step "package the FMUs into dist/"
 package_fmus
 
-step "default study -> results/"
+step "default study (coach) -> results/"
 cargo run --release -q -p rail-study --bin master -- study --fmus dist --out results "$@"
-echo "report: results/REPORT.md"
+step "bogie study (HIL configuration) -> results/bogie2dof/"
+cargo run --release -q -p rail-study --bin master -- study --vehicle bogie2dof --fmus dist --out results/bogie2dof "$@"
+echo "reports: results/REPORT.md, results/bogie2dof/REPORT.md"

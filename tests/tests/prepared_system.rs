@@ -15,7 +15,8 @@ use master::coupling::{RunOptions, SimOutput};
 use master::fmu::extraction_count;
 use master::runset::{execute, run_job, Job, RunSet};
 use master::system::{LoadedSystem, PreparedSystem};
-use rail_study::study::config::{configuration, var, RunRequest, Sources};
+use rail_study::study::config::{configuration, RunRequest, Sources};
+use rail_study::study::VehicleModel;
 
 fn dist() -> PathBuf {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../dist");
@@ -104,15 +105,18 @@ fn prepared_runs_equal_fresh_runs_and_unpack_each_fmu_once() {
         systems: None,
     };
     let c = configuration("mppt2").unwrap();
-    let base = sources.system(c).unwrap();
+    let b = VehicleModel::Bogie2Dof;
+    let base = sources.system(b, c).unwrap();
     let before = extraction_count();
     let system = PreparedSystem::prepare(&base).unwrap();
-    let distinct = rail_study::study::config::required_fmus(&[c]).len();
+    let distinct = rail_study::study::config::required_fmus(b, &[c]).len();
     assert_eq!(extraction_count() - before, distinct as u64);
     let runs = [
-        RunRequest::new("t-", c, 300.0, Some(1), 3.0),
-        RunRequest::new("t-", c, 250.0, None, 2.0)
-            .with(var::MPPT_INITIAL_LEFT, serde_json::json!(10.0)),
+        RunRequest::new("t-", b, c, 300.0, Some(1), 3.0),
+        RunRequest::new("t-", b, c, 250.0, None, 2.0).with(
+            "controller_left.valve.initial_command",
+            serde_json::json!(10.0),
+        ),
     ];
     let jobs: Vec<Job> = runs.iter().map(|r| r.job(&base).unwrap()).collect();
     let prepared: Vec<SimOutput> = jobs
@@ -120,7 +124,7 @@ fn prepared_runs_equal_fresh_runs_and_unpack_each_fmu_once() {
         .map(|j| run_job(&system, j, &cancel).unwrap())
         .collect();
     // a start value the model does not have fails that run only, naming it
-    let bad = RunRequest::new("t-", c, 300.0, Some(1), 1.0).with("bogie.no_such", 1.into());
+    let bad = RunRequest::new("t-", b, c, 300.0, Some(1), 1.0).with("bogie.no_such", 1.into());
     let e = run_job(&system, &bad.job(&base).unwrap(), &cancel).unwrap_err();
     assert!(e.contains("unknown variable 'no_such'"), "{e}");
     assert_eq!(

@@ -1,4 +1,5 @@
-//! End-to-end tests of the stability study (`master study --quick`) with the packaged FMUs:
+//! End-to-end tests of the bogie stability study (`master study --vehicle bogie2dof --quick`,
+//! the seed's HIL configuration) with the packaged FMUs:
 //! the reduced sweep (240-400 km/h in 40 km/h steps, one track seed, bisection to 10 km/h),
 //! the perturbation runs, the c_v sensitivity and the MPPT / slow-valve scenarios, checked
 //! against REFERENCE.md R7-R14.
@@ -17,7 +18,9 @@ use std::sync::OnceLock;
 
 use rail_study::study::config::required_fmus;
 use rail_study::study::run::{configurations_used, scenario};
-use rail_study::study::{run_study, Critical, Sources, StudyOptions, StudyResults, StudySettings};
+use rail_study::study::{
+    run_study, Critical, Sources, StudyOptions, StudyResults, StudySettings, VehicleModel,
+};
 
 static CANCEL: AtomicBool = AtomicBool::new(false);
 static RESULTS: OnceLock<Result<StudyResults, String>> = OnceLock::new();
@@ -52,7 +55,8 @@ fn results() -> &'static StudyResults {
         };
         let start = std::time::Instant::now();
         let unpacked_before = master::fmu::extraction_count();
-        let r = run_study(&StudySettings::quick(), &opts).map_err(|e| e.to_string())?;
+        let r = run_study(&StudySettings::quick(VehicleModel::Bogie2Dof), &opts)
+            .map_err(|e| e.to_string())?;
         UNPACKED.store(
             master::fmu::extraction_count() - unpacked_before,
             Ordering::SeqCst,
@@ -110,8 +114,11 @@ fn no_run_failed() {
 #[test]
 fn each_configuration_unpacks_its_fmus_once() {
     let r = results();
-    let used = configurations_used(&StudySettings::quick()).unwrap();
-    let expected: usize = used.iter().map(|c| required_fmus(&[c]).len()).sum();
+    let used = configurations_used(&StudySettings::quick(VehicleModel::Bogie2Dof)).unwrap();
+    let expected: usize = used
+        .iter()
+        .map(|c| required_fmus(VehicleModel::Bogie2Dof, &[c]).len())
+        .sum();
     assert!(expected >= 2 * used.len(), "{expected}");
     assert_eq!(UNPACKED.load(Ordering::SeqCst), expected as u64);
     assert!(r.runs > expected, "{} runs", r.runs);

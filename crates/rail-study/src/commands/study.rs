@@ -1,32 +1,38 @@
-//! `master study [--fmus DIR] [--out DIR] [--quick] [--jobs N]`: the stability study
-//! (see [`crate::study`]): speed sweep per configuration, critical speeds, perturbation runs,
-//! c_v sensitivity, time histories; REPORT.md, SVG plots and CSVs under `--out`.
+//! `master study [--vehicle vehicle|bogie2dof] [--fmus DIR] [--out DIR] [--quick] [--jobs N]`:
+//! the stability study (see [`crate::study`]): speed sweep per configuration, critical speeds,
+//! car-body acceleration and ride comfort (coach), perturbation runs, c_v sensitivity, time
+//! histories; REPORT.md, SVG plots and CSVs under `--out`.
 
 use std::path::PathBuf;
 use std::time::Instant;
 
 use crate::study::{
     run_study, write_outputs, Sources, StudyError, StudyOptions, StudySettings, Timing,
+    VehicleModel,
 };
 use master::cli::{CommandError, Context};
 
 /// Run the stability study and write REPORT.md, plots and CSVs.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Folder with the FMUs (Bogie2Dof.fmu, SemiActiveDamper.fmu, ...).
+    /// Vehicle model: the coach with four dampers (`vehicle`, RailVehicle.fmu) or the 2-dof
+    /// bogie with two (`bogie2dof`, the seed's HIL configuration).
+    #[arg(long, value_enum, default_value = "vehicle")]
+    pub vehicle: VehicleModel,
+    /// Folder with the FMUs (RailVehicle.fmu, Bogie2Dof.fmu, SemiActiveDamper.fmu, ...).
     #[arg(long)]
     pub fmus: Option<PathBuf>,
     /// Output folder.
     #[arg(long, default_value = "results")]
     pub out: PathBuf,
-    /// Reduced study for CI: 5 speeds, 1 seed, shorter runs, bisection to 10 km/h only.
+    /// Reduced study for CI: 1 seed, shorter runs, fewer speeds, coarser bisection.
     #[arg(long)]
     pub quick: bool,
     /// Number of parallel runs (default: all cores).
     #[arg(short, long)]
     pub jobs: Option<usize>,
     /// Folder with <configuration>.json system descriptions to use instead of the built-in
-    /// copies of systems/*.json.
+    /// ones (the coach's generated systems, the bogie's systems/*.json).
     #[arg(long)]
     pub systems: Option<PathBuf>,
 }
@@ -53,9 +59,9 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         log::set_max_level(log::LevelFilter::Error);
     }
     let settings = if args.quick {
-        StudySettings::quick()
+        StudySettings::quick(args.vehicle)
     } else {
-        StudySettings::full()
+        StudySettings::full(args.vehicle)
     };
     let threads = args
         .jobs
@@ -75,8 +81,12 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         cancel: ctx.cancel,
     };
     eprintln!(
-        "study ({}): {} runs before bisection on {threads} threads, output in {}",
+        "study ({}, {}): {} runs before bisection on {threads} threads, output in {}",
         if args.quick { "quick" } else { "full" },
+        match args.vehicle {
+            VehicleModel::Coach => "coach",
+            VehicleModel::Bogie2Dof => "2-dof bogie",
+        },
         settings.planned_runs(),
         args.out.display()
     );

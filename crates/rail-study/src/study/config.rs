@@ -1,8 +1,10 @@
-//! The yaw-damper configurations of the study, each a system description shipped in
-//! `systems/*.json` (embedded here so `master study` runs from any folder), and how a job is
-//! derived from one (FMU folder, speed, track seed, run length, extra parameters).
+//! The yaw-damper configurations of the study and how a job is derived from one (vehicle
+//! model, FMU folder, speed, track seed, run length, extra parameters). On the bogie each
+//! configuration is a system description shipped in `systems/*.json` (embedded here so
+//! `master study` runs from any folder); on the coach it is generated from the damper positions
+//! ([`crate::study::vehicle::coach_system`]).
 //!
-//! Instance and variable names the study relies on (see the JSON files):
+//! Instance and variable names the study relies on on the bogie (see the JSON files):
 //! * `bogie` (Bogie2Dof): `vehicle.speed` [m/s], `track.source` (0 none, 2 internal ERRI
 //!   generator), `track.seed`, `initial.lateral_displacement` [m]; recorded
 //!   `wheelset_{front,rear}.lateral_{displacement,acceleration}`.
@@ -11,7 +13,7 @@
 //! * controllers `controller_left/right` (MpptController, SkyHookController; `valve.command`
 //!   recorded) or `idf_left/right` (IdealDamperForceController, parameter `c_v`).
 //!
-//! System-level choices (the seed leaves them open):
+//! System-level choices on the bogie (the seed leaves them open):
 //! * each controller takes the signals of its own side: the left MPPT board the frame
 //!   acceleration over the front axle box, the right one over the rear axle box; sky-hook the
 //!   same accelerations and the elongation velocity of its own damper; IDF the elongation
@@ -26,7 +28,9 @@
 //!   of the controller's side (the signal the seed's co-simulation gives the controllers, 4.4),
 //!   `sensor.sign` -1 left / +1 right so both dampers switch together; otherwise the
 //!   controller's defaults (corner 0.3 Hz; c_sky = 330 kNs/m; damping table of our damper at
-//!   4 Hz). See fmu-controller's skyhook module for why not the damper end's velocity.
+//!   4 Hz). See fmu-controller's skyhook module for why not the damper end's velocity: with the
+//!   car body fixed it would equal the elongation velocity. The coach uses the textbook signal
+//!   (see [`crate::study::vehicle`]).
 //! * The bogie starts centred (initial displacement 0) on the irregular track; the
 //!   perturbation and HIL-like runs set 3 mm on an ideal track.
 
@@ -37,6 +41,8 @@ use serde_json::Value;
 
 use master::runset::{sanitize, Job, RunSet, RunSpec};
 use master::system::{LoadedSystem, SystemDescription, SystemError};
+
+use crate::study::vehicle::{coach_system, VehicleModel};
 
 /// Control family of a configuration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -193,56 +199,53 @@ pub fn configuration(id: &str) -> Option<&'static Configuration> {
     CONFIGURATIONS.iter().find(|c| c.id == id)
 }
 
-/// Variables the study sets and reads (instance.variable).
-pub mod var {
-    pub const SPEED: &str = "bogie.vehicle.speed";
-    pub const TRACK_SOURCE: &str = "bogie.track.source";
-    pub const TRACK_SEED: &str = "bogie.track.seed";
-    pub const INITIAL_LATERAL: &str = "bogie.initial.lateral_displacement";
-    pub const WS_FRONT_Y: &str = "bogie.wheelset_front.lateral_displacement_relative";
-    pub const WS_REAR_Y: &str = "bogie.wheelset_rear.lateral_displacement_relative";
-    pub const WS_FRONT_ACC: &str = "bogie.wheelset_front.lateral_acceleration";
-    pub const WS_REAR_ACC: &str = "bogie.wheelset_rear.lateral_acceleration";
-    pub const FORCE_LEFT_DAMPER: &str = "damper_left.damper.force";
-    pub const FORCE_RIGHT_DAMPER: &str = "damper_right.damper.force";
-    pub const FORCE_LEFT_ACTUATOR: &str = "actuator_left.damper.force";
-    pub const FORCE_RIGHT_ACTUATOR: &str = "actuator_right.damper.force";
-    pub const FORCE_REFERENCE_LEFT: &str = "idf_left.reference.force";
-    /// Mechanical power taken from the vehicle, F v (the seed's "dissipated power").
-    pub const POWER_LEFT: &str = "actuator_left.damper.power";
-    pub const POWER_RIGHT: &str = "actuator_right.damper.power";
-    /// Hydraulic power drawn from the supply.
-    pub const HYDRAULIC_POWER_LEFT: &str = "actuator_left.damper.hydraulic_power";
-    pub const HYDRAULIC_POWER_RIGHT: &str = "actuator_right.damper.hydraulic_power";
-    pub const COMMAND_LEFT: &str = "controller_left.valve.command";
-    pub const COMMAND_RIGHT: &str = "controller_right.valve.command";
-    pub const OPENING_LEFT: &str = "damper_left.valve.opening";
-    pub const MPPT_INITIAL_LEFT: &str = "controller_left.valve.initial_command";
-    pub const MPPT_INITIAL_RIGHT: &str = "controller_right.valve.initial_command";
-    pub const CV_LEFT: &str = "idf_left.reference.damping";
-    pub const CV_RIGHT: &str = "idf_right.reference.damping";
-}
-
 /// Where the study takes its system descriptions and FMUs from.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sources {
-    /// Folder with the FMUs (`Bogie2Dof.fmu`, ...); every instance's FMU is looked up here by
-    /// its file name.
+    /// Folder with the FMUs (`RailVehicle.fmu`, `Bogie2Dof.fmu`, ...); every instance's FMU is
+    /// looked up here by its file name.
     pub fmus: PathBuf,
-    /// Folder with `<id>.json` system descriptions to use instead of the embedded copies.
+    /// Folder with `<id>.json` system descriptions to use instead of the built-in ones.
     pub systems: Option<PathBuf>,
 }
 
-/// FMU file names the configurations use (for a clear "missing FMU" message up front).
-pub fn required_fmus(configs: &[&Configuration]) -> Vec<String> {
+/// The built-in system description of a configuration on a vehicle model: the shipped
+/// `systems/<id>.json` for the bogie, the one generated from the damper positions for the coach.
+pub fn builtin_system(vehicle: VehicleModel, c: &Configuration) -> SystemDescription {
+    match vehicle {
+        VehicleModel::Bogie2Dof => serde_json::from_str(c.json).unwrap_or_else(|_| empty_system()),
+        VehicleModel::Coach => {
+            serde_json::from_value(coach_system(c)).unwrap_or_else(|_| empty_system())
+        }
+    }
+}
+
+/// Only reached if a built-in description does not parse, which the unit tests rule out; an
+/// empty system then fails with a clear message when prepared.
+fn empty_system() -> SystemDescription {
+    SystemDescription {
+        instances: Vec::new(),
+        connections: Vec::new(),
+        start_time: 0.0,
+        stop_time: 0.0,
+        step: 1e-3,
+        algorithm: master::coupling::Algorithm::GaussSeidel,
+        order: None,
+        record: None,
+        init_sweeps: 3,
+        max_step_halvings: 0,
+    }
+}
+
+/// FMU file names the configurations use on a vehicle (for a clear "missing FMU" message up
+/// front).
+pub fn required_fmus(vehicle: VehicleModel, configs: &[&Configuration]) -> Vec<String> {
     let mut names: Vec<String> = Vec::new();
     for c in configs {
-        if let Ok(d) = serde_json::from_str::<SystemDescription>(c.json) {
-            for i in d.instances {
-                if let Some(n) = i.fmu.file_name().and_then(|n| n.to_str()) {
-                    if !names.iter().any(|x| x == n) {
-                        names.push(n.to_string());
-                    }
+        for i in builtin_system(vehicle, c).instances {
+            if let Some(n) = i.fmu.file_name().and_then(|n| n.to_str()) {
+                if !names.iter().any(|x| x == n) {
+                    names.push(n.to_string());
                 }
             }
         }
@@ -251,15 +254,27 @@ pub fn required_fmus(configs: &[&Configuration]) -> Vec<String> {
 }
 
 impl Sources {
-    /// The configuration's system description with FMU paths pointing into `self.fmus`.
-    pub fn system(&self, c: &Configuration) -> Result<LoadedSystem, SystemError> {
+    /// The configuration's system description on `vehicle` with FMU paths pointing into
+    /// `self.fmus`.
+    pub fn system(
+        &self,
+        vehicle: VehicleModel,
+        c: &Configuration,
+    ) -> Result<LoadedSystem, SystemError> {
         let mut sys = match &self.systems {
             Some(dir) => LoadedSystem::load(&dir.join(format!("{}.json", c.id)))?,
-            None => LoadedSystem::from_json_str(
-                c.json,
-                Path::new("systems"),
-                &format!("systems/{}.json (embedded)", c.id),
-            )?,
+            None => match vehicle {
+                VehicleModel::Bogie2Dof => LoadedSystem::from_json_str(
+                    c.json,
+                    Path::new("systems"),
+                    &format!("systems/{}.json (embedded)", c.id),
+                )?,
+                VehicleModel::Coach => LoadedSystem::from_description(
+                    builtin_system(vehicle, c),
+                    Path::new("systems"),
+                    &format!("coach system '{}' (built in)", c.id),
+                ),
+            },
         };
         let fmus = std::path::absolute(&self.fmus).unwrap_or_else(|_| self.fmus.clone());
         for inst in &mut sys.desc.instances {
@@ -276,6 +291,7 @@ impl Sources {
 pub struct RunRequest {
     /// Unique run name (folder name).
     pub name: String,
+    pub vehicle: VehicleModel,
     pub config: &'static Configuration,
     pub speed_kmh: f64,
     /// Track seed; `None` = ideal track (track.source = 0).
@@ -288,6 +304,7 @@ pub struct RunRequest {
 impl RunRequest {
     pub fn new(
         prefix: &str,
+        vehicle: VehicleModel,
         config: &'static Configuration,
         speed_kmh: f64,
         seed: Option<u32>,
@@ -300,6 +317,7 @@ impl RunRequest {
                 config.id,
                 fmt_speed(speed_kmh)
             )),
+            vehicle,
             config,
             speed_kmh,
             seed,
@@ -321,14 +339,15 @@ impl RunRequest {
     /// Start values of this run (speed, track, extras).
     pub fn parameters(&self) -> BTreeMap<String, Value> {
         let mut p = BTreeMap::new();
-        p.insert(var::SPEED.to_string(), Value::from(self.speed_kmh / 3.6));
+        let v = self.vehicle;
+        p.insert(v.speed(), Value::from(self.speed_kmh / 3.6));
         match self.seed {
             Some(s) => {
-                p.insert(var::TRACK_SOURCE.to_string(), Value::from(2));
-                p.insert(var::TRACK_SEED.to_string(), Value::from(s));
+                p.insert(v.track_source(), Value::from(2));
+                p.insert(v.track_seed(), Value::from(s));
             }
             None => {
-                p.insert(var::TRACK_SOURCE.to_string(), Value::from(0));
+                p.insert(v.track_source(), Value::from(0));
             }
         }
         for (k, v) in &self.extra {
@@ -338,7 +357,7 @@ impl RunRequest {
     }
 
     /// The self-contained job (resolved FMU paths, stop time set) from the configuration's
-    /// system (`Sources::system` of `self.config`).
+    /// system (`Sources::system` of `self.vehicle`, `self.config`).
     pub fn job(&self, base: &LoadedSystem) -> Result<Job, SystemError> {
         let set = RunSet {
             base: None,
@@ -382,12 +401,12 @@ mod tests {
                 .unwrap_or_else(|e| panic!("systems/{}.json: {e}", c.id));
             assert!(d.instances.iter().any(|i| i.name == "bogie"), "{}", c.id);
             let rec = d.record.clone().unwrap_or_default();
-            for v in [
-                var::WS_FRONT_Y,
-                var::WS_REAR_Y,
-                var::WS_FRONT_ACC,
-                var::WS_REAR_ACC,
-            ] {
+            let b = VehicleModel::Bogie2Dof;
+            for v in b
+                .wheelset_displacements()
+                .iter()
+                .chain(&b.stability_accelerations())
+            {
                 assert!(rec.iter().any(|r| r == v), "{}: {v} not recorded", c.id);
             }
             let has = |n: &str| d.instances.iter().any(|i| i.name == n);
@@ -409,7 +428,11 @@ mod tests {
             }
         }
         assert!(configuration("mppt2").is_some() && configuration("x").is_none());
-        let f = required_fmus(&CONFIGURATIONS.iter().collect::<Vec<_>>());
+        let all: Vec<&Configuration> = CONFIGURATIONS.iter().collect();
+        let coach = required_fmus(VehicleModel::Coach, &all);
+        assert!(coach.iter().any(|x| x == "RailVehicle.fmu"));
+        assert!(!coach.iter().any(|x| x == "Bogie2Dof.fmu"));
+        let f = required_fmus(VehicleModel::Bogie2Dof, &all);
         for n in [
             "Bogie2Dof.fmu",
             "PassiveYawDamper.fmu",
@@ -430,10 +453,11 @@ mod tests {
             fmus: PathBuf::from("/opt/fmus"),
             systems: None,
         };
-        let r = RunRequest::new("sweep-", c, 287.5, Some(3), 12.0)
-            .with(var::MPPT_INITIAL_LEFT, Value::from(8.0));
+        let b = VehicleModel::Bogie2Dof;
+        let r = RunRequest::new("sweep-", b, c, 287.5, Some(3), 12.0)
+            .with("controller_left.valve.initial_command", Value::from(8.0));
         assert_eq!(r.name, "sweep-mppt2_v287.5_s3");
-        let j = r.job(&src.system(c).unwrap()).unwrap();
+        let j = r.job(&src.system(b, c).unwrap()).unwrap();
         assert_eq!(j.name, "sweep-mppt2_v287.5_s3");
         assert!((j.system.stop_time - 12.0).abs() < 1e-12);
         let bogie = j
@@ -454,9 +478,24 @@ mod tests {
             .find(|i| i.name == "controller_left")
             .unwrap();
         assert_eq!(ctl.parameters["valve.initial_command"], Value::from(8.0));
-        let ideal = RunRequest::new("p-", configuration("passive").unwrap(), 220.0, None, 5.0);
+        let ideal = RunRequest::new("p-", b, configuration("passive").unwrap(), 220.0, None, 5.0);
         assert_eq!(ideal.name, "p-passive_v220_ideal");
-        assert_eq!(ideal.parameters()[var::TRACK_SOURCE], Value::from(0));
+        assert_eq!(ideal.parameters()[&b.track_source()], Value::from(0));
+        // the coach: generated system, its own variable names, FMUs from the same folder
+        let v = VehicleModel::Coach;
+        let r = RunRequest::new("s-", v, c, 300.0, Some(2), 3.0);
+        let j = r.job(&src.system(v, c).unwrap()).unwrap();
+        let coach = j
+            .system
+            .instances
+            .iter()
+            .find(|i| i.name == "vehicle")
+            .unwrap();
+        assert_eq!(coach.fmu, PathBuf::from("/opt/fmus/RailVehicle.fmu"));
+        let speed = coach.parameters["running.speed"].as_f64().unwrap();
+        assert!((speed - 300.0 / 3.6).abs() < 1e-12);
+        assert_eq!(coach.parameters["track.seed"], Value::from(2));
+        assert_eq!(j.system.instances.len(), 9);
     }
 
     #[test]

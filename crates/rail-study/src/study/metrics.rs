@@ -2,14 +2,18 @@
 //!
 //! * EN 14363 rms ([`crate::en14363::assess_lateral_acceleration`]): band-pass +-2 Hz around
 //!   the dominant frequency, rms over 100 m windows in 10 m steps, start-up transient skipped;
-//!   evaluated for the front and the rear wheelset, the run's value is the larger one.
+//!   evaluated for every frame acceleration over an axle box (the coach's four, the bogie's
+//!   two wheelsets), the run's value is the largest.
 //! * Wheelset oscillation amplitude: half the peak-to-peak lateral displacement over the last
-//!   `tail_s` seconds (the larger of the two wheelsets): a limit cycle shows as a steady
+//!   `tail_s` seconds (the largest over the wheelsets): a limit cycle shows as a steady
 //!   amplitude, a decaying motion as a small one.
+//! * Car body (coach): rms of the floor lateral acceleration and the EN 12299 lateral comfort
+//!   N_y ([`crate::en12299`]), the largest over front, mid-length and rear.
 //! * Damper force peak, rms hydraulic power (full-active), mean valve command over the tail.
 
+use crate::en12299::{lateral_comfort, ComfortError};
 use crate::en14363::{assess_lateral_acceleration, AssessError, StabilitySettings};
-use crate::study::config::var;
+use crate::study::vehicle::Signals;
 use master::coupling::SimOutput;
 
 /// Bogie mass of the seed [t] (a_lim = 5.39 m/s^2, seed 4.2).
@@ -19,15 +23,23 @@ pub const BOGIE_MASS_T: f64 = 6.1;
 #[derive(Debug, thiserror::Error)]
 pub enum MetricsError {
     #[error("column '{0}' is not in the recorded results")]
-    MissingColumn(&'static str),
+    MissingColumn(String),
     #[error("run too short: {samples} samples after skipping {skip_s} s")]
     TooShort { samples: usize, skip_s: f64 },
     #[error("EN 14363 assessment of '{column}': {source}")]
     Assess {
-        column: &'static str,
+        column: String,
         #[source]
         source: AssessError,
     },
+    #[error("EN 12299 comfort of '{column}': {source}")]
+    Comfort {
+        column: String,
+        #[source]
+        source: ComfortError,
+    },
+    #[error("no EN 14363 signal to assess")]
+    NoStabilitySignal,
 }
 
 /// How a run is evaluated.
@@ -43,10 +55,10 @@ pub struct MetricSpec {
 /// The numbers of one run.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RunMetrics {
-    /// EN 14363 max sliding rms of the front / rear wheelset lateral acceleration [m/s^2].
-    pub rms_front: f64,
-    pub rms_rear: f64,
-    /// Dominant frequency of the front wheelset acceleration [Hz].
+    /// EN 14363 max sliding rms of each assessed acceleration, in [`Signals::stability`]
+    /// order [m/s^2].
+    pub rms_by_signal: Vec<f64>,
+    /// Dominant frequency of the first assessed acceleration [Hz].
     pub frequency_hz: f64,
     /// Half peak-to-peak wheelset displacement over the tail (max of both) [m].
     pub tail_amplitude_m: f64,
@@ -59,19 +71,26 @@ pub struct RunMetrics {
     pub rms_power_w: Option<f64>,
     /// rms of the hydraulic supply power per actuator (mean of both sides) [W], if recorded.
     pub rms_hydraulic_power_w: Option<f64>,
-    /// Mean valve command over the tail (both sides) [V], if recorded.
+    /// Mean valve command over the tail (all dampers) [V], if recorded.
     pub tail_command_v: Option<f64>,
+    /// rms of the car-body floor lateral acceleration after the skip, largest over the
+    /// measuring points [m/s^2]; `None` without a car body.
+    pub carbody_rms_mps2: Option<f64>,
+    /// EN 12299 lateral comfort N_y = 6 a_YP95 (W_d), largest over the measuring points;
+    /// `None` without a car body or when less than one 5 s window follows the skip.
+    pub comfort_ny: Option<f64>,
 }
 
 impl RunMetrics {
-    /// The EN 14363 value of the run: the larger of the two wheelsets.
+    /// The EN 14363 value of the run: the largest over the assessed accelerations.
     pub fn rms(&self) -> f64 {
-        self.rms_front.max(self.rms_rear)
+        self.rms_by_signal.iter().fold(0.0, |m: f64, &r| m.max(r))
     }
 }
 
-fn col(out: &SimOutput, name: &'static str) -> Result<Vec<f64>, MetricsError> {
-    out.column(name).ok_or(MetricsError::MissingColumn(name))
+fn col(out: &SimOutput, name: &str) -> Result<Vec<f64>, MetricsError> {
+    out.column(name)
+        .ok_or_else(|| MetricsError::MissingColumn(name.to_string()))
 }
 
 /// Sampling rate of the recorded output [Hz] from its time column.
@@ -108,8 +127,22 @@ fn mean(x: &[f64]) -> f64 {
     }
 }
 
+/// Mean over the recorded columns of `names` of `f(column)`; `None` if none is recorded.
+fn mean_over(out: &SimOutput, names: &[String], f: impl Fn(&[f64]) -> f64) -> Option<f64> {
+    let v: Vec<f64> = names
+        .iter()
+        .filter_map(|n| out.column(n))
+        .map(|c| f(&c))
+        .collect();
+    (!v.is_empty()).then(|| mean(&v))
+}
+
 /// Evaluates one run.
-pub fn run_metrics(out: &SimOutput, spec: &MetricSpec) -> Result<RunMetrics, MetricsError> {
+pub fn run_metrics(
+    out: &SimOutput,
+    spec: &MetricSpec,
+    signals: &Signals,
+) -> Result<RunMetrics, MetricsError> {
     let fs = sample_rate(out).ok_or(MetricsError::TooShort {
         samples: out.rows().count(),
         skip_s: spec.skip_s,
@@ -128,50 +161,57 @@ pub fn run_metrics(out: &SimOutput, spec: &MetricSpec) -> Result<RunMetrics, Met
         ..StabilitySettings::default()
     };
     let speed = spec.speed_kmh / 3.6;
-    let assess = |column: &'static str| -> Result<(f64, f64), MetricsError> {
+    let mut rms_by_signal = Vec::with_capacity(signals.stability.len());
+    let mut frequency_hz = None;
+    for column in &signals.stability {
         let a = col(out, column)?;
-        let r = assess_lateral_acceleration(&a, fs, speed, BOGIE_MASS_T, &settings)
-            .map_err(|source| MetricsError::Assess { column, source })?;
-        Ok((r.max_rms, r.dominant_frequency_hz))
-    };
-    let (rms_front, frequency_hz) = assess(var::WS_FRONT_ACC)?;
-    let (rms_rear, _) = assess(var::WS_REAR_ACC)?;
-    let yf = col(out, var::WS_FRONT_Y)?;
-    let yr = col(out, var::WS_REAR_Y)?;
-    let tail_amplitude_m = half_peak_to_peak(&yf[tail..]).max(half_peak_to_peak(&yr[tail..]));
-    let max_displacement_m = max_abs(&yf[skip..]).max(max_abs(&yr[skip..]));
-    let mut peak_force_n = 0.0f64;
-    for name in [
-        var::FORCE_LEFT_DAMPER,
-        var::FORCE_RIGHT_DAMPER,
-        var::FORCE_LEFT_ACTUATOR,
-        var::FORCE_RIGHT_ACTUATOR,
-    ] {
-        if let Some(f) = out.column(name) {
-            peak_force_n = peak_force_n.max(max_abs(&f[skip..]));
+        let r = assess_lateral_acceleration(&a, fs, speed, BOGIE_MASS_T, &settings).map_err(
+            |source| MetricsError::Assess {
+                column: column.clone(),
+                source,
+            },
+        )?;
+        rms_by_signal.push(r.max_rms);
+        frequency_hz.get_or_insert(r.dominant_frequency_hz);
+    }
+    let frequency_hz = frequency_hz.ok_or(MetricsError::NoStabilitySignal)?;
+    let mut tail_amplitude_m = 0.0f64;
+    let mut max_displacement_m = 0.0f64;
+    for column in &signals.displacements {
+        let y = col(out, column)?;
+        tail_amplitude_m = tail_amplitude_m.max(half_peak_to_peak(&y[tail..]));
+        max_displacement_m = max_displacement_m.max(max_abs(&y[skip..]));
+    }
+    let peak_force_n = signals
+        .forces
+        .iter()
+        .filter_map(|name| out.column(name))
+        .fold(0.0f64, |m, f| m.max(max_abs(&f[skip..])));
+    // per actuator (the seed's Table 4-3 is per damper): mean of the dampers' rms
+    let rms_after_skip = |x: &[f64]| crate::signal::rms(&x[skip..]);
+    let rms_power_w = mean_over(out, &signals.powers, rms_after_skip);
+    let rms_hydraulic_power_w = mean_over(out, &signals.hydraulic_powers, rms_after_skip);
+    let tail_command_v = mean_over(out, &signals.commands, |x| mean(&x[tail..]));
+    let mut carbody_rms_mps2: Option<f64> = None;
+    let mut comfort_ny: Option<f64> = None;
+    for column in &signals.carbody {
+        let a = col(out, column)?;
+        let r = rms_after_skip(&a);
+        carbody_rms_mps2 = Some(carbody_rms_mps2.map_or(r, |m| m.max(r)));
+        // a run shorter than one 5 s comfort window after the skip has no comfort number
+        match lateral_comfort(&a, fs, spec.skip_s) {
+            Ok(c) => comfort_ny = Some(comfort_ny.map_or(c.n_y, |m| m.max(c.n_y))),
+            Err(ComfortError::TooShort { .. }) => {}
+            Err(source) => {
+                return Err(MetricsError::Comfort {
+                    column: column.clone(),
+                    source,
+                })
+            }
         }
     }
-    // per actuator (the seed's Table 4-3 is per damper): mean of the two sides' rms
-    let rms_sum = |left: &str, right: &str| match (out.column(left), out.column(right)) {
-        (Some(l), Some(r)) => {
-            Some((crate::signal::rms(&l[skip..]) + crate::signal::rms(&r[skip..])) / 2.0)
-        }
-        (Some(l), None) => Some(crate::signal::rms(&l[skip..])),
-        _ => None,
-    };
-    let rms_power_w = rms_sum(var::POWER_LEFT, var::POWER_RIGHT);
-    let rms_hydraulic_power_w = rms_sum(var::HYDRAULIC_POWER_LEFT, var::HYDRAULIC_POWER_RIGHT);
-    let tail_command_v = match (
-        out.column(var::COMMAND_LEFT),
-        out.column(var::COMMAND_RIGHT),
-    ) {
-        (Some(l), Some(r)) => Some((mean(&l[tail..]) + mean(&r[tail..])) / 2.0),
-        (Some(l), None) => Some(mean(&l[tail..])),
-        _ => None,
-    };
     Ok(RunMetrics {
-        rms_front,
-        rms_rear,
+        rms_by_signal,
         frequency_hz,
         tail_amplitude_m,
         max_displacement_m,
@@ -179,6 +219,8 @@ pub fn run_metrics(out: &SimOutput, spec: &MetricSpec) -> Result<RunMetrics, Met
         rms_power_w,
         rms_hydraulic_power_w,
         tail_command_v,
+        carbody_rms_mps2,
+        comfort_ny,
     })
 }
 
@@ -202,22 +244,28 @@ pub fn decimate(out: &SimOutput, factor: usize) -> SimOutput {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::study::vehicle::VehicleModel;
     use master::coupling::Summary;
     use std::f64::consts::PI;
+
+    fn bogie() -> Signals {
+        Signals::of(VehicleModel::Bogie2Dof)
+    }
 
     /// A synthetic run: hunting at `f` Hz with acceleration amplitude `acc` and displacement
     /// amplitude `acc / w^2`, sampled at 500 Hz for `t_end` s.
     pub(crate) fn synthetic(acc: f64, f: f64, t_end: f64, with_command: bool) -> SimOutput {
+        let b = bogie();
         let mut header: Vec<String> = vec![
             "time [s]".into(),
-            format!("{} [m]", var::WS_FRONT_Y),
-            format!("{} [m]", var::WS_REAR_Y),
-            format!("{} [m/s2]", var::WS_FRONT_ACC),
-            format!("{} [m/s2]", var::WS_REAR_ACC),
-            format!("{} [N]", var::FORCE_LEFT_DAMPER),
+            format!("{} [m]", b.displacements[0]),
+            format!("{} [m]", b.displacements[1]),
+            format!("{} [m/s2]", b.stability[0]),
+            format!("{} [m/s2]", b.stability[1]),
+            format!("{} [N]", b.forces[0]),
         ];
         if with_command {
-            header.push(format!("{} [V]", var::COMMAND_LEFT));
+            header.push(format!("{} [V]", b.commands[0]));
         }
         let fs = 500.0;
         let n = (t_end * fs) as usize + 1;
@@ -259,11 +307,18 @@ mod tests {
             tail_s: 4.0,
             speed_kmh: 300.0,
         };
-        let m = run_metrics(&out, &spec).unwrap();
+        let m = run_metrics(&out, &spec, &bogie()).unwrap();
         // a sine of amplitude 6 has rms 6/sqrt(2) = 4.24; the band-pass passes it
-        assert!((m.rms_front - 6.0 / 2f64.sqrt()).abs() < 0.1, "{m:?}");
-        assert!((m.rms_rear - 3.0 / 2f64.sqrt()).abs() < 0.1, "{m:?}");
-        assert!((m.rms() - m.rms_front).abs() < 1e-12);
+        assert!(
+            (m.rms_by_signal[0] - 6.0 / 2f64.sqrt()).abs() < 0.1,
+            "{m:?}"
+        );
+        assert!(
+            (m.rms_by_signal[1] - 3.0 / 2f64.sqrt()).abs() < 0.1,
+            "{m:?}"
+        );
+        assert!((m.rms() - m.rms_by_signal[0]).abs() < 1e-12);
+        assert_eq!((m.carbody_rms_mps2, m.comfort_ny), (None, None));
         assert!((m.frequency_hz - 4.0).abs() < 0.3, "{m:?}");
         let y = 6.0 / (2.0 * PI * 4.0).powi(2);
         assert!((m.tail_amplitude_m - y).abs() < 0.02 * y, "{m:?}");
@@ -282,15 +337,67 @@ mod tests {
             tail_s: 2.0,
             speed_kmh: 300.0,
         };
-        assert!(run_metrics(&out, &spec).unwrap().tail_command_v.is_none());
+        assert!(run_metrics(&out, &spec, &bogie())
+            .unwrap()
+            .tail_command_v
+            .is_none());
         out.header[3] = "other [m/s2]".into();
-        let e = run_metrics(&out, &spec).unwrap_err().to_string();
-        assert!(e.contains(var::WS_FRONT_ACC), "{e}");
+        let e = run_metrics(&out, &spec, &bogie()).unwrap_err().to_string();
+        assert!(e.contains(&bogie().stability[0]), "{e}");
         let short = synthetic(1.0, 4.0, 5.01, false);
         assert!(matches!(
-            run_metrics(&short, &spec),
+            run_metrics(&short, &spec, &bogie()),
             Err(MetricsError::TooShort { .. })
         ));
+    }
+
+    #[test]
+    fn car_body_columns_give_rms_and_comfort() {
+        // the bogie's synthetic run with a car-body floor signal of 0.3 m/s^2 at 1 Hz added
+        let mut out = synthetic(1.0, 4.0, 20.0, false);
+        let w = out.header.len();
+        let mut signals = bogie();
+        signals.carbody = vec!["vehicle.carbody.lateral_acceleration_mid".into()];
+        out.header.push(format!("{} [m/s2]", signals.carbody[0]));
+        let rows: Vec<Vec<f64>> = out
+            .data
+            .chunks(w)
+            .map(|r| {
+                let mut r = r.to_vec();
+                r.push(0.3 * (2.0 * PI * r[0]).sin());
+                r
+            })
+            .collect();
+        out.data = rows.concat();
+        let spec = MetricSpec {
+            skip_s: 5.0,
+            tail_s: 2.0,
+            speed_kmh: 300.0,
+        };
+        let m = run_metrics(&out, &spec, &signals).unwrap();
+        let rms = 0.3 / 2f64.sqrt();
+        assert!(
+            (m.carbody_rms_mps2.unwrap() - rms).abs() < 0.01 * rms,
+            "{m:?}"
+        );
+        // W_d(1 Hz) = 1.011
+        let ny = 6.0 * 1.011 * rms;
+        assert!((m.comfort_ny.unwrap() - ny).abs() < 0.02 * ny, "{m:?}");
+        // shorter than one comfort window after the skip: rms, but no comfort number
+        let short = MetricSpec {
+            skip_s: 16.0,
+            ..spec.clone()
+        };
+        let m = run_metrics(&out, &short, &signals).unwrap();
+        assert!(
+            m.carbody_rms_mps2.is_some() && m.comfort_ny.is_none(),
+            "{m:?}"
+        );
+        signals
+            .carbody
+            .push("vehicle.carbody.lateral_acceleration_front".into());
+        let e = run_metrics(&out, &spec, &signals).unwrap_err().to_string();
+        assert!(e.contains("lateral_acceleration_front"), "{e}");
     }
 
     #[test]

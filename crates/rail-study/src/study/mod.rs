@@ -1,7 +1,10 @@
-//! The stability study of the seed's chapter 4: passive, semi-active (MPPT1/2,
-//! sky-hook on/off and continuous, each with an ideal and a slow valve) and full-active (IDF)
-//! yaw dampers on the non-linear 2-dof bogie, assessed by the EN 14363 rms criterion.
+//! The stability study of the seed's chapter 4: passive, semi-active (MPPT1/2, sky-hook on/off
+//! and continuous, each with an ideal and a slow valve) and full-active (IDF) yaw dampers on
+//! the coach (default, four dampers) or the non-linear 2-dof bogie (the seed's HIL
+//! configuration, two dampers), assessed by the EN 14363 rms criterion, with the car body's
+//! lateral acceleration and ride comfort (EN 12299) on the coach.
 //!
+//! * [`vehicle`]: the two vehicle models, their signal names and the coach's generated systems.
 //! * [`config`]: the configurations (system descriptions in `systems/*.json`) and run requests.
 //! * [`settings`]: the full and the `--quick` study.
 //! * [`metrics`]: numbers of one run (EN 14363 rms, oscillation amplitude, peak force...).
@@ -9,7 +12,7 @@
 //! * [`run`]: runs the batches through [`master::runset`] (parallel, one folder per run).
 //! * [`report`]: CSVs, SVG charts and REPORT.md.
 //!
-//! From a test: `run_study(&StudySettings::quick(), &opts)` gives [`run::StudyResults`].
+//! From a test: `run_study(&StudySettings::quick(VehicleModel::Coach), &opts)` gives [`run::StudyResults`].
 
 pub mod config;
 pub mod critical;
@@ -17,9 +20,11 @@ pub mod metrics;
 pub mod report;
 pub mod run;
 pub mod settings;
+pub mod vehicle;
 
 pub use config::{Configuration, Sources, CONFIGURATIONS};
 pub use critical::Critical;
 pub use report::{write_outputs, Timing};
 pub use run::{run_study, StudyError, StudyOptions, StudyResults};
 pub use settings::StudySettings;
+pub use vehicle::VehicleModel;

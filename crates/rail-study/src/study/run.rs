@@ -16,11 +16,12 @@ use serde_json::Value;
 
 use crate::en14363::acceleration_limit;
 use crate::study::config::{
-    configuration, required_fmus, var, Configuration, Family, RunRequest, Sources,
+    configuration, required_fmus, Configuration, Family, RunRequest, Sources,
 };
 use crate::study::critical::{Critical, CurvePoint};
 use crate::study::metrics::{decimate, run_metrics, MetricSpec, RunMetrics, BOGIE_MASS_T};
 use crate::study::settings::StudySettings;
+use crate::study::vehicle::{Signals, VehicleModel};
 use master::coupling::SimOutput;
 use master::runset::{execute, run_job, Job, SweepError};
 use master::system::{PreparedSystem, RunError, SystemError};
@@ -60,8 +61,21 @@ pub struct StudyOptions<'a> {
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct SpeedPoint {
     pub speed_kmh: f64,
-    /// EN 14363 rms per seed (max over the wheelsets), `None` for a failed run.
+    /// EN 14363 rms per seed (max over the axle boxes), `None` for a failed run.
     pub per_seed: Vec<Option<f64>>,
+    /// Car-body floor lateral acceleration rms per seed (coach), `None` for a failed run or
+    /// without a car body [m/s^2].
+    pub carbody_per_seed: Vec<Option<f64>>,
+    /// EN 12299 lateral comfort N_y per seed (coach).
+    pub comfort_per_seed: Vec<Option<f64>>,
+}
+
+/// Max over seeds; `None` if any is missing (or there are none).
+fn max_all(v: &[Option<f64>]) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.iter().try_fold(0.0f64, |m, r| r.map(|r| m.max(r)))
 }
 
 impl SpeedPoint {
@@ -70,6 +84,16 @@ impl SpeedPoint {
         self.per_seed
             .iter()
             .try_fold(0.0f64, |m, r| r.map(|r| m.max(r)))
+    }
+
+    /// Car-body rms, max over seeds.
+    pub fn carbody_rms(&self) -> Option<f64> {
+        max_all(&self.carbody_per_seed)
+    }
+
+    /// N_y, max over seeds.
+    pub fn comfort(&self) -> Option<f64> {
+        max_all(&self.comfort_per_seed)
     }
 }
 
@@ -175,6 +199,8 @@ struct Executor<'a> {
     opts: &'a StudyOptions<'a>,
     /// Each configuration's system, prepared on its first run.
     prepared: HashMap<&'static str, PreparedSystem>,
+    /// The recorded signals the numbers are computed from.
+    signals: Signals,
     collected: Collected,
 }
 
@@ -186,7 +212,7 @@ impl Executor<'_> {
     /// Prepares the configuration's system unless done before.
     fn prepare(&mut self, c: &'static Configuration) -> Result<(), StudyError> {
         if !self.prepared.contains_key(c.id) {
-            let system = self.opts.sources.system(c)?;
+            let system = self.opts.sources.system(self.settings.vehicle, c)?;
             self.prepared
                 .insert(c.id, PreparedSystem::prepare(&system)?);
         }
@@ -234,12 +260,13 @@ impl Executor<'_> {
         let kept: Mutex<BTreeMap<String, SimOutput>> = Mutex::new(BTreeMap::new());
         let cancel = self.opts.cancel;
         let rate = self.settings.stored_rate_hz;
+        let signals = &self.signals;
         let runner = |job: &Job| -> Result<SimOutput, String> {
             let Some((spec, keep, system)) = specs.get(&job.name) else {
                 return Err(format!("internal: no metric spec for run '{}'", job.name));
             };
             let out = run_job(system, job, cancel)?;
-            let m = run_metrics(&out, spec).map_err(|e| e.to_string());
+            let m = run_metrics(&out, spec, signals).map_err(|e| e.to_string());
             lock(&metrics).insert(job.name.clone(), m);
             let factor = crate::study::metrics::sample_rate(&out)
                 .map_or(1, |fs| (fs / rate).round().max(1.0) as usize);
@@ -299,20 +326,23 @@ impl Executor<'_> {
     }
 
     fn speed_point(&self, c: &'static Configuration, speed: f64, prefix: &str) -> SpeedPoint {
-        let per_seed = self
+        let runs: Vec<Option<&RunMetrics>> = self
             .settings
             .seeds
             .iter()
             .map(|&s| {
                 let name = sweep_request(prefix, c, speed, s, self.settings).name;
-                self.metric(&name)
-                    .and_then(|m| m.as_ref().ok())
-                    .map(RunMetrics::rms)
+                self.metric(&name).and_then(|m| m.as_ref().ok())
             })
             .collect();
         SpeedPoint {
             speed_kmh: speed,
-            per_seed,
+            per_seed: runs.iter().map(|m| m.map(RunMetrics::rms)).collect(),
+            carbody_per_seed: runs
+                .iter()
+                .map(|m| m.and_then(|m| m.carbody_rms_mps2))
+                .collect(),
+            comfort_per_seed: runs.iter().map(|m| m.and_then(|m| m.comfort_ny)).collect(),
         }
     }
 }
@@ -324,7 +354,7 @@ fn sweep_request(
     seed: u32,
     s: &StudySettings,
 ) -> RunRequest {
-    RunRequest::new(prefix, c, speed, Some(seed), s.sweep_stop_s)
+    RunRequest::new(prefix, s.vehicle, c, speed, Some(seed), s.sweep_stop_s)
 }
 
 fn config_or_err(id: &str) -> Result<&'static Configuration, StudyError> {
@@ -362,18 +392,26 @@ fn is_mppt(c: &Configuration) -> bool {
     matches!(c.family, Family::Mppt1 | Family::Mppt2)
 }
 
+/// Every MPPT board starts from the command `v` [V].
 fn with_initial_command(r: RunRequest, c: &Configuration, v: f64) -> RunRequest {
     if is_mppt(c) {
-        r.with(var::MPPT_INITIAL_LEFT, Value::from(v))
-            .with(var::MPPT_INITIAL_RIGHT, Value::from(v))
+        let keys = r
+            .vehicle
+            .per_position("controller", "valve.initial_command");
+        keys.iter().fold(r, |r, k| r.with(k, Value::from(v)))
     } else {
         r
     }
 }
 
-/// Checks that every FMU the configurations need is there; names the first missing one.
-pub fn check_fmus(sources: &Sources, configs: &[&Configuration]) -> Result<(), StudyError> {
-    for name in required_fmus(configs) {
+/// Checks that every FMU the configurations need on `vehicle` is there; names the first
+/// missing one.
+pub fn check_fmus(
+    sources: &Sources,
+    vehicle: VehicleModel,
+    configs: &[&Configuration],
+) -> Result<(), StudyError> {
+    for name in required_fmus(vehicle, configs) {
         let p = sources.fmus.join(&name);
         if !p.is_file() {
             return Err(StudyError::MissingFmu {
@@ -417,13 +455,15 @@ pub fn run_study(
         .iter()
         .map(|id| config_or_err(id))
         .collect::<Result<_, _>>()?;
-    check_fmus(&opts.sources, &configurations_used(settings)?)?;
+    let vehicle = settings.vehicle;
+    check_fmus(&opts.sources, vehicle, &configurations_used(settings)?)?;
     let s = settings;
     let first_seed = s.seeds.first().copied().unwrap_or(1);
     let mut ex = Executor {
         settings,
         opts,
         prepared: HashMap::new(),
+        signals: Signals::of(vehicle),
         collected: Collected::default(),
     };
 
@@ -444,8 +484,18 @@ pub fn run_study(
         .perturbation_speeds_kmh
         .iter()
         .map(|&v| {
-            RunRequest::new("perturbation-", passive, v, None, s.perturbation_stop_s)
-                .with(var::INITIAL_LATERAL, Value::from(s.perturbation_lateral_m))
+            RunRequest::new(
+                "perturbation-",
+                vehicle,
+                passive,
+                v,
+                None,
+                s.perturbation_stop_s,
+            )
+            .with(
+                &vehicle.initial_lateral(),
+                Value::from(s.perturbation_lateral_m),
+            )
         })
         .collect();
     let full = config_or_err("full_active")?;
@@ -453,10 +503,17 @@ pub fn run_study(
         .cv_values_nspm
         .iter()
         .map(|&c_v| {
-            let r = RunRequest::new("cv-", full, s.cv_speed_kmh, Some(first_seed), s.cv_stop_s)
-                .named(&format!("cv-{:.0}", c_v / 1e3))
-                .with(var::CV_LEFT, Value::from(c_v))
-                .with(var::CV_RIGHT, Value::from(c_v));
+            let r = RunRequest::new(
+                "cv-",
+                vehicle,
+                full,
+                s.cv_speed_kmh,
+                Some(first_seed),
+                s.cv_stop_s,
+            )
+            .named(&format!("cv-{:.0}", c_v / 1e3));
+            let keys = vehicle.per_position("idf", "reference.damping");
+            let r = keys.iter().fold(r, |r, k| r.with(k, Value::from(c_v)));
             (r, c_v)
         })
         .collect();
@@ -465,6 +522,7 @@ pub fn run_study(
         let c = config_or_err(id)?;
         let r = RunRequest::new(
             "",
+            vehicle,
             c,
             s.history_speed_kmh,
             Some(first_seed),
@@ -478,6 +536,7 @@ pub fn run_study(
         let c = config_or_err(id)?;
         let r = RunRequest::new(
             "",
+            vehicle,
             c,
             s.mppt_low_speed_kmh,
             Some(first_seed),
@@ -490,9 +549,12 @@ pub fn run_study(
         // ideal track + initial perturbation: the final amplitude is then the hunting motion
         // alone (on the irregular track a stable bogie still moves 3-4 mm relative to the rails)
         let c = config_or_err(id)?;
-        let r = RunRequest::new("", c, s.hil_speed_kmh, None, s.scenario_stop_s)
+        let r = RunRequest::new("", vehicle, c, s.hil_speed_kmh, None, s.scenario_stop_s)
             .named(&scenario::hil(id))
-            .with(var::INITIAL_LATERAL, Value::from(s.perturbation_lateral_m));
+            .with(
+                &vehicle.initial_lateral(),
+                Value::from(s.perturbation_lateral_m),
+            );
         scenarios.push(with_initial_command(r, c, s.hil_initial_command_v));
     }
     for r in perturbation

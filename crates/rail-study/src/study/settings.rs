@@ -1,10 +1,14 @@
-//! What the study runs: the full default study and the reduced `--quick` one.
+//! What the study runs: the full default study and the reduced `--quick` one, on either
+//! vehicle model.
 
 use crate::study::config::CONFIGURATIONS;
+use crate::study::vehicle::VehicleModel;
 
 /// Everything that sizes the study.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct StudySettings {
+    /// The vehicle the dampers act on.
+    pub vehicle: VehicleModel,
     /// Configuration ids (see [`crate::study::config::CONFIGURATIONS`]).
     pub configurations: Vec<&'static str>,
     /// Speeds of the rms sweep [km/h].
@@ -19,7 +23,8 @@ pub struct StudySettings {
     pub tail_s: f64,
     /// Bisection of the critical speed down to this bracket width [km/h]; `None` = no bisection.
     pub bisection_tol_kmh: Option<f64>,
-    /// Initial-perturbation runs of the passive vehicle (seed Figs. 5.11-5.13, R7) [km/h].
+    /// Initial-perturbation runs of the passive vehicle (coach: Figs. 4.4-4.6, R16; bogie:
+    /// Figs. 5.11-5.13, R7) [km/h].
     pub perturbation_speeds_kmh: Vec<f64>,
     /// Initial lateral displacement of the bogie for those runs [m].
     pub perturbation_lateral_m: f64,
@@ -50,18 +55,28 @@ fn range(from: f64, to: f64, step: f64) -> Vec<f64> {
 }
 
 impl StudySettings {
-    /// The full study: 200-400 km/h in 10 km/h steps, 2 seeds, bisection to 2 km/h.
-    pub fn full() -> Self {
+    /// The full study: 200-400 km/h (coach: 200-440 km/h) in 10 km/h steps, 2 seeds,
+    /// bisection to 2 km/h.
+    pub fn full(vehicle: VehicleModel) -> Self {
         StudySettings {
+            vehicle,
             configurations: CONFIGURATIONS.iter().map(|c| c.id).collect(),
-            speeds_kmh: range(200.0, 400.0, 10.0),
+            // the coach's MPPT and full-active curves are still well under the limit at
+            // 400 km/h: 40 km/h more show where they end
+            speeds_kmh: match vehicle {
+                VehicleModel::Coach => range(200.0, 440.0, 10.0),
+                VehicleModel::Bogie2Dof => range(200.0, 400.0, 10.0),
+            },
             seeds: vec![1, 2],
             // 5 s start-up + 10 s assessed: 556 m (46 windows of 100 m) at 200 km/h
             sweep_stop_s: 15.0,
             skip_s: 5.0,
             tail_s: 3.0,
             bisection_tol_kmh: Some(2.0),
-            perturbation_speeds_kmh: vec![220.0, 285.0, 320.0],
+            perturbation_speeds_kmh: match vehicle {
+                VehicleModel::Coach => vec![240.0, 280.0, 300.0],
+                VehicleModel::Bogie2Dof => vec![220.0, 285.0, 320.0],
+            },
             perturbation_lateral_m: 3e-3,
             perturbation_stop_s: 10.0,
             cv_values_nspm: vec![210e3, 270e3, 330e3, 390e3],
@@ -76,18 +91,24 @@ impl StudySettings {
         }
     }
 
-    /// The reduced study for CI: 5 speeds (40 km/h apart), 1 seed, shorter runs, and a coarse
-    /// bisection to 10 km/h (two rounds of one run per configuration) so that the tests can
-    /// check critical speeds to +-10 km/h rather than +-40 km/h.
-    pub fn quick() -> Self {
+    /// The reduced study for CI: 1 seed, shorter runs. Bogie: 5 speeds (40 km/h apart) and a
+    /// coarse bisection to 10 km/h (two rounds of one run per configuration), so that the tests
+    /// can check critical speeds to +-10 km/h rather than +-40 km/h. Coach: 9 speeds (20 km/h
+    /// apart, to 440 km/h) and bisection to 5 km/h, so that its tests can check the passive
+    /// 280-300 km/h.
+    pub fn quick(vehicle: VehicleModel) -> Self {
+        let (speeds_kmh, tol) = match vehicle {
+            VehicleModel::Coach => (range(240.0, 440.0, 20.0), 5.0),
+            VehicleModel::Bogie2Dof => (vec![240.0, 280.0, 320.0, 360.0, 400.0], 10.0),
+        };
         StudySettings {
-            speeds_kmh: vec![240.0, 280.0, 320.0, 360.0, 400.0],
+            speeds_kmh,
             seeds: vec![1],
             sweep_stop_s: 12.0,
-            bisection_tol_kmh: Some(10.0),
+            bisection_tol_kmh: Some(tol),
             perturbation_stop_s: 8.0,
             cv_stop_s: 12.0,
-            ..Self::full()
+            ..Self::full(vehicle)
         }
     }
 
@@ -105,7 +126,7 @@ mod tests {
 
     #[test]
     fn full_and_quick_sizes() {
-        let f = StudySettings::full();
+        let f = StudySettings::full(VehicleModel::Bogie2Dof);
         assert_eq!(f.speeds_kmh.len(), 21);
         assert_eq!(f.speeds_kmh[0], 200.0);
         assert_eq!(f.speeds_kmh[20], 400.0);
@@ -113,8 +134,15 @@ mod tests {
         // several 100 m windows after the skip at the lowest speed
         let assessed_m = (f.sweep_stop_s - f.skip_s) * f.speeds_kmh[0] / 3.6;
         assert!(assessed_m >= 500.0, "{assessed_m}");
-        let q = StudySettings::quick();
+        let q = StudySettings::quick(VehicleModel::Bogie2Dof);
         assert!(q.planned_runs() < f.planned_runs() / 4);
+        let c = StudySettings::quick(VehicleModel::Coach);
+        assert_eq!(c.speeds_kmh.len(), 11);
+        assert!(c.planned_runs() < f.planned_runs() / 2);
+        assert_eq!(
+            StudySettings::full(VehicleModel::Coach).perturbation_speeds_kmh,
+            [240.0, 280.0, 300.0]
+        );
         assert!(q.bisection_tol_kmh.unwrap() > f.bisection_tol_kmh.unwrap());
         let assessed_m = (q.sweep_stop_s - q.skip_s) * q.speeds_kmh[0] / 3.6;
         assert!(assessed_m >= 300.0, "{assessed_m}");

@@ -4,11 +4,12 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::plot::Chart;
-use crate::study::config::{configuration, var};
+use crate::study::config::configuration;
 use crate::study::critical::Critical;
 use crate::study::run::{
-    scenario, ConfigResult, StudyError, StudyResults, HIL_CONFIGS, HISTORY_CONFIGS,
+    scenario, ConfigResult, SpeedPoint, StudyError, StudyResults, HIL_CONFIGS, HISTORY_CONFIGS,
 };
+use crate::study::vehicle::{Signals, VehicleModel};
 use master::output::{write_bytes_atomic, write_csv_atomic, write_json_atomic};
 
 /// Timing of the whole study, measured by the caller.
@@ -95,6 +96,25 @@ fn history_chart(
     Ok(Some(stem.to_string()))
 }
 
+/// Writes a CSV of text cells (quoted where needed).
+fn write_text_csv(path: &Path, header: &[String], rows: &[Vec<String>]) -> Result<(), StudyError> {
+    master::output::write_atomic(path, |w| {
+        let line = |w: &mut dyn std::io::Write, f: &[String]| {
+            let l: Vec<String> = f.iter().map(|x| master::output::csv_field(x)).collect();
+            writeln!(w, "{}", l.join(",")).map_err(|source| master::output::OutputError::Io {
+                path: path.to_path_buf(),
+                source,
+            })
+        };
+        line(w, header)?;
+        for row in rows {
+            line(w, row)?;
+        }
+        Ok(())
+    })?;
+    Ok(())
+}
+
 fn fmt_opt(v: Option<f64>, scale: f64, prec: usize) -> String {
     v.map_or("failed".to_string(), |x| format!("{:.*}", prec, x * scale))
 }
@@ -108,15 +128,34 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     // the numbers first: a plotting problem must not lose them
     write_json_atomic(&out.join("study.json"), r)?;
     let mut figures: Vec<(String, &str)> = Vec::new();
+    let vehicle = r.settings.vehicle;
+    let signals = Signals::of(vehicle);
+    let coach = vehicle == VehicleModel::Coach;
 
-    // ---- rms vs speed (Fig. 4.24)
+    // ---- rms vs speed (Fig. 4.24), car body vs speed (coach)
     let mut rows: Vec<Vec<String>> = Vec::new();
     let mut chart = Chart::new(
-        "EN 14363 rms of the wheelset lateral acceleration vs speed",
+        if coach {
+            "EN 14363 rms of the frame lateral acceleration over the axle boxes vs speed"
+        } else {
+            "EN 14363 rms of the wheelset lateral acceleration vs speed"
+        },
         "speed [km/h]",
         "max sliding rms, band-passed [m/s^2]",
     )
     .with_limit(r.limit_mps2, &format!("a_lim = {:.2} m/s^2", r.limit_mps2));
+    let mut carbody_chart = Chart::new(
+        "car-body floor lateral acceleration vs speed (largest of front, mid, rear)",
+        "speed [km/h]",
+        "rms [m/s^2]",
+    );
+    let mut comfort_chart = Chart::new(
+        "EN 12299 lateral ride comfort vs speed (W_d, largest of front, mid, rear)",
+        "speed [km/h]",
+        "N_y = 6 a_YP95 [-]",
+    );
+    let num = |v: Option<f64>| v.map_or("failed".into(), |v| format!("{v:.4}"));
+    let (mut carbody_rows, mut comfort_rows) = (Vec::new(), Vec::new());
     for c in &r.configs {
         let pts: Vec<(f64, f64)> = c
             .curve()
@@ -126,19 +165,43 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         if !pts.is_empty() {
             chart = chart.with_series(c.label, pts);
         }
+        let by_speed = |f: fn(&SpeedPoint) -> Option<f64>| -> Vec<(f64, f64)> {
+            let mut v: Vec<(f64, f64)> = c
+                .sweep
+                .iter()
+                .chain(&c.bisection)
+                .filter_map(|p| f(p).map(|x| (p.speed_kmh, x)))
+                .collect();
+            v.sort_by(|a, b| a.0.total_cmp(&b.0));
+            v
+        };
+        let cb = by_speed(SpeedPoint::carbody_rms);
+        let ny = by_speed(SpeedPoint::comfort);
+        for (v, x) in &cb {
+            carbody_rows.push(vec![c.id.to_string(), format!("{v}"), format!("{x:.4}")]);
+        }
+        for (v, x) in &ny {
+            comfort_rows.push(vec![c.id.to_string(), format!("{v}"), format!("{x:.4}")]);
+        }
+        if !cb.is_empty() {
+            carbody_chart = carbody_chart.with_series(c.label, cb);
+        }
+        if !ny.is_empty() {
+            comfort_chart = comfort_chart.with_series(c.label, ny);
+        }
         for (kind, pts) in [("sweep", &c.sweep), ("bisection", &c.bisection)] {
             for p in pts.iter() {
                 let mut row = vec![
                     c.id.to_string(),
                     kind.to_string(),
                     format!("{}", p.speed_kmh),
-                    p.rms().map_or("failed".into(), |v| format!("{v:.4}")),
+                    num(p.rms()),
                 ];
-                row.extend(
-                    p.per_seed
-                        .iter()
-                        .map(|v| v.map_or("failed".into(), |v| format!("{v:.4}"))),
-                );
+                row.extend(p.per_seed.iter().map(|v| num(*v)));
+                if coach {
+                    row.push(num(p.carbody_rms()));
+                    row.push(num(p.comfort()));
+                }
                 rows.push(row);
             }
         }
@@ -153,25 +216,41 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             .iter()
             .map(|s| format!("rms seed {s} [m/s2]")),
     );
-    master::output::write_atomic(&out.join("rms_vs_speed.csv"), |w| {
-        let line = |w: &mut dyn std::io::Write, f: &[String]| {
-            let l: Vec<String> = f.iter().map(|x| master::output::csv_field(x)).collect();
-            writeln!(w, "{}", l.join(",")).map_err(|source| master::output::OutputError::Io {
-                path: out.join("rms_vs_speed.csv"),
-                source,
-            })
-        };
-        line(w, &header)?;
-        for row in &rows {
-            line(w, row)?;
-        }
-        Ok(())
-    })?;
+    if coach {
+        header.push("car-body rms max [m/s2]".into());
+        header.push("comfort N_y max [-]".into());
+    }
+    write_text_csv(&out.join("rms_vs_speed.csv"), &header, &rows)?;
     if !r.configs.is_empty() {
         chart.write_lines(&out.join("rms_vs_speed.svg"))?;
         figures.push((
             "rms_vs_speed".into(),
             "rms vs speed, all configurations, a_lim dashed (Figs. 4.13, 4.23, 4.24)",
+        ));
+    }
+    if coach && !r.configs.is_empty() {
+        let head = |what: &str| -> Vec<String> {
+            vec!["configuration".into(), "speed [km/h]".into(), what.into()]
+        };
+        write_text_csv(
+            &out.join("carbody_vs_speed.csv"),
+            &head("car-body rms max [m/s2]"),
+            &carbody_rows,
+        )?;
+        write_text_csv(
+            &out.join("comfort_vs_speed.csv"),
+            &head("comfort N_y max [-]"),
+            &comfort_rows,
+        )?;
+        carbody_chart.write_lines(&out.join("carbody_vs_speed.svg"))?;
+        comfort_chart.write_lines(&out.join("comfort_vs_speed.svg"))?;
+        figures.push((
+            "carbody_vs_speed".into(),
+            "car-body floor lateral acceleration rms vs speed, max over seeds",
+        ));
+        figures.push((
+            "comfort_vs_speed".into(),
+            "EN 12299 lateral comfort N_y vs speed, max over seeds",
         ));
     }
 
@@ -187,12 +266,41 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         .cloned()
         .collect();
     let title = |what: &str| format!("{what} at {v_hist:.0} km/h, irregular track");
-    for (stem, what, ylab, col, scale, runs, caption) in [
-        ("history_displacement", "front wheelset lateral displacement relative to the track", "displacement [mm]", var::WS_FRONT_Y, 1e3, &hist_runs, "wheelset displacement, passive / MPPT2 / sky-hook / full-active (Figs. 4.18, 4.21, 4.25)"),
-        ("history_acceleration", "front wheelset lateral acceleration", "acceleration [m/s^2]", var::WS_FRONT_ACC, 1.0, &hist_runs, "wheelset acceleration (Figs. 4.18, 4.21, 4.26)"),
-        ("history_force", "left yaw damper force", "force [kN]", var::FORCE_LEFT_DAMPER, 1e-3, &semi_runs, "damper force (Figs. 4.18, 4.21)"),
-        ("history_command", "left valve command", "command [V]", var::COMMAND_LEFT, 1.0, &semi_runs, "valve command MPPT2 vs sky-hook (Figs. 4.18, 4.21)"),
-    ] {
+    let ws_y = signals.displacements[0].as_str();
+    let acc = signals.stability[0].as_str();
+    let (acc_what, damper_what) = if coach {
+        (
+            "front frame lateral acceleration over the leading axle",
+            "front-left yaw damper force",
+        )
+    } else {
+        (
+            "front wheelset lateral acceleration",
+            "left yaw damper force",
+        )
+    };
+    let force = vehicle.first("damper", "damper.force");
+    let command = vehicle.first("controller", "valve.command");
+    let opening = vehicle.first("damper", "valve.opening");
+    let carbody_mid = signals.carbody.get(1).cloned().unwrap_or_default();
+    let mut histories = vec![
+        ("history_displacement", "leading wheelset lateral displacement relative to the track", "displacement [mm]", ws_y, 1e3, &hist_runs, "wheelset displacement, passive / MPPT2 / sky-hook / full-active (Figs. 4.18, 4.21, 4.25)"),
+        ("history_acceleration", acc_what, "acceleration [m/s^2]", acc, 1.0, &hist_runs, "EN 14363 acceleration (Figs. 4.18, 4.21, 4.26)"),
+        ("history_force", damper_what, "force [kN]", force.as_str(), 1e-3, &semi_runs, "damper force (Figs. 4.18, 4.21)"),
+        ("history_command", "first damper's valve command", "command [V]", command.as_str(), 1.0, &semi_runs, "valve command MPPT2 vs sky-hook (Figs. 4.18, 4.21)"),
+    ];
+    if coach {
+        histories.push((
+            "history_carbody",
+            "car-body floor lateral acceleration at mid-length",
+            "acceleration [m/s^2]",
+            carbody_mid.as_str(),
+            1.0,
+            &hist_runs,
+            "what each damper concept transmits to the car body (the seed's future work)",
+        ));
+    }
+    for (stem, what, ylab, col, scale, runs, caption) in histories {
         if let Some(s) = history_chart(r, out, stem, &title(what), ylab, runs, col, scale)? {
             figures.push((s, caption));
         }
@@ -200,8 +308,8 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     // full-active force tracking (Fig. 4.27)
     let fa = scenario::history("full_active");
     if let (Some(f), Some(fr)) = (
-        series(r, &fa, var::FORCE_LEFT_ACTUATOR, 1e-3),
-        series(r, &fa, var::FORCE_REFERENCE_LEFT, 1e-3),
+        series(r, &fa, &vehicle.first("actuator", "damper.force"), 1e-3),
+        series(r, &fa, &vehicle.first("idf", "reference.force"), 1e-3),
     ) {
         let t_end = f.last().map_or(0.0, |p| p.0);
         let zoom = |s: &[(f64, f64)]| from_time(s, t_end - 2.0);
@@ -233,10 +341,10 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     let mut chart = Chart::new(
         "passive, ideal track, initial lateral displacement",
         "time [s]",
-        "front wheelset lateral displacement relative to the track [mm]",
+        "leading wheelset lateral displacement relative to the track [mm]",
     );
     for p in &r.perturbation {
-        if let Some(s) = series(r, &p.name, var::WS_FRONT_Y, 1e3) {
+        if let Some(s) = series(r, &p.name, ws_y, 1e3) {
             let label = format!("{:.0} km/h", p.speed_kmh);
             chart = chart.with_series(&label, s.clone());
             pert_cols.push((format!("{label}: displacement [mm]"), s));
@@ -247,7 +355,11 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         chart.write_lines(&out.join("perturbation.svg"))?;
         figures.push((
             "perturbation".into(),
-            "initial-perturbation runs, passive, 220/285/320 km/h (Figs. 5.11-5.13, R7)",
+            if coach {
+                "initial-perturbation runs, passive coach, 240/280/300 km/h (Figs. 4.4-4.6, R16)"
+            } else {
+                "initial-perturbation runs, passive, 220/285/320 km/h (Figs. 5.11-5.13, R7)"
+            },
         ));
     }
 
@@ -265,7 +377,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         &format!("MPPT valve command from a closed valve at {v_low:.0} km/h"),
         "command [V]",
         &low_runs,
-        var::COMMAND_LEFT,
+        &command,
         1.0,
     )? {
         figures.push((
@@ -292,7 +404,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         ),
         "command [V]",
         &mppt_hil,
-        var::COMMAND_LEFT,
+        &command,
         1.0,
     )? {
         figures.push((
@@ -305,11 +417,11 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         out,
         "slow_valve_displacement",
         &format!(
-            "slow valve at {v_hil:.0} km/h: front wheelset displacement relative to the track"
+            "slow valve at {v_hil:.0} km/h: leading wheelset displacement relative to the track"
         ),
         "displacement [mm]",
         &hil_runs,
-        var::WS_FRONT_Y,
+        ws_y,
         1e3,
     )? {
         figures.push((
@@ -321,10 +433,10 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         r,
         out,
         "slow_valve_opening",
-        &format!("slow valve at {v_hil:.0} km/h: actual valve opening (left)"),
+        &format!("slow valve at {v_hil:.0} km/h: actual valve opening (first damper)"),
         "opening [-]",
         &hil_runs,
-        var::OPENING_LEFT,
+        &opening,
         1.0,
     )? {
         figures.push((
@@ -336,8 +448,8 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     // Fig. 5.25: zoom on the on/off sky-hook's command and the valve's actual opening
     let slow = scenario::hil("skyhook_onoff_slow");
     if let (Some(cmd), Some(open)) = (
-        series(r, &slow, var::COMMAND_LEFT, 0.1),
-        series(r, &slow, var::OPENING_LEFT, 1.0),
+        series(r, &slow, &command, 0.1),
+        series(r, &slow, &opening, 1.0),
     ) {
         let t_end = cmd.last().map_or(0.0, |p| p.0);
         let zoom = |s: &[(f64, f64)]| from_time(s, t_end - 1.0);
@@ -422,4 +534,7 @@ mod markdown;
 #[cfg(test)]
 mod tests;
 
-pub use markdown::{gain_over_passive, report_markdown, within_limit_above, DIFFERENCES};
+pub use markdown::{
+    comfort_speeds, gain_over_passive, report_markdown, within_limit_above, DIFFERENCES,
+    DIFFERENCES_COACH,
+};

@@ -3,12 +3,12 @@ use crate::study::critical::Critical;
 use crate::study::metrics::RunMetrics;
 use crate::study::run::{ConfigResult, NamedRun, SpeedPoint};
 use crate::study::settings::StudySettings;
+use crate::study::vehicle::VehicleModel;
 use std::collections::BTreeMap;
 
 fn metrics(rms: f64, amp: f64, cmd: Option<f64>) -> RunMetrics {
     RunMetrics {
-        rms_front: rms,
-        rms_rear: rms * 0.9,
+        rms_by_signal: vec![rms, rms * 0.9],
         frequency_hz: 4.0,
         tail_amplitude_m: amp,
         max_displacement_m: amp * 1.2,
@@ -16,10 +16,16 @@ fn metrics(rms: f64, amp: f64, cmd: Option<f64>) -> RunMetrics {
         rms_power_w: Some(250.0),
         rms_hydraulic_power_w: Some(8000.0),
         tail_command_v: cmd,
+        carbody_rms_mps2: None,
+        comfort_ny: None,
     }
 }
 
 fn results() -> StudyResults {
+    results_on(VehicleModel::Bogie2Dof)
+}
+
+fn results_on(vehicle: VehicleModel) -> StudyResults {
     let cfg = |id: &'static str, k: Critical| {
         let c = configuration(id).unwrap();
         ConfigResult {
@@ -31,10 +37,14 @@ fn results() -> StudyResults {
                 SpeedPoint {
                     speed_kmh: 280.0,
                     per_seed: vec![Some(3.0), Some(2.0)],
+                    carbody_per_seed: vec![Some(0.2), Some(0.25)],
+                    comfort_per_seed: vec![Some(1.5), Some(1.25)],
                 },
                 SpeedPoint {
                     speed_kmh: 290.0,
                     per_seed: vec![Some(6.0), None],
+                    carbody_per_seed: vec![Some(0.5), None],
+                    comfort_per_seed: vec![Some(3.0), None],
                 },
             ],
             bisection: vec![],
@@ -53,7 +63,10 @@ fn results() -> StudyResults {
             }
         };
     StudyResults {
-        settings: StudySettings::quick(),
+        settings: StudySettings {
+            speeds_kmh: vec![280.0, 290.0],
+            ..StudySettings::quick(vehicle)
+        },
         limit_mps2: 5.39,
         configs: vec![
             cfg(
@@ -126,6 +139,8 @@ fn speeds_within_the_limit_above_a_burst_are_listed_as_ranges() {
     let point = |v: f64, rms: Option<f64>| SpeedPoint {
         speed_kmh: v,
         per_seed: vec![rms],
+        carbody_per_seed: vec![],
+        comfort_per_seed: vec![],
     };
     let mut c = results().configs.remove(0);
     c.sweep = vec![
@@ -180,4 +195,55 @@ fn outputs_are_written_even_without_time_histories() {
         "{csv}"
     );
     assert!(!d.path().join("history_displacement.svg").exists());
+}
+
+#[test]
+fn the_coach_report_has_the_car_body_beside_the_en14363_verdict() {
+    let r = results_on(VehicleModel::Coach);
+    assert_eq!(comfort_speeds(&r), [280.0, 290.0]);
+    let md = report_markdown(
+        &r,
+        &Timing {
+            wall_s: 1.0,
+            threads: 1,
+        },
+        &[],
+    );
+    for s in [
+        "on the coach",
+        "## Car body: lateral acceleration and ride comfort",
+        "| passive (30 %) | 280 | 3.00 | met | 0.250 | 1.50 |",
+        "| passive (30 %) | 290 | failed | run failed | failed | failed |",
+        "R16, Figs. 4.4-4.6",
+        DIFFERENCES_COACH,
+    ] {
+        assert!(md.contains(s), "missing {s:?} in\n{md}");
+    }
+    assert!(!report_markdown(
+        &results(),
+        &Timing {
+            wall_s: 1.0,
+            threads: 1
+        },
+        &[]
+    )
+    .contains("Car body"));
+    let d = tempfile::tempdir().unwrap();
+    write_outputs(
+        &r,
+        d.path(),
+        &Timing {
+            wall_s: 1.0,
+            threads: 1,
+        },
+    )
+    .unwrap();
+    for f in ["carbody_vs_speed.svg", "comfort_vs_speed.svg"] {
+        assert!(d.path().join(f).exists(), "{f}");
+    }
+    let csv = std::fs::read_to_string(d.path().join("rms_vs_speed.csv")).unwrap();
+    assert!(
+        csv.contains("passive,sweep,280,3.0000,3.0000,2.0000,0.2500,1.5000"),
+        "{csv}"
+    );
 }
