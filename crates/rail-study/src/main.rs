@@ -26,7 +26,7 @@ enum Command {
     Generic(GenericCommand),
     /// Characterise the yaw dampers: hysteresis loops, FRFs, equivalent stiffness and damping.
     Characterise(commands::characterise::Args),
-    /// Eigenvalues of the linear bogie over speed: root locus, critical speed, hunting frequency.
+    /// Eigenvalues of the linear coach or bogie over speed: root locus, critical speed, mode.
     RootLocus(commands::root_locus::Args),
     /// Wheel/rail contact geometry from profiles: delta r, contact angles, equivalent conicity.
     ContactGeometry(commands::contact_geometry::Args),

@@ -528,6 +528,8 @@ fn root_locus_passive_gives_r5_r6() {
     let out = d.path().join("rl");
     let r = master(&[
         "root-locus",
+        "--model",
+        "bogie2dof",
         "--from",
         "150",
         "--to",
@@ -582,6 +584,8 @@ fn root_locus_damper_options() {
     let run = |damper: &str| {
         master(&[
             "root-locus",
+            "--model",
+            "bogie2dof",
             "--from",
             "100",
             "--to",
@@ -610,6 +614,68 @@ fn root_locus_damper_options() {
     );
     let r = master(&["root-locus", "--from", "300", "--to", "200"]);
     assert!(!r.ok && r.stderr.contains("--to"), "{}", r.stderr);
+}
+
+/// `master root-locus` on the coach (the default model): R15 and the mode named, a soft
+/// mounting moves the critical speed (5 MN/m: 285 -> 310 km/h), bad mounting options are
+/// refused.
+#[test]
+fn root_locus_of_the_coach_gives_r15_and_the_mode() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("rl");
+    let run = |extra: &[&str]| {
+        let mut a = vec![
+            "root-locus",
+            "--from",
+            "250",
+            "--to",
+            "320",
+            "--step",
+            "10",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        a.extend_from_slice(extra);
+        master(&a)
+    };
+    let r = run(&[]);
+    assert!(r.ok, "{}\n{}", r.stdout, r.stderr);
+    check_files(
+        &out,
+        &[
+            "root_locus_eigenvalues.csv",
+            "root_locus_least_damped.csv",
+            "root_locus.svg",
+            "root_locus_zoom.svg",
+            "damping_ratio.svg",
+            "hunting_frequency.svg",
+        ],
+    );
+    let v = number_after(&r.stdout, "linear critical speed:");
+    assert!((280.0..=290.0).contains(&v), "V_cr {v} km/h (R15 280-290)");
+    assert!(
+        r.stdout.contains("mode at onset: bogie hunting"),
+        "{}",
+        r.stdout
+    );
+    let f = number_after(&r.stdout, "rad/s, frequency");
+    assert!((3.0..=5.0).contains(&f), "{f} Hz");
+    let soft = run(&["--mounting-stiffness", "5e6"]);
+    assert!(soft.ok, "{}", soft.stderr);
+    let v_soft = number_after(&soft.stdout, "linear critical speed:");
+    assert!(v_soft > v + 15.0, "{v_soft} vs {v}");
+    let bad = run(&["--model", "bogie2dof", "--mounting-stiffness", "5e6"]);
+    assert!(
+        !bad.ok && bad.stderr.contains("--mounting-stiffness"),
+        "{}",
+        bad.stderr
+    );
+    let bad = run(&["--mounting-stiffness", "0"]);
+    assert!(
+        !bad.ok && bad.stderr.contains("--mounting-stiffness"),
+        "{}",
+        bad.stderr
+    );
 }
 
 /// `master assess` on a synthetic record (two signals, one over the limit) and on bad input.

@@ -10,6 +10,8 @@
 //!   `fmu-damper`).
 //! * [`geometry`]: wheel/rail contact tables and equivalent conicity (crate `wheel-rail`).
 //! * [`locus`]: eigenvalues of the linear bogie over speed (crate `fmu-bogie2dof`).
+//! * [`vehicle_locus`]: eigenvalues of the linear coach over speed, modes named (crate
+//!   `fmu-vehicle`).
 //! * [`assess`]: EN 14363 assessment of recorded signals (ours or a host's export).
 
 use std::path::{Path, PathBuf};
@@ -23,6 +25,7 @@ pub mod damper;
 pub mod figures;
 pub mod geometry;
 pub mod locus;
+pub mod vehicle_locus;
 
 /// Failure of an analysis. Messages name the model, file or option concerned.
 #[derive(Debug, thiserror::Error)]

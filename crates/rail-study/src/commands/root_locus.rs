@@ -1,20 +1,27 @@
-//! `master root-locus`: eigenvalues of the linear bogie over speed, linear critical speed and
-//! hunting frequency (computation in [`crate::analysis::locus`]).
+//! `master root-locus`: eigenvalues of the linear coach (`--model vehicle`, default) or the
+//! linear 2-dof bogie (`--model bogie2dof`) over speed, linear critical speed and the mode at
+//! onset (computation in [`crate::analysis::vehicle_locus`] and [`crate::analysis::locus`]).
 
 use std::path::PathBuf;
 
 use fmu_bogie2dof::Params;
+use fmu_vehicle::VehicleParams;
 
 use super::{failed, write_analysis};
 use crate::analysis::locus::{parse_damper, root_locus, speed_grid_kmh, DamperSpec};
+use crate::analysis::vehicle_locus::vehicle_root_locus;
+use crate::study::VehicleModel;
 use master::cli::{CommandError, Context};
 
 /// Options of `master root-locus` (the description shown by `--help` is the `after_help`).
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Eigenvalues of the linear 2-dof bogie (calibrated fmu-bogie2dof parameters) over speed. Prints the linear critical speed (bisection) and the hunting frequency at onset next to the seed's (270 km/h, about 21 rad/s, 3-4 Hz).\n\nFiles: root_locus_eigenvalues.csv (every eigenvalue per speed: real, imaginary, frequency, damping ratio, hunting flag), root_locus_hunting.csv, root_locus.svg and root_locus_zoom.svg (points coloured by speed, hunting mode ringed), damping_ratio.svg, hunting_frequency.svg."
+    after_help = "Eigenvalues of the linear coach (calibrated fmu-vehicle parameters, --model vehicle) or of the linear 2-dof bogie (calibrated fmu-bogie2dof parameters, --model bogie2dof) over speed. Prints the linear critical speed (bisection) and the mode at onset next to the seed's (coach: 280-290 km/h, R15; bogie: 270 km/h, about 21 rad/s, 3-4 Hz).\n\nFiles: root_locus_eigenvalues.csv (every eigenvalue per speed: real, imaginary, frequency, damping ratio, flag of the hunting / least-damped mode), root_locus_hunting.csv (bogie) or root_locus_least_damped.csv (coach: with the mode's kinetic-energy shares and name), root_locus.svg and root_locus_zoom.svg (points coloured by speed, the mode ringed), damping_ratio.svg, hunting_frequency.svg."
 )]
 pub struct Args {
+    /// Linear model: the coach (`vehicle`) or the 2-dof bogie (`bogie2dof`).
+    #[arg(long, value_enum, default_value = "vehicle")]
+    pub model: VehicleModel,
     /// First speed [km/h].
     #[arg(long, value_name = "KMH", default_value_t = 100.0)]
     pub from: f64,
@@ -24,11 +31,15 @@ pub struct Args {
     /// Speed step [km/h].
     #[arg(long, value_name = "KMH", default_value_t = 5.0)]
     pub step: f64,
-    /// Yaw damper per side: `passive` (the calibrated Maxwell representation of the coupled
-    /// 30 % passive damper), `viscous:C`, `maxwell:K:C`, `kelvin:K:C` (N/m, N s/m; 120k =
-    /// 120e3) or `none`.
+    /// Yaw damper (each of them): `passive` (the calibrated Maxwell representation of the
+    /// coupled 30 % passive damper), `viscous:C`, `maxwell:K:C`, `kelvin:K:C` (N/m, N s/m;
+    /// 120k = 120e3) or `none`.
     #[arg(long, default_value = "passive", value_parser = parse_damper)]
     pub damper: DamperSpec,
+    /// Mounting (series) stiffness of each yaw damper's installation [N/m], coach only
+    /// [default: rigid].
+    #[arg(long, value_name = "N_PER_M")]
+    pub mounting_stiffness: Option<f64>,
     /// Equivalent conicity of the linear model [default: the calibrated value].
     #[arg(long)]
     pub conicity: Option<f64>,
@@ -39,10 +50,35 @@ pub struct Args {
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     let speeds = speed_grid_kmh(args.from, args.to, args.step).map_err(failed)?;
-    let mut params = Params::default();
-    if let Some(c) = args.conicity {
-        params.conicity = c;
+    if let Some(k) = args.mounting_stiffness {
+        if !(k.is_finite() && k > 0.0) {
+            return Err(CommandError::Failed(format!(
+                "invalid option --mounting-stiffness = {k}: must be a finite stiffness > 0 N/m"
+            )));
+        }
     }
-    let r = root_locus(&params, args.damper, &speeds).map_err(failed)?;
-    write_analysis(&args.out, ctx.cancel, &r.summary(), |f| r.add_artefacts(f))
+    match args.model {
+        VehicleModel::Coach => {
+            let mut params = VehicleParams::default();
+            if let Some(c) = args.conicity {
+                params.wheel_rail.conicity = c;
+            }
+            let r = vehicle_root_locus(&params, args.damper, args.mounting_stiffness, &speeds)
+                .map_err(failed)?;
+            write_analysis(&args.out, ctx.cancel, &r.summary(), |f| r.add_artefacts(f))
+        }
+        VehicleModel::Bogie2Dof => {
+            if args.mounting_stiffness.is_some() {
+                return Err(CommandError::Failed(
+                    "--mounting-stiffness applies to --model vehicle only".into(),
+                ));
+            }
+            let mut params = Params::default();
+            if let Some(c) = args.conicity {
+                params.conicity = c;
+            }
+            let r = root_locus(&params, args.damper, &speeds).map_err(failed)?;
+            write_analysis(&args.out, ctx.cancel, &r.summary(), |f| r.add_artefacts(f))
+        }
+    }
 }

@@ -1,0 +1,328 @@
+//! Root locus of the linear coach over speed, through `fmu_vehicle::eigen`: every eigenvalue per
+//! speed, the least-damped oscillatory mode named by its kinetic-energy shares (bogie or
+//! car-body hunting), the linear critical speed by bisection with the mode that crosses (R15).
+//!
+//! The default damper is the coach crate's representation of the passive reference damper
+//! ([`fmu_vehicle::calibration::passive_damper`]: the Maxwell element of the 2-dof bogie's
+//! calibration, on all four dampers), optionally behind a mounting (series) stiffness of the
+//! installation.
+
+use fmu_vehicle::calibration::passive_damper;
+use fmu_vehicle::eigen::{
+    analyse, critical_speed, CriticalSpeed, DamperRepresentation, EigenError, EigenResult, Mode,
+    YawDamperModel,
+};
+use fmu_vehicle::VehicleParams;
+
+use super::figures::ColourScatter;
+use super::locus::DamperSpec;
+use super::{AnalysisError, Artefacts, Table};
+use crate::plot::Chart;
+
+/// Seed R15: linear critical speed of the coach with the passive reference damper [km/h].
+pub const SEED_R15_KMH: (f64, f64) = (280.0, 290.0);
+/// Speed range searched for the critical speed [m/s] (the coach accepts up to 200).
+pub const CRITICAL_SEARCH_MPS: (f64, f64) = (5.0, 199.0);
+
+/// The damper of the coach's linear model for a spec: the spec behind `mounting_n_per_m`.
+pub fn damper_model(spec: DamperSpec, mounting_n_per_m: Option<f64>) -> YawDamperModel {
+    let representation = match spec {
+        DamperSpec::Passive => passive_damper().representation,
+        DamperSpec::Viscous(c) => DamperRepresentation::Viscous { c },
+        DamperSpec::Maxwell(k, c) => DamperRepresentation::Maxwell { k, c },
+        DamperSpec::KelvinVoigt(k, c) => DamperRepresentation::KelvinVoigt { k, c },
+        DamperSpec::None => DamperRepresentation::None,
+    };
+    YawDamperModel {
+        representation,
+        mounting_stiffness_n_per_m: mounting_n_per_m.or(if spec == DamperSpec::Passive {
+            passive_damper().mounting_stiffness_n_per_m
+        } else {
+            None
+        }),
+    }
+}
+
+/// Result of a coach root-locus run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VehicleLocus {
+    pub damper: DamperSpec,
+    pub mounting_n_per_m: Option<f64>,
+    pub speeds_kmh: Vec<f64>,
+    pub results: Vec<EigenResult>,
+    /// Linear critical speed in [`CRITICAL_SEARCH_MPS`], or why there is none.
+    pub critical: Result<CriticalSpeed, String>,
+}
+
+fn vehicle_err(e: EigenError) -> AnalysisError {
+    AnalysisError::Bogie(format!("coach: {e}"))
+}
+
+/// Eigenvalues over the speed grid and the linear critical speed.
+pub fn vehicle_root_locus(
+    params: &VehicleParams,
+    damper: DamperSpec,
+    mounting_n_per_m: Option<f64>,
+    speeds_kmh: &[f64],
+) -> Result<VehicleLocus, AnalysisError> {
+    let model = damper_model(damper, mounting_n_per_m);
+    let results = speeds_kmh
+        .iter()
+        .map(|v| analyse(params, v / 3.6, &model))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(vehicle_err)?;
+    let critical =
+        match critical_speed(params, &model, CRITICAL_SEARCH_MPS.0, CRITICAL_SEARCH_MPS.1) {
+            Ok(c) => Ok(c),
+            Err(EigenError::NoCrossing { .. }) => Err(format!(
+                "stable up to {:.0} km/h (no stability boundary found)",
+                CRITICAL_SEARCH_MPS.1 * 3.6
+            )),
+            Err(EigenError::UnstableAtLowerEnd { .. }) => Err(format!(
+                "unstable already at {:.0} km/h",
+                CRITICAL_SEARCH_MPS.0 * 3.6
+            )),
+            Err(e) => return Err(vehicle_err(e)),
+        };
+    Ok(VehicleLocus {
+        damper,
+        mounting_n_per_m,
+        speeds_kmh: speeds_kmh.to_vec(),
+        results,
+        critical,
+    })
+}
+
+fn freq_hz(im: f64) -> f64 {
+    im.abs() / (2.0 * std::f64::consts::PI)
+}
+
+fn damping_ratio(re: f64, im: f64) -> f64 {
+    let n = re.hypot(im);
+    if n > 0.0 {
+        -re / n
+    } else {
+        0.0
+    }
+}
+
+/// Number of the mode kind in the CSV (0 car body, 1 front bogie, 2 rear bogie, 3 both).
+fn kind_code(m: &Mode) -> f64 {
+    use fmu_vehicle::eigen::ModeKind::*;
+    match m.kind {
+        CarBody => 0.0,
+        FrontBogie => 1.0,
+        RearBogie => 2.0,
+        BothBogies => 3.0,
+    }
+}
+
+impl VehicleLocus {
+    fn least_damped(&self) -> Vec<(f64, Mode)> {
+        self.speeds_kmh
+            .iter()
+            .zip(&self.results)
+            .filter_map(|(v, r)| r.least_damped.map(|m| (*v, m)))
+            .collect()
+    }
+
+    pub fn add_artefacts(&self, a: &mut Artefacts) -> Result<(), AnalysisError> {
+        let mut all = Table::new(&[
+            "speed [km/h]",
+            "eigenvalue index",
+            "real part [1/s]",
+            "imaginary part [rad/s]",
+            "frequency [Hz]",
+            "damping ratio [-]",
+            "least damped",
+        ]);
+        for (v, r) in self.speeds_kmh.iter().zip(&self.results) {
+            for (i, &(re, im)) in r.eigenvalues.iter().enumerate() {
+                let flag = r
+                    .least_damped
+                    .is_some_and(|m| m.re == re && m.im.abs() == im.abs());
+                all.rows.push(vec![
+                    *v,
+                    i as f64,
+                    re,
+                    im,
+                    freq_hz(im),
+                    damping_ratio(re, im),
+                    if flag { 1.0 } else { 0.0 },
+                ]);
+            }
+        }
+        a.add_table("root_locus_eigenvalues.csv", &all)?;
+        let mut modes = Table::new(&[
+            "speed [km/h]",
+            "real part [1/s]",
+            "imaginary part [rad/s]",
+            "frequency [Hz]",
+            "damping ratio [-]",
+            "car-body energy share [-]",
+            "front bogie energy share [-]",
+            "rear bogie energy share [-]",
+            "mode (0 car body, 1 front bogie, 2 rear bogie, 3 both bogies)",
+        ]);
+        let ld = self.least_damped();
+        for (v, m) in &ld {
+            modes.rows.push(vec![
+                *v,
+                m.re,
+                m.im,
+                m.freq_hz,
+                m.damping_ratio,
+                m.shares.carbody,
+                m.shares.front_bogie,
+                m.shares.rear_bogie,
+                kind_code(m),
+            ]);
+        }
+        a.add_table("root_locus_least_damped.csv", &modes)?;
+        let upper: Vec<(f64, f64, f64)> = self
+            .speeds_kmh
+            .iter()
+            .zip(&self.results)
+            .flat_map(|(v, r)| {
+                r.eigenvalues
+                    .iter()
+                    .filter(|e| e.1 >= 0.0)
+                    .map(move |&(re, im)| (re, im, *v))
+            })
+            .collect();
+        let title = format!(
+            "Root locus of the linear coach, {} to {} km/h ({})",
+            self.speeds_kmh.first().copied().unwrap_or(0.0),
+            self.speeds_kmh.last().copied().unwrap_or(0.0),
+            self.damper.describe()
+        );
+        let mut full =
+            ColourScatter::new(&title, "real part [1/s]", "imaginary part [rad/s]", "km/h");
+        full.points = upper.clone();
+        full.highlight = Some((
+            "least-damped mode".into(),
+            ld.iter().map(|(_, m)| (m.re, m.im)).collect(),
+        ));
+        full.zero_line_x = true;
+        a.add_text("root_locus.svg", full.to_svg()?);
+        if !ld.is_empty() {
+            let span = ld.iter().map(|p| p.1.re.abs()).fold(0.0, f64::max).max(1.0);
+            let im_max = ld.iter().map(|p| p.1.im).fold(0.0, f64::max);
+            let mut zoom = full.clone();
+            zoom.title = format!("{title}: zoom on the least-damped mode");
+            zoom.points = upper
+                .into_iter()
+                .filter(|p| p.0 >= -3.0 * span && p.1 <= 2.0 * im_max)
+                .collect();
+            a.add_text("root_locus_zoom.svg", zoom.to_svg()?);
+        }
+        let zeta = Chart::new(
+            "Damping ratio of the least-damped mode vs speed (linear coach)",
+            "speed [km/h]",
+            "damping ratio -Re/|lambda| [-]",
+        )
+        .with_series(
+            "least-damped mode",
+            ld.iter().map(|(v, m)| (*v, m.damping_ratio)).collect(),
+        )
+        .with_limit(0.0, "stability limit");
+        a.add_lines("damping_ratio.svg", &zeta)?;
+        let freq = Chart::new(
+            "Frequency of the least-damped mode vs speed (linear coach)",
+            "speed [km/h]",
+            "frequency [Hz]",
+        )
+        .with_series(
+            "least-damped mode",
+            ld.iter().map(|(v, m)| (*v, m.freq_hz)).collect(),
+        );
+        a.add_lines("hunting_frequency.svg", &freq)?;
+        Ok(())
+    }
+
+    /// Critical speed, frequency and mode at onset next to the seed's.
+    pub fn summary(&self) -> String {
+        let mounting = self
+            .mounting_n_per_m
+            .map_or("rigid mounting".to_string(), |k| {
+                format!("mounting stiffness {:.1} MN/m", k * 1e-6)
+            });
+        let mut s = format!(
+            "linear coach (calibrated fmu-vehicle defaults), damper: {}, {mounting}\n",
+            self.damper.describe()
+        );
+        s.push_str(&format!(
+            "speeds {} to {} km/h, {} points\n",
+            self.speeds_kmh.first().copied().unwrap_or(0.0),
+            self.speeds_kmh.last().copied().unwrap_or(0.0),
+            self.speeds_kmh.len()
+        ));
+        match &self.critical {
+            Ok(c) => {
+                s.push_str(&format!(
+                    "linear critical speed: {:.1} km/h (seed R15: {}-{} km/h with the passive damper)\n",
+                    c.speed_kmh, SEED_R15_KMH.0, SEED_R15_KMH.1
+                ));
+                s.push_str(&format!(
+                    "mode at onset: {}, Im {:.1} rad/s, frequency {:.2} Hz (kinetic energy: car body {:.0} %, front bogie {:.0} %, rear bogie {:.0} %)\n",
+                    c.mode.kind.label(),
+                    c.mode.im,
+                    c.mode.freq_hz,
+                    100.0 * c.mode.shares.carbody,
+                    100.0 * c.mode.shares.front_bogie,
+                    100.0 * c.mode.shares.rear_bogie
+                ));
+            }
+            Err(why) => s.push_str(&format!("linear critical speed: none, {why}\n")),
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::locus::speed_grid_kmh;
+
+    #[test]
+    fn passive_coach_root_locus_gives_r15_and_names_the_mode() {
+        let speeds = speed_grid_kmh(200.0, 320.0, 40.0).unwrap();
+        let r = vehicle_root_locus(
+            &VehicleParams::default(),
+            DamperSpec::Passive,
+            None,
+            &speeds,
+        )
+        .unwrap();
+        let c = r.critical.as_ref().unwrap();
+        // fmu-vehicle is calibrated to 285 km/h (R15: 280-290)
+        assert!((280.0..=290.0).contains(&c.speed_kmh), "{}", c.speed_kmh);
+        assert!((3.0..=5.0).contains(&c.mode.freq_hz), "{:?}", c.mode);
+        let mut a = Artefacts::default();
+        r.add_artefacts(&mut a).unwrap();
+        for f in [
+            "root_locus.svg",
+            "root_locus_least_damped.csv",
+            "damping_ratio.svg",
+        ] {
+            assert!(a.names().contains(&f), "{f}");
+        }
+        let s = r.summary();
+        assert!(
+            s.contains("linear critical speed: 28") && s.contains("hunting"),
+            "{s}"
+        );
+        // a soft mounting in series with the damper changes the critical speed (measured: 5
+        // MN/m raises it from 285.0 to 309.6 km/h: the yaw stiffness between bogie and car
+        // body falls, the damping at the hunting frequency rises)
+        let soft = vehicle_root_locus(
+            &VehicleParams::default(),
+            DamperSpec::Passive,
+            Some(5e6),
+            &speeds,
+        )
+        .unwrap();
+        let v_soft = soft.critical.as_ref().unwrap().speed_kmh;
+        assert!((v_soft - 309.6).abs() < 3.0, "{v_soft} vs {}", c.speed_kmh);
+    }
+}
