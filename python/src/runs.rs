@@ -1,32 +1,13 @@
-//! Run-set bookkeeping the Python package adds to the master's run sets: which runs are already
-//! complete in an output folder (a resumed set skips them), `sweep.json` over all runs, and a
-//! run's folder written from results computed in another process.
+//! Run-set bookkeeping of the Python package: `sweep.json` over all runs of a resumed set, and a
+//! run's folder written from results computed in another process. Which runs are complete is
+//! the master's rule ([`completed`], re-exported).
 
 use std::path::Path;
 
 use master::coupling::SimOutput;
 use master::output::{write_json_atomic, OutputError};
+pub use master::runset::completed;
 use master::runset::{run_one, Job, RunReport};
-use master::system::SystemDescription;
-
-/// The report of `job` in `outdir` if that run is complete and is the same run: its
-/// `summary.json` says ok, its `results.csv` is there and its `system.json` is the job's
-/// resolved system (same FMUs, start values, timing). A failed, unfinished or changed run
-/// gives `None` and is run again.
-pub fn completed(outdir: &Path, job: &Job) -> Option<RunReport> {
-    let dir = outdir.join(&job.name);
-    let report: RunReport =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).ok()?).ok()?;
-    let system: SystemDescription =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("system.json")).ok()?).ok()?;
-    let results = report.results.as_deref()?;
-    let complete = report.ok
-        && report.name == job.name
-        && report.parameters == job.parameters
-        && system == job.system
-        && results.is_file();
-    complete.then_some(report)
-}
 
 /// Writes `<outdir>/sweep.json`, the reports in job order (the master's format).
 pub fn write_sweep(outdir: &Path, reports: &[RunReport]) -> Result<(), OutputError> {
@@ -50,6 +31,7 @@ pub fn write_run(outdir: &Path, job: &Job, result: Result<SimOutput, String>) ->
 mod tests {
     use super::*;
     use master::coupling::Summary;
+    use master::system::SystemDescription;
     use std::collections::BTreeMap;
 
     fn job(name: &str, k: f64) -> Job {

@@ -93,3 +93,24 @@ def test_the_readme_run_set_expands_to_eight_resolved_runs():
     assert job["parameters"] == {"bogie.track.seed": 2, "bogie.vehicle.speed": 66.67}
     assert job["system"]["instances"][0]["parameters"]["vehicle.speed"] == 66.67
     assert all(Path(i["fmu"]).is_absolute() for i in job["system"]["instances"])
+
+
+def test_master_sweep_resume_keeps_complete_runs(dist, master_cmd, tmp_path):
+    set_file = tmp_path / "set.json"
+    set_file.write_text(json.dumps(speed_set(dist, [50.0, 60.0, 70.0, 80.0], stop_time=0.3)))
+    out = tmp_path / "out"
+    assert run_master(master_cmd, "sweep", set_file, "-o", out).returncode == 0
+    before = csv_bytes(out)
+    summaries = {n: (out / n / "summary.json").read_bytes() for n in before}
+    shutil.rmtree(out / "run-001")
+    (out / "run-002" / "results.csv").unlink()
+    r = run_master(master_cmd, "sweep", set_file, "-o", out, "--resume")
+    assert r.returncode == 0, r.stderr
+    assert "2 complete run(s) kept, 2 run" in r.stdout
+    assert csv_bytes(out) == before
+    # kept runs were not run again: their summaries (with their wall times) are untouched
+    for n in ("run-000", "run-003"):
+        assert (out / n / "summary.json").read_bytes() == summaries[n]
+    assert [s["name"] for s in json.loads((out / "sweep.json").read_text())] == sorted(before)
+    r = run_master(master_cmd, "sweep", set_file, "-o", out, "--resume")
+    assert "4 complete run(s) kept, 0 run" in r.stdout

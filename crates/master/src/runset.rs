@@ -349,6 +349,25 @@ where
     report
 }
 
+/// The report of `job` in `outdir` if that run is complete and is the same run: its
+/// `summary.json` says ok, its `results.csv` is there and its `system.json` is the job's
+/// resolved system (same FMUs, start values, timing). A failed, unfinished or changed run
+/// gives `None` and is run again.
+pub fn completed(outdir: &Path, job: &Job) -> Option<RunReport> {
+    let dir = outdir.join(&job.name);
+    let report: RunReport =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).ok()?).ok()?;
+    let system: SystemDescription =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("system.json")).ok()?).ok()?;
+    let results = report.results.as_deref()?;
+    let complete = report.ok
+        && report.name == job.name
+        && report.parameters == job.parameters
+        && system == job.system
+        && results.is_file();
+    complete.then_some(report)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,9 +1,11 @@
-//! `master sweep RUNSET.json [-o outdir] [--jobs N]`: parameter variations in parallel.
+//! `master sweep RUNSET.json [-o outdir] [--jobs N] [--resume] [--dask-scheduler ADDRESS]`:
+//! parameter variations in parallel, on this machine or on a Dask cluster.
 
 use std::path::PathBuf;
 
 use super::{CommandError, Context};
-use crate::runset::{execute as run_all, run_job, RunSet};
+use crate::output::write_json_atomic;
+use crate::runset::{completed, execute as run_all, run_job, Job, RunReport, RunSet};
 use crate::system::PreparedSystem;
 
 /// Run a base system with parameter variations (cartesian product and/or list) in parallel.
@@ -22,6 +24,10 @@ pub struct Args {
     /// for the Python in $RAILFMU_PYTHON (default: python3), with dask.distributed.
     #[arg(long, value_name = "ADDRESS")]
     pub dask_scheduler: Option<String>,
+    /// Keep the runs already complete in the output folder (summary ok, results present, same
+    /// resolved system) and run only the others; sweep.json then lists every run.
+    #[arg(long)]
+    pub resume: bool,
 }
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
@@ -29,14 +35,38 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         return on_dask(args, address, ctx);
     }
     let (base, jobs) = RunSet::load(&args.runset)?;
-    let system = PreparedSystem::prepare(&base)?;
-    let threads = args
-        .jobs
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    let cancel = ctx.cancel;
-    let reports = run_all(&jobs, &args.output, threads, ctx.progress, |job| {
-        run_job(&system, job, cancel)
-    })?;
+    let kept: Vec<Option<RunReport>> = jobs
+        .iter()
+        .map(|j| args.resume.then(|| completed(&args.output, j)).flatten())
+        .collect();
+    let todo: Vec<Job> = jobs
+        .iter()
+        .zip(&kept)
+        .filter(|(_, k)| k.is_none())
+        .map(|(j, _)| j.clone())
+        .collect();
+    let mut fresh = Vec::new();
+    if !todo.is_empty() || !args.resume {
+        let system = PreparedSystem::prepare(&base)?;
+        let threads = args
+            .jobs
+            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+        let cancel = ctx.cancel;
+        fresh = run_all(&todo, &args.output, threads, ctx.progress, |job| {
+            run_job(&system, job, cancel)
+        })?;
+    }
+    let mut fresh = fresh.into_iter();
+    let reports: Vec<RunReport> = kept
+        .into_iter()
+        .map(|k| k.or_else(|| fresh.next()))
+        .collect::<Option<_>>()
+        .ok_or_else(|| CommandError::Failed("internal: a run has no report".into()))?;
+    if args.resume {
+        write_json_atomic(&args.output.join("sweep.json"), &reports)?;
+        let n_kept = reports.len() - todo.len();
+        println!("{n_kept} complete run(s) kept, {} run", todo.len());
+    }
     let failed: Vec<&str> = reports
         .iter()
         .filter(|r| !r.ok)
@@ -76,6 +106,9 @@ fn on_dask(args: &Args, address: &str, ctx: &Context) -> Result<(), CommandError
         .arg("-o")
         .arg(&args.output)
         .args(["--dask-scheduler", address]);
+    if args.resume {
+        cmd.arg("--resume");
+    }
     if !ctx.progress {
         cmd.arg("--quiet");
     }
