@@ -9,6 +9,7 @@
 //! from it (see [`crate::fmu`]).
 
 mod parse;
+mod rules;
 
 /// Error reading a modelDescription.xml. Lines are 1-based.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -45,6 +46,26 @@ pub enum ModelDescriptionError {
     },
     #[error("variable name '{name}' is used twice")]
     DuplicateName { name: String },
+    #[error("variable '{name}' (line {line}): invalid name: {reason}")]
+    InvalidName {
+        name: String,
+        line: usize,
+        reason: String,
+    },
+    #[error("variable '{name}' (line {line}): {reason}")]
+    InvalidVariable {
+        name: String,
+        line: usize,
+        reason: String,
+    },
+    #[error("variable '{name}' (line {line}) has valueReference {value_reference} like '{other}': {reason}")]
+    ValueReference {
+        name: String,
+        line: usize,
+        other: String,
+        value_reference: u32,
+        reason: String,
+    },
 }
 
 /// Scalar type of a variable.
@@ -235,12 +256,15 @@ impl ModelDescription {
     /// attribute depends on everything; an output not listed at all is treated the same way
     /// (conservative).
     pub fn has_direct_feedthrough(&self, input: usize) -> bool {
-        let listed = |i: usize| self.outputs.iter().any(|o| o.output == i);
+        // linear in the number of variables: a set of the listed outputs, not a search per
+        // output variable
+        let listed: std::collections::HashSet<usize> =
+            self.outputs.iter().map(|o| o.output).collect();
         let unlisted_output = self
             .variables
             .iter()
             .enumerate()
-            .any(|(i, v)| v.causality == Causality::Output && !listed(i));
+            .any(|(i, v)| v.causality == Causality::Output && !listed.contains(&i));
         unlisted_output
             || self.outputs.iter().any(|o| match &o.depends_on {
                 None => true,

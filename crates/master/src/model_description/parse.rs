@@ -5,12 +5,35 @@ use std::collections::HashMap;
 
 use super::*;
 
-fn line_of(text: &str, pos: usize) -> usize {
-    text.as_bytes()[..pos.min(text.len())]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-        + 1
+/// Line numbers of byte positions met in increasing order: each call counts only the newlines
+/// since the previous one, so numbering a whole file stays linear in its size.
+struct LineCounter<'a> {
+    text: &'a [u8],
+    pos: usize,
+    line: usize,
+}
+
+impl<'a> LineCounter<'a> {
+    fn new(text: &'a str) -> Self {
+        LineCounter {
+            text: text.as_bytes(),
+            pos: 0,
+            line: 1,
+        }
+    }
+
+    /// 1-based line of byte `pos` (positions before the previous one give its line).
+    fn line_of(&mut self, pos: usize) -> usize {
+        let pos = pos.min(self.text.len());
+        if pos > self.pos {
+            self.line += self.text[self.pos..pos]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count();
+            self.pos = pos;
+        }
+        self.line
+    }
 }
 
 struct Elem<'a> {
@@ -62,18 +85,25 @@ impl Elem<'_> {
     }
 }
 
-/// Replaces the five predefined XML entities and numeric character references.
-fn unescape(s: &str) -> String {
+/// Longest entity reference looked for after a '&' ("#x10FFFF" is 8): a stray '&' costs at
+/// most this much scanning, so unescaping stays linear in the text.
+const MAX_ENTITY_LEN: usize = 10;
+
+/// Replaces the five predefined XML entities and numeric character references. A reference to
+/// a character XML 1.0 forbids (NUL, most control characters) is an error: it would end a C
+/// string early when the text reaches the FMU.
+fn unescape(s: &str) -> Result<String, String> {
     if !s.contains('&') {
-        return s.to_string();
+        return Ok(s.to_string());
     }
     let mut out = String::with_capacity(s.len());
     let mut rest = s;
     while let Some(i) = rest.find('&') {
         out.push_str(&rest[..i]);
         rest = &rest[i..];
-        let end = rest.find(';').unwrap_or(0);
-        let ent = &rest[1..end.max(1)];
+        let window = &rest.as_bytes()[..rest.len().min(MAX_ENTITY_LEN + 2)];
+        let end = window.iter().position(|&b| b == b';').unwrap_or(0);
+        let ent = rest.get(1..end.max(1)).unwrap_or("");
         let rep = match ent {
             "lt" => Some('<'),
             "gt" => Some('>'),
@@ -87,6 +117,11 @@ fn unescape(s: &str) -> String {
             _ => None,
         };
         match (end, rep) {
+            (_, Some(c)) if u32::from(c) < 0x20 && !matches!(c, '\t' | '\n' | '\r') => {
+                return Err(format!(
+                    "the character reference &{ent}; is a control character XML does not allow"
+                ));
+            }
             (e, Some(c)) if e > 0 => {
                 out.push(c);
                 rest = &rest[e + 1..];
@@ -98,7 +133,7 @@ fn unescape(s: &str) -> String {
         }
     }
     out.push_str(rest);
-    out
+    Ok(out)
 }
 
 #[derive(Default)]
@@ -139,6 +174,8 @@ impl ModelDescription {
         let mut output_lines: Vec<usize> = Vec::new();
         let mut stack: Vec<&str> = Vec::new();
         let mut current: Option<Elem> = None;
+        let mut lines = LineCounter::new(xml);
+        let mut structured_names = false;
 
         for tok in Tokenizer::from(xml) {
             let tok = tok.map_err(|e| ModelDescriptionError::Xml(e.to_string()))?;
@@ -146,13 +183,24 @@ impl ModelDescription {
                 Token::ElementStart { local, span, .. } => {
                     current = Some(Elem {
                         name: local.as_str(),
-                        line: line_of(xml, span.start()),
+                        line: lines.line_of(span.start()),
                         attrs: Vec::new(),
                     });
                 }
-                Token::Attribute { local, value, .. } => {
+                Token::Attribute {
+                    local, value, span, ..
+                } => {
                     if let Some(e) = current.as_mut() {
-                        e.attrs.push((local.as_str(), unescape(value.as_str())));
+                        let text = unescape(value.as_str()).map_err(|reason| {
+                            ModelDescriptionError::InvalidAttribute {
+                                element: e.name.to_string(),
+                                attribute: local.as_str().to_string(),
+                                value: value.as_str().chars().take(40).collect(),
+                                line: lines.line_of(span.start()),
+                                reason,
+                            }
+                        })?;
+                        e.attrs.push((local.as_str(), text));
                     }
                 }
                 Token::ElementEnd { end, .. } => match end {
@@ -165,10 +213,35 @@ impl ModelDescription {
                                 md.fmi_version = e.req("fmiVersion")?.to_string();
                                 md.model_name = e.req("modelName")?.to_string();
                                 md.guid = e.req("guid")?.to_string();
+                                for (key, value) in
+                                    [("modelName", &md.model_name), ("guid", &md.guid)]
+                                {
+                                    if value.chars().any(char::is_control) {
+                                        return Err(e.invalid(
+                                            key,
+                                            value,
+                                            "contains a control character",
+                                        ));
+                                    }
+                                }
+                                structured_names = match e.get("variableNamingConvention") {
+                                    None | Some("flat") => false,
+                                    Some("structured") => true,
+                                    Some(v) => {
+                                        return Err(e.invalid(
+                                            "variableNamingConvention",
+                                            v,
+                                            "expected flat or structured",
+                                        ))
+                                    }
+                                };
                             }
                             ("fmiModelDescription", "CoSimulation") => {
+                                let id = e.req("modelIdentifier")?;
+                                rules::check_model_identifier(id)
+                                    .map_err(|r| e.invalid("modelIdentifier", id, &r))?;
                                 md.co_simulation = Some(CoSimulationCaps {
-                                    model_identifier: e.req("modelIdentifier")?.to_string(),
+                                    model_identifier: id.to_string(),
                                     can_get_and_set_fmu_state: e.bool("canGetAndSetFMUstate")?,
                                     can_serialize_fmu_state: e.bool("canSerializeFMUstate")?,
                                     can_handle_variable_communication_step_size: e
@@ -309,7 +382,15 @@ impl ModelDescription {
             return Err(ModelDescriptionError::NoRoot);
         }
         let mut seen = std::collections::HashSet::new();
+        let mut lines_of_vars = Vec::with_capacity(pending.len());
         for p in pending {
+            rules::check_name(&p.name, structured_names).map_err(|reason| {
+                ModelDescriptionError::InvalidName {
+                    name: p.name.clone(),
+                    line: p.line,
+                    reason,
+                }
+            })?;
             let var_type = p.var_type.ok_or_else(|| ModelDescriptionError::NoType {
                 name: p.name.clone(),
                 line: p.line,
@@ -335,6 +416,19 @@ impl ModelDescription {
             } else {
                 Variability::Discrete
             });
+            rules::check_combination(
+                causality,
+                variability,
+                p.initial.as_deref(),
+                var_type,
+                p.start.is_some(),
+            )
+            .map_err(|reason| ModelDescriptionError::InvalidVariable {
+                name: p.name.clone(),
+                line: p.line,
+                reason,
+            })?;
+            lines_of_vars.push(p.line);
             md.variables.push(Variable {
                 name: p.name,
                 value_reference: p.vr,
@@ -347,6 +441,21 @@ impl ModelDescription {
                 description: p.description,
             });
         }
+        let views: Vec<rules::AliasView> = md
+            .variables
+            .iter()
+            .zip(&lines_of_vars)
+            .map(|(v, &line)| rules::AliasView {
+                name: &v.name,
+                line,
+                value_reference: v.value_reference,
+                var_type: v.var_type,
+                causality: v.causality,
+                variability: v.variability,
+                has_start: v.start.is_some(),
+            })
+            .collect();
+        rules::check_aliases(&views)?;
         let count = md.variables.len();
         for (o, line) in md.outputs.iter().zip(output_lines) {
             let bad = std::iter::once(o.output)

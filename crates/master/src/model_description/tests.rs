@@ -125,3 +125,215 @@ fn suggestions() {
     assert_eq!(md.suggest("completely_different"), None);
     assert_eq!(edit_distance("kitten", "sitting"), 3);
 }
+
+/// MASS_SPRING with the attributes of variable `m` (a fixed parameter with start 1) replaced.
+fn with_m(attrs: &str, real: &str) -> String {
+    MASS_SPRING.replace(
+        r#"name="m" valueReference="0" causality="parameter" variability="fixed"><Real start="1" unit="kg"/>"#,
+        &format!(r#"name="m" valueReference="0" {attrs}>{real}"#),
+    )
+}
+
+#[test]
+fn fmi2_causality_variability_initial_table() {
+    let ok = |attrs: &str, real: &str| {
+        ModelDescription::parse(&with_m(attrs, real)).map_err(|e| e.to_string())
+    };
+    // allowed, each with the start value its case needs or forbids
+    for (attrs, real) in [
+        (
+            r#"causality="parameter" variability="tunable""#,
+            r#"<Real start="1"/>"#,
+        ),
+        (
+            r#"causality="calculatedParameter" variability="fixed""#,
+            "<Real/>",
+        ),
+        (
+            r#"causality="calculatedParameter" variability="fixed" initial="approx""#,
+            r#"<Real start="1"/>"#,
+        ),
+        (
+            r#"causality="output" variability="constant""#,
+            r#"<Real start="1"/>"#,
+        ),
+        (r#"causality="local" variability="tunable""#, "<Real/>"),
+        (
+            r#"causality="local" initial="exact""#,
+            r#"<Real start="1"/>"#,
+        ),
+        (
+            r#"causality="input" variability="discrete""#,
+            r#"<Real start="1"/>"#,
+        ),
+        (r#"causality="independent""#, "<Real/>"),
+    ] {
+        ok(attrs, real).unwrap_or_else(|e| panic!("{attrs}: {e}"));
+    }
+    // refused, with the reason
+    for (attrs, real, reason) in [
+        (
+            r#"causality="parameter" variability="continuous""#,
+            r#"<Real start="1"/>"#,
+            "causality 'parameter' with variability 'continuous' is not allowed",
+        ),
+        (
+            r#"causality="input" variability="constant""#,
+            r#"<Real start="1"/>"#,
+            "is not allowed",
+        ),
+        (
+            r#"causality="independent" variability="discrete""#,
+            "<Real/>",
+            "is not allowed",
+        ),
+        (
+            r#"causality="parameter" variability="fixed" initial="approx""#,
+            r#"<Real start="1"/>"#,
+            "allows initial exact, got initial=\"approx\"",
+        ),
+        (
+            r#"causality="input" initial="exact""#,
+            r#"<Real start="1"/>"#,
+            "takes no 'initial' attribute",
+        ),
+        (
+            r#"causality="parameter" variability="fixed""#,
+            "<Real/>",
+            "requires a start value",
+        ),
+        (r#"causality="input""#, "<Real/>", "requires a start value"),
+        (
+            r#"causality="local" variability="fixed""#,
+            r#"<Real start="2"/>"#,
+            "initial 'calculated' must not have a start value",
+        ),
+        (
+            r#"causality="independent""#,
+            r#"<Real start="0"/>"#,
+            "must not have a start value",
+        ),
+        (
+            r#"causality="local" variability="continuous""#,
+            "<Integer/>",
+            "a Integer variable cannot be continuous",
+        ),
+        (
+            r#"causality="local" initial="bogus""#,
+            "<Real/>",
+            "got initial=\"bogus\"",
+        ),
+    ] {
+        let e = ok(attrs, real).unwrap_err();
+        assert!(
+            e.contains(reason) && e.contains("variable 'm' (line 10)"),
+            "{attrs}: {e}"
+        );
+    }
+}
+
+#[test]
+fn value_references_shared_only_by_aliases() {
+    // a local alias of an output (same vr, no start of its own) is fine
+    let alias = MASS_SPRING.replace(
+        r#"<ScalarVariable name="n_steps" valueReference="0" causality="local"><Integer/></ScalarVariable>"#,
+        r#"<ScalarVariable name="n_steps" valueReference="0" causality="local"><Integer/></ScalarVariable>
+<ScalarVariable name="pos_alias" valueReference="4" causality="local"><Real/></ScalarVariable>"#,
+    );
+    ModelDescription::parse(&alias).unwrap();
+    // two parameters on one vr: not aliases of one value
+    let e = ModelDescription::parse(&MASS_SPRING.replace(
+        r#"name="k" valueReference="1""#,
+        r#"name="k" valueReference="0""#,
+    ))
+    .unwrap_err();
+    assert!(
+        matches!(&e, ModelDescriptionError::ValueReference { name, other, value_reference: 0, .. }
+            if name == "k" && other == "m"),
+        "{e}"
+    );
+    // two start values on one vr
+    let e = ModelDescription::parse(&MASS_SPRING.replace(
+        r#"<ScalarVariable name="velocity" valueReference="5" causality="output" description="v &amp; co"><Real unit="m/s"/>"#,
+        r#"<ScalarVariable name="velocity" valueReference="4" causality="local" initial="exact"><Real unit="m/s" start="0"/>"#,
+    ))
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("both have a start value"), "{e}");
+}
+
+#[test]
+fn names_and_identifiers() {
+    let structured = MASS_SPRING.replace(
+        "guid=\"{abc}\"",
+        "guid=\"{abc}\" variableNamingConvention=\"structured\"",
+    );
+    let named = |n: &str| {
+        ModelDescription::parse(&structured.replace("name=\"n_steps\"", &format!("name=\"{n}\"")))
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    };
+    for good in [
+        "a",
+        "_a1.b_2",
+        "x[1]",
+        "x[1,2].y[3]",
+        "der(x)",
+        "der(body.x,2)",
+        "'quoted name'",
+        "'it\\'s'",
+        "a.'b c'[2]",
+    ] {
+        named(good).unwrap_or_else(|e| panic!("{good}: {e}"));
+    }
+    for bad in [
+        "", "1a", "a.", ".a", "a..b", "x[]", "x[1,]", "x[1, 2]", "a b", "der(x", "''",
+    ] {
+        let e = named(bad).unwrap_err();
+        assert!(e.contains("invalid name"), "{bad}: {e}");
+    }
+    // flat names: anything but control characters
+    let flat = |n: &str| {
+        ModelDescription::parse(&MASS_SPRING.replace("name=\"n_steps\"", &format!("name=\"{n}\"")))
+            .map_err(|e| e.to_string())
+    };
+    flat("any name [with] stuff").unwrap();
+    assert!(flat("tab&#9;here").unwrap_err().contains("U+0009"));
+    assert!(flat("nul&#0;here")
+        .unwrap_err()
+        .contains("control character"));
+    let e = ModelDescription::parse(&MASS_SPRING.replace(
+        "modelIdentifier=\"MassSpring\"",
+        "modelIdentifier=\"../lib/evil\"",
+    ))
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("modelIdentifier") && e.contains("C identifier"),
+        "{e}"
+    );
+    let e = ModelDescription::parse(&MASS_SPRING.replace("guid=\"{abc}\"", "guid=\"{a&#x0;}\""))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("guid") && e.contains("control character"), "{e}");
+}
+
+#[test]
+fn stray_ampersands_and_line_numbers_stay_linear() {
+    // 200 000 '&' without ';' used to cost a scan to the end of the value each
+    let desc = "&".repeat(200_000);
+    let md = ModelDescription::parse(&MASS_SPRING.replace("v &amp; co", &desc)).unwrap();
+    assert_eq!(
+        md.variable("velocity").unwrap().1.description.as_deref(),
+        Some(desc.as_str())
+    );
+    // line numbers after many lines are right
+    let padded = MASS_SPRING.replace(
+        "<ModelVariables>",
+        &format!("{}<ModelVariables>", "\n".repeat(5000)),
+    );
+    let e = ModelDescription::parse(&padded.replace(r#"causality="input""#, r#"causality="x""#))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("line 5013"), "{e}");
+}
