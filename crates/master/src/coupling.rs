@@ -35,7 +35,7 @@ mod plan;
 
 pub use plan::{
     check_plan, topological_order, Algorithm, CouplingPlan, PlanConnection, PlanInstance, Recorded,
-    SimError, SimOutput, Summary,
+    RunLimits, SimError, SimOutput, Summary, MAX_RECORDED_VALUES_VAR, MAX_STEPS_VAR,
 };
 
 /// Options of one run.

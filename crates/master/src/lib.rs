@@ -9,6 +9,7 @@
 //! * [`system`]: JSON system description -> validated [`coupling::CouplingPlan`] -> run.
 //! * [`coupling`]: Jacobi / Gauss-Seidel fixed-step master over any [`slave::Slave`].
 //! * [`runset`]: parameter sweeps in parallel.
+//! * [`input`]: input files read without hanging (regular files only) or filling memory.
 //! * [`output`]: atomic CSV/JSON output.
 //! * [`cli`]: the generic subcommands (run, sweep, inspect) and the binary's common main.
 //!
@@ -24,6 +25,7 @@
 pub mod cli;
 pub mod coupling;
 pub mod fmu;
+pub mod input;
 pub mod model_description;
 pub mod output;
 pub mod runset;

@@ -95,7 +95,14 @@ fn invalid(file: &str, field: String, reason: String) -> SystemError {
     }
 }
 
-/// Folder-safe run name.
+/// Most runs a run set may expand to: a product beyond this is refused before any job is
+/// built (a typo such as 1e6 values in one list should not fill the disk).
+pub const MAX_RUNS: usize = 100_000;
+
+/// Longest run name (folder names are limited to 255 bytes on common file systems).
+const MAX_RUN_NAME_LEN: usize = 200;
+
+/// Folder-safe run name: characters other than ASCII letters, digits and `._-=` become `_`.
 pub fn sanitize(name: &str) -> String {
     name.chars()
         .map(|c| {
@@ -108,6 +115,35 @@ pub fn sanitize(name: &str) -> String {
         .collect()
 }
 
+/// The folder name of a run: [`sanitize`]d, and refused when it could not be a folder of its
+/// own inside the output folder: empty, `.`/`..` or any name starting with `.` (hidden, and
+/// the prefix of the sweep's temporary folders), `sweep.json` (the sweep's report) or longer
+/// than 200 characters. `Err` is the reason.
+pub fn run_folder_name(name: &str) -> Result<String, String> {
+    let folder = sanitize(name);
+    if folder.is_empty() {
+        return Err("a run name must not be empty".into());
+    }
+    if folder.starts_with('.') {
+        return Err(format!(
+            "run name '{name}' would be the folder '{folder}': a run folder may not start with \
+             '.' ('.' and '..' are not folders of their own)"
+        ));
+    }
+    if folder.eq_ignore_ascii_case("sweep.json") {
+        return Err(format!(
+            "run name '{name}' is the name of the sweep's report file"
+        ));
+    }
+    if folder.len() > MAX_RUN_NAME_LEN {
+        return Err(format!(
+            "run name '{}...' is longer than {MAX_RUN_NAME_LEN} characters",
+            &folder[..40]
+        ));
+    }
+    Ok(folder)
+}
+
 impl RunSet {
     /// Reads a run-set file and expands it into jobs.
     pub fn load_jobs(path: &Path) -> Result<Vec<Job>, SystemError> {
@@ -116,10 +152,12 @@ impl RunSet {
 
     /// Reads a run-set file: its base system and its jobs.
     pub fn load(path: &Path) -> Result<(LoadedSystem, Vec<Job>), SystemError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SystemError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = crate::input::read_text_file(path, crate::input::MAX_TEXT_FILE_BYTES).map_err(
+            |source| SystemError::Read {
+                path: path.to_path_buf(),
+                source,
+            },
+        )?;
         let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Self::from_str_with_base(&text, &base_dir, &path.display().to_string())
     }
@@ -165,7 +203,26 @@ impl RunSet {
                     ));
                 }
             }
-            let total: usize = self.product.values().map(Vec::len).product();
+            let total = self
+                .product
+                .values()
+                .try_fold(1usize, |n, v| n.checked_mul(v.len()))
+                .filter(|&n| n.saturating_add(self.runs.len()) <= MAX_RUNS)
+                .ok_or_else(|| {
+                    let sizes: Vec<String> =
+                        self.product.values().map(|v| v.len().to_string()).collect();
+                    let combinations: f64 = self.product.values().map(|v| v.len() as f64).product();
+                    invalid(
+                        file,
+                        "product".into(),
+                        format!(
+                            "{} = {combinations:e} combinations plus {} listed runs are more than \
+                             the {MAX_RUNS} runs a run set may have; split it into several run sets",
+                            sizes.join(" x "),
+                            self.runs.len()
+                        ),
+                    )
+                })?;
             for mut idx in 0..total {
                 let mut p = BTreeMap::new();
                 for k in keys.iter().rev() {
@@ -182,7 +239,20 @@ impl RunSet {
         if sets.is_empty() {
             sets.push((Some("base".into()), BTreeMap::new(), String::new()));
         }
+        if self.runs.len() > MAX_RUNS {
+            return Err(invalid(
+                file,
+                "runs".into(),
+                format!(
+                    "{} runs are more than the {MAX_RUNS} a run set may have",
+                    self.runs.len()
+                ),
+            ));
+        }
         let mut jobs = Vec::new();
+        // folder name (lower case: also distinct on case-insensitive file systems) -> run
+        let mut folders: std::collections::HashMap<String, String> =
+            std::collections::HashMap::new();
         for (n, (name, params, field)) in sets.into_iter().enumerate() {
             let mut sys = resolved.clone();
             for (key, value) in &params {
@@ -199,13 +269,19 @@ impl RunSet {
                 };
                 spec.parameters.insert(var.to_string(), value.clone());
             }
-            let name = sanitize(&name.unwrap_or_else(|| format!("run-{n:03}")));
-            if jobs.iter().any(|j: &Job| j.name == name) {
-                return Err(invalid(
-                    file,
-                    field,
-                    format!("run name '{name}' is used twice"),
-                ));
+            let given = name.unwrap_or_else(|| format!("run-{n:03}"));
+            let name = run_folder_name(&given).map_err(|r| invalid(file, field.clone(), r))?;
+            if let Some(other) = folders.insert(name.to_ascii_lowercase(), given.clone()) {
+                let reason = if other == given {
+                    format!("run name '{name}' is used twice")
+                } else {
+                    format!(
+                        "run names '{other}' and '{given}' would both write the folder '{name}' \
+                         (run names are used twice or differ only in characters replaced by '_' \
+                         or in case)"
+                    )
+                };
+                return Err(invalid(file, field, reason));
             }
             jobs.push(Job {
                 name,
@@ -253,8 +329,21 @@ pub fn run_job(
     system.run(&changes, &opts).map_err(|e| e.to_string())
 }
 
+/// Prefix of a run folder being written (renamed onto the run's folder when complete).
+const PARTIAL_PREFIX: &str = ".partial-";
+/// Prefix of a previous run folder being replaced (removed right after the swap).
+const REPLACED_PREFIX: &str = ".replaced-";
+
 /// Runs all jobs on `threads` workers with `runner`, writing each run's folder and
 /// `<outdir>/sweep.json`. Returns the reports in job order.
+///
+/// Each run is written into a fresh hidden folder in `outdir` and swapped onto
+/// `<outdir>/<run>` only when complete (its description, its results if it succeeded, its
+/// summary), so a rerun never leaves the previous run's results beside the new run's
+/// description, and an interrupted sweep leaves no half-written run folder. The previous
+/// `sweep.json` is removed first, so an interrupted sweep never leaves an old report looking
+/// current; hidden folders left by an interrupted sweep are removed at the start. A runner
+/// that panics fails its run (reported like any failure), never the sweep.
 pub fn execute<F>(
     jobs: &[Job],
     outdir: &Path,
@@ -265,12 +354,24 @@ pub fn execute<F>(
 where
     F: Fn(&Job) -> Result<SimOutput, String> + Sync,
 {
-    std::fs::create_dir_all(outdir).map_err(|source| SweepError::Dir {
+    let dir_err = |source| SweepError::Dir {
         path: outdir.to_path_buf(),
         source,
-    })?;
+    };
+    std::fs::create_dir_all(outdir).map_err(dir_err)?;
+    let report_path = outdir.join("sweep.json");
+    match std::fs::remove_file(&report_path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            return Err(SweepError::Dir {
+                path: report_path,
+                source: e,
+            })
+        }
+        _ => {}
+    }
+    remove_partial_folders(outdir);
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.max(1))
+        .num_threads(threads.clamp(1, jobs.len().max(1)))
         .build()
         .map_err(|e| SweepError::Pool {
             jobs: threads,
@@ -304,19 +405,70 @@ where
             .collect()
     });
     bar.finish_and_clear();
-    write_json_atomic(&outdir.join("sweep.json"), &reports)?;
+    write_json_atomic(&report_path, &reports)?;
     Ok(reports)
 }
 
-/// Runs one job with `runner` and writes its folder `<outdir>/<job>/`: `system.json` first,
-/// then `results.csv` and last `summary.json` (each atomically), so a run whose
-/// `summary.json` says ok has all its files. A runner may also hand over results computed
-/// elsewhere (another process or machine).
+/// Removes the hidden run folders an interrupted sweep left in `outdir`.
+fn remove_partial_folders(outdir: &Path) {
+    let Ok(entries) = std::fs::read_dir(outdir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let name = name.to_string_lossy();
+        if (name.starts_with(PARTIAL_PREFIX) || name.starts_with(REPLACED_PREFIX))
+            && e.file_type().is_ok_and(|t| t.is_dir())
+        {
+            let _ = std::fs::remove_dir_all(e.path());
+        }
+    }
+}
+
+/// Puts the complete folder `new` in place of `dest` (which may exist from an earlier
+/// sweep): the old folder is moved aside, the new one renamed onto `dest`, the old one
+/// removed. On failure the old folder is put back.
+fn swap_into_place(new: tempfile::TempDir, dest: &Path, outdir: &Path) -> Result<(), String> {
+    let fail = |e: std::io::Error| format!("cannot move the run into '{}': {e}", dest.display());
+    let old = if dest.symlink_metadata().is_ok() {
+        let aside = tempfile::Builder::new()
+            .prefix(REPLACED_PREFIX)
+            .tempdir_in(outdir)
+            .map_err(fail)?
+            .keep();
+        let aside = aside.join("old");
+        std::fs::rename(dest, &aside).map_err(fail)?;
+        Some(aside)
+    } else {
+        None
+    };
+    let new = new.keep();
+    if let Err(e) = std::fs::rename(&new, dest) {
+        if let Some(a) = &old {
+            let _ = std::fs::rename(a, dest);
+        }
+        let _ = std::fs::remove_dir_all(&new);
+        return Err(fail(e));
+    }
+    if let Some(a) = old {
+        if let Some(holder) = a.parent() {
+            let _ = std::fs::remove_dir_all(holder);
+        }
+    }
+    Ok(())
+}
+
+/// Runs one job with `runner` and writes its folder `<outdir>/<job>/`: `system.json`, then
+/// `results.csv` (if the run succeeded) and `summary.json` (each atomically) into a fresh
+/// hidden folder, which is swapped onto `<outdir>/<job>` when complete, so a run folder never
+/// mixes files of two runs and a run whose `summary.json` says ok has all its files. A runner
+/// may also hand over results computed elsewhere (another process or machine); a runner that
+/// panics fails the run.
 pub fn run_one<F>(job: &Job, outdir: &Path, runner: &F) -> RunReport
 where
     F: Fn(&Job) -> Result<SimOutput, String>,
 {
-    let dir = outdir.join(&job.name);
+    let dest = outdir.join(&job.name);
     let mut report = RunReport {
         name: job.name.clone(),
         parameters: job.parameters.clone(),
@@ -325,26 +477,53 @@ where
         summary: None,
         results: None,
     };
-    let result = (|| -> Result<(Summary, PathBuf), String> {
-        std::fs::create_dir_all(&dir)
-            .map_err(|e| format!("cannot create '{}': {e}", dir.display()))?;
+    let partial = match tempfile::Builder::new()
+        .prefix(&format!("{PARTIAL_PREFIX}{}-", job.name))
+        .tempdir_in(outdir)
+    {
+        Ok(d) => d,
+        Err(e) => {
+            report.error = Some(format!(
+                "cannot create a folder in '{}': {e}",
+                outdir.display()
+            ));
+            return report;
+        }
+    };
+    let dir = partial.path().to_path_buf();
+    let result = (|| -> Result<Summary, String> {
         write_json_atomic(&dir.join("system.json"), &job.system).map_err(|e| e.to_string())?;
-        let out = runner(job)?;
-        let csv = dir.join("results.csv");
-        write_csv_atomic(&csv, &out.header, out.rows()).map_err(|e| e.to_string())?;
-        Ok((out.summary, csv))
+        let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| runner(job)))
+            .unwrap_or_else(|p| {
+                let what = p
+                    .downcast_ref::<&str>()
+                    .map(|s| s.to_string())
+                    .or_else(|| p.downcast_ref::<String>().cloned())
+                    .unwrap_or_default();
+                Err(format!("the run panicked: {what}"))
+            })?;
+        write_csv_atomic(&dir.join("results.csv"), &out.header, out.rows())
+            .map_err(|e| e.to_string())?;
+        Ok(out.summary)
     })();
     match result {
-        Ok((s, csv)) => {
+        Ok(s) => {
             report.ok = true;
             report.summary = Some(s);
-            report.results = Some(csv);
+            report.results = Some(dest.join("results.csv"));
         }
         Err(e) => report.error = Some(e),
     }
-    if let Err(e) = write_json_atomic(&dir.join("summary.json"), &report) {
+    let finished = write_json_atomic(&dir.join("summary.json"), &report)
+        .map_err(|e| e.to_string())
+        .and_then(|()| swap_into_place(partial, &dest, outdir));
+    if let Err(e) = finished {
         report.ok = false;
-        report.error = Some(format!("{}; also: {e}", report.error.unwrap_or_default()));
+        report.results = None;
+        report.error = Some(match report.error.take() {
+            Some(first) => format!("{first}; also: {e}"),
+            None => e,
+        });
     }
     report
 }

@@ -2,10 +2,14 @@
 
 use std::path::PathBuf;
 
-use super::{CommandError, Context};
-use crate::fmu::FmuArchive;
+use std::sync::Arc;
 
-/// Check an FMU (zip, FMI 2.0, co-simulation, binary) and list its variables.
+use super::{CommandError, Context};
+use crate::fmu::{FmuArchive, PreparedFmu};
+
+/// Check an FMU as `master run` does (archive entries and limits, modelDescription against
+/// FMI 2.0, platform binary present, loadable and exporting every function the master calls,
+/// GUID accepted by fmi2Instantiate) and list its variables.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The .fmu file.
@@ -13,10 +17,19 @@ pub struct Args {
     /// Print the parsed model description as JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Check only the archive and its modelDescription: do not unpack, load or instantiate
+    /// the binary (no code of the FMU runs).
+    #[arg(long)]
+    pub no_load: bool,
 }
 
 pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
     let a = FmuArchive::open(&args.fmu)?;
+    if !args.no_load {
+        // the same path as a run: unpack, load, look up the functions, instantiate once
+        let prepared = Arc::new(PreparedFmu::prepare(a.clone(), "inspect")?);
+        drop(prepared.instantiate("inspect", false)?);
+    }
     let md = &a.model;
     if args.json {
         let s =

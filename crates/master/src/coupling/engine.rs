@@ -177,6 +177,8 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
     /// type), which must be finite.
     fn record(&mut self, time: f64, out: &mut Vec<f64>) -> Result<(), SimError> {
         let row = out.len();
+        out.try_reserve(1 + self.plan.record.len())
+            .map_err(|_| SimError::OutOfMemory { time, values: row })?;
         out.push(time);
         out.resize(row + 1 + self.plan.record.len(), f64::NAN);
         let exchange = self.exchange;
@@ -373,8 +375,12 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
     }
 
     pub(super) fn run(&mut self) -> Result<Vec<f64>, SimError> {
-        let mut data =
-            Vec::with_capacity((self.n_steps as usize + 1) * (self.plan.record.len() + 1));
+        // Reserved up to 32 MiB at first, then grown (fallibly, see `record`): the limits of
+        // check_plan bound the total, the memory actually free is only known while growing.
+        let total = (self.n_steps as usize)
+            .saturating_add(1)
+            .saturating_mul(self.plan.record.len() + 1);
+        let mut data = Vec::with_capacity(total.min(1 << 22));
         self.initialise()?;
         self.record(self.plan.start_time, &mut data)?;
         for k in 0..self.n_steps {

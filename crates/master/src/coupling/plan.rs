@@ -137,6 +137,88 @@ pub enum SimError {
     },
     #[error("cancelled at t = {time} s")]
     Cancelled { time: f64 },
+    #[error("at t = {time} s: out of memory for the recorded results ({values} values so far)")]
+    OutOfMemory { time: f64, values: usize },
+}
+
+/// Environment variable raising [`RunLimits::max_steps`].
+pub const MAX_STEPS_VAR: &str = "MASTER_MAX_STEPS";
+/// Environment variable raising [`RunLimits::max_recorded_values`].
+pub const MAX_RECORDED_VALUES_VAR: &str = "MASTER_MAX_RECORDED_VALUES";
+
+/// How large one run may be, checked before any FMU is called: a stop time of 1e9 s at a 1 s
+/// step, or a step of 1e-300 s, is refused up front instead of running for days or running out
+/// of memory for its results.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RunLimits {
+    /// Communication steps of one run (default 1e8: 28 h of simulated time at 1 ms).
+    pub max_steps: u64,
+    /// Recorded values of one run, time included: (steps + 1) x (recorded variables + 1)
+    /// (default 5e8 = 4 GB of results).
+    pub max_recorded_values: u64,
+}
+
+impl Default for RunLimits {
+    fn default() -> Self {
+        RunLimits {
+            max_steps: 100_000_000,
+            max_recorded_values: 500_000_000,
+        }
+    }
+}
+
+impl RunLimits {
+    /// The defaults, each replaced by its environment variable when set ([`MAX_STEPS_VAR`],
+    /// [`MAX_RECORDED_VALUES_VAR`]: a plain integer); one set to anything else is an error.
+    pub fn from_env() -> Result<Self, String> {
+        let mut limits = RunLimits::default();
+        for (var, field) in [
+            (MAX_STEPS_VAR, &mut limits.max_steps),
+            (MAX_RECORDED_VALUES_VAR, &mut limits.max_recorded_values),
+        ] {
+            if let Some(v) = std::env::var_os(var) {
+                let s = v.to_string_lossy();
+                *field = s.trim().parse::<u64>().map_err(|_| {
+                    format!("environment variable {var}='{s}' is not a non-negative integer")
+                })?;
+            }
+        }
+        Ok(limits)
+    }
+
+    /// The number of communication steps over `span_s` at `step_s` (both finite, positive),
+    /// refused when above the limit. The count is compared as a float, so 1e300 steps cannot
+    /// overflow anything.
+    pub fn steps(&self, span_s: f64, step_s: f64) -> Result<u64, String> {
+        let n = (span_s / step_s).round();
+        if n.is_nan() || n > self.max_steps as f64 {
+            return Err(format!(
+                "{span_s} s at a step of {step_s} s is {n:e} communication steps, more than the \
+                 {} allowed (a larger step, or raise the limit with the environment variable \
+                 {MAX_STEPS_VAR})",
+                self.max_steps
+            ));
+        }
+        Ok(n as u64)
+    }
+
+    /// Refuses a run whose recorded results, `steps + 1` rows of `columns` values (time
+    /// included), would be more values than the limit.
+    pub fn recorded(&self, steps: u64, columns: usize) -> Result<(), String> {
+        let values = (steps as f64 + 1.0) * columns as f64;
+        if values > self.max_recorded_values as f64 {
+            return Err(format!(
+                "recording {columns} columns (time included) at {} communication points is \
+                 {values:e} values ({:.1} GB), more than the {} allowed (record fewer \
+                 variables, take a larger step, or raise the limit with the environment \
+                 variable {MAX_RECORDED_VALUES_VAR})",
+                steps + 1,
+                values * 8e-9,
+                self.max_recorded_values
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// Stable topological order of `n` nodes under edges `a -> b` ("a before b"). Cycles are broken
@@ -196,6 +278,8 @@ pub fn check_plan(plan: &CouplingPlan, n_slaves: usize) -> Result<u64, SimError>
         ));
     }
     let span = plan.stop_time - plan.start_time;
+    let limits = RunLimits::from_env().map_err(SimError::Plan)?;
+    limits.steps(span, plan.step).map_err(SimError::Plan)?;
     let n = (span / plan.step).round();
     if n < 1.0 || (n * plan.step - span).abs() > 1e-9 * span.max(plan.step) {
         return bad(format!(
@@ -225,5 +309,8 @@ pub fn check_plan(plan: &CouplingPlan, n_slaves: usize) -> Result<u64, SimError>
     if plan.instances.iter().any(|i| i.step_multiple == 0) {
         return bad("step_multiple must be >= 1".into());
     }
+    limits
+        .recorded(n as u64, plan.record.len() + 1)
+        .map_err(SimError::Plan)?;
     Ok(n as u64)
 }

@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use super::extract::{self, ArchiveLimits, ExtractionDir};
 use super::{count_extraction, platform_binary_dir, FmuError, FmuSlave, PreparedFmu};
 use crate::model_description::ModelDescription;
 
@@ -17,9 +18,8 @@ impl FmuArchive {
     /// Opens and checks an FMU: zip, modelDescription.xml, FMI 2.0, co-simulation, GUID and the
     /// binary for this platform.
     pub fn open(path: &Path) -> Result<Self, FmuError> {
-        use std::io::Read;
         let pb = path.to_path_buf();
-        let file = std::fs::File::open(path).map_err(|source| {
+        let file = crate::input::open_regular_file(path).map_err(|source| {
             if source.kind() == std::io::ErrorKind::NotFound {
                 FmuError::NotFound { path: pb.clone() }
             } else {
@@ -33,18 +33,37 @@ impl FmuArchive {
             path: pb.clone(),
             reason: e.to_string(),
         })?;
-        let mut xml = String::new();
+        let limits = ArchiveLimits::from_env()?;
+        let entries = extract::check_entries(path, &mut zip, &limits)?;
+        if entries.model_description_bytes.is_none() {
+            return Err(FmuError::NoModelDescription { path: pb });
+        }
+        let mut bytes = Vec::new();
         {
-            let mut entry = zip
+            let entry = zip
                 .by_name("modelDescription.xml")
                 .map_err(|_| FmuError::NoModelDescription { path: pb.clone() })?;
-            entry
-                .read_to_string(&mut xml)
-                .map_err(|source| FmuError::Io {
-                    path: pb.clone(),
-                    source,
-                })?;
+            let within =
+                extract::read_limited(entry, limits.max_model_description_bytes, &mut bytes)
+                    .map_err(|source| FmuError::Io {
+                        path: pb.clone(),
+                        source,
+                    })?;
+            if !within {
+                return Err(FmuError::TooLarge {
+                    path: pb,
+                    what: "its modelDescription.xml inflates to more bytes than it declares".into(),
+                    limit: limits.max_model_description_bytes,
+                    variable: extract::MAX_MODEL_DESCRIPTION_BYTES_VAR,
+                });
+            }
         }
+        let xml = String::from_utf8(bytes).map_err(|e| FmuError::ModelDescription {
+            path: pb.clone(),
+            source: Box::new(crate::model_description::ModelDescriptionError::Xml(
+                format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+            )),
+        })?;
         let model = ModelDescription::parse(&xml).map_err(|source| FmuError::ModelDescription {
             path: pb.clone(),
             source: Box::new(source),
@@ -80,19 +99,11 @@ impl FmuArchive {
         })
     }
 
-    /// Unpacks the whole archive into a new temporary folder (removed when dropped).
-    pub(crate) fn unpack(&self) -> Result<tempfile::TempDir, FmuError> {
-        let err = |reason: String| FmuError::Unpack {
-            path: self.path.clone(),
-            reason,
-        };
-        let file = std::fs::File::open(&self.path).map_err(|e| err(e.to_string()))?;
-        let mut zip = zip::ZipArchive::new(file).map_err(|e| err(e.to_string()))?;
-        let dir = tempfile::Builder::new()
-            .prefix("fmu-")
-            .tempdir()
-            .map_err(|e| err(e.to_string()))?;
-        zip.extract(dir.path()).map_err(|e| err(e.to_string()))?;
+    /// Unpacks the whole archive into a new extraction folder (removed when dropped; a folder
+    /// left by a process that died is removed by the next unpack, see [`extract`]).
+    pub(crate) fn unpack(&self) -> Result<ExtractionDir, FmuError> {
+        let limits = ArchiveLimits::from_env()?;
+        let dir = extract::unpack(&self.path, &extract::extraction_root(), &limits)?;
         count_extraction();
         Ok(dir)
     }
@@ -110,7 +121,7 @@ impl FmuArchive {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::io::Write;
+    use std::io::{Read, Write};
 
     fn write_zip(path: &Path, files: &[(&str, &[u8])]) {
         let f = std::fs::File::create(path).unwrap();
@@ -203,5 +214,81 @@ mod tests {
         assert!(matches!(e, FmuError::Load { .. }), "{e}");
         let e = a.instantiate("bad\0name", false).unwrap_err();
         assert!(matches!(e, FmuError::InstanceName { .. }));
+    }
+
+    #[test]
+    fn oversized_model_description_is_refused_unread() {
+        // 300 MB of spaces (above the default 256 MiB), deflated to a few hundred kB
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join("big.fmu");
+        let mut z = zip::ZipWriter::new(std::fs::File::create(&p).unwrap());
+        let o = zip::write::SimpleFileOptions::default()
+            .compression_level(Some(1))
+            .large_file(true);
+        z.start_file("modelDescription.xml", o).unwrap();
+        std::io::copy(&mut std::io::repeat(b' ').take(300_000_000), &mut z).unwrap();
+        z.finish().unwrap();
+        assert!(std::fs::metadata(&p).unwrap().len() < 3_000_000);
+        let e = FmuArchive::open(&p).unwrap_err();
+        assert!(
+            matches!(e, FmuError::TooLarge { limit, .. } if limit == 256 << 20),
+            "{e}"
+        );
+        assert!(
+            e.to_string()
+                .contains("modelDescription.xml has 300000000 bytes"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn unsafe_entries_are_refused_at_open() {
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join("x.fmu");
+        let (dir, suf) = platform_binary_dir().unwrap();
+        let bin = format!("binaries/{dir}/MassSpring{suf}");
+        for (entry, reason) in [
+            ("../evil.so", "leaves the archive"),
+            ("/etc/cron.d/evil", "leaves the archive"),
+            ("resources\\..\\..\\evil", "not a plain path"),
+        ] {
+            write_zip(
+                &p,
+                &[
+                    ("modelDescription.xml", MD.as_bytes()),
+                    (&bin, b""),
+                    (entry, b"x"),
+                ],
+            );
+            let e = FmuArchive::open(&p).unwrap_err();
+            assert!(
+                matches!(&e, FmuError::UnsafeEntry { .. }) && e.to_string().contains(reason),
+                "{entry}: {e}"
+            );
+        }
+    }
+
+    #[test]
+    fn stale_extraction_folders_are_removed_live_ones_kept() {
+        let root = tempfile::tempdir().unwrap();
+        // a folder whose owner died: its lock file is unlocked
+        let stale = root.path().join("master-fmu-dead");
+        std::fs::create_dir_all(stale.join("binaries")).unwrap();
+        std::fs::write(stale.join(".lock"), b"").unwrap();
+        // a folder in use: locked through another descriptor
+        let live = root.path().join("master-fmu-live");
+        std::fs::create_dir_all(&live).unwrap();
+        let lock = std::fs::File::create(live.join(".lock")).unwrap();
+        assert!(super::extract::try_lock(&lock));
+        // someone else's folder and a fresh lockless one are never touched
+        std::fs::create_dir_all(root.path().join("fmu-other")).unwrap();
+        std::fs::create_dir_all(root.path().join("master-fmu-new")).unwrap();
+        assert_eq!(crate::fmu::remove_stale_extractions(root.path()), 1);
+        assert!(!stale.exists());
+        assert!(live.exists() && root.path().join("fmu-other").exists());
+        assert!(root.path().join("master-fmu-new").exists());
+        drop(lock);
+        assert_eq!(crate::fmu::remove_stale_extractions(root.path()), 1);
+        assert!(!live.exists());
     }
 }

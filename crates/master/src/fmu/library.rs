@@ -103,11 +103,12 @@ impl Fmi2Library {
     }
 }
 
-/// The callbacks handed to fmi2Instantiate: fmi-sys's logger (formats the variadic message in
-/// C and forwards it to the `log` facade) and the C allocator.
+/// The callbacks handed to fmi2Instantiate: our logger (formats the variadic message in C,
+/// defensively, and forwards it to the `log` facade, see [`super::logger`]) and the C
+/// allocator.
 pub(crate) fn callbacks() -> ffi::fmi2CallbackFunctions {
     ffi::fmi2CallbackFunctions {
-        logger: Some(ffi::logger::callback_logger_handler),
+        logger: super::logger::callback(),
         allocateMemory: Some(libc::calloc),
         freeMemory: Some(libc::free),
         stepFinished: None,

@@ -1,4 +1,19 @@
-//! The `log` backend for FMU logger messages and the master's own messages.
+//! The FMU logger callback and the `log` backend for FMU messages and the master's own.
+//!
+//! FMI 2.0 (2.1.5) hands the logger a printf format plus variadic arguments, which only C can
+//! expand: `csrc/fmi2_logger.c` does it defensively (NULL strings tolerated, a format with a
+//! `%n` conversion passed on unexpanded instead of letting vsnprintf write through an
+//! argument, text capped at 64 KiB) and calls [`master_fmi2_log`], which turns the text into a
+//! `log` record. Nothing here can unwind into the FMU: an unknown status is logged as an
+//! error, invalid UTF-8 is replaced, a failed write to stderr is ignored.
+
+use std::ffi::{c_char, c_int, c_void, CStr};
+use std::io::Write;
+
+use fmi_sys::fmi2 as ffi;
+
+/// `module_path` of records that come from an FMU (their target is the instance name).
+const FMU_RECORD: &str = "fmu";
 
 /// A `log` backend that prints FMU messages (target = instance name) and the master's own
 /// messages to stderr as `[level] instance: message`.
@@ -9,18 +24,21 @@ impl log::Log for FmuLogger {
         metadata.level() <= log::max_level()
     }
     fn log(&self, record: &log::Record) {
-        if self.enabled(record.metadata()) {
-            let from_fmu = record.module_path() == Some("logger");
-            if from_fmu {
-                eprintln!(
-                    "[{}] FMU instance '{}': {}",
-                    record.level(),
-                    record.target(),
-                    record.args()
-                );
-            } else if record.target().starts_with("master") {
-                eprintln!("[{}] {}", record.level(), record.args());
-            }
+        if !self.enabled(record.metadata()) {
+            return;
+        }
+        // eprintln! panics when stderr is closed; a lost log line must not stop a run
+        let mut err = std::io::stderr().lock();
+        if record.module_path() == Some(FMU_RECORD) {
+            let _ = writeln!(
+                err,
+                "[{}] FMU instance '{}': {}",
+                record.level(),
+                record.target(),
+                record.args()
+            );
+        } else if record.target().starts_with("master") {
+            let _ = writeln!(err, "[{}] {}", record.level(), record.args());
         }
     }
     fn flush(&self) {}
@@ -32,4 +50,90 @@ static LOGGER: FmuLogger = FmuLogger;
 pub fn install_logger(level: log::LevelFilter) {
     let _ = log::set_logger(&LOGGER);
     log::set_max_level(level);
+}
+
+/// Log level of an fmi2Status (an FMU may pass anything: unknown values are errors).
+fn level(status: ffi::fmi2Status) -> log::Level {
+    match status {
+        ffi::fmi2Status_fmi2OK | ffi::fmi2Status_fmi2Pending => log::Level::Info,
+        ffi::fmi2Status_fmi2Warning | ffi::fmi2Status_fmi2Discard => log::Level::Warn,
+        _ => log::Level::Error,
+    }
+}
+
+/// A C string from the FMU, or `fallback` for NULL; invalid UTF-8 is replaced.
+///
+/// # Safety
+/// `p` is NULL or a NUL-terminated string.
+unsafe fn text(p: *const c_char, fallback: &str) -> String {
+    if p.is_null() {
+        fallback.to_string()
+    } else {
+        // SAFETY: non-null and NUL-terminated per the caller.
+        unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+    }
+}
+
+/// Called by the C logger with the expanded (or, when `expanded` is 0, the raw) message of
+/// `length` bytes.
+///
+/// # Safety
+/// `instance` and `category` are NULL or NUL-terminated; `message` points to `length` bytes.
+#[no_mangle]
+pub unsafe extern "C" fn master_fmi2_log(
+    _environment: *mut c_void,
+    instance: *const c_char,
+    status: ffi::fmi2Status,
+    category: *const c_char,
+    message: *const c_char,
+    length: usize,
+    expanded: c_int,
+) {
+    let _ = std::panic::catch_unwind(|| {
+        // SAFETY: per this function's contract.
+        let (instance, category) = unsafe { (text(instance, "?"), text(category, "")) };
+        let bytes = if message.is_null() || length == 0 {
+            &[][..]
+        } else {
+            // SAFETY: the C side passes `length` readable bytes.
+            unsafe { std::slice::from_raw_parts(message.cast::<u8>(), length) }
+        };
+        let body = String::from_utf8_lossy(bytes);
+        let note = if expanded == 0 && !bytes.is_empty() {
+            " (format not expanded: it contains %n)"
+        } else {
+            ""
+        };
+        let category = if category.is_empty() {
+            String::new()
+        } else {
+            format!("[{category}] ")
+        };
+        log::logger().log(
+            &log::Record::builder()
+                .args(format_args!("{category}{body}{note}"))
+                .level(level(status))
+                .module_path(Some(FMU_RECORD))
+                .target(&instance)
+                .build(),
+        );
+    });
+}
+
+extern "C" {
+    /// The fmi2CallbackLogger (csrc/fmi2_logger.c); its C status parameter is an int, the
+    /// same ABI as fmi2Status.
+    fn master_fmi2_logger(
+        environment: ffi::fmi2ComponentEnvironment,
+        instance: ffi::fmi2String,
+        status: ffi::fmi2Status,
+        category: ffi::fmi2String,
+        message: ffi::fmi2String,
+        ...
+    );
+}
+
+/// The logger callback handed to fmi2Instantiate.
+pub(crate) fn callback() -> ffi::fmi2CallbackLogger {
+    Some(master_fmi2_logger)
 }

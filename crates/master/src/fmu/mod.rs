@@ -11,9 +11,11 @@
 //!   gets a private copy per instance instead (a separate file is a separate library image).
 //! * [`FmuSlave`] ([`instance`]): one instance, driven through the FMI 2.0 C functions loaded
 //!   with libloading by their fmi-sys types ([`library`]); implements [`crate::slave::Slave`].
-//! * [`FmuLogger`] ([`logger`]): the FMU logger callback is fmi-sys's, which formats the message
-//!   and routes it into the `log` facade with the instance name as target; this backend prints
-//!   it. Limitation: fmi-sys drops the log *category*.
+//! * [`FmuLogger`] ([`logger`]): the FMU logger callback (C, defensive against NULL strings,
+//!   `%n` formats and endless messages) routes messages into the `log` facade with the
+//!   instance name as target; this backend prints them with their category.
+//! * [`extract`]: archive limits ([`ArchiveLimits`]), refused entries, locked extraction
+//!   folders that a later process removes when their owner died.
 //!
 //! Why not the `fmi` crate for loading and calling: it parses the modelDescription a second time
 //! with fmi-schema, which rejects attributes FMI 2.0 allows (`canHandleMultipleSetPerTimeInstant`,
@@ -27,12 +29,14 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use crate::model_description::ModelDescriptionError;
 
 pub mod archive;
+pub mod extract;
 pub mod instance;
 mod library;
 pub mod logger;
 pub mod prepared;
 
 pub use archive::FmuArchive;
+pub use extract::{remove_stale_extractions, ArchiveLimits};
 pub use instance::FmuSlave;
 pub use logger::{install_logger, FmuLogger};
 pub use prepared::PreparedFmu;
@@ -76,6 +80,27 @@ pub enum FmuError {
     UnsupportedPlatform { os: String, arch: String },
     #[error("instance name '{name}' is not valid: {reason}")]
     InstanceName { name: String, reason: String },
+    #[error(
+        "FMU '{path}' is refused: {what}, more than the limit of {limit} (raise it with \
+         the environment variable {variable})"
+    )]
+    TooLarge {
+        path: PathBuf,
+        what: String,
+        limit: u64,
+        variable: &'static str,
+    },
+    #[error("FMU '{path}' is refused: entry \"{entry}\": {reason}")]
+    UnsafeEntry {
+        path: PathBuf,
+        entry: String,
+        reason: String,
+    },
+    #[error("environment variable {variable}='{value}' is not a non-negative integer")]
+    LimitSetting {
+        variable: &'static str,
+        value: String,
+    },
     #[error("FMU '{path}': cannot unpack it: {reason}")]
     Unpack { path: PathBuf, reason: String },
     #[error("FMU '{path}': cannot load or instantiate '{instance}': {reason}")]

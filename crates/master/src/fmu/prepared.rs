@@ -16,7 +16,7 @@ pub struct PreparedFmu {
     // Field order matters: the library is unloaded before the folder it came from is removed.
     library: Fmi2Library,
     resource_url: CString,
-    dir: tempfile::TempDir,
+    dir: super::extract::ExtractionDir,
 }
 
 impl std::fmt::Debug for PreparedFmu {

@@ -204,10 +204,12 @@ pub fn json_value_for(t: VarType, v: &Value) -> Result<f64, String> {
 impl LoadedSystem {
     /// Reads and parses a JSON file; FMU paths are relative to its folder.
     pub fn load(path: &Path) -> Result<Self, SystemError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SystemError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = crate::input::read_text_file(path, crate::input::MAX_TEXT_FILE_BYTES).map_err(
+            |source| SystemError::Read {
+                path: path.to_path_buf(),
+                source,
+            },
+        )?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Self::from_json_str(&text, &base, &path.display().to_string())
     }

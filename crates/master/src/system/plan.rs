@@ -252,6 +252,14 @@ impl LoadedSystem {
             }
         }
 
+        let limits =
+            crate::coupling::RunLimits::from_env().map_err(|r| self.invalid("step", "step", r))?;
+        let steps = limits
+            .steps(d.stop_time - d.start_time, d.step)
+            .map_err(|r| self.invalid("step", "step", r))?;
+        limits
+            .recorded(steps, record.len() + 1)
+            .map_err(|r| self.invalid("record", "record", r))?;
         Ok(CouplingPlan {
             start_time: d.start_time,
             stop_time: d.stop_time,
@@ -280,6 +288,11 @@ impl LoadedSystem {
             ));
         }
         let span = stop_time - d.start_time;
+        let limits =
+            crate::coupling::RunLimits::from_env().map_err(|r| self.invalid("step", "step", r))?;
+        limits
+            .steps(span, d.step)
+            .map_err(|r| self.invalid("step", "step", r))?;
         let n = (span / d.step).round();
         if (n * d.step - span).abs() > 1e-9 * span.max(d.step) {
             return Err(self.invalid(

@@ -90,6 +90,19 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         settings.planned_runs(),
         args.out.display()
     );
+    // An interrupted or failed study must not leave the previous report looking current: it
+    // is removed before the first run and written again only when every output is ready.
+    for old in ["REPORT.md", "study.json"] {
+        match std::fs::remove_file(args.out.join(old)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(CommandError::Failed(format!(
+                    "cannot remove the previous '{}': {e}",
+                    args.out.join(old).display()
+                )))
+            }
+            _ => {}
+        }
+    }
     let results = run_study(&settings, &opts)?;
     let timing = Timing {
         wall_s: start.elapsed().as_secs_f64(),

@@ -1,0 +1,45 @@
+//! Reading input files (system descriptions, run sets) without hanging or filling memory:
+//! only regular files are read (a FIFO or a device such as /dev/zero is refused before it is
+//! read, so it can neither block the master nor feed it without end) and at most
+//! [`MAX_TEXT_FILE_BYTES`].
+
+use std::io::Read;
+use std::path::Path;
+
+/// Largest system description or run-set file read [bytes].
+pub const MAX_TEXT_FILE_BYTES: u64 = 256 << 20;
+
+/// Opens `path` for reading if it is a regular file. On Unix it is opened non-blocking, so
+/// opening a FIFO returns at once and is then refused.
+pub fn open_regular_file(path: &Path) -> std::io::Result<std::fs::File> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path)?;
+    if !file.metadata()?.is_file() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file",
+        ));
+    }
+    Ok(file)
+}
+
+/// The UTF-8 text of a regular file of at most `max_bytes`.
+pub fn read_text_file(path: &Path, max_bytes: u64) -> std::io::Result<String> {
+    let file = open_regular_file(path)?;
+    let mut text = String::new();
+    file.take(max_bytes.saturating_add(1))
+        .read_to_string(&mut text)?;
+    if text.len() as u64 > max_bytes {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("larger than the {max_bytes} bytes allowed"),
+        ));
+    }
+    Ok(text)
+}
