@@ -208,8 +208,16 @@ fn inspect_reports_bad_fmus_and_help_works() {
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("bad.fmu' is not a valid zip"));
+    // inspect loads the binary as run does: the fake one fails the same way
     let out = Command::new(env!("CARGO_BIN_EXE_master"))
         .arg("inspect")
+        .arg(c.path("Damper.fmu"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot load or instantiate"));
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .args(["inspect", "--no-load"])
         .arg(c.path("Damper.fmu"))
         .output()
         .unwrap();

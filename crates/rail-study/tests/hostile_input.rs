@@ -1,0 +1,518 @@
+//! Hostile input through the built `master` binary, one test per class of bad input: a clear
+//! message, exit status 1 (never 101, never a signal), nothing written outside the output
+//! folder, no stale result. Real FMU code comes from tests/fixtures/hostile_fmu.c, compiled
+//! here with the system C compiler; it misbehaves on request (HOSTILE_FMU_MODE).
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::Duration;
+
+const FIXTURE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/hostile_fmu.c");
+
+const HOSTILE_MD: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="Hostile" guid="{hostile}" variableNamingConvention="structured">
+  <CoSimulation modelIdentifier="Hostile" canHandleVariableCommunicationStepSize="true"/>
+  <ModelVariables>
+    <ScalarVariable name="y" valueReference="0" causality="output"><Real unit="s"/></ScalarVariable>
+    <ScalarVariable name="gain" valueReference="1" causality="parameter" variability="fixed"><Real start="1"/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure><Outputs><Unknown index="1" dependencies=""/></Outputs></ModelStructure>
+</fmiModelDescription>"#;
+
+const SYSTEM: &str = r#"{
+  "instances": [{"name": "h", "fmu": "Hostile.fmu"}],
+  "stop_time": 0.01, "step": 0.001
+}"#;
+
+/// A case folder: `dir/case` holds the inputs and is the only place the master may write
+/// (besides `dir/case/tmp`, its TMPDIR); `dir` itself must stay empty but for `case`.
+struct Case {
+    root: tempfile::TempDir,
+}
+
+impl Case {
+    fn new() -> Case {
+        let root = tempfile::tempdir().unwrap();
+        std::fs::create_dir_all(root.path().join("case/tmp")).unwrap();
+        std::fs::write(root.path().join("case/system.json"), SYSTEM).unwrap();
+        Case { root }
+    }
+    fn path(&self, f: &str) -> PathBuf {
+        self.root.path().join("case").join(f)
+    }
+    fn write(&self, f: &str, text: &str) -> PathBuf {
+        let p = self.path(f);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+    /// Runs the master with `args` (paths relative to the case folder), TMPDIR in the case,
+    /// extra environment `env`; kills it after 120 s (a hang fails the test).
+    fn master(&self, args: &[&str], env: &[(&str, &str)]) -> Output {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_master"));
+        cmd.current_dir(self.path(""))
+            .arg("--quiet")
+            .args(args)
+            .env("TMPDIR", self.path("tmp"))
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped());
+        for (k, v) in env {
+            cmd.env(k, v);
+        }
+        let child = cmd.spawn().unwrap();
+        let pid = child.id();
+        // read the pipes while waiting (a long message must not block the child)
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let _ = tx.send(child.wait_with_output());
+        });
+        let out = match rx.recv_timeout(Duration::from_secs(120)) {
+            Ok(out) => out.unwrap(),
+            Err(_) => {
+                let _ = Command::new("kill").arg("-9").arg(pid.to_string()).status();
+                panic!("master {args:?} hangs");
+            }
+        };
+        // nothing outside the case folder
+        let outside: Vec<_> = std::fs::read_dir(self.root.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .filter(|n| n != "case")
+            .collect();
+        assert!(outside.is_empty(), "written outside the case: {outside:?}");
+        out
+    }
+    /// Runs and expects exit status 1; returns stderr.
+    fn fails(&self, args: &[&str], env: &[(&str, &str)]) -> String {
+        let out = self.master(args, env);
+        let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+        assert_eq!(out.status.code(), Some(1), "master {args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        stderr
+    }
+    fn extraction_folders(&self) -> Vec<String> {
+        std::fs::read_dir(self.path("tmp"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .filter(|n| n.starts_with("master-fmu-"))
+            .collect()
+    }
+}
+
+/// Compiles the hostile FMU's binary once per test process.
+fn hostile_binary() -> PathBuf {
+    static BUILT: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    BUILT
+        .get_or_init(|| {
+            let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+            std::fs::create_dir_all(&dir).unwrap();
+            let so = dir.join("Hostile.so");
+            let status = Command::new("cc")
+                .args(["-shared", "-fPIC", "-O1", "-o"])
+                .arg(&so)
+                .arg(FIXTURE)
+                .status()
+                .expect("a C compiler (cc) is needed for this test");
+            assert!(status.success(), "cc failed on {FIXTURE}");
+            so
+        })
+        .clone()
+}
+
+/// Writes an FMU of `entries` (name, bytes) into the case.
+fn zip_into(path: &Path, entries: &[(&str, &[u8])]) {
+    let mut z = zip::ZipWriter::new(std::fs::File::create(path).unwrap());
+    let o = zip::write::SimpleFileOptions::default();
+    for (name, data) in entries {
+        z.start_file(*name, o).unwrap();
+        z.write_all(data).unwrap();
+    }
+    z.finish().unwrap();
+}
+
+fn hostile_fmu(case: &Case, md: &str) -> PathBuf {
+    let so = std::fs::read(hostile_binary()).unwrap();
+    let p = case.path("Hostile.fmu");
+    zip_into(
+        &p,
+        &[
+            ("modelDescription.xml", md.as_bytes()),
+            ("binaries/linux64/Hostile.so", &so),
+        ],
+    );
+    p
+}
+
+#[test]
+fn run_names_never_escape_or_collide() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    for (runs, expected) in [
+        (
+            r#"[{"name": "..", "parameters": {}}]"#,
+            "may not start with '.'",
+        ),
+        (
+            r#"[{"name": ".", "parameters": {}}]"#,
+            "may not start with '.'",
+        ),
+        (r#"[{"name": "", "parameters": {}}]"#, "must not be empty"),
+        (
+            r#"[{"name": "../../up", "parameters": {}}]"#,
+            "would be the folder '.._.._up'",
+        ),
+        (
+            r#"[{"name": "sweep.json", "parameters": {}}]"#,
+            "report file",
+        ),
+        (
+            r#"[{"name": "a/b", "parameters": {}}, {"name": "a_b", "parameters": {}}]"#,
+            "'a/b' and 'a_b' would both write the folder 'a_b'",
+        ),
+        (
+            r#"[{"name": "Fast", "parameters": {}}, {"name": "fast", "parameters": {}}]"#,
+            "would both write the folder",
+        ),
+    ] {
+        c.write(
+            "set.json",
+            &format!(r#"{{"base": "system.json", "runs": {runs}}}"#),
+        );
+        let e = c.fails(&["sweep", "set.json", "-o", "out"], &[]);
+        assert!(e.contains(expected), "{runs}: {e}");
+        assert!(!c.path("out").exists(), "{runs}: output folder created");
+    }
+    // separators and '..' inside a name stay inside the output folder
+    c.write(
+        "set.json",
+        r#"{"base": "system.json", "runs": [{"name": "x/../../up", "parameters": {}},
+             {"name": "/etc/passwd", "parameters": {}}]}"#,
+    );
+    let out = c.master(&["sweep", "set.json", "-o", "out"], &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut runs: Vec<String> = std::fs::read_dir(c.path("out"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    runs.sort();
+    assert_eq!(runs, ["_etc_passwd", "sweep.json", "x_.._.._up"]);
+    assert!(c.path("out/x_.._.._up/results.csv").exists());
+}
+
+#[test]
+fn rerun_replaces_the_run_folder_and_a_failed_sweep_reports_failure() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    c.write(
+        "set.json",
+        r#"{"base": "system.json", "runs": [{"name": "a", "parameters": {"h.gain": 2}}]}"#,
+    );
+    let out = c.master(&["sweep", "set.json", "-o", "out"], &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(c.path("out/a/results.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 12, "{csv}");
+    std::fs::write(c.path("out/a/stale.txt"), "from an older sweep").unwrap();
+    // the same run now fails: its folder holds the new description and summary only
+    c.write(
+        "set.json",
+        r#"{"base": "system.json", "runs": [{"name": "a", "parameters": {"h.y": 2}}]}"#,
+    );
+    let e = c.fails(&["sweep", "set.json", "-o", "out"], &[]);
+    assert!(e.contains("1 run(s) failed: a"), "{e}");
+    let mut files: Vec<String> = std::fs::read_dir(c.path("out/a"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    files.sort();
+    assert_eq!(files, ["summary.json", "system.json"]);
+    let summary = std::fs::read_to_string(c.path("out/a/summary.json")).unwrap();
+    assert!(summary.contains("\"ok\": false"), "{summary}");
+    let sweep = std::fs::read_to_string(c.path("out/sweep.json")).unwrap();
+    assert!(sweep.contains("cannot be given a start value"), "{sweep}");
+    // no hidden partial folders left
+    let hidden: Vec<_> = std::fs::read_dir(c.path("out"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(hidden.is_empty(), "{hidden:?}");
+}
+
+#[test]
+fn huge_runs_are_refused_up_front() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    for (stop, step) in [("1e9", "1"), ("1", "1e-300")] {
+        c.write(
+            "big.json",
+            &SYSTEM
+                .replace("0.01", stop)
+                .replace("\"step\": 0.001", &format!("\"step\": {step}")),
+        );
+        let e = c.fails(&["run", "big.json", "-o", "out.csv"], &[]);
+        assert!(
+            e.contains("communication steps, more than the 100000000 allowed")
+                && e.contains("MASTER_MAX_STEPS"),
+            "{e}"
+        );
+        assert!(!c.path("out.csv").exists());
+        assert!(
+            c.extraction_folders().is_empty(),
+            "unpacked before refusing"
+        );
+    }
+    // the limit is raised by its variable; the recorded values then bound the run
+    let e = c.fails(
+        &["run", "big.json", "-o", "out.csv"],
+        &[("MASTER_MAX_STEPS", "1e400")],
+    );
+    assert!(e.contains("MASTER_MAX_STEPS='1e400' is not"), "{e}");
+    // 7 lists of 20 values: 1.28e9 runs, refused before any is built
+    let lists: Vec<String> = (0..7)
+        .map(|i| format!("\"h.p{i}\": [{}]", vec!["1"; 20].join(",")))
+        .collect();
+    c.write(
+        "set.json",
+        &format!(
+            r#"{{"base": "system.json", "product": {{{}}}}}"#,
+            lists.join(",")
+        ),
+    );
+    let e = c.fails(&["sweep", "set.json", "-o", "out"], &[]);
+    assert!(
+        e.contains("20 x 20 x 20 x 20 x 20 x 20 x 20 = 1.28e9 combinations")
+            && e.contains("100000 runs"),
+        "{e}"
+    );
+    assert!(!c.path("out").exists());
+}
+
+#[test]
+fn archive_limits_and_unsafe_entries_are_refused_before_extraction() {
+    let c = Case::new();
+    let so = std::fs::read(hostile_binary()).unwrap();
+    let bin = ("binaries/linux64/Hostile.so", so.as_slice());
+    let md = ("modelDescription.xml", HOSTILE_MD.as_bytes());
+    // a zip bomb, scaled down: 8 MB of zeros in a few kB, against a lowered limit
+    let zeros = vec![0u8; 8 << 20];
+    zip_into(
+        &c.path("Hostile.fmu"),
+        &[md, bin, ("resources/bomb", &zeros)],
+    );
+    assert!(std::fs::metadata(c.path("Hostile.fmu")).unwrap().len() < 200_000);
+    for sub in [&["inspect", "Hostile.fmu"][..], &["run", "system.json"][..]] {
+        let e = c.fails(sub, &[("MASTER_FMU_MAX_UNPACKED_BYTES", "4000000")]);
+        assert!(
+            e.contains("is refused: it unpacks to")
+                && e.contains("more than the limit of 4000000")
+                && e.contains("MASTER_FMU_MAX_UNPACKED_BYTES"),
+            "{e}"
+        );
+    }
+    // the same archive is accepted once the limit is raised
+    let out = c.master(
+        &["inspect", "Hostile.fmu"],
+        &[("MASTER_FMU_MAX_UNPACKED_BYTES", "10000000")],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // an oversized modelDescription, entry counts
+    let e = c.fails(
+        &["inspect", "Hostile.fmu"],
+        &[("MASTER_FMU_MAX_MODEL_DESCRIPTION_BYTES", "100")],
+    );
+    assert!(e.contains("its modelDescription.xml has"), "{e}");
+    let e = c.fails(
+        &["inspect", "Hostile.fmu"],
+        &[("MASTER_FMU_MAX_ENTRIES", "2")],
+    );
+    assert!(
+        e.contains("it has 3 entries, more than the limit of 2"),
+        "{e}"
+    );
+    // zip-slip, absolute paths, links: refused, nothing written
+    for (entry, reason) in [
+        ("../../escaped.txt", "leaves the archive"),
+        ("/tmp/absolute.txt", "leaves the archive"),
+    ] {
+        zip_into(&c.path("Hostile.fmu"), &[md, bin, (entry, b"x")]);
+        let e = c.fails(&["run", "system.json"], &[]);
+        assert!(e.contains(reason), "{entry}: {e}");
+        assert!(!c.root.path().join("escaped.txt").exists());
+    }
+    let mut z = zip::ZipWriter::new(std::fs::File::create(c.path("Hostile.fmu")).unwrap());
+    let o = zip::write::SimpleFileOptions::default();
+    z.start_file("modelDescription.xml", o).unwrap();
+    z.write_all(HOSTILE_MD.as_bytes()).unwrap();
+    z.start_file("binaries/linux64/Hostile.so", o).unwrap();
+    z.write_all(&so).unwrap();
+    z.add_symlink("resources/link", "/etc/passwd", o).unwrap();
+    z.finish().unwrap();
+    let e = c.fails(&["inspect", "Hostile.fmu"], &[]);
+    assert!(e.contains("symbolic links are not allowed"), "{e}");
+    assert!(c.extraction_folders().is_empty());
+}
+
+#[test]
+fn extraction_folders_of_a_killed_master_are_removed_by_the_next_one() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    // the FMU kills the process mid-run (SIGKILL: no destructor runs)
+    let out = c.master(&["run", "system.json"], &[("HOSTILE_FMU_MODE", "kill")]);
+    assert_eq!(out.status.code(), None, "expected death by signal");
+    assert_eq!(
+        c.extraction_folders().len(),
+        1,
+        "the killed run leaves its folder"
+    );
+    let out = c.master(&["run", "system.json", "-o", "out.csv"], &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        c.extraction_folders().is_empty(),
+        "{:?}",
+        c.extraction_folders()
+    );
+    assert!(c.path("out.csv").exists());
+}
+
+#[test]
+fn invalid_model_descriptions_are_refused_by_inspect_and_run_alike() {
+    let c = Case::new();
+    let cases = [
+        (
+            HOSTILE_MD.replace(
+                "modelIdentifier=\"Hostile\"",
+                "modelIdentifier=\"../../Hostile\"",
+            ),
+            "must be a C identifier",
+        ),
+        (
+            HOSTILE_MD.replace("guid=\"{hostile}\"", "guid=\"{host&#0;ile}\""),
+            "control character",
+        ),
+        (
+            HOSTILE_MD.replace("valueReference=\"1\"", "valueReference=\"0\""),
+            "has valueReference 0 like 'y': a parameter or input cannot be an alias",
+        ),
+        (
+            HOSTILE_MD.replace("name=\"gain\"", "name=\"gain[1,]\""),
+            "structured naming convention",
+        ),
+        (
+            HOSTILE_MD.replace("<Real start=\"1\"/>", "<Real/>"),
+            "requires a start value",
+        ),
+        (
+            HOSTILE_MD.replace(
+                "causality=\"parameter\" variability=\"fixed\"",
+                "causality=\"input\" variability=\"fixed\"",
+            ),
+            "causality 'input' with variability 'fixed' is not allowed",
+        ),
+        (
+            HOSTILE_MD
+                .replace(
+                    "causality=\"output\">",
+                    "causality=\"output\" initial=\"calculated\">",
+                )
+                .replace("<Real unit=\"s\"/>", "<Real unit=\"s\" start=\"0\"/>"),
+            "must not have a start value",
+        ),
+    ];
+    for (md, expected) in &cases {
+        hostile_fmu(&c, md);
+        for sub in [&["inspect", "Hostile.fmu"][..], &["run", "system.json"][..]] {
+            let e = c.fails(sub, &[]);
+            assert!(e.contains(expected), "{sub:?} {expected}: {e}");
+        }
+    }
+    // a binary without the FMI functions: inspect loads it as run does
+    let dir = tempfile::tempdir().unwrap();
+    let empty_c = dir.path().join("empty.c");
+    std::fs::write(&empty_c, "int not_an_fmu(void) { return 0; }\n").unwrap();
+    let so = dir.path().join("empty.so");
+    assert!(Command::new("cc")
+        .args(["-shared", "-fPIC", "-o"])
+        .arg(&so)
+        .arg(&empty_c)
+        .status()
+        .unwrap()
+        .success());
+    zip_into(
+        &c.path("Hostile.fmu"),
+        &[
+            ("modelDescription.xml", HOSTILE_MD.as_bytes()),
+            ("binaries/linux64/Hostile.so", &std::fs::read(&so).unwrap()),
+        ],
+    );
+    for sub in [&["inspect", "Hostile.fmu"][..], &["run", "system.json"][..]] {
+        let e = c.fails(sub, &[]);
+        assert!(e.contains("does not export fmi2"), "{sub:?}: {e}");
+    }
+    let out = c.master(&["inspect", "--no-load", "Hostile.fmu"], &[]);
+    assert!(out.status.success());
+}
+
+#[test]
+fn logger_messages_with_format_attacks_are_printed_not_executed() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    let out = c.master(
+        &["--log-level", "info", "run", "system.json", "-o", "out.csv"],
+        &[("HOSTILE_FMU_MODE", "log")],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("progress 100%n done (format not expanded: it contains %n)"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("[ERROR] FMU instance '?': status 42 from nowhere"),
+        "{stderr}"
+    );
+    let long = stderr
+        .lines()
+        .find(|l| l.contains("long: xxx"))
+        .expect("the long message");
+    assert!(long.len() < 66_000 && long.len() > 65_000, "{}", long.len());
+}
+
+#[test]
+fn fifos_and_devices_are_refused_without_reading() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    let fifo = c.path("system.fifo");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let e = c.fails(&["run", "system.fifo"], &[]);
+    assert!(e.contains("not a regular file"), "{e}");
+    let e = c.fails(&["run", "/dev/zero"], &[]);
+    assert!(e.contains("not a regular file"), "{e}");
+    c.write(
+        "fifo-fmu.json",
+        &SYSTEM.replace("Hostile.fmu", "system.fifo"),
+    );
+    let e = c.fails(&["run", "fifo-fmu.json"], &[]);
+    assert!(e.contains("not a regular file"), "{e}");
+}
