@@ -468,6 +468,16 @@ fn invalid_model_descriptions_are_refused_by_inspect_and_run_alike() {
     }
     let out = c.master(&["inspect", "--no-load", "Hostile.fmu"], &[]);
     assert!(out.status.success());
+    // the binary's platform and newest glibc symbol version, read from the file
+    hostile_fmu(&c, HOSTILE_MD);
+    let out = c.master(&["inspect", "Hostile.fmu"], &[]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("binary     binaries/linux64/Hostile.so: linux64, ELF"))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(line.contains("needs glibc >= 2."), "{line}");
 }
 
 #[test]

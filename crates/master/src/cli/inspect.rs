@@ -52,6 +52,7 @@ pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
             d.start_time, d.stop_time, d.step_size
         );
     }
+    print_binaries(&args.fmu);
     println!();
     println!(
         "{:<32} {:>5} {:<12} {:<11} {:<8} {:<8} {:>10}  description",
@@ -71,4 +72,41 @@ pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
         );
     }
     Ok(())
+}
+
+/// One line per binary of the FMU (read from the files, not loaded): platform folder, format
+/// and architecture, the newest glibc symbol version it needs (the oldest glibc it loads on),
+/// and any portability problem against the manylinux2014 baseline, as a warning.
+fn print_binaries(fmu: &std::path::Path) {
+    let report = match fmu_binary::check_fmu(fmu, &fmu_binary::Policy::default()) {
+        Ok(r) => r,
+        Err(e) => {
+            println!("binaries: cannot read them: {e}");
+            return;
+        }
+    };
+    for b in &report.binaries {
+        let platform = b
+            .platform
+            .map_or_else(|| "unknown platform".to_string(), |p| p.to_string());
+        let what = match &b.info {
+            Some(info) => {
+                let archs: Vec<String> = info
+                    .images
+                    .iter()
+                    .map(|i| i.architecture.to_string())
+                    .collect();
+                let glibc = info.newest_glibc().map_or_else(
+                    || "no glibc symbol versions".to_string(),
+                    |v| format!("needs glibc >= {v}"),
+                );
+                format!("{platform}, {} {}, {glibc}", info.format, archs.join(" + "))
+            }
+            None => format!("{platform}, unreadable"),
+        };
+        println!("binary     {}: {what}", b.entry);
+        for p in &b.problems {
+            println!("  warning: {p}");
+        }
+    }
 }
