@@ -37,6 +37,13 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // A closed stdout (`master inspect X.fmu | head`) ends the process quietly, as for any
+    // Unix tool, instead of a panic on the failed print.
+    #[cfg(unix)]
+    // SAFETY: restoring the default disposition of SIGPIPE before any thread exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     run_command(&cli.global, |ctx| match &cli.command {
         Command::Generic(c) => c.execute(ctx),

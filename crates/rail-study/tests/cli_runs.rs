@@ -108,3 +108,25 @@ fn ctrl_c_stops_cleanly_without_result_file() {
     assert!(!stderr.contains("not allowed"), "{stderr}");
     assert!(!dir.path().join("r.csv").exists());
 }
+
+/// `master inspect` reads the binaries without loading them: platform, format, architecture
+/// and the newest glibc a Linux binary needs against the portable baseline.
+#[test]
+fn inspect_reports_platforms_and_the_glibc_a_binary_needs() {
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .args(["inspect", "--no-load"])
+        .arg(dist().join("MassSpring.fmu"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("binaries: linux64 (portable baseline: glibc 2.17)"),
+        "{text}"
+    );
+    assert!(
+        text.contains("binaries/linux64/MassSpring.so: ELF (Linux) x86-64, needs glibc >= 2.")
+            && text.contains("(within the baseline)"),
+        "{text}"
+    );
+}
