@@ -7,6 +7,7 @@
 //! * [`fmu`]: open and check a `.fmu`, instantiate it (through the `fmi` crate), drive it.
 //! * [`model_description`]: the parts of modelDescription.xml the master needs.
 //! * [`system`]: JSON system description -> validated [`coupling::CouplingPlan`] -> run.
+//! * [`ssp`]: SSP 1.0/2.0 import (a `.ssp` or `.ssd` becomes a system) and export.
 //! * [`coupling`]: Jacobi / Gauss-Seidel fixed-step master over any [`slave::Slave`].
 //! * [`runset`]: parameter sweeps in parallel.
 //! * [`input`]: input files read without hanging (regular files only) or filling memory.
@@ -30,4 +31,5 @@ pub mod model_description;
 pub mod output;
 pub mod runset;
 pub mod slave;
+pub mod ssp;
 pub mod system;

@@ -1,4 +1,5 @@
-//! The generic subcommands of the `master` binary (run, sweep, inspect; one file each) and the
+//! The generic subcommands of the `master` binary (run, sweep, inspect, export-ssp; one file
+//! each) and the
 //! binary's common main ([`run_command`]: logger, Ctrl-C, error chain, exit status).
 //!
 //! The binary itself lives in the `rail-study` crate, which adds the railway subcommands:
@@ -10,6 +11,7 @@ use std::io::IsTerminal;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+pub mod export_ssp;
 pub mod inspect;
 pub mod run;
 pub mod sweep;
@@ -35,6 +37,8 @@ pub enum CommandError {
     Fmu(#[from] crate::fmu::FmuError),
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),
+    #[error(transparent)]
+    Ssp(#[from] crate::ssp::SspError),
     #[error("{0}")]
     Failed(String),
     /// An error of a subcommand defined outside this crate (its source chain is printed).
@@ -62,6 +66,8 @@ pub enum GenericCommand {
     Sweep(sweep::Args),
     /// Check an FMU and print its variables.
     Inspect(inspect::Args),
+    /// Write a system description as a self-contained SSP (FMUs and parameter sets inside).
+    ExportSsp(export_ssp::Args),
 }
 
 impl GenericCommand {
@@ -70,6 +76,7 @@ impl GenericCommand {
             GenericCommand::Run(a) => run::execute(a, ctx),
             GenericCommand::Sweep(a) => sweep::execute(a, ctx),
             GenericCommand::Inspect(a) => inspect::execute(a, ctx),
+            GenericCommand::ExportSsp(a) => export_ssp::execute(a, ctx),
         }
     }
 }

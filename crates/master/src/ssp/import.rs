@@ -1,0 +1,557 @@
+//! An SSD (with its FMUs, parameter sets and mappings) converted into the master's
+//! [`SystemDescription`].
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde_json::Value as Json;
+
+use super::package::Package;
+use super::ssd::{self, Binding, BindingMapping, BindingValues, Component, ConnectorType, Ssd};
+use super::ssv::{self, Parameter, ParameterSet, Value};
+use super::{ImportOptions, ImportedSsp, SspError};
+use crate::coupling::Algorithm;
+use crate::fmu::FmuArchive;
+use crate::model_description::{Causality, ModelDescription, VarType};
+use crate::system::{ConnectionSpec, InstanceSpec, LoadedSystem, SystemDescription};
+
+/// (target name, value, the parameter as written, where it came from).
+type Supplied = (String, Value, Parameter, String);
+
+struct Importer {
+    pkg: Package,
+    ssd_label: String,
+    models: Vec<ModelDescription>,
+    components: Vec<Component>,
+}
+
+pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, SspError> {
+    let mut pkg = Package::open(path)?;
+    let (text, ssd_label) = pkg.read_ssd()?;
+    let ssd = ssd::parse(&ssd_label, &text)?;
+    let unpacked = match pkg {
+        Package::Zip { .. } => Some(tempfile::Builder::new().prefix("ssp-").tempdir().map_err(
+            |e| SspError::Read {
+                path: path.to_path_buf(),
+                reason: format!("cannot create a temporary folder: {e}"),
+            },
+        )?),
+        Package::Dir { .. } => None,
+    };
+    let base_dir = match (&pkg, &unpacked) {
+        (_, Some(t)) => t.path().to_path_buf(),
+        (Package::Dir { dir, .. }, None) => dir.clone(),
+        (Package::Zip { .. }, None) => path.to_path_buf(),
+    };
+
+    // components: names, FMUs
+    let invalid = |line: usize, message: String| SspError::Invalid {
+        file: ssd_label.clone(),
+        line: Some(line),
+        message,
+    };
+    let mut instances = Vec::new();
+    let mut models = Vec::new();
+    for (i, c) in ssd.system.components.iter().enumerate() {
+        if c.name.is_empty() || c.name.contains('.') {
+            return Err(SspError::Unsupported {
+                file: ssd_label.clone(),
+                line: Some(c.line),
+                what: format!(
+                    "component name '{}' (the master's instance names are non-empty and have no '.')",
+                    c.name
+                ),
+            });
+        }
+        if ssd.system.components[..i].iter().any(|o| o.name == c.name) {
+            return Err(invalid(
+                c.line,
+                format!("component name '{}' is used twice", c.name),
+            ));
+        }
+        let rel = pkg
+            .resolve(&c.source)
+            .map_err(|r| invalid(c.line, format!("component '{}': source {r}", c.name)))?;
+        let dest = base_dir.clone();
+        let file = pkg.fmu_file(&rel, &dest, i)?;
+        let archive = FmuArchive::open(&base_dir.join(&file)).map_err(|source| SspError::Fmu {
+            file: ssd_label.clone(),
+            component: c.name.clone(),
+            source: Box::new(source),
+        })?;
+        models.push(archive.model);
+        instances.push(InstanceSpec {
+            name: c.name.clone(),
+            fmu: file,
+            parameters: BTreeMap::new(),
+            step_multiple: 1,
+            logging: false,
+        });
+    }
+    if instances.is_empty() {
+        return Err(invalid(1, "the system has no components".into()));
+    }
+    let mut imp = Importer {
+        pkg,
+        ssd_label: ssd_label.clone(),
+        models,
+        components: ssd.system.components.clone(),
+    };
+    imp.check_connectors(&ssd)?;
+    let connections = imp.connections(&ssd)?;
+    let values = imp.parameters(&ssd)?;
+    for (i, vals) in values.into_iter().enumerate() {
+        instances[i].parameters = vals;
+    }
+
+    // timing
+    let start_time = ssd.start_time_s.unwrap_or(0.0);
+    let stop_time = opts.stop_time.or(ssd.stop_time_s).ok_or_else(|| {
+        invalid(
+            1,
+            "no stop time: the SSD's DefaultExperiment has no stopTime (give one with --stop-time)"
+                .into(),
+        )
+    })?;
+    let step = opts
+        .step
+        .or(ssd.base_step_s)
+        .or(ssd.system.step_s)
+        .ok_or_else(|| {
+            invalid(
+                1,
+                "no communication step: neither libcosim's osp:FixedStepAlgorithm baseStepSize nor OMSimulator's oms:FixedStepMaster stepSize is given (give one with --step)"
+                    .into(),
+            )
+        })?;
+    for (i, c) in imp.components.iter().enumerate() {
+        if let Some(h) = c.step_size_hint_s {
+            let m = (h / step).round();
+            if !(m >= 1.0 && (m * step - h).abs() <= 1e-9 * h.max(step) && m <= u32::MAX as f64) {
+                return Err(invalid(
+                    c.line,
+                    format!(
+                        "component '{}': step size hint {h} s is not a whole multiple of the communication step {step} s",
+                        c.name
+                    ),
+                ));
+            }
+            instances[i].step_multiple = m as u32;
+        }
+    }
+    let desc = SystemDescription {
+        instances,
+        connections,
+        start_time,
+        stop_time,
+        step,
+        algorithm: opts.algorithm.unwrap_or(Algorithm::Jacobi),
+        order: None,
+        record: None,
+        init_sweeps: 3,
+        max_step_halvings: 0,
+    };
+    Ok(ImportedSsp {
+        system: LoadedSystem::from_description(desc, &base_dir, &imp.pkg.label()),
+        version: ssd.version,
+        _unpacked: unpacked,
+    })
+}
+
+fn var_type_name(t: &ConnectorType) -> &'static str {
+    match t {
+        ConnectorType::Real { .. } => "Real",
+        ConnectorType::Integer => "Integer",
+        ConnectorType::Boolean => "Boolean",
+        ConnectorType::String => "String",
+        ConnectorType::Enumeration => "Enumeration",
+    }
+}
+
+impl Importer {
+    fn invalid(&self, line: usize, message: String) -> SspError {
+        SspError::Invalid {
+            file: self.ssd_label.clone(),
+            line: Some(line),
+            message,
+        }
+    }
+
+    fn component_index(&self, name: &str) -> Option<usize> {
+        self.components.iter().position(|c| c.name == name)
+    }
+
+    /// Every declared connector of a component is a variable of its FMU, of the same type,
+    /// kind and unit.
+    fn check_connectors(&self, ssd: &Ssd) -> Result<(), SspError> {
+        for (i, c) in ssd.system.components.iter().enumerate() {
+            let md = &self.models[i];
+            for k in &c.connectors {
+                let Some((_, v)) = md.variable(&k.name) else {
+                    let hint = md
+                        .suggest(&k.name)
+                        .map(|n| format!(" (did you mean '{n}'?)"))
+                        .unwrap_or_default();
+                    return Err(self.invalid(
+                        k.line,
+                        format!(
+                            "connector '{}.{}': the FMU (model '{}') has no variable '{}'{hint}",
+                            c.name, k.name, md.model_name, k.name
+                        ),
+                    ));
+                };
+                let kind_ok = match k.kind.as_str() {
+                    "input" => v.causality == Causality::Input,
+                    "output" => v.causality == Causality::Output,
+                    _ => true,
+                };
+                if !kind_ok {
+                    return Err(self.invalid(
+                        k.line,
+                        format!(
+                            "connector '{}.{}' of kind '{}' is a variable of causality '{}' in the FMU",
+                            c.name, k.name, k.kind, v.causality
+                        ),
+                    ));
+                }
+                if let Some(t) = &k.ty {
+                    let fits = matches!(
+                        (t, v.var_type),
+                        (ConnectorType::Real { .. }, VarType::Real)
+                            | (ConnectorType::Integer, VarType::Integer)
+                            | (ConnectorType::Boolean, VarType::Boolean)
+                            | (ConnectorType::String, VarType::String)
+                            | (ConnectorType::Enumeration, VarType::Enumeration)
+                    );
+                    if !fits {
+                        return Err(self.invalid(
+                            k.line,
+                            format!(
+                                "connector '{}.{}' is {} but the FMU's variable is {}",
+                                c.name,
+                                k.name,
+                                var_type_name(t),
+                                v.var_type
+                            ),
+                        ));
+                    }
+                    if let (ConnectorType::Real { unit: Some(u) }, Some(fu)) = (t, &v.unit) {
+                        if !same_unit(ssd, u, fu) {
+                            return Err(SspError::Unsupported {
+                                file: self.ssd_label.clone(),
+                                line: Some(k.line),
+                                what: format!(
+                                    "unit conversion: connector '{}.{}' is in [{u}] but the FMU's variable is in [{fu}]",
+                                    c.name, k.name
+                                ),
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn connections(&self, ssd: &Ssd) -> Result<Vec<ConnectionSpec>, SspError> {
+        let mut out = Vec::new();
+        for c in &ssd.system.connections {
+            let (Some(se), Some(ee)) = (&c.start_element, &c.end_element) else {
+                let conn = if c.start_element.is_none() {
+                    &c.start_connector
+                } else {
+                    &c.end_connector
+                };
+                return Err(SspError::Unsupported {
+                    file: self.ssd_label.clone(),
+                    line: Some(c.line),
+                    what: format!(
+                        "connection to the system connector '{}.{conn}' (the master has no system inputs or outputs)",
+                        ssd.system.name
+                    ),
+                });
+            };
+            let end_of = |e: &str, k: &str| -> Result<(usize, Causality), SspError> {
+                let Some(i) = self.component_index(e) else {
+                    return Err(
+                        self.invalid(c.line, format!("connection: no component named '{e}'"))
+                    );
+                };
+                let md = &self.models[i];
+                match md.variable(k) {
+                    Some((_, v)) => Ok((i, v.causality)),
+                    None => Err(self.invalid(
+                        c.line,
+                        format!(
+                            "connection: component '{e}' (model '{}') has no variable '{k}'{}",
+                            md.model_name,
+                            md.suggest(k)
+                                .map(|n| format!(" (did you mean '{n}'?)"))
+                                .unwrap_or_default()
+                        ),
+                    )),
+                }
+            };
+            let (_, sc) = end_of(se, &c.start_connector)?;
+            let (_, ec) = end_of(ee, &c.end_connector)?;
+            let start = format!("{se}.{}", c.start_connector);
+            let end = format!("{ee}.{}", c.end_connector);
+            // SSP connections are directed start -> end; one written input -> output is
+            // read the other way round.
+            let (from, to) = if sc == Causality::Input && ec == Causality::Output {
+                (end, start)
+            } else {
+                (start, end)
+            };
+            out.push(ConnectionSpec { from, to });
+        }
+        Ok(out)
+    }
+
+    fn load_set(&mut self, b: &Binding) -> Result<(ParameterSet, String), SspError> {
+        match &b.values {
+            BindingValues::Inline(set) => {
+                Ok((set.clone(), format!("{} line {}", self.ssd_label, b.line)))
+            }
+            BindingValues::File(src) => {
+                let rel = self
+                    .pkg
+                    .resolve(src)
+                    .map_err(|r| self.invalid(b.line, format!("parameter binding source {r}")))?;
+                let label = self.pkg.file_label(&rel);
+                let text = self.pkg.read_text(&rel)?;
+                Ok((ssv::parse_ssv(&label, &text)?, label))
+            }
+        }
+    }
+
+    /// The (target name, value, origin) pairs a binding supplies, after prefix and mapping.
+    fn binding_values(&mut self, b: &Binding) -> Result<(Vec<Supplied>, ParameterSet), SspError> {
+        let (set, label) = self.load_set(b)?;
+        let origin = |p: &Parameter| {
+            format!(
+                "parameter '{}' of set '{}' ({label} line {})",
+                p.name, set.name, p.line
+            )
+        };
+        let prefixed: Vec<(String, &Parameter)> = set
+            .parameters
+            .iter()
+            .map(|p| (format!("{}{}", b.prefix, p.name), p))
+            .collect();
+        let mut out = Vec::new();
+        match &b.mapping {
+            None => {
+                for (name, p) in &prefixed {
+                    out.push((name.clone(), p.value.clone(), (*p).clone(), origin(p)));
+                }
+            }
+            Some(m) => {
+                let (mapping, mlabel) = match m {
+                    BindingMapping::Inline(m) => {
+                        (m.clone(), format!("{} line {}", self.ssd_label, b.line))
+                    }
+                    BindingMapping::File(src) => {
+                        let rel = self.pkg.resolve(src).map_err(|r| {
+                            self.invalid(b.line, format!("parameter mapping source {r}"))
+                        })?;
+                        let l = self.pkg.file_label(&rel);
+                        let text = self.pkg.read_text(&rel)?;
+                        (ssv::parse_ssm(&l, &text)?, l)
+                    }
+                };
+                for e in &mapping.entries {
+                    let hits: Vec<&(String, &Parameter)> =
+                        prefixed.iter().filter(|(n, _)| *n == e.source).collect();
+                    if hits.is_empty() {
+                        return Err(SspError::Invalid {
+                            file: mlabel.clone(),
+                            line: Some(e.line),
+                            message: format!(
+                                "mapping entry source '{}' is not a parameter of set '{}' ({label})",
+                                e.source, set.name
+                            ),
+                        });
+                    }
+                    for (_, p) in hits {
+                        let v = match &e.transformation {
+                            None => p.value.clone(),
+                            Some(t) => t.apply(&p.value).map_err(|r| SspError::Invalid {
+                                file: mlabel.clone(),
+                                line: Some(e.line),
+                                message: format!("mapping '{}' -> '{}': {r}", e.source, e.target),
+                            })?,
+                        };
+                        let o = format!(
+                            "{} mapped to '{}' ({mlabel} line {})",
+                            origin(p),
+                            e.target,
+                            e.line
+                        );
+                        out.push((e.target.clone(), v, (*p).clone(), o));
+                    }
+                }
+            }
+        }
+        Ok((out, set))
+    }
+
+    /// Parameter values per component: component bindings first, then system bindings, so
+    /// the higher level wins, and within a level a later binding wins (SSP 1.0/2.0 5.x
+    /// ParameterBindings).
+    #[allow(clippy::needless_range_loop)]
+    fn parameters(&mut self, ssd: &Ssd) -> Result<Vec<BTreeMap<String, Json>>, SspError> {
+        let mut out: Vec<BTreeMap<String, Json>> = (0..self.components.len())
+            .map(|_| BTreeMap::new())
+            .collect();
+        for i in 0..self.components.len() {
+            let bindings = self.components[i].bindings.clone();
+            for b in &bindings {
+                let (vals, set) = self.binding_values(b)?;
+                for (target, v, p, origin) in vals {
+                    if self.models[i].variable(&target).is_none() {
+                        let md = &self.models[i];
+                        let hint = md
+                            .suggest(&target)
+                            .map(|n| format!(" (did you mean '{n}'?)"))
+                            .unwrap_or_default();
+                        return Err(self.unmatched(
+                            &origin,
+                            format!(
+                                "matches no variable of component '{}' (model '{}'){hint}",
+                                self.components[i].name, md.model_name
+                            ),
+                        ));
+                    }
+                    let bound = self.convert(ssd, &set, i, &target, &v, &p, &origin)?;
+                    out[i].insert(target, bound);
+                }
+            }
+        }
+        for b in &ssd.system.bindings {
+            let (vals, set) = self.binding_values(b)?;
+            for (target, v, p, origin) in vals {
+                if ssd.system.connectors.iter().any(|k| k.name == target) {
+                    return Err(SspError::Unsupported {
+                        file: self.ssd_label.clone(),
+                        line: Some(b.line),
+                        what: format!(
+                            "{origin} sets the system connector '{target}' (the master has no system connectors)"
+                        ),
+                    });
+                }
+                let mut hit = false;
+                for i in 0..self.components.len() {
+                    let Some(var) = target
+                        .strip_prefix(self.components[i].name.as_str())
+                        .and_then(|r| r.strip_prefix('.'))
+                    else {
+                        continue;
+                    };
+                    if self.models[i].variable(var).is_some() {
+                        let bound = self.convert(ssd, &set, i, var, &v, &p, &origin)?;
+                        out[i].insert(var.to_string(), bound);
+                        hit = true;
+                    }
+                }
+                if !hit {
+                    let names: Vec<&str> =
+                        self.components.iter().map(|c| c.name.as_str()).collect();
+                    return Err(self.unmatched(
+                        &origin,
+                        format!(
+                            "as '{target}' matches no 'component.variable' of system '{}' (components: {})",
+                            ssd.system.name,
+                            names.join(", ")
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// SSP lets a tool ignore a parameter that matches nothing; the master refuses it, so a
+    /// misspelt or misplaced parameter never goes unnoticed.
+    fn unmatched(&self, origin: &str, why: String) -> SspError {
+        SspError::Parameter {
+            message: format!("{origin} {why}"),
+        }
+    }
+
+    /// The JSON start value for variable `var` of component `i`.
+    #[allow(clippy::too_many_arguments)]
+    fn convert(
+        &self,
+        ssd: &Ssd,
+        set: &ParameterSet,
+        i: usize,
+        var: &str,
+        v: &Value,
+        p: &Parameter,
+        origin: &str,
+    ) -> Result<Json, SspError> {
+        let md = &self.models[i];
+        let comp = &self.components[i].name;
+        let fail = |why: String| SspError::Parameter {
+            message: format!("{origin}: {why}"),
+        };
+        let Some((_, fv)) = md.variable(var) else {
+            return Err(fail(format!("component '{comp}' has no variable '{var}'")));
+        };
+        if !fv.is_settable() {
+            return Err(fail(format!(
+                "'{comp}.{var}' has causality '{}' and variability '{}' and cannot be given a start value",
+                fv.causality, fv.variability
+            )));
+        }
+        let value = match (fv.var_type, v) {
+            (VarType::Real, Value::Real(x)) => {
+                if let (Some(u), Some(fu)) = (&p.unit, &fv.unit) {
+                    let defined = |n: &str| set.units.iter().chain(&ssd.units).any(|d| d.name == n);
+                    if u != fu && !(defined(u) && defined(fu) && same_unit_in(ssd, set, u, fu)) {
+                        return Err(SspError::Unsupported {
+                            file: origin.to_string(),
+                            line: None,
+                            what: format!(
+                                "unit conversion: the value is in [{u}] but '{comp}.{var}' is in [{fu}]"
+                            ),
+                        });
+                    }
+                }
+                Json::from(*x)
+            }
+            (VarType::Integer | VarType::Enumeration, Value::Integer(x)) => {
+                if i32::try_from(*x).is_err() {
+                    return Err(fail(format!("{x} does not fit a 32-bit FMI Integer")));
+                }
+                Json::from(*x)
+            }
+            // an item name; the system description resolves it against the FMU's type
+            (VarType::Enumeration, Value::Enumeration(name)) => Json::from(name.clone()),
+            (VarType::Boolean, Value::Boolean(b)) => Json::from(*b),
+            (VarType::String, Value::String(s)) => Json::from(s.clone()),
+            (t, v) => {
+                return Err(fail(format!(
+                    "a {} value cannot set '{comp}.{var}', which is {t}",
+                    v.kind()
+                )))
+            }
+        };
+        Ok(value)
+    }
+}
+
+/// Whether units `a` and `b` are the same: the same name, or identical definitions in the SSD.
+fn same_unit(ssd: &Ssd, a: &str, b: &str) -> bool {
+    a == b
+        || {
+            let find = |n: &str| ssd.units.iter().find(|u| u.name == n);
+            matches!((find(a), find(b)), (Some(x), Some(y)) if x.exponents == y.exponents && x.factor == y.factor && x.offset == y.offset)
+        }
+}
+
+fn same_unit_in(ssd: &Ssd, set: &ParameterSet, a: &str, b: &str) -> bool {
+    let find = |n: &str| set.units.iter().chain(&ssd.units).find(|u| u.name == n);
+    matches!((find(a), find(b)), (Some(x), Some(y)) if x.exponents == y.exponents && x.factor == y.factor && x.offset == y.offset)
+}

@@ -1,0 +1,110 @@
+//! SSP (System Structure and Parameterization, Modelica Association, versions 1.0 and 2.0):
+//! systems of FMUs exchanged between tools.
+//!
+//! * [`import`]: a `.ssp` archive (SystemStructure.ssd at its root, FMUs, `.ssv` parameter sets
+//!   and `.ssm` parameter mappings inside) or a bare `.ssd` next to its files becomes a
+//!   [`LoadedSystem`] that runs like a JSON system description. Components, connectors (type,
+//!   kind and unit checked against the FMU), connections, parameter bindings (inline and
+//!   `.ssv`, on components and on the system, with `prefix` and `.ssm` mappings and their
+//!   transformations), units, the default experiment and the communication step of libcosim's
+//!   and OMSimulator's annotations are read. Whatever the master cannot honour is an error
+//!   naming the file, the line and the element: nested systems, system connectors, signal
+//!   dictionaries, connection transformations, unit conversions, arrays, FMI 3.0 types, other
+//!   component types. A parameter that matches no variable is an error too (SSP lets a tool
+//!   ignore it; silently dropped parameters give plausible but wrong results).
+//! * [`export`]: a system description becomes a self-contained SSP 1.0 archive (the
+//!   version every host reads; valid against the 1.0 and 2.0 schemas): the FMUs under
+//!   `resources/`, one parameter set per component (`resources/INSTANCE.ssv`, bound on the
+//!   component, where libcosim and Ecos look), connectors for every connected or recorded
+//!   input and output, units from the FMUs' UnitDefinitions, the default experiment, and the
+//!   step as libcosim (`osp:FixedStepAlgorithm`) and OMSimulator (`oms:FixedStepMaster`)
+//!   annotations.
+
+use std::path::{Path, PathBuf};
+
+use crate::coupling::Algorithm;
+use crate::fmu::FmuError;
+use crate::system::{LoadedSystem, SystemError};
+
+mod export;
+mod import;
+mod package;
+mod ssd;
+mod ssv;
+mod xml;
+
+pub use export::ExportSummary;
+
+/// A problem with an SSP: always names the file (a member of an archive as `x.ssp:member`).
+#[derive(Debug, thiserror::Error)]
+pub enum SspError {
+    #[error("cannot read '{path}': {reason}")]
+    Read { path: PathBuf, reason: String },
+    #[error("{file}{}: {message}", .line.map(|l| format!(" line {l}")).unwrap_or_default())]
+    Invalid {
+        file: String,
+        line: Option<usize>,
+        message: String,
+    },
+    #[error("{file}{}: not supported: {what}", .line.map(|l| format!(" line {l}")).unwrap_or_default())]
+    Unsupported {
+        file: String,
+        line: Option<usize>,
+        what: String,
+    },
+    #[error("{message}")]
+    Parameter { message: String },
+    #[error("{file}: component '{component}': {source}")]
+    Fmu {
+        file: String,
+        component: String,
+        #[source]
+        source: Box<FmuError>,
+    },
+    #[error(transparent)]
+    System(#[from] SystemError),
+    #[error("cannot export: {0}")]
+    Export(String),
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+}
+
+/// Choices an SSP does not make (or that the user overrides).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ImportOptions {
+    /// Communication step [s]; default: the SSP's libcosim or OMSimulator annotation.
+    pub step: Option<f64>,
+    /// Stop time [s]; default: the DefaultExperiment's stopTime.
+    pub stop_time: Option<f64>,
+    /// Default Jacobi (SSP does not say; libcosim, Ecos and fmpy exchange Jacobi-style).
+    pub algorithm: Option<Algorithm>,
+}
+
+/// An imported SSP: the system, and the folder its FMUs were unpacked into (removed on drop).
+#[derive(Debug)]
+pub struct ImportedSsp {
+    pub system: LoadedSystem,
+    /// The SSD's `version` attribute.
+    pub version: String,
+    _unpacked: Option<tempfile::TempDir>,
+}
+
+/// Whether `path` names an SSP (`.ssp` or `.ssd`) rather than a JSON system description.
+pub fn is_ssp_path(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("ssp") || e.eq_ignore_ascii_case("ssd"))
+}
+
+/// Reads a `.ssp` archive or a bare `.ssd` into a runnable system.
+pub fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, SspError> {
+    import::import(path, opts)
+}
+
+/// Writes `sys` as a self-contained SSP 1.0 archive at `out` (atomically).
+pub fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, SspError> {
+    export::export(sys, out)
+}
+
+#[cfg(test)]
+mod tests;

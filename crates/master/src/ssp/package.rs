@@ -1,0 +1,245 @@
+//! Where the files of an SSP come from: a .ssp zip (SystemStructure.ssd at its root, FMUs,
+//! .ssv and .ssm files inside) or a bare .ssd in a folder (its references relative to that
+//! folder). References are relative URIs; in a zip none may leave the archive.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use super::SspError;
+
+/// Largest .ssd/.ssv/.ssm read (a parameter set of a large model is a few MB).
+const MAX_XML_BYTES: u64 = 64 << 20;
+/// Largest FMU unpacked from a .ssp.
+const MAX_FMU_BYTES: u64 = 4 << 30;
+
+pub(super) enum Package {
+    Zip {
+        path: PathBuf,
+        zip: Box<zip::ZipArchive<std::fs::File>>,
+    },
+    Dir {
+        ssd: PathBuf,
+        dir: PathBuf,
+    },
+}
+
+impl Package {
+    /// Opens `path`: a `.ssp` zip or an `.ssd` file.
+    pub fn open(path: &Path) -> Result<Self, SspError> {
+        let read_err = |reason: String| SspError::Read {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("ssp") => {
+                let f = std::fs::File::open(path).map_err(|e| read_err(e.to_string()))?;
+                let zip = zip::ZipArchive::new(f)
+                    .map_err(|e| read_err(format!("not a zip archive: {e}")))?;
+                Ok(Package::Zip {
+                    path: path.to_path_buf(),
+                    zip: Box::new(zip),
+                })
+            }
+            Some("ssd") => {
+                if !path.is_file() {
+                    return Err(read_err("no such file".into()));
+                }
+                Ok(Package::Dir {
+                    ssd: path.to_path_buf(),
+                    dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+                })
+            }
+            _ => Err(read_err(
+                "an SSP is a .ssp archive or a .ssd file".to_string(),
+            )),
+        }
+    }
+
+    /// How the package is named in messages.
+    pub fn label(&self) -> String {
+        match self {
+            Package::Zip { path, .. } => path.display().to_string(),
+            Package::Dir { ssd, .. } => ssd.display().to_string(),
+        }
+    }
+
+    /// How file `rel` of the package is named in messages.
+    pub fn file_label(&self, rel: &str) -> String {
+        match self {
+            Package::Zip { path, .. } => format!("{}:{rel}", path.display()),
+            Package::Dir { dir, .. } => dir.join(rel).display().to_string(),
+        }
+    }
+
+    /// The SSD's text and its label.
+    pub fn read_ssd(&mut self) -> Result<(String, String), SspError> {
+        match self {
+            Package::Zip { .. } => {
+                let label = self.file_label("SystemStructure.ssd");
+                let text = self.read_text("SystemStructure.ssd")?;
+                Ok((text, label))
+            }
+            Package::Dir { ssd, .. } => {
+                let ssd = ssd.clone();
+                let text = read_file_limited(&ssd, MAX_XML_BYTES)?;
+                Ok((text, ssd.display().to_string()))
+            }
+        }
+    }
+
+    /// Reads the XML file at the normalised reference `rel`.
+    pub fn read_text(&mut self, rel: &str) -> Result<String, SspError> {
+        match self {
+            Package::Zip { path, zip } => {
+                let label = format!("{}:{rel}", path.display());
+                let entry = zip.by_name(rel).map_err(|_| SspError::Read {
+                    path: PathBuf::from(&label),
+                    reason: "no such file in the archive".into(),
+                })?;
+                let mut buf = Vec::new();
+                entry
+                    .take(MAX_XML_BYTES + 1)
+                    .read_to_end(&mut buf)
+                    .map_err(|e| SspError::Read {
+                        path: PathBuf::from(&label),
+                        reason: e.to_string(),
+                    })?;
+                if buf.len() as u64 > MAX_XML_BYTES {
+                    return Err(SspError::Read {
+                        path: PathBuf::from(&label),
+                        reason: format!("larger than {MAX_XML_BYTES} bytes"),
+                    });
+                }
+                String::from_utf8(buf).map_err(|_| SspError::Read {
+                    path: PathBuf::from(&label),
+                    reason: "not UTF-8 text".into(),
+                })
+            }
+            Package::Dir { dir, .. } => read_file_limited(&dir.join(rel), MAX_XML_BYTES),
+        }
+    }
+
+    /// The FMU at reference `rel` as a file: unpacked into `dest` (a fresh folder) from a zip,
+    /// the file itself next to a bare .ssd.
+    pub fn fmu_file(&mut self, rel: &str, dest: &Path, index: usize) -> Result<PathBuf, SspError> {
+        match self {
+            Package::Zip { path, zip } => {
+                let label = PathBuf::from(format!("{}:{rel}", path.display()));
+                let mut entry = zip.by_name(rel).map_err(|_| SspError::Read {
+                    path: label.clone(),
+                    reason: "no such file in the archive".into(),
+                })?;
+                let file_name = rel.rsplit('/').next().unwrap_or("component.fmu");
+                // one folder per component: two sources may share a file name
+                let dir = dest.join(index.to_string());
+                let out = dir.join(file_name);
+                let io = |e: std::io::Error| SspError::Read {
+                    path: label.clone(),
+                    reason: format!("cannot unpack: {e}"),
+                };
+                std::fs::create_dir_all(&dir).map_err(io)?;
+                let mut f = std::fs::File::create(&out).map_err(io)?;
+                let n =
+                    std::io::copy(&mut (&mut entry).take(MAX_FMU_BYTES + 1), &mut f).map_err(io)?;
+                if n > MAX_FMU_BYTES {
+                    return Err(SspError::Read {
+                        path: label,
+                        reason: format!("larger than {MAX_FMU_BYTES} bytes"),
+                    });
+                }
+                Ok(out)
+            }
+            // relative to the folder, which is the system's base folder
+            Package::Dir { .. } => Ok(PathBuf::from(rel)),
+        }
+    }
+
+    /// Normalises a relative URI reference of the SSD: percent-decoded, `.` and `..`
+    /// resolved; `Err` is the reason it is refused.
+    pub fn resolve(&self, reference: &str) -> Result<String, String> {
+        let r = reference.trim();
+        if r.contains('#') {
+            return Err(format!(
+                "'{reference}' has a fragment (references into other SSDs are not supported)"
+            ));
+        }
+        if let Some((scheme, _)) = r.split_once(':') {
+            if !scheme.is_empty()
+                && scheme
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c))
+            {
+                return Err(format!(
+                    "'{reference}' is an absolute URI (only references relative to the SSD)"
+                ));
+            }
+        }
+        if r.starts_with('/') || r.is_empty() {
+            return Err(format!(
+                "'{reference}' is not a relative reference to a file"
+            ));
+        }
+        let decoded = percent_decode(r)
+            .ok_or_else(|| format!("'{reference}' has an invalid percent-encoding"))?;
+        let mut parts: Vec<&str> = Vec::new();
+        let in_zip = matches!(self, Package::Zip { .. });
+        let mut ups = 0usize;
+        for seg in decoded.split('/') {
+            match seg {
+                "" | "." => {}
+                ".." => {
+                    if parts.pop().is_none() {
+                        if in_zip {
+                            return Err(format!("'{reference}' points outside the archive"));
+                        }
+                        ups += 1;
+                    }
+                }
+                s => parts.push(s),
+            }
+        }
+        if parts.is_empty() {
+            return Err(format!("'{reference}' names no file"));
+        }
+        let mut out = "../".repeat(ups);
+        out.push_str(&parts.join("/"));
+        Ok(out)
+    }
+}
+
+fn read_file_limited(path: &Path, limit: u64) -> Result<String, SspError> {
+    let err = |reason: String| SspError::Read {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let f = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
+    let mut buf = Vec::new();
+    f.take(limit + 1)
+        .read_to_end(&mut buf)
+        .map_err(|e| err(e.to_string()))?;
+    if buf.len() as u64 > limit {
+        return Err(err(format!("larger than {limit} bytes")));
+    }
+    String::from_utf8(buf).map_err(|_| err("not UTF-8 text".into()))
+}
+
+fn percent_decode(s: &str) -> Option<String> {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%' {
+            let hex = s.get(i + 1..i + 3)?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(b[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
+}
