@@ -38,6 +38,18 @@ if ! "$VENV/bin/python" -c "import maturin, pandas, distributed, tqdm, pytest" 2
     "tqdm==4.67.1" "pytest==9.2.0" >/dev/null
 fi
 
+# SSP hosts for tests/tests/ssp_interop.rs: libcosim (libcosimpy, whose libcosimc needs the
+# system's oneTBB runtime libtbb12) and Ecos (ecospy) run the exported SSPs.
+if ! ldconfig -p 2>/dev/null | grep -q 'libtbb\.so\.12'; then
+  step "installing libtbb12 (needed by libcosimpy)"
+  as_root apt-get update -qq
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libtbb12 >/dev/null
+fi
+if ! "$VENV/bin/python" -c "import libcosimpy, ecospy" 2>/dev/null; then
+  step "installing libcosimpy and ecospy into $VENV"
+  "$VENV/bin/pip" install -q "libcosimpy==0.0.6" "ecospy==0.7.2" >/dev/null
+fi
+
 # Portable Linux binaries: cargo-zigbuild builds the FMUs against glibc 2.17 (manylinux2014)
 # with zig as C compiler and linker. Both are pinned: cargo-zigbuild from crates.io into
 # target/tools/bin (where package-fmus looks first), zig from PyPI's ziglang package in the venv,

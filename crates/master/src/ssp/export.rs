@@ -17,6 +17,10 @@ const NS_OSP: &str = "http://opensimulationplatform.com/SSP/OSPAnnotations";
 const NS_OMS: &str =
     "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd";
 
+/// The name of every parameter set written. Ecos applies parameter sets only when its
+/// simulation is initialised with their name; one name for all makes one `init` apply all.
+pub const PARAMETER_SET_NAME: &str = "initial";
+
 /// What an export wrote.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExportSummary {
@@ -397,8 +401,7 @@ fn parameter_set(
     let _ = writeln!(s, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
     let _ = writeln!(
         s,
-        r#"<ssv:ParameterSet xmlns:ssv="{NS_SSV}" xmlns:ssc="{NS_SSC}" version="1.0" name="{}">"#,
-        escape(instance)
+        r#"<ssv:ParameterSet xmlns:ssv="{NS_SSV}" xmlns:ssc="{NS_SSC}" version="1.0" name="{PARAMETER_SET_NAME}">"#
     );
     let _ = writeln!(s, "  <ssv:Parameters>");
     for (name, value) in params {

@@ -15,7 +15,8 @@
 //! * [`export`]: a system description becomes a self-contained SSP 1.0 archive (the
 //!   version every host reads; valid against the 1.0 and 2.0 schemas): the FMUs under
 //!   `resources/`, one parameter set per component (`resources/INSTANCE.ssv`, bound on the
-//!   component, where libcosim and Ecos look), connectors for every connected or recorded
+//!   component, where libcosim and Ecos look; all named [`PARAMETER_SET_NAME`]; Enumeration
+//!   values as `ssv:Integer`, since libcosim aborts on `ssv:Enumeration`), connectors for every connected or recorded
 //!   input and output, units from the FMUs' UnitDefinitions, the default experiment, and the
 //!   step as libcosim (`osp:FixedStepAlgorithm`) and OMSimulator (`oms:FixedStepMaster`)
 //!   annotations.
@@ -33,7 +34,7 @@ mod ssd;
 mod ssv;
 mod xml;
 
-pub use export::ExportSummary;
+pub use export::{ExportSummary, PARAMETER_SET_NAME};
 
 /// A problem with an SSP: always names the file (a member of an archive as `x.ssp:member`).
 #[derive(Debug, thiserror::Error)]
