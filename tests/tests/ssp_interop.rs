@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use master::coupling::{Algorithm, RunOptions, SimOutput};
-use master::model_description::{Causality, VarType};
+use master::model_description::VarType;
 use master::ssp::{self, ImportOptions};
 use master::system::LoadedSystem;
 
