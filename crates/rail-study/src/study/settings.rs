@@ -93,13 +93,13 @@ impl StudySettings {
 
     /// The reduced study for CI: 1 seed, shorter runs. Bogie: 5 speeds (40 km/h apart) and a
     /// coarse bisection to 10 km/h (two rounds of one run per configuration), so that the tests
-    /// can check critical speeds to +-10 km/h rather than +-40 km/h. Coach: 9 speeds (20 km/h
-    /// apart, to 440 km/h) and bisection to 5 km/h, so that its tests can check the passive
-    /// 280-300 km/h.
+    /// can check critical speeds to +-10 km/h rather than +-40 km/h. Coach: 5 speeds (260-420
+    /// km/h, 40 km/h apart), bisection to 5 km/h (three rounds) so that its tests can check the
+    /// passive 280-300 km/h, and 20 s scenario runs.
     pub fn quick(vehicle: VehicleModel) -> Self {
-        let (speeds_kmh, tol) = match vehicle {
-            VehicleModel::Coach => (range(240.0, 440.0, 20.0), 5.0),
-            VehicleModel::Bogie2Dof => (vec![240.0, 280.0, 320.0, 360.0, 400.0], 10.0),
+        let (speeds_kmh, tol, scenario_stop_s) = match vehicle {
+            VehicleModel::Coach => (range(260.0, 420.0, 40.0), 5.0, 20.0),
+            VehicleModel::Bogie2Dof => (vec![240.0, 280.0, 320.0, 360.0, 400.0], 10.0, 40.0),
         };
         StudySettings {
             speeds_kmh,
@@ -108,6 +108,7 @@ impl StudySettings {
             bisection_tol_kmh: Some(tol),
             perturbation_stop_s: 8.0,
             cv_stop_s: 12.0,
+            scenario_stop_s,
             ..Self::full(vehicle)
         }
     }
@@ -137,7 +138,7 @@ mod tests {
         let q = StudySettings::quick(VehicleModel::Bogie2Dof);
         assert!(q.planned_runs() < f.planned_runs() / 4);
         let c = StudySettings::quick(VehicleModel::Coach);
-        assert_eq!(c.speeds_kmh.len(), 11);
+        assert_eq!(c.speeds_kmh, [260.0, 300.0, 340.0, 380.0, 420.0]);
         assert!(c.planned_runs() < f.planned_runs() / 2);
         assert_eq!(
             StudySettings::full(VehicleModel::Coach).perturbation_speeds_kmh,

