@@ -23,53 +23,6 @@ pub struct Args {
     pub no_load: bool,
 }
 
-/// The FMU's binaries read without loading them: platform, format and architecture, the newest
-/// glibc a Linux binary needs (the oldest Linux it loads on) against the portable baseline, and
-/// anything that does not fit its platform folder. Informative: a binary that needs a newer
-/// glibc than the baseline still runs where that glibc is installed.
-fn print_binaries(fmu: &std::path::Path) {
-    let report = match fmu_binary::check_fmu(fmu, &fmu_binary::Policy::baseline()) {
-        Ok(r) => r,
-        Err(e) => {
-            println!("binaries: cannot be read: {e}");
-            return;
-        }
-    };
-    let platforms: Vec<String> = report.platforms().iter().map(|p| p.to_string()).collect();
-    println!(
-        "binaries: {} (portable baseline: glibc {})",
-        if platforms.is_empty() {
-            "none".to_string()
-        } else {
-            platforms.join(", ")
-        },
-        fmu_binary::GLIBC_BASELINE
-    );
-    for b in &report.binaries {
-        let mut line = format!("  {}", b.entry);
-        if let Some(info) = &b.info {
-            let archs: Vec<String> = info
-                .images
-                .iter()
-                .map(|i| i.architecture.to_string())
-                .collect();
-            line += &format!(": {} {}", info.format, archs.join(" + "));
-            if let Some(v) = info.newest_glibc() {
-                let verdict = if v <= fmu_binary::GLIBC_BASELINE {
-                    "within the baseline"
-                } else {
-                    "newer than the baseline"
-                };
-                line += &format!(", needs glibc >= {v} ({verdict})");
-            }
-        }
-        println!("{line}");
-        for p in &b.problems {
-            println!("    note: {p}");
-        }
-    }
-}
-
 pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
     let a = FmuArchive::open(&args.fmu)?;
     if !args.no_load {
