@@ -15,6 +15,7 @@ cargo build --release -q -p rail-study --bin master
 step "benchmark (one run; the load average is printed beside every figure)"
 export RAIL_PYTHON="$VENV/bin/python"
 export BENCH_OUT="$PWD/docs/BENCHMARKS.md"
-# studies to time, separated by ';' (each is `master study <options>`)
-export BENCH_STUDY="${BENCH_STUDY:---jobs 2}"
+# studies to time, separated by ";" (each is `master study <options>`): the coach study (the
+# default) and the 2-dof bogie study
+export BENCH_STUDY="${BENCH_STUDY:---jobs 2;--vehicle bogie2dof --jobs 2}"
 cargo bench -q -p tests --bench ratios
