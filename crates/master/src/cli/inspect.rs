@@ -53,7 +53,6 @@ pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
         );
     }
     print_binaries(&args.fmu);
-    print_binary_lines(&args.fmu);
     println!();
     println!(
         "{:<32} {:>5} {:<12} {:<11} {:<8} {:<8} {:>10}  description",
@@ -78,7 +77,7 @@ pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
 /// One line per binary of the FMU (read from the files, not loaded): platform folder, format
 /// and architecture, the newest glibc symbol version it needs (the oldest glibc it loads on),
 /// and any portability problem against the manylinux2014 baseline, as a warning.
-fn print_binary_lines(fmu: &std::path::Path) {
+fn print_binaries(fmu: &std::path::Path) {
     let report = match fmu_binary::check_fmu(fmu, &fmu_binary::Policy::default()) {
         Ok(r) => r,
         Err(e) => {
