@@ -10,10 +10,11 @@ use model_description::{
     MAX_PARAMETER_FILE_BYTES,
 };
 use serde::{Deserialize, Serialize};
+use vehicle_elements::TrackLevel;
 use wheel_rail::GeometryTable;
 
 use crate::model::{Bogie, Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep};
-use crate::params::{ContactSource, ModelKind, ParamError, Params, PsdLevel, TrackSource};
+use crate::params::{ContactSource, ModelKind, Params, TrackSource};
 
 /// Speed of the FMU's start values (default experiment: hunting with flange contact) [m/s].
 pub const FMU_DEFAULT_SPEED_MPS: f64 = 300.0 / 3.6;
@@ -27,58 +28,10 @@ fmi_enum! {
     }
 }
 
-/// Where the lateral track alignment comes from (the FMI choice behind the physics'
-/// [`TrackSource`], whose internal generator also carries level and seed).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum TrackChoice {
-    None,
-    External,
-    Internal,
-}
-
-fmi_enum! {
-    TrackChoice as "TrackSource", "Source of the lateral track alignment" {
-        None = 0, "none", "Ideal straight track";
-        External = 1, "external", "The input track.lateral_alignment at the front wheelset (the rear sees it 2p/V later)";
-        Internal = 2, "internal", "The built-in ERRI B176 generator (track.level, track.seed)";
-    }
-}
-
-/// ERRI B176 spectrum level of the internal generator (the FMI choice behind the track
-/// generator's [`PsdLevel`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum TrackLevel {
-    Low,
-    High,
-}
-
-fmi_enum! {
-    TrackLevel as "TrackLevel", "ERRI B176 spectrum level of the internal track generator" {
-        Low = 0, "low", "A = 2.119e-7 m rad";
-        High = 1, "high", "A = 6.125e-7 m rad";
-    }
-}
-
-impl From<TrackLevel> for PsdLevel {
-    fn from(level: TrackLevel) -> Self {
-        match level {
-            TrackLevel::Low => PsdLevel::Low,
-            TrackLevel::High => PsdLevel::High,
-        }
-    }
-}
-
-/// The physics names the parameter it rejects (a field of [`Params`]); the glue reports it
-/// under the FMI variable bound to that field.
-impl FieldError for ParamError {
-    fn field(&self) -> Option<&str> {
-        Some(self.name)
-    }
-
-    fn reason(&self) -> String {
-        self.reason.clone()
-    }
-}
+// The FMI Enumeration `TrackSource`, with where this model applies the external input.
+vehicle_elements::track_choice_enum!(
+    "The input track.lateral_alignment at the front wheelset (the rear sees it 2p/V later)"
+);
 
 impl FieldError for PhysicsModelError {
     fn field(&self) -> Option<&str> {
@@ -186,14 +139,9 @@ impl Bogie2Dof {
     }
 
     fn build_params(&self) -> Params {
-        let track = match self.track_source {
-            TrackChoice::None => TrackSource::None,
-            TrackChoice::External => TrackSource::External,
-            TrackChoice::Internal => TrackSource::Internal {
-                level: self.track_level.into(),
-                seed: u64::from(self.track_seed.unsigned_abs()),
-            },
-        };
+        let track = self
+            .track_source
+            .track_source(self.track_level, self.track_seed);
         Params {
             track,
             contact: self.contact_source(),

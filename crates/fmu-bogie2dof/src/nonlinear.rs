@@ -15,7 +15,7 @@
 //! (y_i - y_track,i), no normal-force term except the optional gravitational stiffness, and
 //! no spin dofs; it equals (5.16) exactly (checked against the state matrix in tests).
 
-use wheel_rail::{saturation_factor, GeometryTable, SegmentHint};
+use wheel_rail::{saturated_wheelset_creep, GeometryTable, SegmentHint};
 
 use crate::params::{ModelKind, Params};
 
@@ -154,14 +154,9 @@ pub fn rhs_with_hints(
             let w = c.omega + x[4 + i];
             let eps_lr = (v - vi * sig + c.s * sigd - w * rr) * c.inv_v;
             let eps_ll = (v - vi * sig - c.s * sigd - w * rl) * c.inv_v;
-            let ft = -c.f22 * eps_t;
-            let (flr, fll) = (-c.f11 * eps_lr, -c.f11 * eps_ll);
-            // resultant creep force per wheel; forces stay far below the square's overflow
-            // (a diverging state is caught as non-finite), so no hypot is needed
-            let kr = saturation_factor((ft * ft + flr * flr).sqrt(), c.mu_p);
-            let kl = saturation_factor((ft * ft + fll * fll).sqrt(), c.mu_p);
-            let (ftr, flr) = (kr * ft, kr * flr);
-            let (ftl, fll) = (kl * ft, kl * fll);
+            let creep = saturated_wheelset_creep(c.f11, c.f22, c.mu_p, eps_t, eps_ll, eps_lr);
+            let (ftr, flr) = (creep.lateral_right_n, creep.longitudinal_right_n);
+            let (ftl, fll) = (creep.lateral_left_n, creep.longitudinal_left_n);
             let fbl = c.load * g.tan_gamma_left;
             let fbr = -c.load * g.tan_gamma_right;
             lat = ftr + ftl + fbl + fbr;

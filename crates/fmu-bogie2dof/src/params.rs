@@ -23,6 +23,9 @@
 //! below (this module imports no other module of the crate).
 
 use serde::{Deserialize, Serialize};
+use vehicle_elements::{finite, non_negative, positive};
+
+pub use vehicle_elements::ParamError;
 
 // Calibrated values: the defaults below use them; the procedure that produced them and its
 // reasoning are in the calibration module.
@@ -44,25 +47,6 @@ pub const CALIBRATED_K_SSX_N_PER_M: f64 = 0.390e6;
 /// Wheel/rail friction coefficient [-] (dry rail 0.3-0.4).
 pub const CALIBRATED_FRICTION: f64 = 0.35;
 
-/// A parameter is out of its admissible range; names the parameter and the reason.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("invalid parameter `{name}`: {reason}")]
-pub struct ParamError {
-    /// Field name as in [`Params`].
-    pub name: &'static str,
-    /// Why it was rejected.
-    pub reason: String,
-}
-
-impl ParamError {
-    pub(crate) fn new(name: &'static str, reason: impl Into<String>) -> Self {
-        Self {
-            name,
-            reason: reason.into(),
-        }
-    }
-}
-
 /// Which wheel/rail force law the time-domain model uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum ModelKind {
@@ -74,26 +58,7 @@ pub enum ModelKind {
     NonLinear,
 }
 
-pub use wheel_rail::track::PsdLevel;
-
-/// Where the lateral track alignment comes from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-pub enum TrackSource {
-    /// Input `track_lateral_m` (value at the FRONT wheelset; the rear wheelset sees it
-    /// delayed by 2p/V).
-    #[default]
-    External,
-    /// Internal ERRI B176 generator ([`wheel_rail::track::TrackGenerator`]: synthesised
-    /// periodic realisation, default band), reproducible from `seed`.
-    Internal {
-        /// Spectrum level.
-        level: PsdLevel,
-        /// Random seed for the phases (ChaCha8).
-        seed: u64,
-    },
-    /// Ideal straight track (y_track = 0), inputs ignored.
-    None,
-}
+pub use wheel_rail::track::{PsdLevel, TrackSource};
 
 /// Which wheel/rail contact table the non-linear model uses.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -211,32 +176,6 @@ impl Default for Params {
             track: TrackSource::External,
             contact: ContactSource::WornSurrogate,
         }
-    }
-}
-
-fn finite(name: &'static str, v: f64) -> Result<(), ParamError> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(ParamError::new(name, format!("must be finite, got {v}")))
-    }
-}
-
-fn positive(name: &'static str, v: f64) -> Result<(), ParamError> {
-    finite(name, v)?;
-    if v > 0.0 {
-        Ok(())
-    } else {
-        Err(ParamError::new(name, format!("must be > 0, got {v}")))
-    }
-}
-
-fn non_negative(name: &'static str, v: f64) -> Result<(), ParamError> {
-    finite(name, v)?;
-    if v >= 0.0 {
-        Ok(())
-    } else {
-        Err(ParamError::new(name, format!("must be >= 0, got {v}")))
     }
 }
 

@@ -10,7 +10,7 @@
 //!   r_{L,R} = r0 + delta_r_{L,R}(y_rel) from the contact table (5.19), wheel speed
 //!   Omega + beta_j' (5.26), Omega = V / r_c with r_c the table's centred rolling radius;
 //! * Kalker forces (5.2)-(5.3) with kappa f11, kappa f22, saturated per wheel by
-//!   Vermeulen-Johnson (5.21)-(5.25) (`wheel_rail::saturation_factor`), static load P;
+//!   Vermeulen-Johnson (5.21)-(5.25) (`wheel_rail::saturated_wheelset_creep`), static load P;
 //! * normal-force lateral components (5.20) F_BL = +P tan g_L, F_BR = -P tan g_R (contact
 //!   angles from the table; flange contact is the steep part of the table);
 //! * wheelset yaw moment s (F_LR - F_LL), spin equation J_w beta'' = -(F_LL R_L + F_LR R_R).
@@ -19,7 +19,7 @@
 //! the assembled sparse matrices, the yaw dampers enter as -E^T F.
 
 use serde::{Deserialize, Serialize};
-use wheel_rail::{saturation_factor, GeometryTable, SegmentHint};
+use wheel_rail::{saturated_wheelset_creep, GeometryTable, SegmentHint};
 
 use crate::layout::{
     damper_rows, mass_diagonal, wheelset_y, wheelset_yaw, SparseSuspension, Suspension, N_DAMPERS,
@@ -192,13 +192,9 @@ fn nonlinear_wheelset(
     let eps_lr = (v - vy * yaw + c.s * yaw_rate - w * rr) * v_inv;
     let eps_ll = (v - vy * yaw - c.s * yaw_rate - w * rl) * v_inv;
     // (5.2)-(5.3), saturated (5.21)-(5.25)
-    let ft = -c.f22 * eps_t;
-    let (flr, fll) = (-c.f11 * eps_lr, -c.f11 * eps_ll);
-    // plain root of the sum of squares: forces are far from overflow (|F| < 1e9 N)
-    let kr = saturation_factor((ft * ft + flr * flr).sqrt(), c.mu_p);
-    let kl = saturation_factor((ft * ft + fll * fll).sqrt(), c.mu_p);
-    let (ftr, flr) = (kr * ft, kr * flr);
-    let (ftl, fll) = (kl * ft, kl * fll);
+    let creep = saturated_wheelset_creep(c.f11, c.f22, c.mu_p, eps_t, eps_ll, eps_lr);
+    let (ftr, flr) = (creep.lateral_right_n, creep.longitudinal_right_n);
+    let (ftl, fll) = (creep.lateral_left_n, creep.longitudinal_left_n);
     // (5.20)
     let fbl = c.load * g.tan_gamma_left;
     let fbr = -c.load * g.tan_gamma_right;

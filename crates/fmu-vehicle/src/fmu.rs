@@ -9,11 +9,10 @@ use model_description::{
     ModelError, ModelInfo, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
+use vehicle_elements::TrackLevel;
 
 use crate::model::{Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep, Vehicle};
-use crate::params::{
-    ContactSource, Initial, ModelKind, ParamError, PsdLevel, TrackSource, VehicleParams,
-};
+use crate::params::{ContactSource, Initial, ModelKind, TrackSource, VehicleParams};
 
 /// Speed of the FMU's start values (default experiment: hunting into flange contact) [m/s].
 pub const FMU_DEFAULT_SPEED_MPS: f64 = 300.0 / 3.6;
@@ -27,48 +26,10 @@ fmi_enum! {
     }
 }
 
-/// Where the lateral track alignment comes from (the FMI choice behind the physics'
-/// [`TrackSource`], whose internal generator also carries level and seed).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum TrackChoice {
-    None,
-    External,
-    Internal,
-}
-
-fmi_enum! {
-    TrackChoice as "TrackSource", "Source of the lateral track alignment" {
-        None = 0, "none", "Ideal straight track";
-        External = 1, "external", "The input track.lateral_alignment under the leading wheelset (the others see it delayed by their distance over V)";
-        Internal = 2, "internal", "The built-in ERRI B176 generator (track.level, track.seed)";
-    }
-}
-
-/// ERRI B176 spectrum level (the FMI form of `wheel_rail::track::PsdLevel`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum TrackLevel {
-    Low,
-    High,
-}
-
-fmi_enum! {
-    TrackLevel as "TrackLevel", "ERRI B176 spectrum level of the internal track generator" {
-        Low = 0, "low", "A = 2.119e-7 m rad";
-        High = 1, "high", "A = 6.125e-7 m rad";
-    }
-}
-
-/// The physics names the parameter it rejects (a dotted field path of [`VehicleParams`]); the
-/// glue reports it under the FMI variable bound to that field.
-impl FieldError for ParamError {
-    fn field(&self) -> Option<&str> {
-        Some(self.name)
-    }
-
-    fn reason(&self) -> String {
-        self.reason.clone()
-    }
-}
+// The FMI Enumeration `TrackSource`, with where this model applies the external input.
+vehicle_elements::track_choice_enum!(
+    "The input track.lateral_alignment under the leading wheelset (the others see it delayed by their distance over V)"
+);
 
 impl FieldError for PhysicsModelError {
     fn field(&self) -> Option<&str> {
@@ -163,17 +124,9 @@ impl RailVehicle {
     }
 
     fn build_params(&self) -> VehicleParams {
-        let track = match self.track_source {
-            TrackChoice::None => TrackSource::None,
-            TrackChoice::External => TrackSource::External,
-            TrackChoice::Internal => TrackSource::Internal {
-                level: match self.track_level {
-                    TrackLevel::Low => PsdLevel::Low,
-                    TrackLevel::High => PsdLevel::High,
-                },
-                seed: u64::from(self.track_seed.unsigned_abs()),
-            },
-        };
+        let track = self
+            .track_source
+            .track_source(self.track_level, self.track_seed);
         VehicleParams {
             track,
             contact: self.contact_source(),

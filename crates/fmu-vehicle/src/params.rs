@@ -27,25 +27,9 @@
 //! vehicle carries the bogie's wheel/rail contact at its own load.
 
 use serde::{Deserialize, Serialize};
+use vehicle_elements::{finite, in_range, non_negative, positive};
 
-/// A parameter is out of its admissible range; names the parameter and the reason.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("invalid parameter `{name}`: {reason}")]
-pub struct ParamError {
-    /// Dotted field path as in [`VehicleParams`], e.g. `carbody.mass_kg`.
-    pub name: &'static str,
-    /// Why it was rejected.
-    pub reason: String,
-}
-
-impl ParamError {
-    pub(crate) fn new(name: &'static str, reason: impl Into<String>) -> Self {
-        Self {
-            name,
-            reason: reason.into(),
-        }
-    }
-}
+pub use vehicle_elements::ParamError;
 
 /// Standard gravity [m/s^2].
 pub const STANDARD_GRAVITY_MPS2: f64 = 9.81;
@@ -70,25 +54,7 @@ pub enum ModelKind {
     NonLinear,
 }
 
-pub use wheel_rail::track::PsdLevel;
-
-/// Where the lateral track alignment comes from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-pub enum TrackSource {
-    /// Ideal straight track (y_track = 0), the track input is ignored.
-    #[default]
-    None,
-    /// Input `track_lateral_m`: alignment under the LEADING wheelset; the others see it delayed
-    /// by their distance behind it divided by the speed.
-    External,
-    /// Internal ERRI B176 generator (sum of cosines), reproducible from `seed`.
-    Internal {
-        /// Spectrum level.
-        level: PsdLevel,
-        /// Random seed of the phases.
-        seed: u64,
-    },
-}
+pub use wheel_rail::track::{PsdLevel, TrackSource};
 
 /// Car body [MB].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -361,44 +327,6 @@ impl Default for VehicleParams {
             contact: ContactSource::WornSurrogate,
             solver_substep_s: crate::calibration::SOLVER_SUBSTEP_S,
         }
-    }
-}
-
-fn finite(name: &'static str, v: f64) -> Result<(), ParamError> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(ParamError::new(name, format!("must be finite, got {v}")))
-    }
-}
-
-fn positive(name: &'static str, v: f64) -> Result<(), ParamError> {
-    finite(name, v)?;
-    if v > 0.0 {
-        Ok(())
-    } else {
-        Err(ParamError::new(name, format!("must be > 0, got {v}")))
-    }
-}
-
-fn non_negative(name: &'static str, v: f64) -> Result<(), ParamError> {
-    finite(name, v)?;
-    if v >= 0.0 {
-        Ok(())
-    } else {
-        Err(ParamError::new(name, format!("must be >= 0, got {v}")))
-    }
-}
-
-fn in_range(name: &'static str, v: f64, lo: f64, hi: f64, why: &str) -> Result<(), ParamError> {
-    finite(name, v)?;
-    if v >= lo && v <= hi {
-        Ok(())
-    } else {
-        Err(ParamError::new(
-            name,
-            format!("must be within [{lo}, {hi}] ({why}), got {v}"),
-        ))
     }
 }
 

@@ -1,52 +1,43 @@
-//! Closed loop with a linear yaw-damper law evaluated beside the model, co-simulation style
-//! (each damper's force from the outputs of the previous step, held over the step). Used by
-//! the calibration and convergence tests; the coupled runs with the hydraulic damper FMUs
-//! happen in the master.
+//! Closed loop with the stand-in yaw damper law of `vehicle-elements` evaluated beside the
+//! model, co-simulation style (each damper's force from the outputs of the previous step,
+//! held over the step). Used by the calibration and convergence tests; the coupled runs with
+//! the hydraulic damper FMUs happen in the master.
 
-use serde::{Deserialize, Serialize};
+pub use vehicle_elements::LoopDamper;
+use vehicle_elements::{damper, ClosedLoopModel};
 
 use crate::layout::N_DAMPERS;
 use crate::model::{Inputs, Outputs, StepError, Vehicle};
 
-/// A yaw damper law (all four identical).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum LoopDamper {
-    /// No damper.
-    None,
-    /// Spring k in series with dashpot c: F' = k (e' - F / c), advanced exactly over a step
-    /// for a constant elongation velocity; the force held over the step is the mean of its
-    /// values at the step ends.
-    Maxwell {
-        /// Stiffness [N/m].
-        k: f64,
-        /// Damping [N s/m].
-        c: f64,
-    },
-}
+/// The coach's four yaw-damper ports (front left, front right, rear left, rear right).
+impl ClosedLoopModel<N_DAMPERS> for Vehicle {
+    type Inputs = Inputs;
+    type Outputs = Outputs;
+    type Error = StepError;
 
-/// Forces of the Maxwell elements.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct LoopDamperState {
-    /// Force of each damper [N].
-    pub force_n: [f64; N_DAMPERS],
-}
+    fn time_s(&self) -> f64 {
+        Vehicle::time_s(self)
+    }
 
-impl LoopDamper {
-    /// Forces for the next step of length h from the current outputs.
-    pub fn forces(&self, o: &Outputs, st: &mut LoopDamperState, h: f64) -> [f64; N_DAMPERS] {
-        match *self {
-            LoopDamper::None => [0.0; N_DAMPERS],
-            LoopDamper::Maxwell { k, c } => {
-                let a = (-k * h / c).exp();
-                let mut held = [0.0; N_DAMPERS];
-                for (d, f) in st.force_n.iter_mut().enumerate() {
-                    let old = *f;
-                    *f = old * a + c * o.damper[d].elongation_velocity_mps * (1.0 - a);
-                    held[d] = 0.5 * (old + *f);
-                }
-                held
-            }
-        }
+    fn outputs(&self, inputs: &Inputs) -> Result<Outputs, StepError> {
+        Vehicle::outputs(self, inputs)
+    }
+
+    fn step(&mut self, h_s: f64, inputs: &Inputs) -> Result<Outputs, StepError> {
+        Vehicle::step(self, h_s, inputs)
+    }
+
+    fn set_track_lateral_m(inputs: &mut Inputs, track_lateral_m: f64) {
+        inputs.track_lateral_m = track_lateral_m;
+    }
+
+    fn damper_motion(o: &Outputs) -> [(f64, f64); N_DAMPERS] {
+        o.damper
+            .map(|d| (d.elongation_m, d.elongation_velocity_mps))
+    }
+
+    fn set_damper_force_n(inputs: &mut Inputs, force_n: [f64; N_DAMPERS]) {
+        inputs.damper_force_n = force_n;
     }
 }
 
@@ -60,19 +51,5 @@ pub fn run_closed_loop(
     track_lateral_m: &dyn Fn(f64) -> f64,
     record: &mut dyn FnMut(&Outputs),
 ) -> Result<(), StepError> {
-    let mut st = LoopDamperState::default();
-    let mut inputs = Inputs {
-        track_lateral_m: track_lateral_m(vehicle.time_s()),
-        ..Inputs::default()
-    };
-    let mut out = vehicle.outputs(&inputs)?;
-    record(&out);
-    let n = (t_end / h).round() as usize;
-    for _ in 0..n {
-        inputs.damper_force_n = damper.forces(&out, &mut st, h);
-        inputs.track_lateral_m = track_lateral_m(vehicle.time_s());
-        out = vehicle.step(h, &inputs)?;
-        record(&out);
-    }
-    Ok(())
+    damper::run_closed_loop(vehicle, damper, h, t_end, track_lateral_m, record)
 }

@@ -19,6 +19,48 @@ pub fn saturation_factor(f_res: f64, mu_p: f64) -> f64 {
     }
 }
 
+/// Creep forces of the two wheels of a wheelset, each saturated on its own resultant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WheelsetCreepForces {
+    /// Lateral creep force on the left wheel [N].
+    pub lateral_left_n: f64,
+    /// Lateral creep force on the right wheel [N].
+    pub lateral_right_n: f64,
+    /// Longitudinal creep force on the left wheel [N].
+    pub longitudinal_left_n: f64,
+    /// Longitudinal creep force on the right wheel [N].
+    pub longitudinal_right_n: f64,
+}
+
+/// Kalker forces (5.2)-(5.3) F = -f eps of a wheelset from its lateral creepage (the same on
+/// both wheels) and the longitudinal creepage of each wheel, each wheel's pair scaled by
+/// [`saturation_factor`] (5.21)-(5.25) of its resultant; `mu_p_n` = mu P per wheel.
+#[inline]
+pub fn saturated_wheelset_creep(
+    f11_n: f64,
+    f22_n: f64,
+    mu_p_n: f64,
+    lateral_creepage: f64,
+    longitudinal_creepage_left: f64,
+    longitudinal_creepage_right: f64,
+) -> WheelsetCreepForces {
+    let ft = -f22_n * lateral_creepage;
+    let (flr, fll) = (
+        -f11_n * longitudinal_creepage_right,
+        -f11_n * longitudinal_creepage_left,
+    );
+    // plain root of the sum of squares: forces stay far below the square's overflow (a
+    // diverging state is caught as non-finite by the models), so no hypot is needed
+    let kr = saturation_factor((ft * ft + flr * flr).sqrt(), mu_p_n);
+    let kl = saturation_factor((ft * ft + fll * fll).sqrt(), mu_p_n);
+    WheelsetCreepForces {
+        lateral_left_n: kl * ft,
+        lateral_right_n: kr * ft,
+        longitudinal_left_n: kl * fll,
+        longitudinal_right_n: kr * flr,
+    }
+}
+
 /// Kalker longitudinal coefficient C11 for Poisson 0.25 as a function of g = b/a
 /// (a: semi-axis in rolling direction). The seed's (5.6)-(5.7) swap the labels: the fit the
 /// seed calls "C22" reproduces Kalker's C11 (4.25 vs 4.12 at a = b), so it is used here.
@@ -114,6 +156,23 @@ pub fn hertz_kalker(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn wheelset_creep_saturates_each_wheel_on_its_resultant() {
+        // Unsaturated far below mu P: F = -f eps (factor 1 - u/3 + u^2/27 ~ 1).
+        let small = saturated_wheelset_creep(1e7, 1e7, 1e12, 1e-6, 0.0, 0.0);
+        assert!((small.lateral_left_n + 10.0).abs() < 1e-3);
+        assert_eq!(small.lateral_left_n, small.lateral_right_n);
+        assert_eq!(small.longitudinal_left_n, 0.0);
+        // Left wheel far into saturation, right wheel free of longitudinal creep: the left
+        // resultant is mu P, the right one is smaller and its lateral force larger.
+        let f = saturated_wheelset_creep(1e7, 1e7, 2e4, 1e-3, 1e-1, 0.0);
+        let left = f.lateral_left_n.hypot(f.longitudinal_left_n);
+        assert!((left - 2e4).abs() < 1e-9 * 2e4, "{left}");
+        assert!(f.lateral_right_n.abs() > f.lateral_left_n.abs());
+        assert_eq!(f.longitudinal_right_n, 0.0);
+        assert!(f.longitudinal_left_n < 0.0);
+    }
 
     #[test]
     fn kalker_labels_match_kalker_table() {

@@ -112,7 +112,9 @@ pub use contact::{
     ContactTable, LateralReference, RadiusConvention, RailPlacement, WheelContact, WheelPlacement,
     WheelSide, CONTACT_ZONE_DEPTH_M,
 };
-pub use creep::{hertz_kalker, saturation_factor, HertzKalker};
+pub use creep::{
+    hertz_kalker, saturated_wheelset_creep, saturation_factor, HertzKalker, WheelsetCreepForces,
+};
 pub use profile::{Profile, ProfileError, MIN_POINTS};
 pub use table::{
     write_csv, ContactGeometry, CsvNumbers, CsvRow, GeometryTable, SegmentHint, TableError,

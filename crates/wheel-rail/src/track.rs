@@ -61,6 +61,24 @@ pub enum PsdLevel {
     High,
 }
 
+/// Where a vehicle model's lateral track alignment comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum TrackSource {
+    /// Ideal straight track (y_track = 0), the track input is ignored.
+    None,
+    /// The model's input `track_lateral_m`: the alignment under the leading wheelset; a
+    /// wheelset at distance d behind it sees it delayed by d/V.
+    External,
+    /// Internal ERRI B176 generator ([`TrackGenerator`]: synthesised periodic realisation,
+    /// default band), reproducible from `seed`.
+    Internal {
+        /// Spectrum level.
+        level: PsdLevel,
+        /// Random seed of the phases (ChaCha8).
+        seed: u64,
+    },
+}
+
 /// Omega_c [rad/m].
 pub const OMEGA_C: f64 = 0.8246;
 /// Omega_r [rad/m].

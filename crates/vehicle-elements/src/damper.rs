@@ -1,0 +1,130 @@
+//! The stand-in yaw damper of the closed-loop runs: a linear damper law evaluated beside a
+//! vehicle model, co-simulation style (each damper's force from the outputs of the previous
+//! step, held over the step), and the loop itself. The coupled runs with the hydraulic damper
+//! FMUs happen in the master; this loop serves the models' calibration and convergence tests.
+
+use serde::{Deserialize, Serialize};
+
+/// A yaw damper law, the same for every damper of the model.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum LoopDamper {
+    /// No damper.
+    None,
+    /// Spring k parallel to dashpot c: F = k e + c e'.
+    KelvinVoigt {
+        /// Stiffness [N/m].
+        k: f64,
+        /// Damping [N s/m].
+        c: f64,
+    },
+    /// Spring k in series with dashpot c: F' = k (e' - F / c), advanced exactly over a step
+    /// for a constant elongation velocity; the force held over the step is the mean of its
+    /// values at the step ends.
+    Maxwell {
+        /// Stiffness [N/m].
+        k: f64,
+        /// Damping [N s/m].
+        c: f64,
+    },
+}
+
+impl LoopDamper {
+    /// Force of one damper held over the next step of length `h_s`, from its elongation
+    /// [m] and elongation velocity [m/s] at the start of the step; `state_n` is the
+    /// Maxwell element's force [N], advanced to the end of the step.
+    pub fn held_force_n(
+        &self,
+        elongation_m: f64,
+        velocity_mps: f64,
+        state_n: &mut f64,
+        h_s: f64,
+    ) -> f64 {
+        match *self {
+            LoopDamper::None => 0.0,
+            LoopDamper::KelvinVoigt { k, c } => k * elongation_m + c * velocity_mps,
+            LoopDamper::Maxwell { k, c } => {
+                let old = *state_n;
+                let a = (-k * h_s / c).exp();
+                *state_n = old * a + c * velocity_mps * (1.0 - a);
+                0.5 * (old + *state_n)
+            }
+        }
+    }
+}
+
+/// A vehicle model with `N` yaw-damper ports as the closed loop drives it.
+pub trait ClosedLoopModel<const N: usize> {
+    /// The model's inputs.
+    type Inputs: Default;
+    /// The model's outputs.
+    type Outputs;
+    /// Error of a step or an output evaluation.
+    type Error;
+
+    /// Model time [s].
+    fn time_s(&self) -> f64;
+    /// Outputs at the current state for `inputs`.
+    fn outputs(&self, inputs: &Self::Inputs) -> Result<Self::Outputs, Self::Error>;
+    /// One communication step of length `h_s`.
+    fn step(&mut self, h_s: f64, inputs: &Self::Inputs) -> Result<Self::Outputs, Self::Error>;
+    /// Sets the track alignment input [m].
+    fn set_track_lateral_m(inputs: &mut Self::Inputs, track_lateral_m: f64);
+    /// Elongation [m] and elongation velocity [m/s] of each damper.
+    fn damper_motion(outputs: &Self::Outputs) -> [(f64, f64); N];
+    /// Sets the force input [N] of each damper.
+    fn set_damper_force_n(inputs: &mut Self::Inputs, force_n: [f64; N]);
+}
+
+/// Runs `t_end_s` seconds with communication step `h_s`, the track input from
+/// `track_lateral_m` (time -> alignment), `damper` on every port; calls `record` with every
+/// output, the initial one included.
+pub fn run_closed_loop<M: ClosedLoopModel<N>, const N: usize>(
+    model: &mut M,
+    damper: LoopDamper,
+    h_s: f64,
+    t_end_s: f64,
+    track_lateral_m: &dyn Fn(f64) -> f64,
+    record: &mut dyn FnMut(&M::Outputs),
+) -> Result<(), M::Error> {
+    let mut state_n = [0.0; N];
+    let mut inputs = M::Inputs::default();
+    M::set_track_lateral_m(&mut inputs, track_lateral_m(model.time_s()));
+    let mut out = model.outputs(&inputs)?;
+    record(&out);
+    let n = (t_end_s / h_s).round() as usize;
+    for _ in 0..n {
+        let motion = M::damper_motion(&out);
+        let mut force_n = [0.0; N];
+        for (d, (e, v)) in motion.into_iter().enumerate() {
+            force_n[d] = damper.held_force_n(e, v, &mut state_n[d], h_s);
+        }
+        M::set_damper_force_n(&mut inputs, force_n);
+        M::set_track_lateral_m(&mut inputs, track_lateral_m(model.time_s()));
+        out = model.step(h_s, &inputs)?;
+        record(&out);
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn maxwell_reaches_the_dashpot_force_and_holds_the_step_mean() {
+        let d = LoopDamper::Maxwell { k: 1e6, c: 1e5 };
+        let mut f = 0.0;
+        // k h / c = 1: F(h) = c v (1 - e^-1), held force its half.
+        let held = d.held_force_n(0.0, 0.1, &mut f, 0.1);
+        let end = 1e4 * (1.0 - (-1.0f64).exp());
+        assert!((f - end).abs() < 1e-9 * end);
+        assert!((held - 0.5 * end).abs() < 1e-9 * end);
+        for _ in 0..100 {
+            d.held_force_n(0.0, 0.1, &mut f, 0.1);
+        }
+        assert!((f - 1e4).abs() < 1e-6);
+        let kv = LoopDamper::KelvinVoigt { k: 2.0, c: 3.0 };
+        assert_eq!(kv.held_force_n(5.0, 7.0, &mut f, 0.1), 31.0);
+        assert_eq!(LoopDamper::None.held_force_n(5.0, 7.0, &mut f, 0.1), 0.0);
+    }
+}

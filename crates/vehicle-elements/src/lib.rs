@@ -1,0 +1,19 @@
+//! Pieces the two rail-vehicle models (the 2-dof bogie and the coach) share without importing
+//! each other:
+//! * [`params`]: the parameter error that names the rejected physics field, and the range
+//!   checks (finite, positive, non-negative, within bounds) that produce it;
+//! * [`track`]: the FMI-facing choices of the track input (the ERRI B176 level, and the
+//!   source through [`track_choice_enum!`]) and their mapping onto the physics'
+//!   [`wheel_rail::track::TrackSource`];
+//! * [`damper`]: the stand-in yaw damper (none, Kelvin-Voigt, Maxwell) that the closed-loop
+//!   runs evaluate beside a model, co-simulation style, and the loop itself.
+//!
+//! Wheel/rail contact and the track generator are physics of contact and live in `wheel-rail`.
+
+pub mod damper;
+pub mod params;
+pub mod track;
+
+pub use damper::{run_closed_loop, ClosedLoopModel, LoopDamper};
+pub use params::{finite, in_range, non_negative, positive, ParamError};
+pub use track::TrackLevel;
