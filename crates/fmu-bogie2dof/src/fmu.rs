@@ -10,7 +10,7 @@ use model_description::{
     MAX_PARAMETER_FILE_BYTES,
 };
 use serde::{Deserialize, Serialize};
-use vehicle_elements::TrackLevel;
+use vehicle_elements::{InputError, TrackLevel};
 use wheel_rail::GeometryTable;
 
 use crate::model::{Bogie, Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep};
@@ -68,14 +68,14 @@ impl FieldError for ContactFileError {
 impl FieldError for PStep {
     fn field(&self) -> Option<&str> {
         match self {
-            PStep::NonFiniteInput { name, .. } => Some(name),
+            PStep::Input(i) => i.field(),
             _ => None,
         }
     }
 
     fn reason(&self) -> String {
         match self {
-            PStep::NonFiniteInput { value, .. } => format!("not finite ({value})"),
+            PStep::Input(i) => i.reason(),
             other => other.to_string(),
         }
     }
@@ -381,7 +381,9 @@ impl FmuModel for Bogie2Dof {
             )));
         };
         let map = |e: PStep| match e {
-            PStep::Diverged { .. } | PStep::InvalidStep { .. } => StepError::Discard(e.to_string()),
+            PStep::Diverged { .. } | PStep::Input(InputError::InvalidStep { .. }) => {
+                StepError::Discard(e.to_string())
+            }
             other => StepError::Error(ModelError::Other(other.to_string())),
         };
         if step <= 1.0 {

@@ -32,6 +32,9 @@
 //! [`Bogie::outputs`] with the current inputs to get them without stepping.
 
 use serde::{Deserialize, Serialize};
+use vehicle_elements::{check_inputs, check_step};
+
+pub use vehicle_elements::InputError;
 
 use crate::nonlinear::{rhs, rhs_with_hints, Consts, Eval, N_STATES};
 use crate::params::{
@@ -81,20 +84,9 @@ pub enum ModelError {
 /// Errors of a step or an output evaluation.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum StepError {
-    /// An input is NaN or infinite.
-    #[error("input `{name}` is not finite ({value})")]
-    NonFiniteInput {
-        /// Input name.
-        name: &'static str,
-        /// Value.
-        value: f64,
-    },
-    /// Step size not usable.
-    #[error("invalid communication step {h} s (must be finite, > 0 and <= 1 s)")]
-    InvalidStep {
-        /// Step [s].
-        h: f64,
-    },
+    /// A non-finite input or an unusable step size.
+    #[error(transparent)]
+    Input(#[from] InputError),
     /// The state became NaN/inf (a smaller step may help).
     #[error("state diverged at t = {time_s} s: {what}")]
     Diverged {
@@ -132,17 +124,12 @@ pub struct Inputs {
 }
 
 impl Inputs {
-    fn check(&self) -> Result<(), StepError> {
-        for (name, value) in [
+    fn check(&self) -> Result<(), InputError> {
+        check_inputs([
             ("damper_left_force_n", self.damper_left_force_n),
             ("damper_right_force_n", self.damper_right_force_n),
             ("track_lateral_m", self.track_lateral_m),
-        ] {
-            if !value.is_finite() {
-                return Err(StepError::NonFiniteInput { name, value });
-            }
-        }
-        Ok(())
+        ])
     }
 }
 
@@ -422,9 +409,7 @@ impl Bogie {
     /// outputs at the end of the step (evaluated with the same held inputs). On error the
     /// model is left exactly as it was (a host may retry with a smaller step).
     pub fn step(&mut self, h: f64, inputs: &Inputs) -> Result<Outputs, StepError> {
-        if !(h.is_finite() && h > 0.0 && h <= 1.0) {
-            return Err(StepError::InvalidStep { h });
-        }
+        check_step(h)?;
         inputs.check()?;
         let undo = if self.params.track == TrackSource::External {
             Some(

@@ -611,7 +611,9 @@ fn bad_params_and_inputs_rejected() {
         ..Inputs::default()
     };
     match b.step(1e-3, &bad) {
-        Err(StepError::NonFiniteInput { name, .. }) => assert_eq!(name, "damper_left_force_n"),
+        Err(StepError::Input(model::InputError::NonFiniteInput { name, .. })) => {
+            assert_eq!(name, "damper_left_force_n")
+        }
         r => panic!("{r:?}"),
     }
     assert!(b.outputs(&bad).is_err());

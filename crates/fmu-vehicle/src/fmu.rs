@@ -9,7 +9,7 @@ use model_description::{
     ModelError, ModelInfo, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
-use vehicle_elements::TrackLevel;
+use vehicle_elements::{InputError, TrackLevel};
 
 use crate::model::{Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep, Vehicle};
 use crate::params::{ContactSource, Initial, ModelKind, TrackSource, VehicleParams};
@@ -53,14 +53,14 @@ impl FieldError for PhysicsModelError {
 impl FieldError for PStep {
     fn field(&self) -> Option<&str> {
         match self {
-            PStep::NonFiniteInput { name, .. } => Some(name),
+            PStep::Input(i) => i.field(),
             _ => None,
         }
     }
 
     fn reason(&self) -> String {
         match self {
-            PStep::NonFiniteInput { value, .. } => format!("not finite ({value})"),
+            PStep::Input(i) => i.reason(),
             other => other.to_string(),
         }
     }
@@ -519,8 +519,12 @@ impl FmuModel for RailVehicle {
         // A diverged state may be avoided with a smaller step (fmi2Discard); a derailment or a
         // bad input cannot (fmi2Error). The physics is unchanged after either.
         let map = |e: PStep| match e {
-            PStep::Diverged { .. } | PStep::InvalidStep { .. } => StepError::Discard(e.to_string()),
-            PStep::NonFiniteInput { .. } => StepError::Error(field_error::<Self>(&e)),
+            PStep::Diverged { .. } | PStep::Input(InputError::InvalidStep { .. }) => {
+                StepError::Discard(e.to_string())
+            }
+            PStep::Input(InputError::NonFiniteInput { .. }) => {
+                StepError::Error(field_error::<Self>(&e))
+            }
             other => StepError::Error(ModelError::Other(other.to_string())),
         };
         if step <= 1.0 {

@@ -17,6 +17,9 @@
 //! acceleration at once. [`Vehicle::outputs`] evaluates them without stepping.
 
 use serde::{Deserialize, Serialize};
+use vehicle_elements::{check_inputs, check_step};
+
+pub use vehicle_elements::InputError;
 use wheel_rail::{GeometryTable, SegmentHint, TableError};
 
 use crate::dynamics::{rhs, Consts, Eval, N_STATES, RATES};
@@ -67,20 +70,9 @@ pub enum ModelError {
 /// Errors of a step or an output evaluation; the model is unchanged after any of them.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum StepError {
-    /// An input is NaN or infinite.
-    #[error("input `{name}` is not finite ({value})")]
-    NonFiniteInput {
-        /// Input name (physics field).
-        name: &'static str,
-        /// Value.
-        value: f64,
-    },
-    /// Step size not usable.
-    #[error("invalid communication step {h} s (must be finite, > 0 and <= 1 s)")]
-    InvalidStep {
-        /// Step [s].
-        h: f64,
-    },
+    /// A non-finite input or an unusable step size.
+    #[error(transparent)]
+    Input(#[from] InputError),
     /// The state became NaN or infinite.
     #[error("state diverged at t = {time_s} s")]
     Diverged {
@@ -115,25 +107,15 @@ pub struct Inputs {
 }
 
 impl Inputs {
-    fn check(&self) -> Result<(), StepError> {
+    fn check(&self) -> Result<(), InputError> {
         const NAMES: [&str; N_DAMPERS] = [
             "damper_force_n[0]",
             "damper_force_n[1]",
             "damper_force_n[2]",
             "damper_force_n[3]",
         ];
-        for (name, &value) in NAMES.iter().zip(&self.damper_force_n) {
-            if !value.is_finite() {
-                return Err(StepError::NonFiniteInput { name, value });
-            }
-        }
-        if !self.track_lateral_m.is_finite() {
-            return Err(StepError::NonFiniteInput {
-                name: "track_lateral_m",
-                value: self.track_lateral_m,
-            });
-        }
-        Ok(())
+        check_inputs(NAMES.into_iter().zip(self.damper_force_n))?;
+        check_inputs([("track_lateral_m", self.track_lateral_m)])
     }
 }
 
@@ -465,9 +447,7 @@ impl Vehicle {
     /// end of the step. On error the model is unchanged.
     pub fn step(&mut self, h: f64, inputs: &Inputs) -> Result<Outputs, StepError> {
         inputs.check()?;
-        if !(h.is_finite() && h > 0.0 && h <= 1.0) {
-            return Err(StepError::InvalidStep { h });
-        }
+        check_step(h)?;
         let x0 = self.position_m;
         let x1 = x0 + self.consts.v * h;
         let input = inputs.track_lateral_m;

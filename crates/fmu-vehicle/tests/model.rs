@@ -5,7 +5,7 @@
 use fmu_vehicle::dynamics::{rhs, Consts, N_STATES, RATES};
 use fmu_vehicle::eigen::{state_matrix, DamperRepresentation, YawDamperModel};
 use fmu_vehicle::layout::{frame_yaw, wheelset_y, Positions, CARBODY_YAW, N_DOF};
-use fmu_vehicle::model::worn_surrogate_table;
+use fmu_vehicle::model::{worn_surrogate_table, InputError};
 use fmu_vehicle::params::Initial;
 use fmu_vehicle::{
     Inputs, ModelError, ModelKind, PsdLevel, StepError, TrackSource, Vehicle, VehicleParams,
@@ -197,15 +197,15 @@ fn bad_inputs_are_refused_and_change_nothing() {
     };
     assert!(matches!(
         v.step(1e-3, &bad),
-        Err(StepError::NonFiniteInput { .. })
+        Err(StepError::Input(InputError::NonFiniteInput { .. }))
     ));
     assert!(matches!(
         v.step(0.0, &Inputs::default()),
-        Err(StepError::InvalidStep { .. })
+        Err(StepError::Input(InputError::InvalidStep { .. }))
     ));
     assert!(matches!(
         v.step(f64::INFINITY, &Inputs::default()),
-        Err(StepError::InvalidStep { .. })
+        Err(StepError::Input(InputError::InvalidStep { .. }))
     ));
     assert_eq!(v, before);
 }

@@ -2,6 +2,7 @@
 //! each other:
 //! * [`params`]: the parameter error that names the rejected physics field, and the range
 //!   checks (finite, positive, non-negative, within bounds) that produce it;
+//! * [`step`]: the checks of a step's size and inputs, and the error that names the input;
 //! * [`track`]: the FMI-facing choices of the track input (the ERRI B176 level, and the
 //!   source through [`track_choice_enum!`]) and their mapping onto the physics'
 //!   [`wheel_rail::track::TrackSource`];
@@ -12,8 +13,10 @@
 
 pub mod damper;
 pub mod params;
+pub mod step;
 pub mod track;
 
 pub use damper::{run_closed_loop, ClosedLoopModel, LoopDamper};
 pub use params::{finite, in_range, non_negative, positive, ParamError};
+pub use step::{check_inputs, check_step, InputError};
 pub use track::TrackLevel;

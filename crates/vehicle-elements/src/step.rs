@@ -1,0 +1,86 @@
+//! Checks of what a host hands a model's step: the communication step and the inputs, with
+//! the error that names the offending input.
+
+use model_description::FieldError;
+
+/// The largest communication step a model accepts [s].
+pub const MAX_STEP_S: f64 = 1.0;
+
+/// A step refused before it starts; the model is unchanged.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum InputError {
+    /// An input is NaN or infinite.
+    #[error("input `{name}` is not finite ({value})")]
+    NonFiniteInput {
+        /// Input name (physics field).
+        name: &'static str,
+        /// Value.
+        value: f64,
+    },
+    /// Step size not usable.
+    #[error("invalid communication step {h} s (must be finite, > 0 and <= 1 s)")]
+    InvalidStep {
+        /// Step [s].
+        h: f64,
+    },
+}
+
+/// `h` [s] is finite, > 0 and <= [`MAX_STEP_S`].
+pub fn check_step(h: f64) -> Result<(), InputError> {
+    if h.is_finite() && h > 0.0 && h <= MAX_STEP_S {
+        Ok(())
+    } else {
+        Err(InputError::InvalidStep { h })
+    }
+}
+
+/// Every `(name, value)` is finite; the error names the first that is not.
+pub fn check_inputs(
+    inputs: impl IntoIterator<Item = (&'static str, f64)>,
+) -> Result<(), InputError> {
+    for (name, value) in inputs {
+        if !value.is_finite() {
+            return Err(InputError::NonFiniteInput { name, value });
+        }
+    }
+    Ok(())
+}
+
+/// A bad input is reported under the FMI variable bound to the input it names.
+impl FieldError for InputError {
+    fn field(&self) -> Option<&str> {
+        match self {
+            InputError::NonFiniteInput { name, .. } => Some(name),
+            InputError::InvalidStep { .. } => None,
+        }
+    }
+
+    fn reason(&self) -> String {
+        match self {
+            InputError::NonFiniteInput { value, .. } => format!("not finite ({value})"),
+            other => other.to_string(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn step_and_inputs_are_checked_with_the_name() {
+        assert_eq!(check_step(1.0), Ok(()));
+        for h in [0.0, -1e-3, 1.5, f64::NAN] {
+            assert!(
+                matches!(check_step(h), Err(InputError::InvalidStep { .. })),
+                "{h}"
+            );
+        }
+        assert_eq!(check_inputs([("a", 1.0), ("b", 2.0)]), Ok(()));
+        let e = check_inputs([("a", 1.0), ("b", f64::INFINITY), ("c", f64::NAN)]).unwrap_err();
+        assert_eq!(e.field(), Some("b"));
+        assert_eq!(e.reason(), "not finite (inf)");
+        assert_eq!(e.to_string(), "input `b` is not finite (inf)");
+        assert_eq!(check_step(2.0).unwrap_err().field(), None);
+    }
+}
