@@ -477,6 +477,9 @@ fn write_run(
                 header,
                 data,
                 summary,
+                // computed elsewhere and handed over as numbers: every column Real
+                columns: Vec::new(),
+                strings: Vec::new(),
             })
         }
         _ => Err("internal: a run came back with neither results nor an error".to_string()),

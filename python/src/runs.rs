@@ -59,7 +59,10 @@ mod tests {
                 simulated_time_s: 0.002,
                 wall_time_s: 1e-4,
                 realtime_ratio: 20.0,
+                terminated: None,
             },
+            columns: vec![],
+            strings: vec![],
         }
     }
 

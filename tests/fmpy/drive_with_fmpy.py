@@ -32,7 +32,10 @@ output (ModelStructure/Outputs), cycles broken at the lowest remaining index.
 Prints one line per instance and writes REPORT.json ({instance: {"rows", "values",
 "max_rel_diff", "worst", "input_shift", "ok"}}); exits 1 if any instance disagrees beyond rtol.
 Limitations: every instance's step_multiple must divide the number of macro steps; String
-variables are not exchanged (the master does not exchange them either).
+variables are not exchanged; a Gauss-Seidel order that steps an instance with direct
+feedthrough before the source of that input (both every macro step) is not replayed: the master
+then reads that instance's outputs again after the source has set its inputs, and the instances
+stepped in between used values no row records.
 """
 import argparse
 import csv

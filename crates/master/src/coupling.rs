@@ -17,6 +17,10 @@
 //!   slave lacks canHandleVariableCommunicationStepSize (its step must stay constant).
 //! * A slave without canHandleVariableCommunicationStepSize is only accepted when its
 //!   `step_multiple` divides the number of steps (no shortened last window).
+//! * Termination requested by a slave: a step that returns fmi2Discard while
+//!   fmi2GetBooleanStatus(fmi2Terminated) is true ends the run normally (FMI 2.0 section
+//!   4.2.3), never retried: every slave is terminated, the results stop at the last
+//!   communication point all completed, and the summary names the slave and that time.
 //! * Every exit path (success, error, cancellation) calls fmi2Terminate on each slave that
 //!   reached step mode (exitInitializationMode) and did not report fmi2Fatal; freeing
 //!   (fmi2FreeInstance, allowed in every state) is the slaves' `Drop`.
@@ -34,8 +38,9 @@ mod exchange;
 mod plan;
 
 pub use plan::{
-    check_plan, topological_order, Algorithm, CouplingPlan, PlanConnection, PlanInstance, Recorded,
-    RunLimits, SimError, SimOutput, Summary, MAX_RECORDED_VALUES_VAR, MAX_STEPS_VAR,
+    check_plan, topological_order, Algorithm, ColumnInfo, CouplingPlan, PlanConnection,
+    PlanInstance, Recorded, RunLimits, SimError, SimOutput, Summary, Terminated,
+    MAX_RECORDED_VALUES_VAR, MAX_STEPS_VAR,
 };
 
 /// Options of one run.
@@ -85,15 +90,25 @@ pub fn simulate(
     let term = eng.terminate_all();
     let data = res?;
     term?;
+    let terminated = eng.terminated().map(|(i, t)| Terminated {
+        instance: plan.instances[i].name.clone(),
+        time_s: t,
+    });
+    let strings = eng.take_strings();
     let wall = started.elapsed().as_secs_f64();
-    let sim = plan.stop_time - plan.start_time;
+    let end = terminated.as_ref().map_or(plan.stop_time, |t| t.time_s);
+    let sim = end - plan.start_time;
     let mut header = vec!["time [s]".to_string()];
     header.extend(plan.record.iter().map(|r| r.label.clone()));
+    let steps = ((end - plan.start_time) / plan.step).round() as u64;
     Ok(SimOutput {
         header,
         data,
+        columns: plan.record.iter().map(|r| r.info.clone()).collect(),
+        strings,
         summary: Summary {
-            steps: n_steps,
+            terminated,
+            steps: steps.min(n_steps),
             rejected_steps: eng.rejected(),
             simulated_time_s: sim,
             wall_time_s: wall,

@@ -5,6 +5,9 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use crate::coupling::{ColumnInfo, SimOutput};
+use crate::slave::ScalarType;
+
 /// Failure to write an output file.
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
@@ -127,6 +130,58 @@ where
     })
 }
 
+/// The CSV header of results: each column's label, and after an Enumeration column one
+/// holding its item names (`label (item)`).
+pub fn results_header(out: &SimOutput) -> Vec<String> {
+    let mut head = Vec::with_capacity(out.header.len());
+    for (c, h) in out.header.iter().enumerate() {
+        head.push(h.clone());
+        if out.column_info(c).scalar_type() == ScalarType::Enumeration {
+            head.push(format!("{h} (item)"));
+        }
+    }
+    head
+}
+
+/// Writes results as CSV atomically, each value as its type reads: Reals in Rust's shortest
+/// round-trip form, Integers and Enumerations as integers (an Enumeration followed by its item
+/// name), Booleans as 0/1, Strings quoted (RFC 4180).
+pub fn write_results_csv(path: &Path, out: &SimOutput) -> Result<(), OutputError> {
+    let types: Vec<ColumnInfo> = (0..out.header.len()).map(|c| out.column_info(c)).collect();
+    write_atomic(path, |w| {
+        let head: Vec<String> = results_header(out).iter().map(|h| csv_field(h)).collect();
+        writeln!(w, "{}", head.join(",")).map_err(io_err(path))?;
+        let mut line = String::new();
+        for row in out.rows() {
+            line.clear();
+            for (c, (&v, info)) in row.iter().zip(&types).enumerate() {
+                if c > 0 {
+                    line.push(',');
+                }
+                match info.scalar_type() {
+                    ScalarType::Real | ScalarType::Integer => {
+                        let _ = std::fmt::Write::write_fmt(&mut line, format_args!("{v}"));
+                    }
+                    ScalarType::Boolean => line.push(if v != 0.0 { '1' } else { '0' }),
+                    ScalarType::Enumeration => {
+                        let _ = std::fmt::Write::write_fmt(&mut line, format_args!("{v},"));
+                        line.push_str(&csv_field(info.item(v).unwrap_or("")));
+                    }
+                    ScalarType::String => {
+                        let t = out.text(v).unwrap_or("");
+                        line.push('"');
+                        line.push_str(&t.replace('"', "\"\""));
+                        line.push('"');
+                    }
+                }
+            }
+            line.push('\n');
+            w.write_all(line.as_bytes()).map_err(io_err(path))?;
+        }
+        Ok(())
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -166,6 +221,55 @@ mod tests {
         std::fs::write(&p, "old").unwrap();
         let _ = write_csv_atomic(&p, &header, bad.iter().map(|r| r.as_slice()));
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "old");
+    }
+
+    #[test]
+    fn results_csv_writes_every_type() {
+        use crate::coupling::Summary;
+        let col = |ty, items: Vec<(i32, String)>| ColumnInfo {
+            ty: Some(ty),
+            items,
+            ..Default::default()
+        };
+        let out = SimOutput {
+            header: vec![
+                "time [s]".into(),
+                "a.x [m]".into(),
+                "a.n".into(),
+                "a.b".into(),
+                "a.e".into(),
+                "a.s".into(),
+            ],
+            data: vec![0.0, 1.5, 3.0, 1.0, 2.0, 0.0, 0.5, -2.0, -4.0, 0.0, 1.0, 1.0],
+            summary: Summary {
+                steps: 1,
+                rejected_steps: 0,
+                simulated_time_s: 0.5,
+                wall_time_s: 0.0,
+                realtime_ratio: 0.0,
+                terminated: None,
+            },
+            columns: vec![
+                col(ScalarType::Real, vec![]),
+                col(ScalarType::Integer, vec![]),
+                col(ScalarType::Boolean, vec![]),
+                col(
+                    ScalarType::Enumeration,
+                    vec![(1, "Option 1".into()), (2, "Option, 2".into())],
+                ),
+                col(ScalarType::String, vec![]),
+            ],
+            strings: vec!["Set me!".into(), "say \"hi\"".into()],
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("r.csv");
+        write_results_csv(&p, &out).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&p).unwrap(),
+            "time [s],a.x [m],a.n,a.b,a.e,a.e (item),a.s\n\
+             0,1.5,3,1,2,\"Option, 2\",\"Set me!\"\n\
+             0.5,-2,-4,0,1,Option 1,\"say \"\"hi\"\"\"\n"
+        );
     }
 
     #[test]

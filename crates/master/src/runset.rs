@@ -25,7 +25,7 @@ use rayon::prelude::*;
 use serde_json::Value;
 
 use crate::coupling::{RunOptions, SimOutput, Summary};
-use crate::output::{write_csv_atomic, write_json_atomic, OutputError};
+use crate::output::{write_json_atomic, write_results_csv, OutputError};
 use crate::system::{split_ref, LoadedSystem, PreparedSystem, SystemDescription, SystemError};
 
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -502,8 +502,7 @@ where
                     .unwrap_or_default();
                 Err(format!("the run panicked: {what}"))
             })?;
-        write_csv_atomic(&dir.join("results.csv"), &out.header, out.rows())
-            .map_err(|e| e.to_string())?;
+        write_results_csv(&dir.join("results.csv"), &out).map_err(|e| e.to_string())?;
         Ok(out.summary)
     })();
     match result {

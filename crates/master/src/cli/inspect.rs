@@ -53,6 +53,25 @@ pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
         );
     }
     print_binaries(&args.fmu);
+    let (start, stop, step) = crate::system::default_timing(md);
+    let outputs = md
+        .variables
+        .iter()
+        .filter(|v| v.causality == crate::model_description::Causality::Output)
+        .count();
+    println!(
+        "master run {} alone: instance '{}', start {start} s, stop {stop} s, step {step} s, \
+         records its {outputs} outputs",
+        args.fmu.display(),
+        crate::system::instance_name(md)
+    );
+    for (t, items) in &md.enumerations {
+        let items: Vec<String> = items
+            .iter()
+            .map(|i| format!("{} = {}", i.value, i.name))
+            .collect();
+        println!("enumeration {t}: {}", items.join(", "));
+    }
     println!();
     println!(
         "{:<32} {:>5} {:<12} {:<11} {:<8} {:<8} {:>10}  description",

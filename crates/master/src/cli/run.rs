@@ -1,19 +1,19 @@
-//! `master run SYSTEM.json|SYSTEM.ssp|SYSTEM.ssd [-o results.csv]`: one co-simulation, results
-//! as CSV.
+//! `master run SYSTEM.json|SYSTEM.ssp|SYSTEM.ssd [-o results.csv]` or
+//! `master run MODEL.fmu [--stop ..] [--set ..]`: one co-simulation, results as CSV.
 
 use std::path::PathBuf;
 
 use super::{CommandError, Context};
 use crate::coupling::{Algorithm, RunOptions};
-use crate::output::{write_csv_atomic, write_json_atomic};
+use crate::output::{write_json_atomic, write_results_csv};
 use crate::ssp::{self, ImportOptions};
-use crate::system::LoadedSystem;
+use crate::system::{LoadedSystem, SingleFmuOptions};
 
-/// Run one system description and write the recorded variables as CSV.
+/// Run one system description, or one FMU alone, and write the recorded variables as CSV.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// System description: JSON (FMU paths relative to its folder), or an SSP (a .ssp archive,
-    /// or a .ssd next to its FMUs).
+    /// System description: JSON (FMU paths relative to its folder), an SSP (a .ssp archive,
+    /// or a .ssd next to its FMUs), or an .fmu to run alone over its DefaultExperiment.
     pub system: PathBuf,
     /// Results CSV (time plus recorded variables, units in the header); written atomically.
     #[arg(short, long, default_value = "results.csv")]
@@ -21,7 +21,8 @@ pub struct Args {
     /// Also write the run summary (steps, wall time, real-time ratio) as JSON.
     #[arg(long)]
     pub summary: Option<PathBuf>,
-    /// SSP only: communication step [s] (default: the SSP's libcosim or OMSimulator annotation).
+    /// SSP or single FMU: communication step [s] (default: the SSP's libcosim or OMSimulator
+    /// annotation; the FMU's DefaultExperiment, else 1/500 to 1/1000 of the run as fmpy).
     #[arg(long)]
     pub step: Option<f64>,
     /// SSP only: stop time [s] (default: the SSP's DefaultExperiment).
@@ -30,6 +31,22 @@ pub struct Args {
     /// SSP only: coupling algorithm, jacobi (default) or gauss-seidel.
     #[arg(long, value_parser = parse_algorithm)]
     pub algorithm: Option<Algorithm>,
+    /// Single FMU: start time [s] (default: its DefaultExperiment's, else 0).
+    #[arg(long)]
+    pub start: Option<f64>,
+    /// Single FMU: stop time [s] (default: its DefaultExperiment's, else start + 1).
+    #[arg(long)]
+    pub stop: Option<f64>,
+    /// Single FMU: start value of a parameter or input, NAME=VALUE (repeatable; numbers,
+    /// true/false, text for Strings, an item name or integer for Enumerations).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+    /// Single FMU: variables to record (default: every output).
+    #[arg(long, num_args = 1.., value_name = "NAME")]
+    pub record: Vec<String>,
+    /// Single FMU: switch the FMU's own logging on (loggingOn).
+    #[arg(long)]
+    pub fmu_logging: bool,
 }
 
 fn parse_algorithm(s: &str) -> Result<Algorithm, String> {
@@ -40,9 +57,45 @@ fn parse_algorithm(s: &str) -> Result<Algorithm, String> {
     }
 }
 
+impl Args {
+    fn is_fmu(&self) -> bool {
+        self.system
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("fmu"))
+    }
+    fn single_only(&self) -> bool {
+        self.start.is_some()
+            || self.stop.is_some()
+            || !self.set.is_empty()
+            || !self.record.is_empty()
+            || self.fmu_logging
+    }
+}
+
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
+    if !args.is_fmu() && args.single_only() {
+        return Err(CommandError::Failed(format!(
+            "{}: --start, --stop, --set, --record and --fmu-logging apply to an .fmu run alone",
+            args.system.display()
+        )));
+    }
     // an imported SSP's FMUs live in a temporary folder as long as `_imported` does
-    let (sys, _imported) = if ssp::is_ssp_path(&args.system) {
+    let (sys, _imported) = if args.is_fmu() {
+        if args.stop_time.is_some() || args.algorithm.is_some() {
+            return Err(CommandError::Failed(
+                "--stop-time and --algorithm apply to SSPs; an .fmu alone takes --stop".into(),
+            ));
+        }
+        let opts = SingleFmuOptions {
+            start_time: args.start,
+            stop_time: args.stop,
+            step: args.step,
+            set: args.set.clone(),
+            record: args.record.clone(),
+            logging: args.fmu_logging,
+        };
+        (LoadedSystem::single_fmu(&args.system, &opts)?, None)
+    } else if ssp::is_ssp_path(&args.system) {
         let opts = ImportOptions {
             step: args.step,
             stop_time: args.stop_time,
@@ -78,10 +131,16 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     let out = sys.run(&opts);
     bar.finish_and_clear();
     let out = out?;
-    write_csv_atomic(&args.output, &out.header, out.rows())?;
+    write_results_csv(&args.output, &out)?;
     if let Some(p) = &args.summary {
         write_json_atomic(p, &out.summary)?;
     }
     println!("{}: {}", args.output.display(), out.summary);
+    if let Some(t) = &out.summary.terminated {
+        println!(
+            "the simulation was ended by instance '{}' (fmi2Terminated) at t = {} s; results up to there",
+            t.instance, t.time_s
+        );
+    }
     Ok(())
 }

@@ -5,7 +5,7 @@ use std::sync::atomic::Ordering;
 
 use super::exchange::{Dest, Exchange};
 use super::{Algorithm, CouplingPlan, RunOptions, SimError};
-use crate::slave::{FailStatus, Slave, SlaveError, StepStatus, VarBatch};
+use crate::slave::{FailStatus, ScalarType, Slave, SlaveError, StepStatus, StringTable, VarBatch};
 
 pub(super) struct Engine<'p, 's, 'd, 'o> {
     plan: &'p CouplingPlan,
@@ -23,6 +23,41 @@ pub(super) struct Engine<'p, 's, 'd, 'o> {
     previous: Vec<f64>,
     /// Scratch: the recorded variables of one instance.
     recorded: Vec<f64>,
+    /// The texts of String values (the plan's start values first).
+    strings: StringTable,
+    /// Scratch: texts read from a slave.
+    texts: Vec<String>,
+    /// Set when a slave asked to end the run: (instance, last completed point).
+    terminated: Option<(usize, f64)>,
+    /// Gauss-Seidel: the slaves at the current communication point (stepped to it), whose
+    /// direct-feedthrough outputs are read again when their inputs change; and scratch for
+    /// the instances refreshed after one step.
+    current: Vec<bool>,
+    refreshed: Vec<bool>,
+    pending: Vec<usize>,
+}
+
+/// How a macro step ended.
+enum StepEnd {
+    Done,
+    /// A slave discarded the step (and did not ask to end the simulation).
+    Discarded(usize),
+    /// A slave asked to end the simulation; `completed`: it got to the end of the step (its
+    /// fmi2LastSuccessfulTime), and so did the others, so the point is recorded.
+    Terminated {
+        instance: usize,
+        completed: bool,
+    },
+}
+
+/// How a single slave's step ended.
+enum SlaveStep {
+    Ok,
+    Discarded,
+    /// The slave ends the simulation; whether it completed this step.
+    Terminating {
+        completed: bool,
+    },
 }
 
 impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
@@ -47,7 +82,57 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             inputs: Vec::new(),
             previous: Vec::new(),
             recorded: Vec::new(),
+            strings: StringTable::from_texts(&plan.strings),
+            texts: Vec::new(),
+            terminated: None,
+            current: vec![false; n],
+            refreshed: vec![false; n],
+            pending: Vec::new(),
         }
+    }
+
+    /// The instance that ended the run and the time of the last result row, if one did.
+    pub(super) fn terminated(&self) -> Option<(usize, f64)> {
+        self.terminated
+    }
+
+    /// The texts of the run's String values.
+    pub(super) fn take_strings(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.strings).into_texts()
+    }
+
+    /// Reads a batch of slave `i` (numbers in one call per type, then the Strings, whose texts
+    /// are interned into values).
+    fn get_batch(&mut self, i: usize, batch: &VarBatch, out: &mut [f64]) -> Result<(), SlaveError> {
+        self.slaves[i].get(batch, out)?;
+        let g = batch.group(ScalarType::String);
+        if !g.vrs.is_empty() {
+            let mut texts = std::mem::take(&mut self.texts);
+            let r = self.slaves[i].get_strings(&g.vrs, &mut texts);
+            if r.is_ok() {
+                for (&k, t) in g.positions.iter().zip(&texts) {
+                    out[k] = self.strings.intern(t);
+                }
+            }
+            self.texts = texts;
+            r?;
+        }
+        Ok(())
+    }
+
+    /// Writes a batch to slave `i` (numbers, then the Strings by their texts).
+    fn set_batch(&mut self, i: usize, batch: &VarBatch, values: &[f64]) -> Result<(), SlaveError> {
+        self.slaves[i].set(batch, values)?;
+        let g = batch.group(ScalarType::String);
+        if !g.vrs.is_empty() {
+            let texts: Vec<&str> = g
+                .positions
+                .iter()
+                .map(|&k| self.strings.text(values[k]).unwrap_or(""))
+                .collect();
+            self.slaves[i].set_strings(&g.vrs, &texts)?;
+        }
+        Ok(())
     }
 
     /// Macro steps redone with sub-steps after a discard.
@@ -78,7 +163,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         }
         let mut values = std::mem::take(&mut self.outputs[i]);
         values.resize(src.outputs.len(), 0.0);
-        let r = self.slaves[i].get(&src.outputs, &mut values);
+        let r = self.get_batch(i, &src.outputs, &mut values);
         self.outputs[i] = values;
         r.map_err(|e| self.slave_err(time, i, e))
     }
@@ -115,7 +200,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             let mut old = std::mem::take(&mut self.previous);
             old.clear();
             old.resize(inputs.len(), f64::NAN);
-            let before = self.slaves[j].get(&dest.inputs, &mut old).is_ok();
+            let before = self.get_batch(j, &dest.inputs, &mut old).is_ok();
             for (&o, &x) in old.iter().zip(&inputs) {
                 if !before || (o - x).abs() > 0.0 || o.is_nan() {
                     change = change.max(if before { (o - x).abs() } else { f64::INFINITY });
@@ -123,7 +208,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             }
             self.previous = old;
         }
-        let r = self.slaves[j].set(&dest.inputs, &inputs);
+        let r = self.set_batch(j, &dest.inputs, &inputs);
         self.inputs = inputs;
         r.map_err(|e| self.slave_err(time, j, e))?;
         Ok(change)
@@ -140,6 +225,42 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             change = change.max(self.write_inputs(time, dest, compare)?);
         }
         Ok(change)
+    }
+
+    /// Gauss-Seidel, after instance `from` passed on its outputs: every instance at the
+    /// current point whose outputs depend directly on the inputs just set (ModelStructure) is
+    /// read again and passes its fresh outputs on, and so on down the chain (FMI 2.0 allows
+    /// reading outputs again after setting inputs at the same instant). Each instance is read
+    /// again at most once per call, so an algebraic loop ends.
+    fn refresh_feedthrough(&mut self, time: f64, from: usize) -> Result<(), SimError> {
+        let exchange = self.exchange;
+        // a source ahead of the others (a longer step) does not refresh them
+        if exchange.sources[from].feeds_through.is_empty() || !self.current[from] {
+            return Ok(());
+        }
+        self.refreshed.iter_mut().for_each(|r| *r = false);
+        self.refreshed[from] = true;
+        let mut pending = std::mem::take(&mut self.pending);
+        pending.clear();
+        pending.push(from);
+        let mut result = Ok(());
+        while let Some(s) = pending.pop() {
+            for &j in &exchange.sources[s].feeds_through {
+                if self.current[j] && !self.refreshed[j] {
+                    self.refreshed[j] = true;
+                    if let Err(e) = self.propagate_from(time, j, false) {
+                        result = Err(e);
+                        break;
+                    }
+                    pending.push(j);
+                }
+            }
+            if result.is_err() {
+                break;
+            }
+        }
+        self.pending = pending;
+        result
     }
 
     /// Jacobi exchange: read all connected outputs first, then set all inputs.
@@ -164,9 +285,12 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         match self.plan.algorithm {
             Algorithm::Jacobi => self.exchange_all_jacobi(time),
             Algorithm::GaussSeidel => {
+                // every slave is at this point
+                self.current.iter_mut().for_each(|c| *c = true);
                 for idx in 0..self.plan.order.len() {
                     let i = self.plan.order[idx];
                     self.propagate_from(time, i, false)?;
+                    self.refresh_feedthrough(time, i)?;
                 }
                 Ok(())
             }
@@ -185,7 +309,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let mut values = std::mem::take(&mut self.recorded);
         for g in &exchange.record {
             values.resize(g.vars.len(), 0.0);
-            if let Err(e) = self.slaves[g.instance].get(&g.vars, &mut values) {
+            if let Err(e) = self.get_batch(g.instance, &g.vars, &mut values) {
                 self.recorded = values;
                 return Err(self.slave_err(time, g.instance, e));
             }
@@ -216,16 +340,22 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             let inst = &plan.instances[i];
             // one call per start value, so that a refused one is named
             for (k, &(v, x)) in inst.parameters.iter().enumerate() {
-                self.slaves[i]
-                    .set(&VarBatch::new(vec![v]), &[x])
+                self.set_batch(i, &VarBatch::new(vec![v]), &[x])
                     .map_err(|source| SimError::StartValue {
                         instance: inst.name.clone(),
-                        name: inst
-                            .parameter_names
-                            .get(k)
-                            .cloned()
-                            .unwrap_or_else(|| format!("vr {}", v.vr)),
-                        value: x,
+                        assignment: format!(
+                            "'{}' = {}",
+                            inst.parameter_names
+                                .get(k)
+                                .cloned()
+                                .unwrap_or_else(|| format!("vr {}", v.vr)),
+                            match v.ty {
+                                ScalarType::String => {
+                                    format!("{:?}", self.strings.text(x).unwrap_or(""))
+                                }
+                                _ => x.to_string(),
+                            }
+                        ),
                         source,
                     })?;
             }
@@ -254,9 +384,28 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         self.exchange_all(t0)
     }
 
-    /// Tries macro step `k` split into `parts` sub-steps; returns the index of a slave that
-    /// discarded, if any.
-    fn try_macro_step(&mut self, k: u64, parts: u64) -> Result<Option<usize>, SimError> {
+    /// Steps slave `i` over `[ts, ts + h]`; a discard asks the slave whether it ends the
+    /// simulation, and how far it got (fmi2LastSuccessfulTime).
+    fn step_slave(&mut self, i: usize, ts: f64, h: f64) -> Result<SlaveStep, SimError> {
+        match self.slaves[i].do_step(ts, h) {
+            Ok(StepStatus::Ok) => Ok(SlaveStep::Ok),
+            Ok(StepStatus::Discard) => {
+                if !self.slaves[i].terminate_requested() {
+                    return Ok(SlaveStep::Discarded);
+                }
+                let end = ts + h;
+                let completed = self.slaves[i]
+                    .last_successful_time()
+                    .is_some_and(|t| (t - end).abs() <= 1e-9 * end.abs().max(h));
+                Ok(SlaveStep::Terminating { completed })
+            }
+            Err(e) => Err(self.slave_err(ts, i, e)),
+        }
+    }
+
+    /// Tries macro step `k` split into `parts` sub-steps. A slave that ends the simulation
+    /// after completing the last sub-step lets the others complete it too.
+    fn try_macro_step(&mut self, k: u64, parts: u64) -> Result<StepEnd, SimError> {
         let plan = self.plan;
         let n = self.slaves.len();
         let t = self.t(k);
@@ -279,16 +428,32 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             };
             (s, e - s)
         };
+        let mut ending: Option<usize> = None;
         for j in 0..parts {
+            let last_part = j + 1 == parts;
+            // the outcome of one slave's step: Some(end) stops the macro step
+            let mut outcome = |i: usize, step: SlaveStep| -> Option<StepEnd> {
+                match step {
+                    SlaveStep::Ok => None,
+                    SlaveStep::Discarded => Some(StepEnd::Discarded(i)),
+                    SlaveStep::Terminating { completed } if completed && last_part => {
+                        ending.get_or_insert(i);
+                        None
+                    }
+                    SlaveStep::Terminating { .. } => Some(StepEnd::Terminated {
+                        instance: i,
+                        completed: false,
+                    }),
+                }
+            };
             match plan.algorithm {
                 Algorithm::Jacobi => {
                     for (i, w) in windows.iter().enumerate().take(n) {
                         if let Some(w) = *w {
                             let (ts, h) = sub(w, j);
-                            match self.slaves[i].do_step(ts, h) {
-                                Ok(StepStatus::Ok) => {}
-                                Ok(StepStatus::Discard) => return Ok(Some(i)),
-                                Err(e) => return Err(self.slave_err(ts, i, e)),
+                            let step = self.step_slave(i, ts, h)?;
+                            if let Some(end) = outcome(i, step) {
+                                return Ok(end);
                             }
                         }
                     }
@@ -296,25 +461,36 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                     self.exchange_all_jacobi(te.0 + te.1)?;
                 }
                 Algorithm::GaussSeidel => {
+                    self.current.iter_mut().for_each(|c| *c = false);
                     for idx in 0..plan.order.len() {
                         let i = plan.order[idx];
                         if let Some(w) = windows[i] {
                             let (ts, h) = sub(w, j);
-                            match self.slaves[i].do_step(ts, h) {
-                                Ok(StepStatus::Ok) => {}
-                                Ok(StepStatus::Discard) => return Ok(Some(i)),
-                                Err(e) => return Err(self.slave_err(ts, i, e)),
+                            let step = self.step_slave(i, ts, h)?;
+                            if let Some(end) = outcome(i, step) {
+                                return Ok(end);
                             }
+                            // at the same point as the others stepping every point
+                            self.current[i] = plan.instances[i].step_multiple <= 1;
                             self.propagate_from(ts + h, i, false)?;
+                            self.refresh_feedthrough(ts + h, i)?;
                         }
                     }
                 }
             }
         }
-        Ok(None)
+        Ok(match ending {
+            Some(instance) => StepEnd::Terminated {
+                instance,
+                completed: true,
+            },
+            None => StepEnd::Done,
+        })
     }
 
-    fn macro_step(&mut self, k: u64) -> Result<(), SimError> {
+    /// Macro step `k` with retry; `Ok(Some((i, completed)))` when slave `i` asked to end the
+    /// simulation (`completed`: at the end of this step, else at its start).
+    fn macro_step(&mut self, k: u64) -> Result<Option<(usize, bool)>, SimError> {
         let t = self.t(k);
         let h = self.t(k + 1) - t;
         let retry = self.plan.max_step_halvings > 0;
@@ -332,8 +508,13 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let mut parts = 1u64;
         let mut halvings = 0u32;
         loop {
-            let Some(i) = self.try_macro_step(k, parts)? else {
-                return Ok(());
+            let i = match self.try_macro_step(k, parts)? {
+                StepEnd::Done => return Ok(None),
+                StepEnd::Terminated {
+                    instance,
+                    completed,
+                } => return Ok(Some((instance, completed))),
+                StepEnd::Discarded(instance) => instance,
             };
             let name = self.slaves[i].name().to_string();
             let refusal = if !retry {
@@ -389,7 +570,16 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                     return Err(SimError::Cancelled { time: self.t(k) });
                 }
             }
-            self.macro_step(k)?;
+            if let Some((i, completed)) = self.macro_step(k)? {
+                // the FMU ends the run: the results stop at the last completed point
+                let t = if completed { self.t(k + 1) } else { self.t(k) };
+                if completed {
+                    self.record(t, &mut data)?;
+                }
+                log::info!(target: "master", "instance '{}' asked to end the simulation at t = {t} s", self.slaves[i].name());
+                self.terminated = Some((i, t));
+                break;
+            }
             let t = self.t(k + 1);
             self.record(t, &mut data)?;
             if let Some(p) = self.opts.progress {

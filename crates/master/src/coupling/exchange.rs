@@ -14,6 +14,9 @@ pub(super) struct Source {
     pub connections: Vec<usize>,
     /// The instances its outputs feed, in order of first connection.
     pub dests: Vec<Dest>,
+    /// The instances among `dests` with an input from it that feeds directly through to one
+    /// of their outputs (their outputs change when it sets them).
+    pub feeds_through: Vec<usize>,
 }
 
 /// Inputs of one instance written together.
@@ -113,6 +116,16 @@ impl Exchange {
                     outputs: VarBatch::new(mine().map(|(_, (c, _))| c.from).collect()),
                     connections: mine().map(|(ci, _)| ci).collect(),
                     dests: dests(group(mine().map(|(_, (c, at))| (c.to_instance, c.to, at)))),
+                    feeds_through: {
+                        let mut f: Vec<usize> = mine()
+                            .filter(|(_, (c, _))| c.feedthrough)
+                            .map(|(_, (c, _))| c.to_instance)
+                            .collect();
+                        f.dedup();
+                        f.sort_unstable();
+                        f.dedup();
+                        f
+                    },
                 }
             })
             .collect();

@@ -1,7 +1,7 @@
 //! The plan the coupling algorithm runs (validated by [`crate::system`]), its results and
 //! errors, and the checks made before any call.
 
-use crate::slave::{SlaveError, VarRef};
+use crate::slave::{ScalarType, SlaveError, VarRef};
 
 /// Coupling algorithm.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -15,7 +15,8 @@ pub enum Algorithm {
 pub struct PlanInstance {
     pub name: String,
     pub step_multiple: u32,
-    /// Start values set before initialisation (value reference, value as f64).
+    /// Start values set before initialisation (value reference, value as f64; a String's
+    /// value indexes [`CouplingPlan::strings`]).
     pub parameters: Vec<(VarRef, f64)>,
     /// Names of `parameters` (same order) for messages; may be empty.
     pub parameter_names: Vec<String>,
@@ -29,6 +30,9 @@ pub struct PlanConnection {
     pub to: VarRef,
     /// "instance.variable" of the source, for messages.
     pub label: String,
+    /// Whether the target input feeds directly through to an output of the target instance
+    /// (ModelStructure/Outputs): after setting it, that output is read again (Gauss-Seidel).
+    pub feedthrough: bool,
 }
 
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -37,6 +41,38 @@ pub struct Recorded {
     pub var: VarRef,
     /// CSV header, e.g. `bogie.wheelset_front.y [m]`.
     pub label: String,
+    /// What a reader of the results needs to know of the variable.
+    pub info: ColumnInfo,
+}
+
+/// A recorded variable as a reader of the results sees it: type (with the items of an
+/// Enumeration), unit and the FMU variable it comes from.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ColumnInfo {
+    pub ty: Option<ScalarType>,
+    /// `instance.variable`.
+    pub name: String,
+    pub unit: Option<String>,
+    pub causality: String,
+    pub description: Option<String>,
+    pub instance: String,
+    pub fmu_guid: String,
+    /// Enumeration items (value, name).
+    pub items: Vec<(i32, String)>,
+}
+
+impl ColumnInfo {
+    /// The type, Real when unknown.
+    pub fn scalar_type(&self) -> ScalarType {
+        self.ty.unwrap_or(ScalarType::Real)
+    }
+    /// The item name of an Enumeration value.
+    pub fn item(&self, value: f64) -> Option<&str> {
+        self.items
+            .iter()
+            .find(|(v, _)| f64::from(*v) == value)
+            .map(|(_, n)| n.as_str())
+    }
 }
 
 /// Everything the coupling algorithm needs, already validated (see [`crate::system`]).
@@ -54,6 +90,8 @@ pub struct CouplingPlan {
     pub record: Vec<Recorded>,
     pub init_sweeps: usize,
     pub max_step_halvings: u32,
+    /// Texts of the String start values (their values index this list).
+    pub strings: Vec<String>,
 }
 
 /// Run statistics.
@@ -65,6 +103,19 @@ pub struct Summary {
     pub wall_time_s: f64,
     /// simulated time / wall time.
     pub realtime_ratio: f64,
+    /// Set when an FMU asked to end the simulation before the stop time.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub terminated: Option<Terminated>,
+}
+
+/// An FMU ended the run: its step returned fmi2Discard with fmi2Terminated true (FMI 2.0
+/// section 4.2.3). The results stop at the last communication point every instance completed.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Terminated {
+    /// The instance that asked.
+    pub instance: String,
+    /// The last completed communication point (the last result row) [s].
+    pub time_s: f64,
 }
 
 impl std::fmt::Display for Summary {
@@ -77,7 +128,15 @@ impl std::fmt::Display for Summary {
             self.simulated_time_s,
             self.wall_time_s,
             self.realtime_ratio
-        )
+        )?;
+        if let Some(t) = &self.terminated {
+            write!(
+                f,
+                "; terminated by instance '{}' at t = {} s",
+                t.instance, t.time_s
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -87,9 +146,35 @@ pub struct SimOutput {
     pub header: Vec<String>,
     pub data: Vec<f64>,
     pub summary: Summary,
+    /// What each column after time holds (may be empty: all Real).
+    pub columns: Vec<ColumnInfo>,
+    /// Texts of the String values (a String column's values index this list).
+    pub strings: Vec<String>,
 }
 
 impl SimOutput {
+    /// The description of column `c` (0 is time), Real when not described.
+    pub fn column_info(&self, c: usize) -> ColumnInfo {
+        c.checked_sub(1)
+            .and_then(|k| self.columns.get(k))
+            .cloned()
+            .unwrap_or_default()
+    }
+    /// The text of a String value.
+    pub fn text(&self, value: f64) -> Option<&str> {
+        if value >= 0.0 && value.fract() == 0.0 {
+            self.strings.get(value as usize).map(String::as_str)
+        } else {
+            None
+        }
+    }
+    /// The strings of a String column, by label as in [`SimOutput::column`].
+    pub fn text_column(&self, name: &str) -> Option<Vec<String>> {
+        let x = self.column(name)?;
+        x.into_iter()
+            .map(|v| self.text(v).map(str::to_string))
+            .collect()
+    }
     pub fn rows(&self) -> impl Iterator<Item = &[f64]> {
         self.data.chunks(self.header.len().max(1))
     }
@@ -108,11 +193,11 @@ impl SimOutput {
 pub enum SimError {
     #[error("invalid plan: {0}")]
     Plan(String),
-    #[error("instance '{instance}': setting start value '{name}' = {value} failed: {source}")]
+    #[error("instance '{instance}': setting start value {assignment} failed: {source}")]
     StartValue {
         instance: String,
-        name: String,
-        value: f64,
+        /// `'name' = value`.
+        assignment: String,
         #[source]
         source: SlaveError,
     },

@@ -21,6 +21,8 @@ pub struct Hooks {
     pub cancel_after: Option<(usize, Arc<AtomicBool>)>,
     pub step_times: Vec<(f64, f64)>,
     pub fail_set_vr: Option<u32>,
+    /// From this time on, every step is discarded with fmi2Terminated (the slave ends the run).
+    pub terminate_from: Option<f64>,
     /// Number of get and set calls (each a batch).
     pub gets: usize,
     pub sets: usize,
@@ -188,6 +190,13 @@ impl<M: Model + Clone> Slave for Mock<M> {
                 flag.store(true, Ordering::Relaxed);
             }
         }
+        if self
+            .hooks
+            .terminate_from
+            .is_some_and(|t_end| t + 1e-12 >= t_end)
+        {
+            return Ok(StepStatus::Discard);
+        }
         if self.hooks.discard_above.is_some_and(|hmax| h > hmax) {
             return Ok(StepStatus::Discard);
         }
@@ -206,6 +215,9 @@ impl<M: Model + Clone> Slave for Mock<M> {
         }
         self.m.outputs();
         Ok(StepStatus::Ok)
+    }
+    fn terminate_requested(&mut self) -> bool {
+        self.hooks.terminate_from.is_some()
     }
     fn can_save_state(&self) -> bool {
         self.hooks.can_state
@@ -242,6 +254,7 @@ pub fn two_mass_plan(alg: Algorithm, order: Vec<usize>, h: f64, stop: f64) -> Co
         to_instance: ti,
         to: r(t),
         label: l.into(),
+        feedthrough: false,
     };
     CouplingPlan {
         start_time: 0.0,
@@ -273,20 +286,24 @@ pub fn two_mass_plan(alg: Algorithm, order: Vec<usize>, h: f64, stop: f64) -> Co
                 instance: 0,
                 var: r(4),
                 label: "ms.position [m]".into(),
+                info: Default::default(),
             },
             Recorded {
                 instance: 1,
                 var: r(6),
                 label: "sdm.position [m]".into(),
+                info: Default::default(),
             },
             Recorded {
                 instance: 0,
                 var: r(3),
                 label: "ms.force [N]".into(),
+                info: Default::default(),
             },
         ],
         init_sweeps: 3,
         max_step_halvings: 0,
+        strings: vec![],
     }
 }
 
@@ -452,6 +469,46 @@ fn discard_without_state_support_or_retry_is_an_error_and_terminates() {
 }
 
 #[test]
+fn termination_requested_by_a_slave_ends_the_run_at_the_last_completed_point() {
+    for alg in [Algorithm::Jacobi, Algorithm::GaussSeidel] {
+        // retry on: a terminating discard is never retried
+        let mut plan = two_mass_plan(alg, vec![0, 1], 1e-2, 1.0);
+        plan.max_step_halvings = 3;
+        let (mut a, mut b) = slaves();
+        let log = CallLog::default();
+        a.hooks.log = log.clone();
+        b.hooks.log = log.clone();
+        b.hooks.terminate_from = Some(0.3);
+        let out = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap();
+        let t = out.column("time").unwrap();
+        assert_eq!(t.len(), 31, "{alg:?}");
+        assert!((t[30] - 0.3).abs() < 1e-12, "{alg:?}: {}", t[30]);
+        let term = out.summary.terminated.clone().unwrap();
+        assert_eq!(term.instance, "sdm");
+        assert!((term.time_s - 0.3).abs() < 1e-12);
+        assert_eq!(out.summary.steps, 30);
+        assert_eq!(out.summary.rejected_steps, 0);
+        assert!((out.summary.simulated_time_s - 0.3).abs() < 1e-12);
+        assert!(out
+            .summary
+            .to_string()
+            .contains("terminated by instance 'sdm' at t = 0.3"));
+        // the results equal those of a run that stops at 0.3 s
+        let (full, _, _) = run(&two_mass_plan(alg, vec![0, 1], 1e-2, 0.3));
+        assert_eq!(out.data, full.data, "{alg:?}");
+        let l = log.borrow();
+        assert_eq!(l.iter().filter(|s| s.ends_with(":terminate")).count(), 2);
+        assert!(!l.iter().any(|s| s.ends_with(":restore")));
+    }
+    // a discard without fmi2Terminated stays an error
+    let plan = two_mass_plan(Algorithm::Jacobi, vec![0, 1], 1e-2, 1.0);
+    let (mut a, mut b) = slaves();
+    b.hooks.discard_above = Some(1e-3);
+    let e = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap_err();
+    assert!(matches!(e, SimError::Discarded { .. }), "{e}");
+}
+
+#[test]
 fn cancel_flag_stops_and_terminates_everything() {
     let plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 1.0);
     let flag = Arc::new(AtomicBool::new(false));
@@ -594,5 +651,159 @@ fn every_step_makes_one_get_and_one_set_call_per_slave() {
         let (short, long) = (calls(0.1), calls(0.2));
         let per_10_steps: Vec<usize> = long.iter().zip(&short).map(|(l, s)| l - s).collect();
         assert_eq!(per_10_steps, [20, 10, 20, 10], "{alg:?}");
+    }
+}
+
+/// A slave of a direct-feedthrough chain: `Clock` outputs (vr 0) its time, `Gain` outputs
+/// y = 2 u (vr 1) from its input u (vr 0) at once (direct feedthrough), `Sink` only has an
+/// input (vr 0).
+enum ChainKind {
+    Clock,
+    Gain,
+    Sink,
+}
+
+struct ChainSlave {
+    name: String,
+    kind: ChainKind,
+    vals: [f64; 2],
+    t: f64,
+}
+
+impl ChainSlave {
+    fn new(name: &str, kind: ChainKind) -> Self {
+        ChainSlave {
+            name: name.into(),
+            kind,
+            vals: [0.0; 2],
+            t: 0.0,
+        }
+    }
+    fn update(&mut self) {
+        match self.kind {
+            ChainKind::Clock => self.vals[0] = self.t,
+            ChainKind::Gain => self.vals[1] = 2.0 * self.vals[0],
+            ChainKind::Sink => {}
+        }
+    }
+}
+
+impl Slave for ChainSlave {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn setup_experiment(&mut self, t0: f64, _: f64) -> Result<(), SlaveError> {
+        self.t = t0;
+        Ok(())
+    }
+    fn enter_initialization_mode(&mut self) -> Result<(), SlaveError> {
+        Ok(())
+    }
+    fn exit_initialization_mode(&mut self) -> Result<(), SlaveError> {
+        Ok(())
+    }
+    fn get(&mut self, batch: &VarBatch, out: &mut [f64]) -> Result<(), SlaveError> {
+        self.update();
+        for (v, o) in batch.vars().iter().zip(out) {
+            *o = self.vals[v.vr as usize];
+        }
+        Ok(())
+    }
+    fn set(&mut self, batch: &VarBatch, values: &[f64]) -> Result<(), SlaveError> {
+        for (v, x) in batch.vars().iter().zip(values) {
+            self.vals[v.vr as usize] = *x;
+        }
+        Ok(())
+    }
+    fn do_step(&mut self, t: f64, h: f64) -> Result<StepStatus, SlaveError> {
+        self.t = t + h;
+        self.update();
+        Ok(StepStatus::Ok)
+    }
+    fn can_save_state(&self) -> bool {
+        false
+    }
+    fn can_vary_step(&self) -> bool {
+        true
+    }
+    fn save_state(&mut self) -> Result<(), SlaveError> {
+        Ok(())
+    }
+    fn restore_state(&mut self) -> Result<(), SlaveError> {
+        Ok(())
+    }
+    fn terminate(&mut self) -> Result<(), SlaveError> {
+        Ok(())
+    }
+}
+
+/// clock -> gain (direct feedthrough) -> sink, the gain stepped first: its output depends
+/// on the clock's, which changes after the gain has stepped.
+fn chain_plan(alg: Algorithm) -> CouplingPlan {
+    let conn = |fi, f, ti, t, feedthrough, l: &str| PlanConnection {
+        from_instance: fi,
+        from: r(f),
+        to_instance: ti,
+        to: r(t),
+        label: l.into(),
+        feedthrough,
+    };
+    let inst = |name: &str| PlanInstance {
+        name: name.into(),
+        step_multiple: 1,
+        parameters: vec![],
+        parameter_names: vec![],
+    };
+    CouplingPlan {
+        start_time: 0.0,
+        stop_time: 1.0,
+        step: 0.1,
+        instances: vec![inst("gain"), inst("clock"), inst("sink")],
+        connections: vec![
+            conn(1, 0, 0, 0, true, "clock.t"),
+            conn(0, 1, 2, 0, false, "gain.y"),
+        ],
+        algorithm: alg,
+        order: vec![0, 1, 2],
+        record: vec![Recorded {
+            instance: 2,
+            var: r(0),
+            label: "sink.u".into(),
+            info: Default::default(),
+        }],
+        init_sweeps: 3,
+        max_step_halvings: 0,
+        strings: vec![],
+    }
+}
+
+#[test]
+fn gauss_seidel_reads_direct_feedthrough_outputs_again_after_setting_inputs() {
+    let run_chain = |alg| {
+        let mut g = ChainSlave::new("gain", ChainKind::Gain);
+        let mut c = ChainSlave::new("clock", ChainKind::Clock);
+        let mut s = ChainSlave::new("sink", ChainKind::Sink);
+        let out = simulate(
+            &chain_plan(alg),
+            &mut [&mut g, &mut c, &mut s],
+            &RunOptions::default(),
+        )
+        .unwrap();
+        out.column("sink.u").unwrap()
+    };
+    let gs = run_chain(Algorithm::GaussSeidel);
+    let jacobi = run_chain(Algorithm::Jacobi);
+    assert_eq!(gs.len(), 11);
+    for (k, (&g, &j)) in gs.iter().zip(&jacobi).enumerate() {
+        let t = k as f64 * 0.1;
+        // the exact coupled answer: sink.u = 2 t at every point
+        assert!((g - 2.0 * t).abs() < 1e-12, "GS at t = {t}: {g}");
+        // Jacobi passes the gain's output computed from the clock one step earlier
+        if k > 0 {
+            assert!(
+                (j - 2.0 * (t - 0.1)).abs() < 1e-12,
+                "Jacobi at t = {t}: {j}"
+            );
+        }
     }
 }

@@ -123,6 +123,14 @@ impl FmuSlave {
         }
     }
 
+    fn absent(&self, call: &'static str) -> SlaveError {
+        SlaveError {
+            instance: self.name.clone(),
+            call,
+            status: FailStatus::Other(format!("the binary does not export {call}")),
+        }
+    }
+
     fn missing(&self, call: &'static str) -> SlaveError {
         SlaveError {
             instance: self.name.clone(),
@@ -255,6 +263,80 @@ impl Slave for FmuSlave {
             self.check(call, s)?;
         }
         Ok(())
+    }
+    fn get_strings(&mut self, vrs: &[u32], out: &mut Vec<String>) -> Result<(), SlaveError> {
+        out.clear();
+        if vrs.is_empty() {
+            return Ok(());
+        }
+        let Some(get) = self.lib().get_string else {
+            return Err(self.absent("fmi2GetString"));
+        };
+        let mut ptrs: Vec<ffi::fmi2String> = vec![std::ptr::null(); vrs.len()];
+        let s = unsafe { get(self.component, vrs.as_ptr(), vrs.len(), ptrs.as_mut_ptr()) };
+        self.check("fmi2GetString", s)?;
+        for p in ptrs {
+            if p.is_null() {
+                return Err(SlaveError {
+                    instance: self.name.clone(),
+                    call: "fmi2GetString",
+                    status: FailStatus::Other("returned a NULL string".into()),
+                });
+            }
+            // SAFETY: FMI 2.0 (2.1.7): the FMU's strings stay valid until its next call; they
+            // are copied at once.
+            let text = unsafe { std::ffi::CStr::from_ptr(p) };
+            out.push(text.to_string_lossy().into_owned());
+        }
+        Ok(())
+    }
+    fn set_strings(&mut self, vrs: &[u32], values: &[&str]) -> Result<(), SlaveError> {
+        if vrs.len() != values.len() {
+            return Err(self.internal("fmi2SetString", "batch and value lengths differ"));
+        }
+        if vrs.is_empty() {
+            return Ok(());
+        }
+        let Some(set) = self.lib().set_string else {
+            return Err(self.absent("fmi2SetString"));
+        };
+        let mut texts = Vec::with_capacity(values.len());
+        for v in values {
+            texts.push(CString::new(*v).map_err(|_| SlaveError {
+                instance: self.name.clone(),
+                call: "fmi2SetString",
+                status: FailStatus::Other(format!("the string {v:?} contains a NUL byte")),
+            })?);
+        }
+        let ptrs: Vec<ffi::fmi2String> = texts.iter().map(|t| t.as_ptr()).collect();
+        let s = unsafe { set(self.component, vrs.as_ptr(), vrs.len(), ptrs.as_ptr()) };
+        self.check("fmi2SetString", s)
+    }
+    fn terminate_requested(&mut self) -> bool {
+        let Some(get) = self.lib().get_boolean_status else {
+            return false;
+        };
+        let mut terminated: ffi::fmi2Boolean = 0;
+        let s = unsafe {
+            get(
+                self.component,
+                ffi::fmi2StatusKind_fmi2Terminated,
+                &mut terminated,
+            )
+        };
+        status(s).is_ok() && terminated != 0
+    }
+    fn last_successful_time(&mut self) -> Option<f64> {
+        let get = self.lib().get_real_status?;
+        let mut t: ffi::fmi2Real = f64::NAN;
+        let s = unsafe {
+            get(
+                self.component,
+                ffi::fmi2StatusKind_fmi2LastSuccessfulTime,
+                &mut t,
+            )
+        };
+        (status(s).is_ok() && t.is_finite()).then_some(t)
     }
     fn do_step(&mut self, t: f64, h: f64) -> Result<StepStatus, SlaveError> {
         let s = unsafe { (self.lib().do_step)(self.component, t, h, 1) };

@@ -34,6 +34,12 @@ pub(crate) struct Fmi2Library {
     pub set_integer: Function<ffi::fmi2SetIntegerTYPE>,
     pub set_boolean: Function<ffi::fmi2SetBooleanTYPE>,
     pub do_step: Function<ffi::fmi2DoStepTYPE>,
+    /// Required by FMI 2.0 but only used when a String variable is set or read, or a step is
+    /// discarded: a binary that lacks one still runs everything else.
+    pub get_string: Option<Function<ffi::fmi2GetStringTYPE>>,
+    pub set_string: Option<Function<ffi::fmi2SetStringTYPE>>,
+    pub get_boolean_status: Option<Function<ffi::fmi2GetBooleanStatusTYPE>>,
+    pub get_real_status: Option<Function<ffi::fmi2GetRealStatusTYPE>>,
     /// Present when the FMU declares canGetAndSetFMUstate.
     pub fmu_state: Option<StateFunctions>,
     _library: libloading::Library,
@@ -97,6 +103,14 @@ impl Fmi2Library {
             set_integer: symbol::<ffi::fmi2SetIntegerTYPE>(l, b"fmi2SetInteger\0")?,
             set_boolean: symbol::<ffi::fmi2SetBooleanTYPE>(l, b"fmi2SetBoolean\0")?,
             do_step: symbol::<ffi::fmi2DoStepTYPE>(l, b"fmi2DoStep\0")?,
+            get_string: symbol::<ffi::fmi2GetStringTYPE>(l, b"fmi2GetString\0").ok(),
+            set_string: symbol::<ffi::fmi2SetStringTYPE>(l, b"fmi2SetString\0").ok(),
+            get_boolean_status: symbol::<ffi::fmi2GetBooleanStatusTYPE>(
+                l,
+                b"fmi2GetBooleanStatus\0",
+            )
+            .ok(),
+            get_real_status: symbol::<ffi::fmi2GetRealStatusTYPE>(l, b"fmi2GetRealStatus\0").ok(),
             fmu_state,
             _library: library,
         })

@@ -180,6 +180,16 @@ pub struct Variable {
     pub unit: Option<String>,
     pub start: Option<String>,
     pub description: Option<String>,
+    /// `declaredType` of the type element, if any (an Enumeration's items are its type's).
+    pub declared_type: Option<String>,
+}
+
+/// One `<Item>` of an Enumeration type.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct EnumItem {
+    pub name: String,
+    pub value: i32,
+    pub description: Option<String>,
 }
 
 impl Variable {
@@ -229,6 +239,8 @@ pub struct ModelDescription {
     pub default_experiment: Option<DefaultExperiment>,
     pub variables: Vec<Variable>,
     pub outputs: Vec<OutputDependency>,
+    /// Enumeration SimpleTypes of TypeDefinitions: type name -> items in declaration order.
+    pub enumerations: std::collections::BTreeMap<String, Vec<EnumItem>>,
 }
 
 impl ModelDescription {
@@ -238,6 +250,16 @@ impl ModelDescription {
             .iter()
             .enumerate()
             .find(|(_, v)| v.name == name)
+    }
+
+    /// The items of an Enumeration variable (empty for other types or an unknown type).
+    pub fn enum_items(&self, v: &Variable) -> &[EnumItem] {
+        match (&v.var_type, &v.declared_type) {
+            (VarType::Enumeration, Some(t)) => {
+                self.enumerations.get(t).map(Vec::as_slice).unwrap_or(&[])
+            }
+            _ => &[],
+        }
     }
 
     /// The closest variable name (edit distance at most max(2, len/3)), for "did you mean".

@@ -166,6 +166,7 @@ impl ModelDescription {
             default_experiment: None,
             variables: Vec::new(),
             outputs: Vec::new(),
+            enumerations: Default::default(),
         };
         // SimpleType name -> unit
         let mut type_units: HashMap<String, Option<String>> = HashMap::new();
@@ -268,6 +269,27 @@ impl ModelDescription {
                             ("SimpleType", "Real") => {
                                 if let Some(t) = &current_type {
                                     type_units.insert(t.clone(), e.get("unit").map(String::from));
+                                }
+                            }
+                            ("SimpleType", "Enumeration") => {
+                                if let Some(t) = &current_type {
+                                    md.enumerations.insert(t.clone(), Vec::new());
+                                }
+                            }
+                            ("Enumeration", "Item") => {
+                                if let Some(items) = current_type
+                                    .as_ref()
+                                    .and_then(|t| md.enumerations.get_mut(t))
+                                {
+                                    let v = e.req("value")?;
+                                    let value = v.trim().parse::<i32>().map_err(|_| {
+                                        e.invalid("value", v, "expected a 32-bit integer")
+                                    })?;
+                                    items.push(EnumItem {
+                                        name: e.req("name")?.to_string(),
+                                        value,
+                                        description: e.get("description").map(String::from),
+                                    });
                                 }
                             }
                             ("ModelVariables", "ScalarVariable") => {
@@ -439,6 +461,7 @@ impl ModelDescription {
                 unit: unit.filter(|u| !u.is_empty()),
                 start: p.start,
                 description: p.description,
+                declared_type: p.declared_type,
             });
         }
         let views: Vec<rules::AliasView> = md

@@ -34,7 +34,7 @@ use serde_json::Value;
 
 use crate::coupling::{Algorithm, RunOptions, SimError, SimOutput};
 use crate::fmu::{FmuArchive, FmuError};
-use crate::model_description::{ModelDescription, VarType};
+use crate::model_description::{ModelDescription, VarType, Variable};
 use crate::slave::ScalarType;
 
 fn default_alg() -> Algorithm {
@@ -76,7 +76,8 @@ pub struct SystemDescription {
 pub struct InstanceSpec {
     pub name: String,
     pub fmu: PathBuf,
-    /// Start values by variable name (numbers for Real/Integer, true/false for Boolean).
+    /// Start values by variable name: numbers for Real/Integer, true/false for Boolean, text
+    /// for String, an item name (or its integer) for Enumeration.
     #[serde(default)]
     pub parameters: BTreeMap<String, Value>,
     /// This instance steps every `step_multiple` communication steps.
@@ -174,29 +175,82 @@ pub fn split_ref(s: &str) -> Option<(&str, &str)> {
     (!a.is_empty() && !b.is_empty()).then_some((a, b))
 }
 
-fn type_of(t: VarType) -> Option<ScalarType> {
+pub(crate) fn type_of(t: VarType) -> ScalarType {
     match t {
-        VarType::Real => Some(ScalarType::Real),
-        // An Enumeration's value is an Integer (FMI 2.0: fmi2SetInteger / fmi2GetInteger).
-        VarType::Integer | VarType::Enumeration => Some(ScalarType::Integer),
-        VarType::Boolean => Some(ScalarType::Boolean),
-        VarType::String => None,
+        VarType::Real => ScalarType::Real,
+        VarType::Integer => ScalarType::Integer,
+        VarType::Enumeration => ScalarType::Enumeration,
+        VarType::Boolean => ScalarType::Boolean,
+        VarType::String => ScalarType::String,
     }
 }
 
-/// Converts a JSON start value to the variable's type; `Err` is the reason.
-pub fn json_value_for(t: VarType, v: &Value) -> Result<f64, String> {
+/// Converts a JSON start value to variable `var` of model `md`; `Err` is the reason. Reals
+/// and Integers take numbers, Booleans true/false (or 0/1), Strings text (its value is its
+/// index in `strings`, where it is added), Enumerations an item name or its integer value.
+pub fn json_value_for(
+    md: &ModelDescription,
+    var: &Variable,
+    v: &Value,
+    strings: &mut Vec<String>,
+) -> Result<f64, String> {
+    let t = var.var_type;
+    let items = md.enum_items(var);
+    let item_names = || {
+        items
+            .iter()
+            .map(|i| format!("'{}' ({})", i.name, i.value))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     match (t, v) {
         (VarType::Real, Value::Number(n)) => n
             .as_f64()
             .filter(|x| x.is_finite())
             .ok_or_else(|| format!("{n} is not a finite number")),
-        (VarType::Integer | VarType::Enumeration, Value::Number(n)) => n
-            .as_i64()
-            .filter(|x| i32::try_from(*x).is_ok())
-            .map(|x| x as f64)
-            .ok_or_else(|| format!("{n} is not a 32-bit integer (variable is {t})")),
+        (VarType::Integer | VarType::Enumeration, Value::Number(n)) => {
+            let x = n
+                .as_i64()
+                .filter(|x| i32::try_from(*x).is_ok())
+                .ok_or_else(|| format!("{n} is not a 32-bit integer (variable is {t})"))?;
+            if t == VarType::Enumeration
+                && !items.is_empty()
+                && !items.iter().any(|i| i64::from(i.value) == x)
+            {
+                return Err(format!(
+                    "{x} is no item of this enumeration; items: {}",
+                    item_names()
+                ));
+            }
+            Ok(x as f64)
+        }
+        (VarType::Enumeration, Value::String(name)) => items
+            .iter()
+            .find(|i| &i.name == name)
+            .map(|i| f64::from(i.value))
+            .ok_or_else(|| {
+                format!(
+                    "'{name}' is no item of this enumeration; items: {}",
+                    item_names()
+                )
+            }),
         (VarType::Boolean, Value::Bool(b)) => Ok(if *b { 1.0 } else { 0.0 }),
+        (VarType::Boolean, Value::Number(n)) if n.as_u64().is_some_and(|x| x <= 1) => {
+            Ok(n.as_u64().unwrap_or(0) as f64)
+        }
+        (VarType::String, Value::String(text)) => {
+            if text.contains('\0') {
+                return Err("a String may not contain a NUL character".into());
+            }
+            let k = match strings.iter().position(|s| s == text) {
+                Some(k) => k,
+                None => {
+                    strings.push(text.clone());
+                    strings.len() - 1
+                }
+            };
+            Ok(k as f64)
+        }
         (t, v) => Err(format!("a {t} variable cannot take the value {v}")),
     }
 }
@@ -364,8 +418,10 @@ impl LoadedSystem {
 
 mod plan;
 mod prepared;
+mod single;
 
 pub use prepared::{PreparedSystem, RunChanges};
+pub use single::{default_timing, instance_name, parse_set_value, round_step, SingleFmuOptions};
 
 #[cfg(test)]
 mod tests;

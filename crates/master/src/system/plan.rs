@@ -7,7 +7,7 @@ use serde_json::Value;
 
 use super::{json_value_for, type_of, LoadedSystem, SystemError};
 use crate::coupling::{
-    topological_order, Algorithm, CouplingPlan, PlanConnection, PlanInstance, Recorded,
+    topological_order, Algorithm, ColumnInfo, CouplingPlan, PlanConnection, PlanInstance, Recorded,
 };
 use crate::model_description::{Causality, ModelDescription};
 use crate::slave::VarRef;
@@ -36,6 +36,7 @@ impl LoadedSystem {
         }
         self.check_stop_time(d.stop_time)?;
         let mut instances = Vec::new();
+        let mut strings = Vec::new();
         for (i, inst) in d.instances.iter().enumerate() {
             let f = format!("instances[{i}].name");
             if inst.name.is_empty() || inst.name.contains('.') || inst.name.contains('\0') {
@@ -67,7 +68,7 @@ impl LoadedSystem {
             let mut parameter_names = Vec::new();
             let invalid = |f: String, needle: &str, r: String| self.invalid(f, needle, r);
             for (name, value) in &inst.parameters {
-                params.push(start_value(i, md, name, value, &invalid)?);
+                params.push(start_value(i, md, name, value, &mut strings, &invalid)?);
                 parameter_names.push(name.clone());
             }
             instances.push(PlanInstance {
@@ -119,13 +120,23 @@ impl LoadedSystem {
                     ),
                 ));
             }
-            let Some(ty) = type_of(fv.var_type) else {
+            let ty = type_of(fv.var_type);
+            let items = |md: &ModelDescription, v| {
+                md.enum_items(v)
+                    .iter()
+                    .map(|i| (i.value, i.name.clone()))
+                    .collect::<Vec<_>>()
+            };
+            if items(models[fi], fv) != items(models[ti], tv) {
                 return Err(self.invalid(
                     format!("connections[{ci}]"),
-                    &c.from,
-                    format!("{} connections are not supported", fv.var_type),
+                    &c.to,
+                    format!(
+                        "enumeration mismatch: '{}' and '{}' have different items",
+                        c.from, c.to
+                    ),
                 ));
-            };
+            }
             if let (Some(uf), Some(ut)) = (&fv.unit, &tv.unit) {
                 if uf != ut {
                     return Err(self.invalid(
@@ -145,7 +156,8 @@ impl LoadedSystem {
                     format!("input '{}' is already driven by connections[{prev}]", c.to),
                 ));
             }
-            if models[ti].has_direct_feedthrough(tvi) {
+            let feedthrough = models[ti].has_direct_feedthrough(tvi);
+            if feedthrough {
                 feedthrough_edges.push((fi, ti));
             }
             let _ = fvi;
@@ -161,6 +173,7 @@ impl LoadedSystem {
                     ty,
                 },
                 label: c.from.clone(),
+                feedthrough,
             });
         }
 
@@ -214,27 +227,37 @@ impl LoadedSystem {
             Some(u) => format!("{}.{} [{u}]", d.instances[i].name, v.name),
             None => format!("{}.{}", d.instances[i].name, v.name),
         };
-        let recorded = |i: usize, v: &crate::model_description::Variable, ty| Recorded {
-            instance: i,
-            var: VarRef {
-                vr: v.value_reference,
-                ty,
-            },
-            label: label(i, v),
+        let recorded = |i: usize, v: &crate::model_description::Variable| {
+            let ty = type_of(v.var_type);
+            Recorded {
+                instance: i,
+                var: VarRef {
+                    vr: v.value_reference,
+                    ty,
+                },
+                label: label(i, v),
+                info: ColumnInfo {
+                    ty: Some(ty),
+                    name: format!("{}.{}", d.instances[i].name, v.name),
+                    unit: v.unit.clone(),
+                    causality: v.causality.to_string(),
+                    description: v.description.clone(),
+                    instance: d.instances[i].name.clone(),
+                    fmu_guid: models[i].guid.clone(),
+                    items: models[i]
+                        .enum_items(v)
+                        .iter()
+                        .map(|it| (it.value, it.name.clone()))
+                        .collect(),
+                },
+            }
         };
         let mut record = Vec::new();
         match &d.record {
             Some(list) => {
                 for (k, s) in list.iter().enumerate() {
                     let (i, _, v) = self.resolve(&format!("record[{k}]"), s, models)?;
-                    let Some(ty) = type_of(v.var_type) else {
-                        return Err(self.invalid(
-                            format!("record[{k}]"),
-                            s,
-                            format!("{} variables cannot be recorded", v.var_type),
-                        ));
-                    };
-                    record.push(recorded(i, v, ty));
+                    record.push(recorded(i, v));
                 }
             }
             None => {
@@ -243,9 +266,7 @@ impl LoadedSystem {
                         let connected_input =
                             v.causality == Causality::Input && inputs_taken.contains_key(&(i, vi));
                         if v.causality == Causality::Output || connected_input {
-                            if let Some(ty) = type_of(v.var_type) {
-                                record.push(recorded(i, v, ty));
-                            }
+                            record.push(recorded(i, v));
                         }
                     }
                 }
@@ -271,6 +292,7 @@ impl LoadedSystem {
             record,
             init_sweeps: d.init_sweeps,
             max_step_halvings: d.max_step_halvings,
+            strings,
         })
     }
 
@@ -311,13 +333,14 @@ impl LoadedSystem {
 /// Builds the error of a field: (field, text to find the line by, reason).
 pub(super) type Invalid<'a> = dyn Fn(String, &str, String) -> SystemError + 'a;
 
-/// The start value `name = value` of instance `i` (model `md`): a settable variable of a
-/// supported type, the value converted to that type.
+/// The start value `name = value` of instance `i` (model `md`): a settable variable, the
+/// value converted to its type (a String's text added to `strings`).
 pub(super) fn start_value(
     i: usize,
     md: &ModelDescription,
     name: &str,
     value: &Value,
+    strings: &mut Vec<String>,
     invalid: &Invalid,
 ) -> Result<(VarRef, f64), SystemError> {
     let field = format!("instances[{i}].parameters.{name}");
@@ -345,14 +368,8 @@ pub(super) fn start_value(
             ),
         ));
     }
-    let Some(ty) = type_of(v.var_type) else {
-        return Err(invalid(
-            field,
-            name,
-            format!("{} variables are not supported", v.var_type),
-        ));
-    };
-    let x = json_value_for(v.var_type, value).map_err(|r| invalid(field.clone(), name, r))?;
+    let ty = type_of(v.var_type);
+    let x = json_value_for(md, v, value, strings).map_err(|r| invalid(field.clone(), name, r))?;
     Ok((
         VarRef {
             vr: v.value_reference,

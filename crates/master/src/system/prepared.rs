@@ -17,9 +17,10 @@ use crate::slave::{Slave, VarRef};
 /// system's or added to them) and the stop time.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct RunChanges {
-    /// (instance index, variable name, variable, value as f64)
+    /// (instance index, variable name, variable, value as f64; a String's indexes `strings`)
     start_values: Vec<(usize, String, VarRef, f64)>,
     stop_time: Option<f64>,
+    strings: Vec<String>,
 }
 
 impl RunChanges {
@@ -107,6 +108,7 @@ impl PreparedSystem {
             reason,
         };
         let mut start_values = Vec::with_capacity(parameters.len());
+        let mut strings = Vec::new();
         for (key, value) in parameters {
             let Some((inst, var)) = split_ref(key) else {
                 return Err(invalid(
@@ -123,7 +125,7 @@ impl PreparedSystem {
                     format!("unknown instance '{inst}'"),
                 ));
             };
-            let (v, x) = start_value(i, self.fmus[i].model(), var, value, &invalid)?;
+            let (v, x) = start_value(i, self.fmus[i].model(), var, value, &mut strings, &invalid)?;
             start_values.push((i, var.to_string(), v, x));
         }
         if let Some(t) = stop_time {
@@ -134,6 +136,7 @@ impl PreparedSystem {
         Ok(RunChanges {
             start_values,
             stop_time,
+            strings,
         })
     }
 
@@ -166,8 +169,23 @@ fn apply(plan: &CouplingPlan, changes: &RunChanges) -> CouplingPlan {
     if let Some(t) = changes.stop_time {
         plan.stop_time = t;
     }
+    // the run's texts follow the system's
+    let offset = plan.strings.len() as f64;
+    plan.strings.extend(changes.strings.iter().cloned());
+    let shifted: Vec<(usize, String, VarRef, f64)> = changes
+        .start_values
+        .iter()
+        .map(|(i, n, v, x)| {
+            let x = if v.ty == crate::slave::ScalarType::String {
+                x + offset
+            } else {
+                *x
+            };
+            (*i, n.clone(), *v, x)
+        })
+        .collect();
     for (i, inst) in plan.instances.iter_mut().enumerate() {
-        let mut run = changes.start_values.iter().filter(|c| c.0 == i).peekable();
+        let mut run = shifted.iter().filter(|c| c.0 == i).peekable();
         if run.peek().is_none() {
             continue;
         }
@@ -206,6 +224,7 @@ mod tests {
                 (0, "x0".into(), VarRef::real(4), 0.2),
             ],
             stop_time: Some(2.0),
+            strings: vec![],
         };
         let p = apply(&plan, &changes);
         assert_eq!(p.stop_time, 2.0);

@@ -238,6 +238,8 @@ pub fn decimate(out: &SimOutput, factor: usize) -> SimOutput {
         header: out.header.clone(),
         data,
         summary: out.summary.clone(),
+        columns: out.columns.clone(),
+        strings: out.strings.clone(),
     }
 }
 
@@ -295,7 +297,10 @@ mod tests {
                 simulated_time_s: t_end,
                 wall_time_s: 1.0,
                 realtime_ratio: t_end,
+                terminated: None,
             },
+            columns: vec![],
+            strings: vec![],
         }
     }
 

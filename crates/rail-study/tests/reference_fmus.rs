@@ -1,0 +1,305 @@
+//! The Modelica Association's Reference FMUs (FMI 2.0 co-simulation, in ../shared/reference-fmus
+//! or RAIL_REFERENCE_FMUS) run through `master run MODEL.fmu` over their DefaultExperiment and
+//! give fmpy's results to rounding: every recorded column of every row, relative 1e-9. Stair
+//! asks the host to end the run at t = 9 s (fmi2Discard with fmi2Terminated): exit 0, results
+//! up to 9 s, the summary names it. Feedthrough records every variable type and takes String
+//! and Enumeration start values.
+//!
+//! Skipped, with the reason printed, when the folder is absent (a fresh clone elsewhere) or no
+//! Python with fmpy is known (RAIL_PYTHON, else the project's .venv).
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const MODELS: [&str; 6] = [
+    "BouncingBall",
+    "Dahlquist",
+    "Feedthrough",
+    "Resource",
+    "Stair",
+    "VanDerPol",
+];
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn reference_dir() -> Option<PathBuf> {
+    let d = std::env::var_os("RAIL_REFERENCE_FMUS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join("../shared/reference-fmus"));
+    if d.join("Stair.fmu").exists() {
+        Some(d)
+    } else {
+        eprintln!(
+            "skipped: no Reference FMUs in {} (set RAIL_REFERENCE_FMUS)",
+            d.display()
+        );
+        None
+    }
+}
+
+fn python() -> Option<PathBuf> {
+    let p = std::env::var_os("RAIL_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join(".venv/bin/python"));
+    if p.exists() {
+        Some(p)
+    } else {
+        eprintln!("skipped: no Python with fmpy (RAIL_PYTHON unset, no .venv)");
+        None
+    }
+}
+
+/// A CSV of numbers (strings quoted are kept as text): header and rows.
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let split = |l: &str| -> Vec<String> {
+        // fields without embedded commas except inside quotes
+        let mut out = Vec::new();
+        let mut cur = String::new();
+        let mut quoted = false;
+        let mut chars = l.chars().peekable();
+        while let Some(c) = chars.next() {
+            match c {
+                '"' if quoted && chars.peek() == Some(&'"') => {
+                    cur.push('"');
+                    chars.next();
+                }
+                '"' => quoted = !quoted,
+                ',' if !quoted => out.push(std::mem::take(&mut cur)),
+                c => cur.push(c),
+            }
+        }
+        out.push(cur);
+        out
+    };
+    let header = split(lines.next().unwrap());
+    (header, lines.map(split).collect())
+}
+
+fn master(args: &[&str], dir: &Path) -> (bool, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .arg("--quiet")
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out.status.success(), text)
+}
+
+#[test]
+fn every_reference_fmu_gives_fmpys_results() {
+    let (Some(refs), Some(py)) = (reference_dir(), python()) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let fmus: Vec<PathBuf> = MODELS
+        .iter()
+        .map(|m| std::path::absolute(refs.join(format!("{m}.fmu"))).unwrap())
+        .collect();
+    let status = Command::new(&py)
+        .arg(repo().join("tests/fmpy/reference_fmus.py"))
+        .arg(dir.path())
+        .args(&fmus)
+        .status()
+        .unwrap();
+    assert!(status.success(), "fmpy failed");
+    for (model, fmu) in MODELS.iter().zip(&fmus) {
+        let csv = dir.path().join(format!("{model}.master.csv"));
+        let summary = dir.path().join(format!("{model}.summary.json"));
+        let (ok, text) = master(
+            &[
+                "run",
+                fmu.to_str().unwrap(),
+                "-o",
+                csv.to_str().unwrap(),
+                "--summary",
+                summary.to_str().unwrap(),
+            ],
+            dir.path(),
+        );
+        assert!(ok, "{model}: {text}");
+        let (fh, frows) = read_csv(&dir.path().join(format!("{model}.fmpy.csv")));
+        let (mh, mrows) = read_csv(&csv);
+        assert_eq!(frows.len(), mrows.len(), "{model}: rows");
+        let mut compared = 0;
+        for (fc, name) in fh.iter().enumerate() {
+            // master's header: "time [s]", "Model.variable [unit]"
+            let want = if name == "time" {
+                "time".to_string()
+            } else {
+                format!("{model}.{name}")
+            };
+            let mc = mh
+                .iter()
+                .position(|h| h == &want || h.split(" [").next() == Some(&want))
+                .unwrap_or_else(|| panic!("{model}: no column {want} in {mh:?}"));
+            for (k, (fr, mr)) in frows.iter().zip(&mrows).enumerate() {
+                let a: f64 = fr[fc].parse().unwrap();
+                let b: f64 = mr[mc].parse().unwrap();
+                assert!(
+                    (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1e-12),
+                    "{model}.{name} row {k}: fmpy {a}, master {b}"
+                );
+                compared += 1;
+            }
+        }
+        assert!(compared >= 2 * frows.len(), "{model}: compared {compared}");
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+        if *model == "Stair" {
+            let last: f64 = mrows.last().unwrap()[0].parse().unwrap();
+            assert!((last - 9.0).abs() < 1e-12, "Stair ends at {last}");
+            assert_eq!(summary["terminated"]["instance"], "Stair", "{summary}");
+            assert_eq!(summary["terminated"]["time_s"], 9.0, "{summary}");
+            assert!(text.contains("ended by instance 'Stair'"), "{text}");
+        } else {
+            assert!(summary.get("terminated").is_none(), "{model}: {summary}");
+        }
+    }
+}
+
+#[test]
+fn feedthrough_records_sets_and_connects_every_type() {
+    let Some(refs) = reference_dir() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let fmu = std::path::absolute(refs.join("Feedthrough.fmu")).unwrap();
+    let csv = dir.path().join("ft.csv");
+    let (ok, text) = master(
+        &[
+            "run",
+            fmu.to_str().unwrap(),
+            "--stop",
+            "0.01",
+            "--step",
+            "0.005",
+            "--set",
+            "String_input=a \"quoted\", text",
+            "--set",
+            "Enumeration_input=Option 2",
+            "--set",
+            "Boolean_input=true",
+            "--set",
+            "Int32_input=-7",
+            "--set",
+            "Float64_continuous_input=2.5",
+            "-o",
+            csv.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    assert!(ok, "{text}");
+    let raw = std::fs::read_to_string(&csv).unwrap();
+    let (h, rows) = read_csv(&csv);
+    let col = |n: &str| {
+        h.iter()
+            .position(|x| x == n)
+            .unwrap_or_else(|| panic!("no {n} in {h:?}"))
+    };
+    assert_eq!(rows.len(), 3);
+    for r in &rows {
+        assert_eq!(r[col("Feedthrough.Float64_continuous_output")], "2.5");
+        assert_eq!(r[col("Feedthrough.Int32_output")], "-7");
+        assert_eq!(r[col("Feedthrough.Boolean_output")], "1");
+        assert_eq!(r[col("Feedthrough.Enumeration_output")], "2");
+        assert_eq!(r[col("Feedthrough.Enumeration_output (item)")], "Option 2");
+        assert_eq!(r[col("Feedthrough.String_output")], "a \"quoted\", text");
+    }
+    // the String is quoted in the file (RFC 4180)
+    assert!(raw.contains("\"a \"\"quoted\"\", text\""), "{raw}");
+    // an enumeration by its integer, and a wrong item named with the choices
+    let (ok, _) = master(
+        &[
+            "run",
+            fmu.to_str().unwrap(),
+            "--stop",
+            "0.01",
+            "--step",
+            "0.005",
+        ]
+        .iter()
+        .copied()
+        .chain(["--set", "Enumeration_input=2", "-o", "b.csv"])
+        .collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert!(ok);
+    let (ok, text) = master(
+        &[
+            "run",
+            fmu.to_str().unwrap(),
+            "--set",
+            "Enumeration_input=Option 3",
+        ],
+        dir.path(),
+    );
+    assert!(!ok);
+    assert!(
+        text.contains("'Option 3' is no item") && text.contains("'Option 2' (2)"),
+        "{text}"
+    );
+
+    // two Feedthrough instances connected by every type: the second's outputs are the
+    // first's (type checks as for Reals: a String output cannot drive an Integer input)
+    let system = |extra: &str| {
+        format!(
+            r#"{{"instances": [
+              {{"name": "a", "fmu": "{f}", "parameters": {{"String_input": "from a",
+                "Enumeration_input": "Option 2", "Int32_input": 5, "Boolean_input": true,
+                "Float64_continuous_input": 1.25}}}},
+              {{"name": "b", "fmu": "{f}"}}],
+            "connections": [
+              {{"from": "a.String_output", "to": "b.String_input"}},
+              {{"from": "a.Enumeration_output", "to": "b.Enumeration_input"}},
+              {{"from": "a.Int32_output", "to": "b.Int32_input"}},
+              {{"from": "a.Boolean_output", "to": "b.Boolean_input"}},
+              {{"from": "a.Float64_continuous_output", "to": "b.Float64_continuous_input"}}{extra}],
+            "stop_time": 0.02, "step": 0.01,
+            "record": ["b.String_output", "b.Enumeration_output", "b.Int32_output",
+                       "b.Boolean_output", "b.Float64_continuous_output"]}}"#,
+            f = fmu.display()
+        )
+    };
+    std::fs::write(dir.path().join("two.json"), system("")).unwrap();
+    let (ok, text) = master(&["run", "two.json", "-o", "two.csv"], dir.path());
+    assert!(ok, "{text}");
+    let (h, rows) = read_csv(&dir.path().join("two.csv"));
+    assert_eq!(
+        h,
+        [
+            "time [s]",
+            "b.String_output",
+            "b.Enumeration_output",
+            "b.Enumeration_output (item)",
+            "b.Int32_output",
+            "b.Boolean_output",
+            "b.Float64_continuous_output"
+        ]
+    );
+    for r in &rows {
+        assert_eq!(
+            r[1..],
+            ["from a", "2", "Option 2", "5", "1", "1.25"],
+            "{rows:?}"
+        );
+    }
+    std::fs::write(
+        dir.path().join("bad.json"),
+        system(r#", {"from": "a.String_output", "to": "b.Int32_input"}"#),
+    )
+    .unwrap();
+    let (ok, text) = master(&["run", "bad.json"], dir.path());
+    assert!(!ok);
+    assert!(text.contains("type mismatch"), "{text}");
+}
