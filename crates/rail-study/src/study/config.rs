@@ -57,6 +57,11 @@ pub enum Family {
     SkyHookOnOff,
     /// SemiActiveDamper x2 + SkyHookController x2, continuous (3.11).
     SkyHookContinuous,
+    /// The seed's accelerometer-based on/off sky-hook (3.13) on the coach: x' estimated from the
+    /// frame lateral acceleration over the controller's axle box, as on the bogie, beside the
+    /// textbook sky-hook of [`Family::SkyHookOnOff`]. On the bogie it is `SkyHookOnOff` itself,
+    /// so the bogie study does not run it (see [`Configuration::on_bogie`]).
+    SkyHookAccelerometerOnOff,
     /// FullActiveActuator x2 + IdealDamperForceController x2 (3.14)-(3.15).
     FullActive,
 }
@@ -184,6 +189,24 @@ pub const CONFIGURATIONS: &[Configuration] = &[
         reference: "R12",
     },
     Configuration {
+        id: "skyhook_accel_onoff",
+        label: "sky-hook on/off (frame accelerometer), ideal valve",
+        family: Family::SkyHookAccelerometerOnOff,
+        valve: Valve::Ideal,
+        json: system_json!("skyhook_onoff"),
+        seed_value: "about the same as MPPT",
+        reference: "R11",
+    },
+    Configuration {
+        id: "skyhook_accel_onoff_slow",
+        label: "sky-hook on/off (frame accelerometer), slow valve",
+        family: Family::SkyHookAccelerometerOnOff,
+        valve: Valve::Slow,
+        json: system_json!("skyhook_onoff_slow"),
+        seed_value: "fails at 260 km/h (+-6 mm, HIL)",
+        reference: "R12",
+    },
+    Configuration {
         id: "full_active",
         label: "full-active IDF, c_v = 330 kNs/m",
         family: Family::FullActive,
@@ -193,6 +216,14 @@ pub const CONFIGURATIONS: &[Configuration] = &[
         reference: "R13",
     },
 ];
+
+impl Configuration {
+    /// Whether the bogie study runs this configuration (the accelerometer-based sky-hook is the
+    /// bogie's `skyhook_onoff` already).
+    pub fn on_bogie(&self) -> bool {
+        self.family != Family::SkyHookAccelerometerOnOff
+    }
+}
 
 /// The configuration with this id.
 pub fn configuration(id: &str) -> Option<&'static Configuration> {

@@ -60,7 +60,11 @@ impl StudySettings {
     pub fn full(vehicle: VehicleModel) -> Self {
         StudySettings {
             vehicle,
-            configurations: CONFIGURATIONS.iter().map(|c| c.id).collect(),
+            configurations: CONFIGURATIONS
+                .iter()
+                .filter(|c| vehicle == VehicleModel::Coach || c.on_bogie())
+                .map(|c| c.id)
+                .collect(),
             // the coach's MPPT and full-active curves are still well under the limit at
             // 400 km/h: 40 km/h more show where they end
             speeds_kmh: match vehicle {
@@ -131,7 +135,13 @@ mod tests {
         assert_eq!(f.speeds_kmh.len(), 21);
         assert_eq!(f.speeds_kmh[0], 200.0);
         assert_eq!(f.speeds_kmh[20], 400.0);
-        assert_eq!(f.configurations.len(), CONFIGURATIONS.len());
+        assert_eq!(f.configurations.len(), CONFIGURATIONS.len() - 2);
+        assert_eq!(
+            StudySettings::full(VehicleModel::Coach)
+                .configurations
+                .len(),
+            CONFIGURATIONS.len()
+        );
         // several 100 m windows after the skip at the lowest speed
         let assessed_m = (f.sweep_stop_s - f.skip_s) * f.speeds_kmh[0] / 3.6;
         assert!(assessed_m >= 500.0, "{assessed_m}");

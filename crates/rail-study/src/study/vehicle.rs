@@ -19,6 +19,11 @@
 //!   from the frame end towards the car-body end and the elongation velocity as car-body end
 //!   minus frame end, so the condition x' (x' - x0') of (3.11)/(3.13) needs `sensor.sign = +1`
 //!   on every damper: the damper then pushes the car body as a damper to the sky would.
+//! * Accelerometer-based sky-hook (the seed's, beside the textbook one): wired as on the bogie,
+//!   x' estimated from the frame lateral acceleration over the axle box of the position's MPPT
+//!   board (`sensor.velocity_source = estimated`), `sensor.sign` -1 on the left dampers and +1
+//!   on the right ones (the coach's elongations follow the bogie's e_L = +b psi_frame when the
+//!   car body is still).
 //! * IDF: each on its own actuator's elongation velocity and force, `command_sign = -1`.
 
 use serde_json::{json, Value};
@@ -326,6 +331,20 @@ pub fn coach_system(c: &Configuration) -> Value {
                 ));
                 Some((controller.clone(), "SkyHookController", sky(mode)))
             }
+            Family::SkyHookAccelerometerOnOff => {
+                connections.push(connect(
+                    format!("{COACH}.{}", p.mppt_acceleration),
+                    format!("{controller}.sensor.acceleration"),
+                ));
+                connections.push(connect(
+                    port("elongation_velocity"),
+                    format!("{controller}.damper.elongation_velocity"),
+                ));
+                let sign = if p.name.ends_with("left") { -1 } else { 1 };
+                let params =
+                    json!({"control.mode": 0, "sensor.velocity_source": 0, "sensor.sign": sign});
+                Some((controller.clone(), "SkyHookController", params))
+            }
             Family::FullActive => {
                 let idf = format!("idf_{}", p.name);
                 connections.push(connect(
@@ -442,6 +461,23 @@ mod tests {
                 {
                     assert_eq!(i.parameters["sensor.sign"], json!(1));
                     assert_eq!(i.parameters["sensor.velocity_source"], json!(1));
+                }
+            }
+            if c.family == Family::SkyHookAccelerometerOnOff {
+                // the seed's sky-hook: frame acceleration over the position's axle box,
+                // estimated velocity, -1 left / +1 right as on the bogie
+                for p in COACH_POSITIONS {
+                    let ctl = format!("controller_{}", p.name);
+                    let k = d
+                        .connections
+                        .iter()
+                        .find(|k| k.to == format!("{ctl}.sensor.acceleration"))
+                        .unwrap();
+                    assert_eq!(k.from, format!("vehicle.{}", p.mppt_acceleration));
+                    let i = d.instances.iter().find(|i| i.name == ctl).unwrap();
+                    assert_eq!(i.parameters["sensor.velocity_source"], json!(0));
+                    let sign = if p.name.ends_with("left") { -1 } else { 1 };
+                    assert_eq!(i.parameters["sensor.sign"], json!(sign), "{ctl}");
                 }
             }
             let slow = d
