@@ -184,6 +184,29 @@ fn textbook_skyhook_lowers_the_critical_speed() {
     }
 }
 
+/// R11/R12, the seed's accelerometer-based on/off sky-hook (x' from the frame acceleration over
+/// the axle box, as on the bogie): with the ideal valve it raises the critical speed above
+/// passive (quick study: 330 vs 305 km/h) but stays well below MPPT (> 420); the slow valve
+/// takes that gain away (285 km/h, at or below passive).
+#[test]
+fn accelerometer_skyhook_between_passive_and_mppt_and_broken_by_the_slow_valve() {
+    let p = vcr("passive");
+    let m = vcr("mppt1").min(vcr("mppt2"));
+    let ideal = vcr("skyhook_accel_onoff");
+    let slow = vcr("skyhook_accel_onoff_slow");
+    assert!(
+        (10.0..=50.0).contains(&(ideal - p)),
+        "ideal valve: {ideal} km/h vs passive {p} (measured +25)"
+    );
+    assert!(m - ideal > 50.0, "ideal valve: {ideal} vs MPPT {m}");
+    assert!(
+        slow <= p + 5.0 && ideal - slow >= 20.0,
+        "slow valve: {slow} km/h vs passive {p}, ideal {ideal} (measured 285)"
+    );
+    // and the textbook sky-hook stays below it
+    assert!(vcr("skyhook_onoff") < ideal);
+}
+
 /// R12: the slow valve (lag 0.15 s) does not break MPPT: from an 8 V command and a 3 mm
 /// perturbation at 260 km/h on ideal track the coach comes to rest, and in the sweep the
 /// slow-valve MPPT keeps its gain over passive. The sky-hook with the slow valve does not
