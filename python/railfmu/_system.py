@@ -55,7 +55,8 @@ class System:
 
     @classmethod
     def load(cls, path: PathLike) -> "System":
-        """Loads a system description file (FMU paths relative to its folder)."""
+        """Loads a system description file: JSON (FMU paths relative to its folder), or an SSP
+        (a ``.ssp`` archive, or a bare ``.ssd`` next to its FMUs) as ``master run`` reads it."""
         return cls(_railfmu.PreparedSystem.load(os.fspath(path)))
 
     @classmethod

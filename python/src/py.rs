@@ -62,6 +62,14 @@ fn system_err(e: &SystemError) -> PyErr {
     }
 }
 
+fn ssp_err(e: &master::ssp::SspError) -> PyErr {
+    match e {
+        master::ssp::SspError::System(s) => system_err(s),
+        master::ssp::SspError::Output(_) => OutputError::new_err(error_message(e)),
+        _ => SystemDescriptionError::new_err(error_message(e)),
+    }
+}
+
 fn run_err(e: &RunError) -> PyErr {
     match e {
         RunError::System(s) => system_err(s),
@@ -207,6 +215,8 @@ fn table<'py>(py: Python<'py>, out: &SimOutput) -> PyResult<Table<'py>> {
 pub struct PySystem {
     prepared: PreparedSystem,
     models_json: String,
+    /// An imported SSP's unpacked FMUs live as long as the system.
+    _ssp: Option<master::ssp::ImportedSsp>,
 }
 
 impl PySystem {
@@ -221,15 +231,24 @@ impl PySystem {
         Ok(PySystem {
             prepared,
             models_json,
+            _ssp: None,
         })
     }
 }
 
 #[pymethods]
 impl PySystem {
-    /// Loads a system description (JSON file; FMU paths relative to its folder) and prepares it.
+    /// Loads a system description and prepares it: JSON (FMU paths relative to its folder),
+    /// or an SSP (`.ssp` archive, or a bare `.ssd` next to its FMUs) as `master run` reads it.
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        if master::ssp::is_ssp_path(&path) {
+            let imported = master::ssp::import(&path, &master::ssp::ImportOptions::default())
+                .map_err(|e| ssp_err(&e))?;
+            let mut system = Self::prepare(py, imported.system.clone())?;
+            system._ssp = Some(imported);
+            return Ok(system);
+        }
         let system = LoadedSystem::load(&path).map_err(|e| system_err(&e))?;
         Self::prepare(py, system)
     }

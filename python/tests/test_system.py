@@ -174,3 +174,23 @@ except KeyboardInterrupt:
     out, err = p.communicate(timeout=120)
     assert p.returncode == 3, err
     assert out.strip() == "interrupted"
+
+
+def test_an_ssp_loads_and_runs_as_the_command_line_runs_it(passive_file, master_cmd, tmp_path):
+    # the passive system exported by the master, then run from the .ssp by both
+    ssp = tmp_path / "passive.ssp"
+    r = run_master(master_cmd, "export-ssp", passive_file, ssp)
+    assert r.returncode == 0, r.stderr
+    cli_csv = tmp_path / "cli.csv"
+    r = run_master(master_cmd, "run", ssp, "-o", cli_csv)
+    assert r.returncode == 0, r.stderr
+    res = railfmu.System.load(ssp).run()
+    cli = railfmu.read_results(cli_csv)
+    assert cli.header == res.header
+    assert np.array_equal(bits(cli.values), bits(res.values))
+    assert np.max(np.abs(res["bogie.wheelset_front.lateral_displacement_relative"])) > 1e-6
+    # a broken SSP raises with the master's message naming the file
+    broken = tmp_path / "broken.ssp"
+    broken.write_bytes(b"not a zip")
+    with pytest.raises(railfmu.Error, match="broken.ssp"):
+        railfmu.System.load(broken)
