@@ -1,4 +1,4 @@
-//! Issue 4: the linear bogie FMU coupled in our master to two passive damper FMUs (the real
+//! The linear bogie FMU coupled in our master to two passive damper FMUs (the real
 //! pressure-state damper, not its linear fit) starts hunting at the speed the eigen-analysis
 //! predicts when it represents that damper the way the coupled system sees it, within 10 km/h.
 //!

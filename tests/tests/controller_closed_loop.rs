@@ -1,4 +1,4 @@
-//! Issue 5: controllers in closed loop with our damper FMU models on a prescribed sinusoidal
+//! Controllers in closed loop with our damper FMU models on a prescribed sinusoidal
 //! stroke (no bogie), coupled through the glue's FMI state machine (same code as the C API):
 //! each communication step the host sets inputs, steps both models and exchanges outputs
 //! (Gauss-Seidel: damper first, its force feeds the controller of the same step).

@@ -52,7 +52,7 @@ fn worst(errs: &[(f64, f64)]) -> (f64, f64) {
     })
 }
 
-/// Issue 8 criterion: every reference point with |y| <= 6 mm within 0.1 mm of the reference.
+/// E1 target (docs/VALIDATION.md): every reference point with |y| <= 6 mm within 0.1 mm of the reference.
 /// Measured: RMS 0.038 mm, max 0.076 mm at |y| = 5.6 mm.
 #[test]
 fn e1_delta_r_matches_reference() {
