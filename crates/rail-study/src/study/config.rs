@@ -77,6 +77,18 @@ pub enum Valve {
     Slow,
 }
 
+impl Valve {
+    /// The semi-active damper's `valve.model` item for this valve (0 ideal, 1 slow), `None`
+    /// where the configuration has no valve.
+    pub fn model(self) -> Option<i64> {
+        match self {
+            Valve::None => None,
+            Valve::Ideal => Some(0),
+            Valve::Slow => Some(1),
+        }
+    }
+}
+
 /// One configuration of the study.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Configuration {
@@ -421,6 +433,19 @@ pub fn fmt_speed(v: f64) -> String {
     }
 }
 
+/// Asserts that the damper instance of a system takes the configuration's valve model (and none
+/// where the configuration has no valve).
+#[cfg(test)]
+pub(crate) fn assert_valve_model(d: &SystemDescription, damper: &str, c: &Configuration) {
+    let model = d
+        .instances
+        .iter()
+        .find(|i| i.name == damper)
+        .and_then(|i| i.parameters.get("valve.model"))
+        .and_then(Value::as_i64);
+    assert_eq!(model, c.valve.model(), "{}: {damper}", c.id);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -446,17 +471,7 @@ mod tests {
                 Family::FullActive => assert!(has("actuator_left") && has("idf_right")),
                 _ => assert!(has("damper_left") && has("controller_right")),
             }
-            let slow = d
-                .instances
-                .iter()
-                .find(|i| i.name == "damper_left")
-                .and_then(|i| i.parameters.get("valve.model"))
-                .and_then(Value::as_i64);
-            match c.valve {
-                Valve::Slow => assert_eq!(slow, Some(1), "{}", c.id),
-                Valve::Ideal => assert_eq!(slow, Some(0), "{}", c.id),
-                Valve::None => assert_eq!(slow, None, "{}", c.id),
-            }
+            assert_valve_model(&d, "damper_left", c);
         }
         assert!(configuration("mppt2").is_some() && configuration("x").is_none());
         let all: Vec<&Configuration> = CONFIGURATIONS.iter().collect();

@@ -267,9 +267,10 @@ pub fn coach_system(c: &Configuration) -> Value {
     record.extend(v.carbody_accelerations());
     record.push(v.var("wheelset_1.guiding_force"));
     record.push(v.var("wheelset_1.y_over_q"));
+    let valve_model = c.valve.model().unwrap_or(0);
     let valve = match c.valve {
-        Valve::Slow => json!({"valve.model": 1, "valve.time_constant": 0.15}),
-        _ => json!({"valve.model": 0}),
+        Valve::Slow => json!({"valve.model": valve_model, "valve.time_constant": 0.15}),
+        _ => json!({"valve.model": valve_model}),
     };
     let mppt = |k_force: f64| {
         json!({
@@ -404,7 +405,7 @@ pub fn coach_system(c: &Configuration) -> Value {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::study::config::CONFIGURATIONS;
+    use crate::study::config::{assert_valve_model, CONFIGURATIONS};
     use master::system::SystemDescription;
 
     #[test]
@@ -480,17 +481,7 @@ mod tests {
                     assert_eq!(i.parameters["sensor.sign"], json!(sign), "{ctl}");
                 }
             }
-            let slow = d
-                .instances
-                .iter()
-                .find(|i| i.name == "damper_front_left")
-                .and_then(|i| i.parameters.get("valve.model"))
-                .and_then(Value::as_i64);
-            match c.valve {
-                Valve::Slow => assert_eq!(slow, Some(1), "{}", c.id),
-                Valve::Ideal => assert_eq!(slow, Some(0), "{}", c.id),
-                Valve::None => assert_eq!(slow, None, "{}", c.id),
-            }
+            assert_valve_model(&d, "damper_front_left", c);
         }
     }
 
