@@ -4,6 +4,8 @@
 
 #![allow(clippy::missing_safety_doc)]
 
+pub mod csv;
+
 use std::ffi::{c_char, c_void, CStr, CString};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};

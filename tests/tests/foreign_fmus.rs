@@ -19,6 +19,7 @@ use std::path::{Path, PathBuf};
 
 use master::coupling::{RunOptions, SimOutput};
 use master::system::LoadedSystem;
+use tests::csv::read_csv;
 
 const CHILD: &str = "RAIL_PYFMU_CHILD";
 
@@ -43,22 +44,6 @@ fn need(path: &Path) -> &Path {
     path
 }
 
-/// fmpy's CSV: header and rows.
-fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(need(path)).unwrap();
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-        .collect();
-    (header, rows)
-}
-
 fn run_system(path: &Path, edit: impl FnOnce(&mut LoadedSystem)) -> SimOutput {
     let mut sys = LoadedSystem::load(need(path)).unwrap();
     edit(&mut sys);
@@ -74,7 +59,7 @@ fn close(a: f64, b: f64, scale: f64) -> bool {
 /// Compares the master's output with fmpy's CSV at the rows `k` where `keep(k)`; returns the
 /// number of values compared.
 fn compare(name: &str, out: &SimOutput, fmpy: &Path, keep: impl Fn(usize) -> bool) -> usize {
-    let (header, rows) = read_csv(fmpy);
+    let (header, rows) = read_csv(need(fmpy)).unwrap();
     let time = out.column("time").unwrap();
     assert_eq!(
         time.len(),

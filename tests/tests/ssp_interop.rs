@@ -20,6 +20,7 @@ use master::coupling::{Algorithm, RunOptions, SimOutput};
 use master::model_description::VarType;
 use master::ssp::{self, ImportOptions};
 use master::system::LoadedSystem;
+use tests::csv::read_csv;
 
 const STOP_TIME_S: f64 = 2.0;
 
@@ -69,21 +70,6 @@ fn export(sys: &LoadedSystem, dir: &Path) -> PathBuf {
     assert_eq!(summary.components, sys.desc.instances.len());
     assert_eq!(summary.connections, sys.desc.connections.len());
     out
-}
-
-fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|x| x.parse::<f64>().unwrap()).collect())
-        .collect();
-    (header, rows)
 }
 
 fn schema_valid(py: &Path, ssp_file: &Path) {
@@ -216,7 +202,7 @@ fn host_vs_master(py: &Path, host: &str, name: &str) -> Vec<(String, f64)> {
         String::from_utf8_lossy(&res.stdout),
         String::from_utf8_lossy(&res.stderr)
     );
-    let (header, rows) = read_csv(&csv);
+    let (header, rows) = read_csv(&csv).unwrap();
     assert_eq!(rows.len(), 2000, "{host}: {name}");
     let mut out = Vec::new();
     for v in &vars {

@@ -16,6 +16,7 @@ mod inspect;
 mod platform;
 mod policy;
 mod version;
+mod xml_text;
 
 pub use fmu::{check_fmu, required_functions, FmuBinaryReport, FmuError, FmuReport};
 pub use inspect::{
@@ -27,6 +28,7 @@ pub use policy::{
     GLIBC_BASELINE,
 };
 pub use version::{ParseVersionError, SymbolVersion};
+pub use xml_text::escape_attribute;
 
 /// The functions every FMI 2.0 binary exports, whatever its interface type (FMI 2.0.4, 2.1.9).
 pub const FMI2_COMMON_FUNCTIONS: [&str; 25] = [

@@ -123,21 +123,7 @@ pub fn is_structured_name(name: &str) -> bool {
         })
 }
 
-pub(crate) fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            '\n' => out.push_str("&#10;"),
-            c => out.push(c),
-        }
-    }
-    out
-}
+pub(crate) use fmu_binary::escape_attribute as escape;
 
 pub(crate) fn fmt_real(x: f64) -> String {
     // Debug formatting is the shortest representation that parses back to the same f64.

@@ -149,21 +149,4 @@ pub(super) fn scalar<'a>(ctx: Ctx, n: Node<'a, '_>) -> Result<&'a str, SspError>
     Ok(v.trim())
 }
 
-/// Escapes text for an XML attribute value in double quotes.
-pub(super) fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            '\n' => out.push_str("&#10;"),
-            '\r' => out.push_str("&#13;"),
-            '\t' => out.push_str("&#9;"),
-            c => out.push(c),
-        }
-    }
-    out
-}
+pub(super) use fmu_binary::escape_attribute as escape;
