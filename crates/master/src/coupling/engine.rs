@@ -35,6 +35,8 @@ pub(super) struct Engine<'p, 's, 'd, 'o> {
     current: Vec<bool>,
     refreshed: Vec<bool>,
     pending: Vec<usize>,
+    /// Scratch: each instance's window of the current macro step.
+    windows: Vec<Option<(f64, f64)>>,
 }
 
 /// How a macro step ended.
@@ -88,6 +90,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             current: vec![false; n],
             refreshed: vec![false; n],
             pending: Vec::new(),
+            windows: Vec::with_capacity(n),
         }
     }
 
@@ -407,18 +410,32 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
     /// after completing the last sub-step lets the others complete it too.
     fn try_macro_step(&mut self, k: u64, parts: u64) -> Result<StepEnd, SimError> {
         let plan = self.plan;
+        let t = self.t(k);
+        // (start, end) of each active slave's window (a scratch vector: no allocation per step)
+        let mut windows = std::mem::take(&mut self.windows);
+        windows.clear();
+        for inst in &plan.instances {
+            let m = u64::from(inst.step_multiple.max(1));
+            windows.push(
+                k.is_multiple_of(m)
+                    .then(|| (t, self.t((k + m).min(self.n_steps)))),
+            );
+        }
+        let result = self.step_windows(k, parts, &windows);
+        self.windows = windows;
+        result
+    }
+
+    /// [`Self::try_macro_step`] over the given windows.
+    fn step_windows(
+        &mut self,
+        k: u64,
+        parts: u64,
+        windows: &[Option<(f64, f64)>],
+    ) -> Result<StepEnd, SimError> {
+        let plan = self.plan;
         let n = self.slaves.len();
         let t = self.t(k);
-        // (start, end) of each active slave's window
-        let windows: Vec<Option<(f64, f64)>> = plan
-            .instances
-            .iter()
-            .map(|inst| {
-                let m = u64::from(inst.step_multiple.max(1));
-                k.is_multiple_of(m)
-                    .then(|| (t, self.t((k + m).min(self.n_steps))))
-            })
-            .collect();
         let sub = |(a, b): (f64, f64), j: u64| -> (f64, f64) {
             let s = a + (b - a) * (j as f64) / (parts as f64);
             let e = if j + 1 == parts {

@@ -30,8 +30,9 @@ pub struct PlanConnection {
     pub to: VarRef,
     /// "instance.variable" of the source, for messages.
     pub label: String,
-    /// Whether the target input feeds directly through to an output of the target instance
-    /// (ModelStructure/Outputs): after setting it, that output is read again (Gauss-Seidel).
+    /// Whether the target input feeds directly through (ModelStructure/Outputs) to an output
+    /// of the target instance that is itself the source of a connection: after setting it,
+    /// that output is read again and passed on (Gauss-Seidel).
     pub feedthrough: bool,
 }
 

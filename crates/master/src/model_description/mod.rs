@@ -277,6 +277,19 @@ impl ModelDescription {
     /// least one output, per ModelStructure/Outputs. An output without a `dependencies`
     /// attribute depends on everything; an output not listed at all is treated the same way
     /// (conservative).
+    /// Whether output `output` depends directly on input `input` (both 0-based variable
+    /// indices), per ModelStructure/Outputs; an unlisted output or one without `dependencies`
+    /// depends on every input (conservative).
+    pub fn output_depends_on(&self, output: usize, input: usize) -> bool {
+        match self.outputs.iter().find(|o| o.output == output) {
+            Some(OutputDependency {
+                depends_on: Some(d),
+                ..
+            }) => d.contains(&input),
+            _ => true,
+        }
+    }
+
     pub fn has_direct_feedthrough(&self, input: usize) -> bool {
         // linear in the number of variables: a set of the listed outputs, not a search per
         // output variable

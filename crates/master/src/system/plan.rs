@@ -82,6 +82,8 @@ impl LoadedSystem {
         let mut connections = Vec::new();
         let mut inputs_taken: HashMap<(usize, usize), usize> = HashMap::new();
         let mut feedthrough_edges = Vec::new();
+        // ((source instance, output index), (target instance, input index)) per connection
+        let mut ends: Vec<((usize, usize), (usize, usize))> = Vec::new();
         for (ci, c) in d.connections.iter().enumerate() {
             let ff = format!("connections[{ci}].from");
             let tf = format!("connections[{ci}].to");
@@ -156,11 +158,11 @@ impl LoadedSystem {
                     format!("input '{}' is already driven by connections[{prev}]", c.to),
                 ));
             }
-            let feedthrough = models[ti].has_direct_feedthrough(tvi);
-            if feedthrough {
+            // the order follows every direct dependency of the target's outputs
+            if models[ti].has_direct_feedthrough(tvi) {
                 feedthrough_edges.push((fi, ti));
             }
-            let _ = fvi;
+            ends.push(((fi, fvi), (ti, tvi)));
             connections.push(PlanConnection {
                 from_instance: fi,
                 from: VarRef {
@@ -173,8 +175,16 @@ impl LoadedSystem {
                     ty,
                 },
                 label: c.from.clone(),
-                feedthrough,
+                feedthrough: false,
             });
+        }
+        // Gauss-Seidel reads a target's outputs again after setting this input only if one of
+        // them that is itself connected depends on it: outputs nothing consumes are read once,
+        // when they are recorded.
+        for (c, &(_, (ti, tvi))) in connections.iter_mut().zip(&ends) {
+            c.feedthrough = ends
+                .iter()
+                .any(|&((fi, fvi), _)| fi == ti && models[ti].output_depends_on(fvi, tvi));
         }
 
         let order = match &d.order {

@@ -98,6 +98,25 @@ fn valid_system_gives_feedthrough_order_and_default_record() {
 }
 
 #[test]
+fn outputs_read_again_only_where_a_connected_output_depends_on_the_input() {
+    // sdm.coupling_force depends on both sdm inputs and drives ms.force: after the inputs are
+    // set, it is read again (Gauss-Seidel)
+    let p = plan_of(SYS).unwrap();
+    let ft: Vec<bool> = p.connections.iter().map(|c| c.feedthrough).collect();
+    assert_eq!(ft, [true, true, false]);
+    // without that connection no connected output of sdm depends on its inputs, so nothing
+    // is read again, while the order still puts ms first
+    let t = SYS.replace(
+        r#",
+{"from": "sdm.coupling_force", "to": "ms.force"}"#,
+        "",
+    );
+    let p = plan_of(&t).unwrap();
+    assert!(p.connections.iter().all(|c| !c.feedthrough));
+    assert_eq!(p.order, vec![1, 0]);
+}
+
+#[test]
 fn explicit_order_and_record() {
     let t = SYS.replace("\"step\": 0.001", "\"step\": 0.001, \"order\": [\"sdm\", \"ms\"], \"record\": [\"ms.position\"], \"algorithm\": \"jacobi\"");
     let p = plan_of(&t).unwrap();
