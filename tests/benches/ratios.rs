@@ -14,7 +14,9 @@
 //!    options (scripts/bench.sh sets it).
 //!
 //! `bash scripts/bench.sh` builds what it needs and runs this; it writes docs/BENCHMARKS.md.
-//! By hand: `cargo bench -p tests --bench ratios` (needs dist/).
+//! By hand: `cargo bench -p tests --bench ratios` (needs dist/). `BENCH_ONLY=coupled,fmpy`
+//! measures only the named sections (`models`, `coupled`, `fmpy`, `runset`, `studies`) and
+//! writes to target/BENCHMARKS.md unless `BENCH_OUT` is set.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // benchmark code
 
@@ -41,6 +43,11 @@ const FMPY_STOP_S: f64 = 2.0;
 
 fn repo() -> PathBuf {
     std::path::absolute(Path::new(env!("CARGO_MANIFEST_DIR")).join("..")).unwrap()
+}
+
+/// Whether section `name` is measured (`BENCH_ONLY` unset: every section).
+fn wanted(name: &str) -> bool {
+    std::env::var("BENCH_ONLY").map_or(true, |only| only.split(',').any(|s| s.trim() == name))
 }
 
 fn load_average() -> String {
@@ -272,93 +279,104 @@ fn main() {
         load_average()
     ));
     r.line(String::new());
-    r.line("## Each model alone (physics called directly, 1 ms steps, one core)".into());
-    r.line(String::new());
-    r.line("| model | real-time factor | load average |".into());
-    r.line("|---|---|---|".into());
-    let rtf =
-        fmu_bogie2dof::perf::realtime_factor(ReferenceTrack::InternalIrregular, 10.0, 5).unwrap();
-    r.line(format!(
-        "| Bogie2Dof non-linear, 320 km/h, internal irregular track (target >= 500) | {rtf:.0} x | {} |",
-        load_average()
-    ));
-    for case in DamperCase::ALL {
-        let ns = fmu_damper::perf::ns_per_step(case, 5000, 7).unwrap();
+    if wanted("models") {
+        r.line("## Each model alone (physics called directly, 1 ms steps, one core)".into());
+        r.line(String::new());
+        r.line("| model | real-time factor | load average |".into());
+        r.line("|---|---|---|".into());
+        let rtf = fmu_bogie2dof::perf::realtime_factor(ReferenceTrack::InternalIrregular, 10.0, 5)
+            .unwrap();
         r.line(format!(
-            "| damper: {} | {:.0} x ({ns:.0} ns per step) | {} |",
-            case.name(),
-            1e6 / ns,
+            "| Bogie2Dof non-linear, 320 km/h, internal irregular track (target >= 500) | {rtf:.0} x | {} |",
+            load_average()
+        ));
+        for case in DamperCase::ALL {
+            let ns = fmu_damper::perf::ns_per_step(case, 5000, 7).unwrap();
+            r.line(format!(
+                "| damper: {} | {:.0} x ({ns:.0} ns per step) | {} |",
+                case.name(),
+                1e6 / ns,
+                load_average()
+            ));
+        }
+        for case in fmu_controller::perf::ControllerCase::ALL {
+            let ns = fmu_controller::perf::ns_per_step(case, 5000, 7).unwrap();
+            r.line(format!(
+                "| controller: {} | {:.0} x ({ns:.0} ns per step) | {} |",
+                case.name(),
+                1e6 / ns,
+                load_average()
+            ));
+        }
+        let vehicle = vehicle_rtf();
+        r.line(format!(
+            "| RailVehicle non-linear, 300 km/h, high-level irregular track, 4 Maxwell dampers | {vehicle:.0} x | {} |",
             load_average()
         ));
     }
-    for case in fmu_controller::perf::ControllerCase::ALL {
-        let ns = fmu_controller::perf::ns_per_step(case, 5000, 7).unwrap();
+    // wall per simulated second of our master, for the fmpy ratio
+    let mut master_s = None;
+    if wanted("coupled") {
+        r.line(String::new());
         r.line(format!(
-            "| controller: {} | {:.0} x ({ns:.0} ns per step) | {} |",
-            case.name(),
-            1e6 / ns,
+            "## Coupled passive system (Bogie2Dof + 2 PassiveYawDamper, Gauss-Seidel, 1 ms, {COUPLED_STOP_S} s simulated, best of {REPEATS})"
+        ));
+        r.line(String::new());
+        let load = load_average();
+        let (t_direct, fin_direct) = direct_passive();
+        let (t_master, fin_master) = master_passive();
+        // The FMUs' binaries are built against glibc 2.17, whose libm may round exp/pow in the
+        // last bit differently from the build machine's: the two agree to rounding, not bit for bit.
+        let relative = (fin_direct - fin_master).abs() / fin_direct.abs().max(1e-9);
+        assert!(
+            relative <= 1e-6,
+            "direct {fin_direct} vs master {fin_master}: not the same computation"
+        );
+        r.line(format!(
+            "- our master: {:.0} x real time ({:.2} ms per simulated second; target >= 300 x)",
+            1.0 / t_master,
+            t_master * 1e3
+        ));
+        r.line(format!(
+            "- the same physics in plain Rust: {:.0} x real time ({:.2} ms per simulated second)",
+            1.0 / t_direct,
+            t_direct * 1e3
+        ));
+        r.line(format!(
+            "- ratio master / direct Rust: {:.2} (target <= 1.1); both end at the same state \
+             ({fin_master:.6e} m, relative difference {relative:.1e})",
+            t_master / t_direct
+        ));
+        r.line(format!(
+            "- load average before / after: {load} / {}",
+            load_average()
+        ));
+        master_s = Some(t_master);
+    }
+    if wanted("fmpy") {
+        match fmpy_passive() {
+            Ok(t_fmpy) => r.line(format!(
+                "- fmpy Python loop: {:.1} x real time; ratio fmpy / master: {} (load {})",
+                1.0 / t_fmpy,
+                master_s.map_or("not measured".into(), |t| format!("{:.1}", t_fmpy / t)),
+                load_average()
+            )),
+            Err(why) => r.line(format!("- fmpy loop: not measured ({why})")),
+        }
+    }
+    if wanted("runset") {
+        let (w1, c1) = runset_wall(1);
+        let (w2, c2) = runset_wall(2);
+        r.line(format!(
+            "- run set of 4 runs of {COUPLED_STOP_S} s: --jobs 1 {w1:.2} s, --jobs 2 {w2:.2} s, speed-up {:.2} (cores used {:.2} / {:.2}; load {})",
+            w1 / w2,
+            c1 / w1,
+            c2 / w2,
             load_average()
         ));
     }
-    let vehicle = vehicle_rtf();
-    r.line(format!(
-        "| RailVehicle non-linear, 300 km/h, high-level irregular track, 4 Maxwell dampers | {vehicle:.0} x | {} |",
-        load_average()
-    ));
 
-    r.line(String::new());
-    r.line(format!(
-        "## Coupled passive system (Bogie2Dof + 2 PassiveYawDamper, Gauss-Seidel, 1 ms, {COUPLED_STOP_S} s simulated, best of {REPEATS})"
-    ));
-    r.line(String::new());
-    let load = load_average();
-    let (t_direct, fin_direct) = direct_passive();
-    let (t_master, fin_master) = master_passive();
-    // The FMUs' binaries are built against glibc 2.17, whose libm may round exp/pow in the
-    // last bit differently from the build machine's: the two agree to rounding, not bit for bit.
-    let relative = (fin_direct - fin_master).abs() / fin_direct.abs().max(1e-9);
-    assert!(
-        relative <= 1e-6,
-        "direct {fin_direct} vs master {fin_master}: not the same computation"
-    );
-    r.line(format!(
-        "- our master: {:.0} x real time ({:.2} ms per simulated second; target >= 300 x)",
-        1.0 / t_master,
-        t_master * 1e3
-    ));
-    r.line(format!(
-        "- the same physics in plain Rust: {:.0} x real time ({:.2} ms per simulated second)",
-        1.0 / t_direct,
-        t_direct * 1e3
-    ));
-    r.line(format!(
-        "- ratio master / direct Rust: {:.2} (target <= 1.1); both end at the same state \
-         ({fin_master:.6e} m, relative difference {relative:.1e})",
-        t_master / t_direct
-    ));
-    match fmpy_passive() {
-        Ok(t_fmpy) => r.line(format!(
-            "- fmpy Python loop: {:.1} x real time; ratio fmpy / master: {:.1}",
-            1.0 / t_fmpy,
-            t_fmpy / t_master
-        )),
-        Err(why) => r.line(format!("- fmpy loop: not measured ({why})")),
-    }
-    r.line(format!(
-        "- load average before / after: {load} / {}",
-        load_average()
-    ));
-    let (w1, c1) = runset_wall(1);
-    let (w2, c2) = runset_wall(2);
-    r.line(format!(
-        "- run set of 4 runs of {COUPLED_STOP_S} s: --jobs 1 {w1:.2} s, --jobs 2 {w2:.2} s, speed-up {:.2} (cores used {:.2} / {:.2}; load {})",
-        w1 / w2,
-        c1 / w1,
-        c2 / w2,
-        load_average()
-    ));
-
-    if let Ok(studies) = std::env::var("BENCH_STUDY") {
+    if let (true, Ok(studies)) = (wanted("studies"), std::env::var("BENCH_STUDY")) {
         r.line(String::new());
         r.line("## Studies (the `master` binary, all cores)".into());
         r.line(String::new());
