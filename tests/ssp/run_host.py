@@ -13,6 +13,13 @@ HOST is one of
             bindings, so the sets are read with fmpy's own read_ssv from the archive and passed
             as its parameter_set argument (names prefixed with the component, as fmpy expects);
             values are fmpy's connector values.
+  fmpy-stepwise
+            simulate_ssp's loop written out over fmpy's own pieces (read_ssd, its parameter
+            handling, instantiate_fmu, do_step, get_value), with the two details in which
+            simulate_ssp differs from the master as options: --fmpy-start zero (simulate_ssp:
+            every input starts at 0 in the first step) or exchange (the master: inputs take the
+            outputs at the start time, after initialisation), and --fmpy-time accumulated
+            (simulate_ssp: t += H) or grid (the master: t_k = t_0 + k*H, steps t_(k+1) - t_k).
 
 The CSV has a header `time,VAR...` and one row per communication point t_k = k*H, k = 1..N,
 holding the values after the step that ends at t_k (all three hosts step Jacobi-style: every
@@ -23,12 +30,13 @@ printed and gives 1.
 import argparse
 import csv
 import os
+import shutil
 import sys
 import tempfile
 import zipfile
 
 
-def run_libcosim(ssp, stop, step, names):
+def run_libcosim(ssp, stop, step, names, opts):
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
@@ -54,7 +62,7 @@ def run_libcosim(ssp, stop, step, names):
     return rows
 
 
-def run_ecos(ssp, stop, step, names):
+def run_ecos(ssp, stop, step, names, opts):
     from ecospy import EcosSimulation
 
     from xml.etree import ElementTree
@@ -77,11 +85,10 @@ def run_ecos(ssp, stop, step, names):
     return rows
 
 
-def run_fmpy(ssp, stop, step, names):
-    from fmpy.ssp.simulation import simulate_ssp
-    from fmpy.ssp.ssd import ParameterSet, Parameter, read_ssd
+def fmpy_parameters(ssd):
+    """The SSD's parameter sets as one fmpy parameter_set, names prefixed with the component."""
+    from fmpy.ssp.ssd import ParameterSet, Parameter
 
-    ssd = read_ssd(ssp)
     combined = ParameterSet(name="combined")
     for comp in ssd.system.elements:
         for binding in comp.parameterBindings:
@@ -90,6 +97,14 @@ def run_fmpy(ssp, stop, step, names):
                     q = Parameter(name=comp.name + "." + p.name)
                     q.type, q.value = p.type, p.value
                     combined.parameters.append(q)
+    return combined
+
+
+def run_fmpy(ssp, stop, step, names, opts):
+    from fmpy.ssp.simulation import simulate_ssp
+    from fmpy.ssp.ssd import read_ssd
+
+    combined = fmpy_parameters(read_ssd(ssp))
     # fmpy advances time by adding the step; stop half a step early to get exactly N steps
     n_steps = round(stop / step)
     res = simulate_ssp(ssp, stop_time=(n_steps - 0.5) * step, step_size=step,
@@ -99,7 +114,55 @@ def run_fmpy(ssp, stop, step, names):
     return [[(k + 1) * step] + [float(r[n]) for n in names] for k, r in enumerate(res)]
 
 
-HOSTS = {"libcosim": run_libcosim, "ecos": run_ecos, "fmpy": run_fmpy}
+def run_fmpy_stepwise(ssp, stop, step, names, opts):
+    from fmpy import extract
+    from fmpy.ssp.simulation import (add_path, do_step, find_components, find_connectors,
+                                     free_fmu, get_connections, get_value, instantiate_fmu)
+    from fmpy.ssp.ssd import read_ssd
+
+    ssd = read_ssd(ssp)
+    add_path(ssd.system)
+    components = find_components(ssd.system)
+    connections = get_connections(ssd.system)
+    unzipdir = extract(ssp)
+    for connector in find_connectors(ssd.system):
+        connector.value = 0.0
+    params = fmpy_parameters(ssd)
+    start = 0.0
+    for component in components:
+        instantiate_fmu(component, unzipdir, start, stop, params)
+    if opts.fmpy_start == "exchange":
+        for component in components:
+            for connector in component.connectors:
+                if connector.kind == "output":
+                    connector.value = get_value(component, connector.name)
+        for a, b in connections:
+            b.value = a.value
+    by_path = {c.path: c for c in find_connectors(ssd.system)}
+    n_steps = round(stop / step)
+    rows = []
+    time = start
+    for k in range(n_steps):
+        if opts.fmpy_time == "grid":
+            time = start + k * step
+            h = (stop if k + 1 == n_steps else start + (k + 1) * step) - time
+        else:
+            h = step
+        for component in components:
+            do_step(component, time, h)
+        for a, b in connections:
+            b.value = a.value
+        rows.append([(k + 1) * step] + [float(by_path[n].value) for n in names])
+        if opts.fmpy_time == "accumulated":
+            time += step
+    for component in components:
+        free_fmu(component)
+    shutil.rmtree(unzipdir, ignore_errors=True)
+    return rows
+
+
+HOSTS = {"libcosim": run_libcosim, "ecos": run_ecos, "fmpy": run_fmpy,
+         "fmpy-stepwise": run_fmpy_stepwise}
 
 
 def main():
@@ -109,6 +172,8 @@ def main():
     ap.add_argument("out")
     ap.add_argument("--stop-time", type=float, required=True)
     ap.add_argument("--step", type=float, required=True)
+    ap.add_argument("--fmpy-start", choices=["zero", "exchange"], default="exchange")
+    ap.add_argument("--fmpy-time", choices=["accumulated", "grid"], default="grid")
     ap.add_argument("names", nargs="+")
     a = ap.parse_args()
     ssp = os.path.abspath(a.ssp)
@@ -118,7 +183,7 @@ def main():
     # hosts unpack into the working folder or the temporary one; keep both private
     with tempfile.TemporaryDirectory() as tmp:
         os.chdir(tmp)
-        rows = HOSTS[a.host](ssp, a.stop_time, a.step, a.names)
+        rows = HOSTS[a.host](ssp, a.stop_time, a.step, a.names, a)
     with open(out, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["time"] + a.names)
