@@ -120,6 +120,37 @@ fn exported_systems_are_valid_and_import_back_bit_for_bit() {
     }
 }
 
+/// Enumeration parameters given by item name are exported as ssv:Integer with the item's
+/// value, as a number would be: libcosim aborts on ssv:Enumeration (ssp_parser "Internal
+/// error"), Ecos refuses it ("Unknown XML node in ssv:Parameter") and fmpy reads every
+/// Enumeration value with int().
+#[test]
+fn enumeration_items_are_exported_as_their_integer_values() {
+    let by_number = system("passive.json");
+    let mut by_name = system("passive.json");
+    let bogie = &mut by_name.desc.instances[0].parameters;
+    assert_eq!(bogie["track.source"], 2);
+    assert_eq!(bogie["contact.model"], 1);
+    bogie.insert("track.source".into(), "internal".into());
+    bogie.insert("contact.model".into(), "nonlinear".into());
+    let member = |sys: &LoadedSystem| {
+        let dir = tempfile::tempdir().unwrap();
+        let file = export(sys, dir.path());
+        let mut zip = zip::ZipArchive::new(std::fs::File::open(file).unwrap()).unwrap();
+        let mut text = String::new();
+        std::io::Read::read_to_string(&mut zip.by_name("resources/bogie.ssv").unwrap(), &mut text)
+            .unwrap();
+        text
+    };
+    let text = member(&by_name);
+    assert!(
+        text.contains(r#"<ssv:Parameter name="track.source"><ssv:Integer value="2"/>"#),
+        "{text}"
+    );
+    assert!(!text.contains("ssv:Enumeration"), "{text}");
+    assert_eq!(text, member(&by_number));
+}
+
 /// Largest difference over the run relative to the largest magnitude of the master's signal.
 fn relative_difference(ours: &[f64], theirs: &[f64]) -> f64 {
     let scale = ours.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);
@@ -304,9 +335,9 @@ fn ecos_runs_the_exported_ssp_like_the_master() {
 ///   controllers integrate 0 instead of those over the first step; their absolute-velocity
 ///   estimate is offset from then on and an on/off valve command switches at another step
 ///   (measured: the first at step 15), after which the runs part;
-/// * time advances by t += h, so the communication points differ from t_0 + k*h by a few ulps;
-///   the dampers' adaptive internal steps turn that into 1.6e-10 (passive) and 4e-11
-///   (sky-hook, with the master's start) of the damper force.
+/// * time advances by t += h, so the communication points differ from t_0 + k*h by a few ulps,
+///   which alone makes 1.6e-10 (passive) and 4e-11 (sky-hook, with the master's start) of the
+///   damper force.
 ///
 /// So simulate_ssp is asserted on the passive system over the whole run and on the sky-hook
 /// up to the first step at which a valve command differs; and the same loop over fmpy's own

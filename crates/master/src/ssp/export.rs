@@ -429,8 +429,16 @@ fn parameter_set(
             (VarType::Integer | VarType::Enumeration, Json::Number(n)) => {
                 format!(r#"<ssv:Integer value="{}"/>"#, n.as_i64().ok_or_else(bad)?)
             }
+            // an item name as its value: libcosim aborts on ssv:Enumeration and fmpy reads
+            // every Enumeration value as an integer
             (VarType::Enumeration, Json::String(item)) => {
-                format!(r#"<ssv:Enumeration value="{}"/>"#, escape(item))
+                let value = md
+                    .enum_items(v)
+                    .iter()
+                    .find(|i| &i.name == item)
+                    .ok_or_else(bad)?
+                    .value;
+                format!(r#"<ssv:Integer value="{value}"/>"#)
             }
             (VarType::Boolean, Json::Bool(b)) => format!(r#"<ssv:Boolean value="{b}"/>"#),
             (VarType::String, Json::String(t)) => {
