@@ -189,6 +189,16 @@ pub fn workspace_root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
+/// The python of the venv with fmpy and the SSP hosts (RAIL_PYTHON, which scripts/test.sh sets);
+/// `None`, with a note on stderr, when it is not set, so a plain `cargo test` skips what needs it.
+pub fn rail_python() -> Option<PathBuf> {
+    let p = std::env::var_os("RAIL_PYTHON").map(PathBuf::from);
+    if p.is_none() {
+        eprintln!("RAIL_PYTHON not set: run scripts/test.sh (it points it to the venv with fmpy, libcosimpy and ecospy)");
+    }
+    p
+}
+
 /// One instance; freed on drop.
 pub struct Instance<'a> {
     pub fmu: &'a TestFmu,

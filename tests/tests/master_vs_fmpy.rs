@@ -16,27 +16,12 @@ use std::process::Command;
 
 use master::coupling::RunOptions;
 use master::system::LoadedSystem;
+use tests::{rail_python, workspace_root};
 
 const CHILD: &str = "RAIL_PYFMU_COUPLED_CHILD";
 
-fn python() -> Option<PathBuf> {
-    match std::env::var_os("RAIL_PYTHON") {
-        Some(p) => Some(p.into()),
-        None => {
-            eprintln!(
-                "RAIL_PYTHON not set: run scripts/test.sh (it points it to the venv with fmpy)"
-            );
-            None
-        }
-    }
-}
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
 fn dist_fmu(name: &str) -> PathBuf {
-    let p = repo().join("dist").join(name);
+    let p = workspace_root().join("dist").join(name);
     assert!(
         p.exists(),
         "{} is missing: scripts/test.sh packages the FMUs into dist/ first",
@@ -82,7 +67,7 @@ fn master_vs_fmpy(python: &Path, system: &str) -> Vec<String> {
     let out = sys.run(&RunOptions::default()).unwrap();
     let csv = dir.path().join("results.csv");
     master::output::write_csv_atomic(&csv, &out.header, out.rows()).unwrap();
-    let script = repo().join("tests/fmpy/drive_with_fmpy.py");
+    let script = workspace_root().join("tests/fmpy/drive_with_fmpy.py");
     let res = Command::new(python)
         .arg(&script)
         .arg(&sys_path)
@@ -121,7 +106,7 @@ fn master_vs_fmpy(python: &Path, system: &str) -> Vec<String> {
 
 #[test]
 fn gauss_seidel_in_feedthrough_order() {
-    let Some(py) = python() else { return };
+    let Some(py) = rail_python() else { return };
     let lines = master_vs_fmpy(&py, &ms_sdm("gauss-seidel", ""));
     // sdm steps after ms, so it used ms's outputs of the same macro step
     assert!(
@@ -134,13 +119,13 @@ fn gauss_seidel_in_feedthrough_order() {
 
 #[test]
 fn jacobi() {
-    let Some(py) = python() else { return };
+    let Some(py) = rail_python() else { return };
     master_vs_fmpy(&py, &ms_sdm("jacobi", ""));
 }
 
 #[test]
 fn gauss_seidel_reversed_order_and_step_multiple() {
-    let Some(py) = python() else { return };
+    let Some(py) = rail_python() else { return };
     let sys = ms_sdm("gauss-seidel", r#", "order": ["sdm", "ms"]"#).replace(
         r#""initial_position": 0.1}"#,
         r#""initial_position": 0.1}, "step_multiple": 2"#,
@@ -157,7 +142,7 @@ fn gauss_seidel_reversed_order_and_step_multiple() {
 /// The pythonfmu FMU (not our binary) coupled with our SpringDamperMass: each agrees with fmpy.
 #[test]
 fn python_fmu_coupled_with_ours() {
-    let Some(_) = python() else { return };
+    let Some(_) = rail_python() else { return };
     let Some(dir) = std::env::var_os("RAIL_FOREIGN_FMUS").map(PathBuf::from) else {
         eprintln!(
             "RAIL_FOREIGN_FMUS not set: run scripts/test.sh (it builds the foreign FMUs first)"
@@ -205,7 +190,7 @@ fn python_fmu_coupled_in_child_process() {
         eprintln!("runs only as the child process of python_fmu_coupled_with_ours (needs LD_PRELOAD of libpython)");
         return;
     }
-    let py = python().unwrap();
+    let py = rail_python().unwrap();
     let dir = PathBuf::from(std::env::var_os("RAIL_FOREIGN_FMUS").unwrap());
     let osc = std::path::absolute(dir.join("PyOscillator.fmu")).unwrap();
     let system = format!(

@@ -23,26 +23,13 @@ use master::model_description::VarType;
 use master::ssp::{self, ImportOptions};
 use master::system::LoadedSystem;
 use tests::csv::read_csv;
+use tests::{rail_python, workspace_root};
 
 const STOP_TIME_S: f64 = 2.0;
 
-fn python() -> Option<PathBuf> {
-    match std::env::var_os("RAIL_PYTHON") {
-        Some(p) => Some(p.into()),
-        None => {
-            eprintln!("RAIL_PYTHON not set: run scripts/test.sh (it points it to the venv with the SSP hosts)");
-            None
-        }
-    }
-}
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
 /// The system `name` of systems/, over [`STOP_TIME_S`], coupled Jacobi-style.
 fn system(name: &str) -> LoadedSystem {
-    let path = repo().join("systems").join(name);
+    let path = workspace_root().join("systems").join(name);
     let mut sys = LoadedSystem::load(&path).unwrap();
     for i in 0..sys.desc.instances.len() {
         let p = sys.fmu_path(i);
@@ -76,8 +63,8 @@ fn export(sys: &LoadedSystem, dir: &Path) -> PathBuf {
 
 fn schema_valid(py: &Path, ssp_file: &Path) {
     let res = Command::new(py)
-        .arg(repo().join("tests/ssp/validate_schema.py"))
-        .arg(repo().join("tests/ssp/schema"))
+        .arg(workspace_root().join("tests/ssp/validate_schema.py"))
+        .arg(workspace_root().join("tests/ssp/schema"))
         .arg(ssp_file)
         .output()
         .unwrap();
@@ -92,7 +79,7 @@ fn schema_valid(py: &Path, ssp_file: &Path) {
 
 #[test]
 fn exported_systems_are_valid_and_import_back_bit_for_bit() {
-    let Some(py) = python() else { return };
+    let Some(py) = rail_python() else { return };
     for name in ["passive.json", "skyhook_onoff.json"] {
         let sys = system(name);
         let dir = tempfile::tempdir().unwrap();
@@ -162,7 +149,8 @@ fn relative_difference(ours: &[f64], theirs: &[f64]) -> f64 {
 
 /// libcosim (0.0.6 in libcosimpy) and Ecos ignore FMI 2.0 Enumeration variables (each logs
 /// "Enumeration variable type not supported" / has no property of that name), so an
-/// Enumeration parameter the SSP binds is dropped there. They run a variant in which every
+/// Enumeration parameter the SSP binds is dropped there, also as ssv:Integer
+/// ([`libcosim_and_ecos_drop_enumeration_parameters`]). They run a variant in which every
 /// Enumeration parameter keeps its FMU's start value; for the bogie that is track.source =
 /// external with the input unconnected (ideal straight track), so the response is excited by an
 /// initial lateral displacement of 3 mm instead of the internal track irregularity.
@@ -237,6 +225,31 @@ impl HostRun {
     }
 }
 
+/// tests/ssp/run_host.py `host` on `ssp` over [`STOP_TIME_S`], its values of `vars` to `csv`.
+fn run_host(
+    py: &Path,
+    host: &str,
+    ssp: &Path,
+    csv: &Path,
+    step: f64,
+    options: &[&str],
+    vars: &[String],
+) -> std::process::Output {
+    Command::new(py)
+        .arg(workspace_root().join("tests/ssp/run_host.py"))
+        .arg(host)
+        .arg(ssp)
+        .arg(csv)
+        .arg("--stop-time")
+        .arg(STOP_TIME_S.to_string())
+        .arg("--step")
+        .arg(step.to_string())
+        .args(options)
+        .args(vars)
+        .output()
+        .unwrap()
+}
+
 /// Runs `host` of tests/ssp/run_host.py (with `options`) on the exported `name`.
 fn host_run(py: &Path, host: &str, options: &[&str], name: &str) -> HostRun {
     let mut sys = system(name);
@@ -248,19 +261,7 @@ fn host_run(py: &Path, host: &str, options: &[&str], name: &str) -> HostRun {
     let ours = run(&sys);
     let vars = recorded(&sys);
     let csv = dir.path().join("host.csv");
-    let res = Command::new(py)
-        .arg(repo().join("tests/ssp/run_host.py"))
-        .arg(host)
-        .arg(&file)
-        .arg(&csv)
-        .arg("--stop-time")
-        .arg(STOP_TIME_S.to_string())
-        .arg("--step")
-        .arg(sys.desc.step.to_string())
-        .args(options)
-        .args(&vars)
-        .output()
-        .unwrap();
+    let res = run_host(py, host, &file, &csv, sys.desc.step, options, &vars);
     assert!(
         res.status.success(),
         "{host} {options:?} failed on {name}:\n{}{}",
@@ -311,7 +312,7 @@ fn assert_within(run: &HostRun, what: &str, rows: usize, tolerance: f64) {
 }
 
 fn assert_agree(host: &str, systems: &[&str], tolerance: f64) {
-    let Some(py) = python() else { return };
+    let Some(py) = rail_python() else { return };
     for &name in systems {
         let r = host_run(&py, host, &[], name);
         assert_within(&r, &format!("{host} on {name}"), 2000, tolerance);
@@ -326,6 +327,46 @@ fn libcosim_runs_the_exported_ssp_like_the_master() {
 #[test]
 fn ecos_runs_the_exported_ssp_like_the_master() {
     assert_agree("ecos", &["passive.json", "skyhook_onoff.json"], 1e-9);
+}
+
+/// libcosim and Ecos apply no Enumeration parameter in any SSP spelling: bound as ssv:Integer
+/// (as exported) each says there is no such variable (ssv:Enumeration aborts or is refused),
+/// which is why they run [`without_enumeration_parameters`]. Should a release apply them,
+/// this fails and that variant can go.
+#[test]
+fn libcosim_and_ecos_drop_enumeration_parameters() {
+    let Some(py) = rail_python() else { return };
+    let sys = system("passive.json");
+    let dir = tempfile::tempdir().unwrap();
+    let file = export(&sys, dir.path());
+    let vars = ["damper_left.damper.force".to_string()];
+    for (host, message) in [
+        ("libcosim", "No such variable: bogie:track.source"),
+        (
+            "ecos",
+            "No variable named 'track.source' of type int registered for instance 'bogie'",
+        ),
+    ] {
+        let res = run_host(
+            &py,
+            host,
+            &file,
+            &dir.path().join("x.csv"),
+            sys.desc.step,
+            &[],
+            &vars,
+        );
+        let log = format!(
+            "{}{}",
+            String::from_utf8_lossy(&res.stdout),
+            String::from_utf8_lossy(&res.stderr)
+        );
+        assert!(res.status.success(), "{host}:\n{log}");
+        assert!(
+            log.contains(message),
+            "{host} no longer says '{message}':\n{log}"
+        );
+    }
 }
 
 /// fmpy's simulate_ssp differs from the master in two details of its loop, both fmpy's:
@@ -345,7 +386,7 @@ fn ecos_runs_the_exported_ssp_like_the_master() {
 /// details, and the master's Jacobi run bit for bit without them.
 #[test]
 fn fmpy_runs_the_exported_ssp_like_the_master() {
-    let Some(py) = python() else { return };
+    let Some(py) = rail_python() else { return };
     let passive = host_run(&py, "fmpy", &[], "passive.json");
     assert_within(&passive, "fmpy on passive.json", 2000, 1e-9);
 
@@ -374,7 +415,7 @@ fn fmpy_runs_the_exported_ssp_like_the_master() {
 
 #[test]
 fn fmpy_loop_with_the_masters_start_and_time_grid_is_the_master_bit_for_bit() {
-    let Some(py) = python() else { return };
+    let Some(py) = rail_python() else { return };
     let fmpy_details = ["--fmpy-start", "zero", "--fmpy-time", "accumulated"];
     for name in ["passive.json", "skyhook_onoff.json"] {
         let proper = host_run(&py, "fmpy", &[], name);
