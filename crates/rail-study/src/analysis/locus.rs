@@ -16,9 +16,8 @@ use fmu_bogie2dof::eigen::{
 };
 use fmu_bogie2dof::Params;
 
-use super::figures::ColourScatter;
+use super::locus_figures::{speeds_line, LocusFigures, LocusSpeed};
 use super::{AnalysisError, Artefacts, Table};
-use crate::plot::Chart;
 
 /// Seed R5: linear critical speed with the passive damper [km/h].
 pub const SEED_R5_KMH: f64 = 270.0;
@@ -202,56 +201,34 @@ pub fn root_locus(
     })
 }
 
-fn freq_hz(im: f64) -> f64 {
-    im.abs() / (2.0 * std::f64::consts::PI)
-}
-
-fn damping_ratio(re: f64, im: f64) -> f64 {
-    let n = re.hypot(im);
-    if n > 0.0 {
-        -re / n
-    } else {
-        0.0
-    }
-}
-
 impl LocusResults {
-    /// Hunting-mode points (Re, Im) at the grid speeds.
-    fn hunting_points(&self) -> Vec<(f64, f64, f64)> {
-        self.speeds_kmh
-            .iter()
-            .zip(&self.results)
-            .filter_map(|(v, r)| r.hunting.map(|h| (h.re, h.im, *v)))
-            .collect()
+    /// The eigenvalues per speed and the hunting mode, as the shared figures take them.
+    fn figures(&self) -> LocusFigures<'_> {
+        LocusFigures {
+            model: "bogie",
+            damper: match self.damper {
+                DamperSpec::Passive => "passive damper".to_string(),
+                d => d.describe(),
+            },
+            mode: "hunting mode",
+            mode_column: "hunting mode",
+            frequency_title: "Hunting frequency vs speed (linear bogie)".into(),
+            speeds: self
+                .speeds_kmh
+                .iter()
+                .zip(&self.results)
+                .map(|(v, r)| LocusSpeed {
+                    speed_kmh: *v,
+                    eigenvalues: &r.eigenvalues,
+                    mode: r.hunting.map(|h| (h.re, h.im)),
+                })
+                .collect(),
+        }
     }
 
     pub fn add_artefacts(&self, a: &mut Artefacts) -> Result<(), AnalysisError> {
-        let mut all = Table::new(&[
-            "speed [km/h]",
-            "eigenvalue index",
-            "real part [1/s]",
-            "imaginary part [rad/s]",
-            "frequency [Hz]",
-            "damping ratio [-]",
-            "hunting mode",
-        ]);
-        for (v, r) in self.speeds_kmh.iter().zip(&self.results) {
-            for (i, &(re, im)) in r.eigenvalues.iter().enumerate() {
-                let is_hunting = r
-                    .hunting
-                    .is_some_and(|h| h.re == re && h.im.abs() == im.abs());
-                all.rows.push(vec![
-                    *v,
-                    i as f64,
-                    re,
-                    im,
-                    freq_hz(im),
-                    damping_ratio(re, im),
-                    if is_hunting { 1.0 } else { 0.0 },
-                ]);
-            }
-        }
-        a.add_table("root_locus_eigenvalues.csv", &all)?;
+        let figures = self.figures();
+        figures.add_eigenvalue_table(a)?;
         let mut hunt = Table::new(&[
             "speed [km/h]",
             "real part [1/s]",
@@ -275,69 +252,7 @@ impl LocusResults {
             }
         }
         a.add_table("root_locus_hunting.csv", &hunt)?;
-
-        // upper half-plane only (conjugates carry no information)
-        let upper: Vec<(f64, f64, f64)> = self
-            .speeds_kmh
-            .iter()
-            .zip(&self.results)
-            .flat_map(|(v, r)| {
-                r.eigenvalues
-                    .iter()
-                    .filter(|e| e.1 >= 0.0)
-                    .map(move |&(re, im)| (re, im, *v))
-            })
-            .collect();
-        let hp = self.hunting_points();
-        let title = format!(
-            "Root locus of the linear bogie, {} to {} km/h ({})",
-            self.speeds_kmh.first().copied().unwrap_or(0.0),
-            self.speeds_kmh.last().copied().unwrap_or(0.0),
-            match self.damper {
-                DamperSpec::Passive => "passive damper".to_string(),
-                d => d.describe(),
-            }
-        );
-        let mut full =
-            ColourScatter::new(&title, "real part [1/s]", "imaginary part [rad/s]", "km/h");
-        full.points = upper.clone();
-        full.highlight = Some((
-            "hunting mode".into(),
-            hp.iter().map(|p| (p.0, p.1)).collect(),
-        ));
-        full.zero_line_x = true;
-        a.add_text("root_locus.svg", full.to_svg()?);
-        // zoom on the hunting mode: real parts within a few times its excursion
-        if !hp.is_empty() {
-            let span = hp.iter().map(|p| p.0.abs()).fold(0.0, f64::max).max(1.0);
-            let im_max = hp.iter().map(|p| p.1).fold(0.0, f64::max);
-            let mut zoom = full.clone();
-            zoom.title = format!("{title}: zoom on the hunting mode");
-            zoom.points = upper
-                .into_iter()
-                .filter(|p| p.0 >= -3.0 * span && p.1 <= 2.0 * im_max)
-                .collect();
-            a.add_text("root_locus_zoom.svg", zoom.to_svg()?);
-        }
-        let series = |f: fn(&(f64, f64, f64)) -> f64| -> Vec<(f64, f64)> {
-            hp.iter().map(|p| (p.2, f(p))).collect()
-        };
-        let zeta = Chart::new(
-            "Damping ratio of the hunting mode vs speed (linear bogie)",
-            "speed [km/h]",
-            "damping ratio -Re/|lambda| [-]",
-        )
-        .with_series("hunting mode", series(|p| damping_ratio(p.0, p.1)))
-        .with_limit(0.0, "stability limit");
-        a.add_lines("damping_ratio.svg", &zeta)?;
-        let freq = Chart::new(
-            "Hunting frequency vs speed (linear bogie)",
-            "speed [km/h]",
-            "frequency [Hz]",
-        )
-        .with_series("hunting mode", series(|p| freq_hz(p.1)));
-        a.add_lines("hunting_frequency.svg", &freq)?;
-        Ok(())
+        figures.add_figures(a)
     }
 
     /// Critical speed and hunting frequency at onset next to the seed's.
@@ -347,12 +262,7 @@ impl LocusResults {
             self.conicity,
             self.damper.describe()
         );
-        s.push_str(&format!(
-            "speeds {} to {} km/h, {} points\n",
-            self.speeds_kmh.first().copied().unwrap_or(0.0),
-            self.speeds_kmh.last().copied().unwrap_or(0.0),
-            self.speeds_kmh.len()
-        ));
+        s.push_str(&speeds_line(&self.speeds_kmh));
         match &self.critical {
             Ok(c) => {
                 s.push_str(&format!(

@@ -10,6 +10,7 @@
 //!   `fmu-damper`).
 //! * [`geometry`]: wheel/rail contact tables and equivalent conicity (crate `wheel-rail`).
 //! * [`locus`]: eigenvalues of the linear bogie over speed (crate `fmu-bogie2dof`).
+//! * [`locus_figures`]: the eigenvalue table and figures both root loci draw.
 //! * [`vehicle_locus`]: eigenvalues of the linear coach over speed, modes named (crate
 //!   `fmu-vehicle`).
 //! * [`assess`]: EN 14363 assessment of recorded signals (ours or a host's export).
@@ -25,6 +26,7 @@ pub mod damper;
 pub mod figures;
 pub mod geometry;
 pub mod locus;
+pub mod locus_figures;
 pub mod vehicle_locus;
 
 /// Failure of an analysis. Messages name the model, file or option concerned.

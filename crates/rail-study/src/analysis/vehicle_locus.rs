@@ -14,10 +14,9 @@ use fmu_vehicle::eigen::{
 };
 use fmu_vehicle::VehicleParams;
 
-use super::figures::ColourScatter;
 use super::locus::DamperSpec;
+use super::locus_figures::{speeds_line, LocusFigures, LocusSpeed};
 use super::{AnalysisError, Artefacts, Table};
-use crate::plot::Chart;
 
 /// Seed R15: linear critical speed of the coach with the passive reference damper [km/h].
 pub const SEED_R15_KMH: (f64, f64) = (280.0, 290.0);
@@ -93,19 +92,6 @@ pub fn vehicle_root_locus(
     })
 }
 
-fn freq_hz(im: f64) -> f64 {
-    im.abs() / (2.0 * std::f64::consts::PI)
-}
-
-fn damping_ratio(re: f64, im: f64) -> f64 {
-    let n = re.hypot(im);
-    if n > 0.0 {
-        -re / n
-    } else {
-        0.0
-    }
-}
-
 /// Number of the mode kind in the CSV (0 car body, 1 front bogie, 2 rear bogie, 3 both).
 fn kind_code(m: &Mode) -> f64 {
     use fmu_vehicle::eigen::ModeKind::*;
@@ -126,33 +112,30 @@ impl VehicleLocus {
             .collect()
     }
 
-    pub fn add_artefacts(&self, a: &mut Artefacts) -> Result<(), AnalysisError> {
-        let mut all = Table::new(&[
-            "speed [km/h]",
-            "eigenvalue index",
-            "real part [1/s]",
-            "imaginary part [rad/s]",
-            "frequency [Hz]",
-            "damping ratio [-]",
-            "least damped",
-        ]);
-        for (v, r) in self.speeds_kmh.iter().zip(&self.results) {
-            for (i, &(re, im)) in r.eigenvalues.iter().enumerate() {
-                let flag = r
-                    .least_damped
-                    .is_some_and(|m| m.re == re && m.im.abs() == im.abs());
-                all.rows.push(vec![
-                    *v,
-                    i as f64,
-                    re,
-                    im,
-                    freq_hz(im),
-                    damping_ratio(re, im),
-                    if flag { 1.0 } else { 0.0 },
-                ]);
-            }
+    /// The eigenvalues per speed and the least-damped mode, as the shared figures take them.
+    fn figures(&self) -> LocusFigures<'_> {
+        LocusFigures {
+            model: "coach",
+            damper: self.damper.describe(),
+            mode: "least-damped mode",
+            mode_column: "least damped",
+            frequency_title: "Frequency of the least-damped mode vs speed (linear coach)".into(),
+            speeds: self
+                .speeds_kmh
+                .iter()
+                .zip(&self.results)
+                .map(|(v, r)| LocusSpeed {
+                    speed_kmh: *v,
+                    eigenvalues: &r.eigenvalues,
+                    mode: r.least_damped.map(|m| (m.re, m.im)),
+                })
+                .collect(),
         }
-        a.add_table("root_locus_eigenvalues.csv", &all)?;
+    }
+
+    pub fn add_artefacts(&self, a: &mut Artefacts) -> Result<(), AnalysisError> {
+        let figures = self.figures();
+        figures.add_eigenvalue_table(a)?;
         let mut modes = Table::new(&[
             "speed [km/h]",
             "real part [1/s]",
@@ -179,65 +162,7 @@ impl VehicleLocus {
             ]);
         }
         a.add_table("root_locus_least_damped.csv", &modes)?;
-        let upper: Vec<(f64, f64, f64)> = self
-            .speeds_kmh
-            .iter()
-            .zip(&self.results)
-            .flat_map(|(v, r)| {
-                r.eigenvalues
-                    .iter()
-                    .filter(|e| e.1 >= 0.0)
-                    .map(move |&(re, im)| (re, im, *v))
-            })
-            .collect();
-        let title = format!(
-            "Root locus of the linear coach, {} to {} km/h ({})",
-            self.speeds_kmh.first().copied().unwrap_or(0.0),
-            self.speeds_kmh.last().copied().unwrap_or(0.0),
-            self.damper.describe()
-        );
-        let mut full =
-            ColourScatter::new(&title, "real part [1/s]", "imaginary part [rad/s]", "km/h");
-        full.points = upper.clone();
-        full.highlight = Some((
-            "least-damped mode".into(),
-            ld.iter().map(|(_, m)| (m.re, m.im)).collect(),
-        ));
-        full.zero_line_x = true;
-        a.add_text("root_locus.svg", full.to_svg()?);
-        if !ld.is_empty() {
-            let span = ld.iter().map(|p| p.1.re.abs()).fold(0.0, f64::max).max(1.0);
-            let im_max = ld.iter().map(|p| p.1.im).fold(0.0, f64::max);
-            let mut zoom = full.clone();
-            zoom.title = format!("{title}: zoom on the least-damped mode");
-            zoom.points = upper
-                .into_iter()
-                .filter(|p| p.0 >= -3.0 * span && p.1 <= 2.0 * im_max)
-                .collect();
-            a.add_text("root_locus_zoom.svg", zoom.to_svg()?);
-        }
-        let zeta = Chart::new(
-            "Damping ratio of the least-damped mode vs speed (linear coach)",
-            "speed [km/h]",
-            "damping ratio -Re/|lambda| [-]",
-        )
-        .with_series(
-            "least-damped mode",
-            ld.iter().map(|(v, m)| (*v, m.damping_ratio)).collect(),
-        )
-        .with_limit(0.0, "stability limit");
-        a.add_lines("damping_ratio.svg", &zeta)?;
-        let freq = Chart::new(
-            "Frequency of the least-damped mode vs speed (linear coach)",
-            "speed [km/h]",
-            "frequency [Hz]",
-        )
-        .with_series(
-            "least-damped mode",
-            ld.iter().map(|(v, m)| (*v, m.freq_hz)).collect(),
-        );
-        a.add_lines("hunting_frequency.svg", &freq)?;
-        Ok(())
+        figures.add_figures(a)
     }
 
     /// Critical speed, frequency and mode at onset next to the seed's.
@@ -251,12 +176,7 @@ impl VehicleLocus {
             "linear coach (calibrated fmu-vehicle defaults), damper: {}, {mounting}\n",
             self.damper.describe()
         );
-        s.push_str(&format!(
-            "speeds {} to {} km/h, {} points\n",
-            self.speeds_kmh.first().copied().unwrap_or(0.0),
-            self.speeds_kmh.last().copied().unwrap_or(0.0),
-            self.speeds_kmh.len()
-        ));
+        s.push_str(&speeds_line(&self.speeds_kmh));
         match &self.critical {
             Ok(c) => {
                 s.push_str(&format!(
