@@ -13,6 +13,9 @@ use std::sync::{Arc, Mutex};
 use ffi::{fmi2CallbackFunctions, fmi2Component, fmi2Status};
 pub use fmi_sys::fmi2 as ffi;
 
+pub mod coach;
+pub mod study;
+
 extern "C" {
     fn test_logger(
         env: *mut c_void,

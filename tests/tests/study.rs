@@ -12,99 +12,20 @@
 // test helpers outside #[test] fns: allowed like the other end-to-end test files
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::OnceLock;
-
 use rail_study::study::config::required_fmus;
 use rail_study::study::run::{configurations_used, scenario};
-use rail_study::study::{
-    run_study, Critical, Sources, StudyOptions, StudyResults, StudySettings, VehicleModel,
-};
+use rail_study::study::{Critical, StudySettings, VehicleModel};
+use tests::study::SharedStudy;
 
-static CANCEL: AtomicBool = AtomicBool::new(false);
-static RESULTS: OnceLock<Result<StudyResults, String>> = OnceLock::new();
-/// FMU archives unpacked while the study ran (nothing else in this test binary unpacks FMUs).
-static UNPACKED: AtomicU64 = AtomicU64::new(0);
-
-fn dist() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../dist")
-}
-
-fn results() -> &'static StudyResults {
-    let r = RESULTS.get_or_init(|| {
-        let fmus = std::env::var_os("STUDY_FMUS").map_or_else(dist, PathBuf::from);
-        if !fmus.join("Bogie2Dof.fmu").is_file() {
-            return Err(format!(
-                "{} has no Bogie2Dof.fmu: build the FMUs first with \
-                 `cargo run --release -p model-description --bin package-fmus`",
-                fmus.display()
-            ));
-        }
-        let out = tempfile::tempdir().map_err(|e| e.to_string())?;
-        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let opts = StudyOptions {
-            sources: Sources {
-                fmus,
-                systems: None,
-            },
-            out: out.path().to_path_buf(),
-            threads,
-            progress: false,
-            cancel: &CANCEL,
-        };
-        let start = std::time::Instant::now();
-        let unpacked_before = master::fmu::extraction_count();
-        let r = run_study(&StudySettings::quick(VehicleModel::Bogie2Dof), &opts)
-            .map_err(|e| e.to_string())?;
-        UNPACKED.store(
-            master::fmu::extraction_count() - unpacked_before,
-            Ordering::SeqCst,
-        );
-        // the report must be writable from these results (plots need the kept runs)
-        let timing = rail_study::study::Timing {
-            wall_s: start.elapsed().as_secs_f64(),
-            threads,
-        };
-        let md =
-            rail_study::study::write_outputs(&r, out.path(), &timing).map_err(|e| e.to_string())?;
-        if !md.contains("Critical speeds") || !out.path().join("rms_vs_speed.svg").is_file() {
-            return Err("report or rms plot missing".into());
-        }
-        eprintln!("{md}");
-        Ok(r)
-    });
-    match r {
-        Ok(r) => r,
-        Err(e) => panic!("the quick study did not run: {e}"),
-    }
-}
-
-fn critical(id: &str) -> Critical {
-    let c = results()
-        .config(id)
-        .unwrap_or_else(|| panic!("configuration {id} missing"));
-    c.critical
-        .unwrap_or_else(|| panic!("{id}: no critical speed (empty curve)"))
-}
-
-/// The critical speed, or the end of the range (400) when stable throughout.
-fn vcr(id: &str) -> f64 {
-    critical(id).at_least_kmh()
-}
-
-fn scenario_metrics(name: &str) -> &'static rail_study::study::metrics::RunMetrics {
-    let r = results()
-        .scenario(name)
-        .unwrap_or_else(|| panic!("scenario {name} missing"));
-    r.metrics
-        .as_ref()
-        .unwrap_or_else(|| panic!("scenario {name} failed: {:?}", r.error))
-}
+static STUDY: SharedStudy = SharedStudy::new(
+    VehicleModel::Bogie2Dof,
+    &["rms_vs_speed.svg"],
+    "Critical speeds",
+);
 
 #[test]
 fn no_run_failed() {
-    let r = results();
+    let r = STUDY.results();
     assert!(r.failures.is_empty(), "failed runs: {:?}", r.failures);
     assert!(r.simulated_s > 0.0);
 }
@@ -113,14 +34,14 @@ fn no_run_failed() {
 /// not once per run and instance.
 #[test]
 fn each_configuration_unpacks_its_fmus_once() {
-    let r = results();
+    let r = STUDY.results();
     let used = configurations_used(&StudySettings::quick(VehicleModel::Bogie2Dof)).unwrap();
     let expected: usize = used
         .iter()
         .map(|c| required_fmus(VehicleModel::Bogie2Dof, &[c]).len())
         .sum();
     assert!(expected >= 2 * used.len(), "{expected}");
-    assert_eq!(UNPACKED.load(Ordering::SeqCst), expected as u64);
+    assert_eq!(STUDY.get().unpacked, expected as u64);
     assert!(r.runs > expected, "{} runs", r.runs);
 }
 
@@ -128,7 +49,7 @@ fn each_configuration_unpacks_its_fmus_once() {
 /// brackets to 10 km/h: the first unstable speed must lie in (260, 320].
 #[test]
 fn r8_passive_critical_speed() {
-    let k = critical("passive");
+    let k = STUDY.critical("passive");
     let v = k.speed_kmh().unwrap_or(f64::INFINITY);
     assert!(
         (260.0..=320.0).contains(&v),
@@ -147,14 +68,14 @@ fn r8_passive_critical_speed() {
 /// is pinned (>= 100 km/h); see REPORT.md.
 #[test]
 fn r9_mppt_raises_critical_speed() {
-    let p = vcr("passive");
+    let p = STUDY.vcr("passive");
     for id in ["mppt1", "mppt2"] {
-        let gain = vcr(id) - p;
+        let gain = STUDY.vcr(id) - p;
         assert!(
             gain >= 50.0,
             "{id}: gain over passive {gain} km/h ({} vs {}) below R9's 50-90 km/h",
-            critical(id).describe(),
-            critical("passive").describe()
+            STUDY.critical(id).describe(),
+            STUDY.critical("passive").describe()
         );
         // pinned measured value (seed: about +70 km/h)
         assert!(
@@ -169,10 +90,12 @@ fn r9_mppt_raises_critical_speed() {
 /// 260 km/h (HIL-like, Fig. 5.19/5.21) both close it and stabilise.
 #[test]
 fn r10_mppt1_stays_closed_mppt2_reopens() {
-    let c1 = scenario_metrics(&scenario::mppt_low("mppt1"))
+    let c1 = STUDY
+        .scenario_metrics(&scenario::mppt_low("mppt1"))
         .tail_command_v
         .unwrap_or(f64::NAN);
-    let c2 = scenario_metrics(&scenario::mppt_low("mppt2"))
+    let c2 = STUDY
+        .scenario_metrics(&scenario::mppt_low("mppt2"))
         .tail_command_v
         .unwrap_or(f64::NAN);
     assert!(
@@ -189,7 +112,7 @@ fn r10_mppt1_stays_closed_mppt2_reopens() {
     // up again over the last seconds of the run (0.5-2.8 V for MPPT1, 0-3.3 V for MPPT2 with
     // bogie sub-steps from 0.02 to 1 ms), so the tail is only asserted well below the start.
     for id in ["mppt1_slow", "mppt2_slow"] {
-        let m = scenario_metrics(&scenario::hil(id));
+        let m = STUDY.scenario_metrics(&scenario::hil(id));
         let c = m.tail_command_v.unwrap_or(f64::NAN);
         assert!(
             c <= 5.0,
@@ -205,14 +128,14 @@ fn r10_mppt1_stays_closed_mppt2_reopens() {
 /// passive < ideal sky-hook <= MPPT, and the pinned gain (20-60 km/h); see REPORT.md.
 #[test]
 fn r11_ideal_skyhook_between_passive_and_mppt() {
-    let p = vcr("passive");
-    let m = vcr("mppt2").min(vcr("mppt1"));
+    let p = STUDY.vcr("passive");
+    let m = STUDY.vcr("mppt2").min(STUDY.vcr("mppt1"));
     for id in ["skyhook_onoff", "skyhook_continuous"] {
-        let s = vcr(id);
+        let s = STUDY.vcr(id);
         assert!(
             p < s && s <= m,
             "{id}: ordering passive {p} < sky-hook {s} <= MPPT {m} violated ({})",
-            critical(id).describe()
+            STUDY.critical(id).describe()
         );
         let gain = s - p;
         assert!(
@@ -227,9 +150,9 @@ fn r11_ideal_skyhook_between_passive_and_mppt() {
 /// open valve and a 3 mm perturbation.
 #[test]
 fn r12_slow_valve_mppt_stabilises() {
-    let lim = results().limit_mps2;
+    let lim = STUDY.results().limit_mps2;
     for id in ["mppt1_slow", "mppt2_slow"] {
-        let m = scenario_metrics(&scenario::hil(id));
+        let m = STUDY.scenario_metrics(&scenario::hil(id));
         assert!(
             m.tail_amplitude_m < 1e-3,
             "{id}: final wheelset amplitude {:.2} mm, expected stabilised (< 1 mm)",
@@ -240,9 +163,9 @@ fn r12_slow_valve_mppt_stabilises() {
     // and the slow-valve MPPT stays above the passive vehicle in the sweep
     for id in ["mppt1_slow", "mppt2_slow"] {
         assert!(
-            vcr(id) > vcr("passive") + 50.0,
+            STUDY.vcr(id) > STUDY.vcr("passive") + 50.0,
             "{id}: {}",
-            critical(id).describe()
+            STUDY.critical(id).describe()
         );
     }
 }
@@ -255,25 +178,25 @@ fn r12_slow_valve_mppt_stabilises() {
 #[test]
 fn r12_slow_valve_breaks_skyhook() {
     for id in ["skyhook_onoff_slow", "skyhook_continuous_slow"] {
-        let m = scenario_metrics(&scenario::hil(id));
+        let m = STUDY.scenario_metrics(&scenario::hil(id));
         assert!(
             m.tail_amplitude_m >= 4e-3,
             "{id}: final wheelset amplitude {:.2} mm, expected >= 4 mm (seed +-6 mm)",
             m.tail_amplitude_m * 1e3
         );
     }
-    let ideal = scenario_metrics(&scenario::hil("skyhook_onoff"));
+    let ideal = STUDY.scenario_metrics(&scenario::hil("skyhook_onoff"));
     assert!(
         ideal.tail_amplitude_m < 1e-3,
         "ideal-valve sky-hook should damp the 3 mm perturbation at 260 km/h, final {:.2} mm",
         ideal.tail_amplitude_m * 1e3
     );
-    let p = vcr("passive");
+    let p = STUDY.vcr("passive");
     for (slow, fast) in [
         ("skyhook_onoff_slow", "skyhook_onoff"),
         ("skyhook_continuous_slow", "skyhook_continuous"),
     ] {
-        let (s, f) = (vcr(slow), vcr(fast));
+        let (s, f) = (STUDY.vcr(slow), STUDY.vcr(fast));
         assert!(
             s < f && s <= p + 10.0,
             "{slow}: {s} km/h should lose the ideal valve's gain ({fast} {f}, passive {p})"
@@ -285,7 +208,7 @@ fn r12_slow_valve_breaks_skyhook() {
 /// passive < semi-active <= full-active holds for the critical speeds.
 #[test]
 fn r13_full_active_stable_at_380_and_ordering() {
-    let r = results();
+    let r = STUDY.results();
     let cv330 =
         r.cv.iter()
             .find(|c| c.c_v_nspm.is_some_and(|v| (v - 330e3).abs() < 1.0))
@@ -297,14 +220,14 @@ fn r13_full_active_stable_at_380_and_ordering() {
         cv330.rms()
     );
     assert!(
-        vcr("full_active") > 380.0,
+        STUDY.vcr("full_active") > 380.0,
         "{}",
-        critical("full_active").describe()
+        STUDY.critical("full_active").describe()
     );
-    let p = vcr("passive");
-    let f = vcr("full_active");
+    let p = STUDY.vcr("passive");
+    let f = STUDY.vcr("full_active");
     for id in ["mppt1", "mppt2", "skyhook_onoff", "skyhook_continuous"] {
-        let s = vcr(id);
+        let s = STUDY.vcr(id);
         assert!(
             p < s && s <= f,
             "ordering: passive {p} < {id} {s} <= full-active {f}"
@@ -318,7 +241,7 @@ fn r13_full_active_stable_at_380_and_ordering() {
 /// checked against the seed's span.
 #[test]
 fn r14_cv_trends() {
-    let r = results();
+    let r = STUDY.results();
     let rows: Vec<(f64, f64, f64)> =
         r.cv.iter()
             .map(|c| {
@@ -350,7 +273,7 @@ fn r14_cv_trends() {
 /// non-linear bogie is less stable between 260 and 290 km/h).
 #[test]
 fn r7_perturbation_runs() {
-    let r = results();
+    let r = STUDY.results();
     let amp = |v: f64| {
         r.perturbation
             .iter()

@@ -8,9 +8,9 @@
 //! 300 km/h on seed 2 and at 310 km/h on seed 1).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use fmu_damper::{SemiActiveDamper, SemiActiveInputs};
-use fmu_vehicle::{Inputs, PsdLevel, TrackSource, Vehicle, VehicleParams};
+use fmu_vehicle::{PsdLevel, TrackSource, VehicleParams};
 use rail_study::en14363::{acceleration_limit, assess_lateral_acceleration, StabilitySettings};
+use tests::coach::run_with_passive_dampers;
 
 /// Largest EN 14363 rms over the two frames [m/s^2] for a 20 s run (the first 5 s skipped).
 fn max_rms(kmh: f64, seed: u64) -> f64 {
@@ -23,32 +23,13 @@ fn max_rms(kmh: f64, seed: u64) -> f64 {
         ..VehicleParams::default()
     };
     let bogie_t = p.bogie_mass_kg() / 1000.0;
-    let mut v = Vehicle::new(p).unwrap();
-    let mut dampers: Vec<SemiActiveDamper> = (0..4)
-        .map(|_| SemiActiveDamper::passive_reference().unwrap())
-        .collect();
-    let h = 1e-3;
-    let mut inputs = Inputs::default();
-    let mut out = v.outputs(&inputs).unwrap();
     let (mut front, mut rear) = (Vec::new(), Vec::new());
-    for _ in 0..20_000 {
-        for (d, damper) in dampers.iter_mut().enumerate() {
-            let o = damper
-                .step(
-                    h,
-                    &SemiActiveInputs {
-                        elongation_m: out.damper[d].elongation_m,
-                        elongation_velocity_mps: out.damper[d].elongation_velocity_mps,
-                        valve_command_v: 0.0,
-                    },
-                )
-                .unwrap();
-            inputs.damper_force_n[d] = o.force_n;
-        }
-        out = v.step(h, &inputs).unwrap();
+    let h = 1e-3;
+    run_with_passive_dampers(p, h, 20_000, |out| {
         front.push(out.frame[0].lateral_acc_leading_axle_mps2);
         rear.push(out.frame[1].lateral_acc_leading_axle_mps2);
-    }
+    })
+    .unwrap();
     let s = StabilitySettings {
         skip_s: 5.0,
         ..StabilitySettings::default()

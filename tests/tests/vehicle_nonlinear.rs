@@ -6,9 +6,9 @@
 //! flange contact at 280 km/h; a 6-7 mm flange-contact limit cycle at 300 km/h.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use fmu_damper::{SemiActiveDamper, SemiActiveInputs};
 use fmu_vehicle::params::Initial;
-use fmu_vehicle::{Inputs, Vehicle, VehicleParams};
+use fmu_vehicle::VehicleParams;
+use tests::coach::run_with_passive_dampers;
 
 struct Run {
     /// Peak |y_rel| over all wheelsets, 1-3 s [m].
@@ -31,13 +31,7 @@ fn run(kmh: f64, t_end: f64) -> Run {
         },
         ..VehicleParams::default()
     };
-    let mut v = Vehicle::new(p).unwrap();
-    let mut dampers: Vec<SemiActiveDamper> = (0..4)
-        .map(|_| SemiActiveDamper::passive_reference().unwrap())
-        .collect();
     let h = 1e-3;
-    let mut inputs = Inputs::default();
-    let mut out = v.outputs(&inputs).unwrap();
     let mut r = Run {
         early_m: 0.0,
         late_m: 0.0,
@@ -45,21 +39,7 @@ fn run(kmh: f64, t_end: f64) -> Run {
         flange_share: 0.0,
     };
     let (mut late_steps, mut flange_steps) = (0usize, 0usize);
-    for _ in 0..(t_end / h).round() as usize {
-        for (d, damper) in dampers.iter_mut().enumerate() {
-            let o = damper
-                .step(
-                    h,
-                    &SemiActiveInputs {
-                        elongation_m: out.damper[d].elongation_m,
-                        elongation_velocity_mps: out.damper[d].elongation_velocity_mps,
-                        valve_command_v: 0.0,
-                    },
-                )
-                .unwrap();
-            inputs.damper_force_n[d] = o.force_n;
-        }
-        out = v.step(h, &inputs).unwrap();
+    run_with_passive_dampers(p, h, (t_end / h).round() as usize, |out| {
         let y = out
             .wheelset
             .iter()
@@ -78,7 +58,8 @@ fn run(kmh: f64, t_end: f64) -> Run {
                 flange_steps += 1;
             }
         }
-    }
+    })
+    .unwrap();
     r.flange_share = flange_steps as f64 / late_steps as f64;
     eprintln!(
         "{kmh} km/h: early {:.2} mm, last 2 s {:.2} mm, Y/Q {:.2}, on the flange {:.1} % of the time",

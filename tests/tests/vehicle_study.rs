@@ -11,98 +11,23 @@
 // test helpers outside #[test] fns: allowed like the other end-to-end test files
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
-use std::sync::OnceLock;
-
-use rail_study::study::metrics::RunMetrics;
 use rail_study::study::run::scenario;
-use rail_study::study::{
-    run_study, Critical, Sources, StudyOptions, StudyResults, StudySettings, VehicleModel,
-};
+use rail_study::study::{Critical, VehicleModel};
+use tests::study::SharedStudy;
 
-static CANCEL: AtomicBool = AtomicBool::new(false);
-static RESULTS: OnceLock<Result<StudyResults, String>> = OnceLock::new();
-
-fn results() -> &'static StudyResults {
-    let r = RESULTS.get_or_init(|| {
-        let fmus = std::env::var_os("STUDY_FMUS").map_or_else(
-            || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../dist"),
-            PathBuf::from,
-        );
-        if !fmus.join("RailVehicle.fmu").is_file() {
-            return Err(format!(
-                "{} has no RailVehicle.fmu: build the FMUs first with \
-                 `cargo run --release -p model-description --bin package-fmus`",
-                fmus.display()
-            ));
-        }
-        let out = tempfile::tempdir().map_err(|e| e.to_string())?;
-        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let opts = StudyOptions {
-            sources: Sources {
-                fmus,
-                systems: None,
-            },
-            out: out.path().to_path_buf(),
-            threads,
-            progress: false,
-            cancel: &CANCEL,
-        };
-        let start = std::time::Instant::now();
-        let r = run_study(&StudySettings::quick(VehicleModel::Coach), &opts)
-            .map_err(|e| e.to_string())?;
-        let timing = rail_study::study::Timing {
-            wall_s: start.elapsed().as_secs_f64(),
-            threads,
-        };
-        let md =
-            rail_study::study::write_outputs(&r, out.path(), &timing).map_err(|e| e.to_string())?;
-        for f in [
-            "rms_vs_speed.svg",
-            "carbody_vs_speed.svg",
-            "comfort_vs_speed.svg",
-        ] {
-            if !out.path().join(f).is_file() {
-                return Err(format!("{f} missing"));
-            }
-        }
-        if !md.contains("## Car body") {
-            return Err("car-body section missing from the report".into());
-        }
-        eprintln!("{md}");
-        Ok(r)
-    });
-    match r {
-        Ok(r) => r,
-        Err(e) => panic!("the quick coach study did not run: {e}"),
-    }
-}
-
-fn critical(id: &str) -> Critical {
-    results()
-        .config(id)
-        .and_then(|c| c.critical)
-        .unwrap_or_else(|| panic!("{id}: no critical speed"))
-}
-
-/// The critical speed, or the end of the range (420) when stable throughout.
-fn vcr(id: &str) -> f64 {
-    critical(id).at_least_kmh()
-}
-
-fn scenario_metrics(name: &str) -> &'static RunMetrics {
-    let r = results()
-        .scenario(name)
-        .unwrap_or_else(|| panic!("scenario {name} missing"));
-    r.metrics
-        .as_ref()
-        .unwrap_or_else(|| panic!("scenario {name} failed: {:?}", r.error))
-}
+static STUDY: SharedStudy = SharedStudy::new(
+    VehicleModel::Coach,
+    &[
+        "rms_vs_speed.svg",
+        "carbody_vs_speed.svg",
+        "comfort_vs_speed.svg",
+    ],
+    "## Car body",
+);
 
 #[test]
 fn no_run_failed_and_every_run_has_car_body_numbers() {
-    let r = results();
+    let r = STUDY.results();
     assert!(r.failures.is_empty(), "failed runs: {:?}", r.failures);
     for c in &r.configs {
         for p in &c.sweep {
@@ -124,7 +49,7 @@ fn no_run_failed_and_every_run_has_car_body_numbers() {
 /// longer runs move the first exceedance by one step, tests/tests/vehicle_en14363.rs).
 #[test]
 fn passive_critical_speed_280_to_310() {
-    let k = critical("passive");
+    let k = STUDY.critical("passive");
     match k {
         Critical::Between {
             stable_kmh,
@@ -146,19 +71,19 @@ fn passive_critical_speed_280_to_310() {
 /// suspension (the seed names the mounting stiffness; ours is rigid by default).
 #[test]
 fn mppt_raises_the_critical_speed() {
-    let p = vcr("passive");
+    let p = STUDY.vcr("passive");
     for id in ["mppt1", "mppt2"] {
-        let gain = vcr(id) - p;
+        let gain = STUDY.vcr(id) - p;
         assert!(
             gain >= 40.0,
             "{id}: gain {gain} km/h ({})",
-            critical(id).describe()
+            STUDY.critical(id).describe()
         );
         // pinned: stable through the quick grid
         assert!(
-            matches!(critical(id), Critical::Above { .. }),
+            matches!(STUDY.critical(id), Critical::Above { .. }),
             "{id}: {} (was stable to 420 km/h): update REPORT/tests",
-            critical(id).describe()
+            STUDY.critical(id).describe()
         );
     }
 }
@@ -172,10 +97,10 @@ fn mppt_raises_the_critical_speed() {
 /// Asserted: both below passive by 10-60 km/h, far below MPPT.
 #[test]
 fn textbook_skyhook_lowers_the_critical_speed() {
-    let p = vcr("passive");
-    let m = vcr("mppt1").min(vcr("mppt2"));
+    let p = STUDY.vcr("passive");
+    let m = STUDY.vcr("mppt1").min(STUDY.vcr("mppt2"));
     for id in ["skyhook_onoff", "skyhook_continuous"] {
-        let s = vcr(id);
+        let s = STUDY.vcr(id);
         assert!(
             (10.0..=60.0).contains(&(p - s)),
             "{id}: {s} km/h vs passive {p} (measured 25-45 km/h below)"
@@ -190,10 +115,10 @@ fn textbook_skyhook_lowers_the_critical_speed() {
 /// takes that gain away (285 km/h, at or below passive).
 #[test]
 fn accelerometer_skyhook_between_passive_and_mppt_and_broken_by_the_slow_valve() {
-    let p = vcr("passive");
-    let m = vcr("mppt1").min(vcr("mppt2"));
-    let ideal = vcr("skyhook_accel_onoff");
-    let slow = vcr("skyhook_accel_onoff_slow");
+    let p = STUDY.vcr("passive");
+    let m = STUDY.vcr("mppt1").min(STUDY.vcr("mppt2"));
+    let ideal = STUDY.vcr("skyhook_accel_onoff");
+    let slow = STUDY.vcr("skyhook_accel_onoff_slow");
     assert!(
         (10.0..=50.0).contains(&(ideal - p)),
         "ideal valve: {ideal} km/h vs passive {p} (measured +25)"
@@ -204,7 +129,7 @@ fn accelerometer_skyhook_between_passive_and_mppt_and_broken_by_the_slow_valve()
         "slow valve: {slow} km/h vs passive {p}, ideal {ideal} (measured 285)"
     );
     // and the textbook sky-hook stays below it
-    assert!(vcr("skyhook_onoff") < ideal);
+    assert!(STUDY.vcr("skyhook_onoff") < ideal);
 }
 
 /// R12: the slow valve (lag 0.15 s) does not break MPPT: from an 8 V command and a 3 mm
@@ -216,30 +141,34 @@ fn accelerometer_skyhook_between_passive_and_mppt_and_broken_by_the_slow_valve()
 /// to a mean opening, i.e. a passive damper), while with the ideal valve it keeps 6.7 mm.
 #[test]
 fn slow_valve_keeps_mppt_and_not_the_skyhook() {
-    let p = vcr("passive");
+    let p = STUDY.vcr("passive");
     for id in ["mppt1_slow", "mppt2_slow"] {
-        let m = scenario_metrics(&scenario::hil(id));
+        let m = STUDY.scenario_metrics(&scenario::hil(id));
         assert!(
             m.tail_amplitude_m < 1e-3,
             "{id}: final amplitude {:.2} mm",
             m.tail_amplitude_m * 1e3
         );
-        assert!(vcr(id) >= p + 40.0, "{id}: {}", critical(id).describe());
+        assert!(
+            STUDY.vcr(id) >= p + 40.0,
+            "{id}: {}",
+            STUDY.critical(id).describe()
+        );
     }
     for id in ["skyhook_onoff_slow", "skyhook_continuous_slow"] {
         assert!(
-            vcr(id) <= p,
+            STUDY.vcr(id) <= p,
             "{id}: {} vs passive {p}",
-            critical(id).describe()
+            STUDY.critical(id).describe()
         );
     }
-    let cont = scenario_metrics(&scenario::hil("skyhook_continuous_slow"));
+    let cont = STUDY.scenario_metrics(&scenario::hil("skyhook_continuous_slow"));
     assert!(
         cont.tail_amplitude_m >= 4e-3,
         "continuous slow sky-hook: {:.2} mm",
         cont.tail_amplitude_m * 1e3
     );
-    let ideal = scenario_metrics(&scenario::hil("skyhook_onoff"));
+    let ideal = STUDY.scenario_metrics(&scenario::hil("skyhook_onoff"));
     assert!(
         ideal.tail_amplitude_m >= 4e-3,
         "on/off ideal sky-hook: {:.2} mm",
@@ -251,11 +180,11 @@ fn slow_valve_keeps_mppt_and_not_the_skyhook() {
 /// quick grid, 420 km/h), and within the limit in the c_v run at 380 km/h.
 #[test]
 fn full_active_stable_to_380() {
-    let r = results();
+    let r = STUDY.results();
     assert!(
-        vcr("full_active") >= 380.0,
+        STUDY.vcr("full_active") >= 380.0,
         "{}",
-        critical("full_active").describe()
+        STUDY.critical("full_active").describe()
     );
     let cv330 =
         r.cv.iter()
@@ -274,7 +203,8 @@ fn full_active_stable_to_380() {
 /// value at most the 210 one + 1 kN).
 #[test]
 fn cv_sensitivity_of_the_full_active_damper() {
-    let rows: Vec<(f64, f64, f64)> = results()
+    let rows: Vec<(f64, f64, f64)> = STUDY
+        .results()
         .cv
         .iter()
         .map(|c| {
@@ -301,7 +231,8 @@ fn cv_sensitivity_of_the_full_active_damper() {
 #[test]
 fn perturbation_runs_of_the_passive_coach() {
     let amp = |v: f64| {
-        results()
+        STUDY
+            .results()
             .perturbation
             .iter()
             .find(|p| (p.speed_kmh - v).abs() < 0.5)
@@ -322,7 +253,8 @@ fn perturbation_runs_of_the_passive_coach() {
 #[test]
 fn active_dampers_calm_the_car_body() {
     let at = |id: &str| {
-        let p = results()
+        let p = STUDY
+            .results()
             .config(id)
             .and_then(|c| c.sweep.iter().find(|p| (p.speed_kmh - 300.0).abs() < 1e-6))
             .unwrap_or_else(|| panic!("{id} at 300 km/h"));
