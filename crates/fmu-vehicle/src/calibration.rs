@@ -63,30 +63,20 @@ use crate::eigen::{
     critical_speed, CriticalSpeed, DamperRepresentation, EigenError, YawDamperModel,
 };
 use crate::params::VehicleParams;
+// The calibrated values the default parameters take live with the parameters (so that module
+// imports no other of the crate); they are named here too, where they are explained.
+pub use crate::params::{
+    CREEP_REDUCTION, FRICTION_COEFFICIENT, MB_PRIMARY_KX_N_PER_M, MB_PRIMARY_KY_N_PER_M,
+    PRIMARY_STIFFNESS_FACTOR, SOLVER_SUBSTEP_S, TABLE_CONICITY_1MM,
+    TABLE_GRAVITY_STIFFNESS_PER_LOAD_1MM,
+};
 
-/// Equivalent conicity of the worn-profile surrogate at 1 mm amplitude [-].
-pub const TABLE_CONICITY_1MM: f64 = 0.25;
-/// Gravitational stiffness per wheelset of the surrogate at 1 mm divided by the wheel load
-/// [1/m] (the bogie: 2.022 MN/m at 70 kN).
-pub const TABLE_GRAVITY_STIFFNESS_PER_LOAD_1MM: f64 = 2.022e6 / 70e3;
-/// Kalker reduction factor kappa [-].
-pub const CREEP_REDUCTION: f64 = 0.6;
-/// Wheel/rail friction coefficient [-].
-pub const FRICTION_COEFFICIENT: f64 = 0.35;
 /// Maxwell series stiffness of the passive reference damper [N/m].
 pub const PASSIVE_MAXWELL_K_N_PER_M: f64 = 16.9e6;
 /// Maxwell damping of the passive reference damper [N s/m].
 pub const PASSIVE_MAXWELL_C_NS_PER_M: f64 = 104e3;
-/// Manchester Benchmark primary longitudinal stiffness per axle box [N/m].
-pub const MB_PRIMARY_KX_N_PER_M: f64 = 31.391e6;
-/// Manchester Benchmark primary lateral stiffness per axle box [N/m].
-pub const MB_PRIMARY_KY_N_PER_M: f64 = 3.884e6;
-/// Factor on the benchmark's primary longitudinal and lateral stiffness, calibrated for R15.
-pub const PRIMARY_STIFFNESS_FACTOR: f64 = 3.15;
 /// R15 target [km/h] (middle of 280-290).
 pub const TARGET_CRITICAL_SPEED_KMH: f64 = 285.0;
-/// Largest RK4 sub-step of the time-domain model [s].
-pub const SOLVER_SUBSTEP_S: f64 = 1e-3;
 
 /// The passive reference damper as the eigen-analysis sees it (rigid mounting).
 pub fn passive_damper() -> YawDamperModel {

@@ -31,6 +31,27 @@ use vehicle_elements::{finite, in_range, non_negative, positive};
 
 pub use vehicle_elements::ParamError;
 
+// Calibrated values the defaults below take; the procedure that produced them and its reasoning
+// are in the calibration module.
+
+/// Equivalent conicity of the worn-profile surrogate at 1 mm amplitude [-].
+pub const TABLE_CONICITY_1MM: f64 = 0.25;
+/// Gravitational stiffness per wheelset of the surrogate at 1 mm divided by the wheel load
+/// [1/m] (the bogie: 2.022 MN/m at 70 kN).
+pub const TABLE_GRAVITY_STIFFNESS_PER_LOAD_1MM: f64 = 2.022e6 / 70e3;
+/// Kalker reduction factor kappa [-].
+pub const CREEP_REDUCTION: f64 = 0.6;
+/// Wheel/rail friction coefficient [-].
+pub const FRICTION_COEFFICIENT: f64 = 0.35;
+/// Manchester Benchmark primary longitudinal stiffness per axle box [N/m].
+pub const MB_PRIMARY_KX_N_PER_M: f64 = 31.391e6;
+/// Manchester Benchmark primary lateral stiffness per axle box [N/m].
+pub const MB_PRIMARY_KY_N_PER_M: f64 = 3.884e6;
+/// Factor on the benchmark's primary longitudinal and lateral stiffness, calibrated for R15.
+pub const PRIMARY_STIFFNESS_FACTOR: f64 = 3.15;
+/// Largest RK4 sub-step of the time-domain model [s].
+pub const SOLVER_SUBSTEP_S: f64 = 1e-3;
+
 /// Standard gravity [m/s^2].
 pub const STANDARD_GRAVITY_MPS2: f64 = 9.81;
 
@@ -293,10 +314,8 @@ impl Default for VehicleParams {
                 lateral_damper_height_m: 0.8275,
             },
             primary: Primary {
-                kx_n_per_m: crate::calibration::PRIMARY_STIFFNESS_FACTOR
-                    * crate::calibration::MB_PRIMARY_KX_N_PER_M,
-                ky_n_per_m: crate::calibration::PRIMARY_STIFFNESS_FACTOR
-                    * crate::calibration::MB_PRIMARY_KY_N_PER_M,
+                kx_n_per_m: PRIMARY_STIFFNESS_FACTOR * MB_PRIMARY_KX_N_PER_M,
+                ky_n_per_m: PRIMARY_STIFFNESS_FACTOR * MB_PRIMARY_KY_N_PER_M,
                 kz_n_per_m: 1.22e6,
                 cx_ns_per_m: 15e3,
                 cy_ns_per_m: 2e3,
@@ -312,20 +331,19 @@ impl Default for VehicleParams {
                 anti_roll_bar_nm_per_rad: 940e3,
             },
             wheel_rail: WheelRail {
-                conicity: crate::calibration::TABLE_CONICITY_1MM,
-                gravity_stiffness_n_per_m: crate::calibration::TABLE_GRAVITY_STIFFNESS_PER_LOAD_1MM
-                    * load,
+                conicity: TABLE_CONICITY_1MM,
+                gravity_stiffness_n_per_m: TABLE_GRAVITY_STIFFNESS_PER_LOAD_1MM * load,
                 f11_n: scale_creep_coefficient(BOGIE_F11_N, BOGIE_WHEEL_LOAD_N, load),
                 f22_n: scale_creep_coefficient(BOGIE_F22_N, BOGIE_WHEEL_LOAD_N, load),
-                creep_reduction: crate::calibration::CREEP_REDUCTION,
+                creep_reduction: CREEP_REDUCTION,
                 wheel_load_n: load,
-                friction_coefficient: crate::calibration::FRICTION_COEFFICIENT,
+                friction_coefficient: FRICTION_COEFFICIENT,
             },
             gravity_mps2: STANDARD_GRAVITY_MPS2,
             initial: Initial::default(),
             track: TrackSource::None,
             contact: ContactSource::WornSurrogate,
-            solver_substep_s: crate::calibration::SOLVER_SUBSTEP_S,
+            solver_substep_s: SOLVER_SUBSTEP_S,
         }
     }
 }
