@@ -18,12 +18,19 @@ use serde::{Deserialize, Serialize};
 
 const MAX_SUBSTEP_S: f64 = 1.0e-4;
 
-/// Integrate x'' = (f(x, v)) with RK4 sub-steps; `accel` closes over parameters and inputs.
-fn rk4(x: &mut f64, v: &mut f64, h: f64, accel: impl Fn(f64, f64) -> f64) {
+/// One communication step of x'' = accel(x, v) from (x, v) with RK4 sub-steps; `accel` closes
+/// over parameters and inputs. A state that is no longer finite discards the step (the caller
+/// keeps its state).
+fn rk4_step(
+    mut x: f64,
+    mut v: f64,
+    h: f64,
+    accel: impl Fn(f64, f64) -> f64,
+) -> Result<(f64, f64), StepError> {
     let n = (h / MAX_SUBSTEP_S).ceil().max(1.0);
     let dt = h / n;
     for _ in 0..n as usize {
-        let (x0, v0) = (*x, *v);
+        let (x0, v0) = (x, v);
         let k1x = v0;
         let k1v = accel(x0, v0);
         let k2x = v0 + 0.5 * dt * k1v;
@@ -32,8 +39,13 @@ fn rk4(x: &mut f64, v: &mut f64, h: f64, accel: impl Fn(f64, f64) -> f64) {
         let k3v = accel(x0 + 0.5 * dt * k2x, v0 + 0.5 * dt * k2v);
         let k4x = v0 + dt * k3v;
         let k4v = accel(x0 + dt * k3x, v0 + dt * k3v);
-        *x = x0 + dt / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
-        *v = v0 + dt / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+        x = x0 + dt / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+        v = v0 + dt / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+    }
+    if x.is_finite() && v.is_finite() {
+        Ok((x, v))
+    } else {
+        Err(StepError::Discard("state is no longer finite".into()))
     }
 }
 
@@ -164,13 +176,10 @@ impl FmuModel for MassSpring {
     }
 
     fn do_step(&mut self, _t: f64, h: f64, _diag: &mut Diagnostics) -> Result<(), StepError> {
-        let (mut x, mut v) = (self.position_m, self.velocity_mps);
-        rk4(&mut x, &mut v, h, |x, v| self.accel(x, v));
-        if !(x.is_finite() && v.is_finite()) {
-            return Err(StepError::Discard("state is no longer finite".into()));
-        }
-        self.position_m = x;
-        self.velocity_mps = v;
+        (self.position_m, self.velocity_mps) =
+            rk4_step(self.position_m, self.velocity_mps, h, |x, v| {
+                self.accel(x, v)
+            })?;
         Ok(())
     }
 }
@@ -290,13 +299,10 @@ impl FmuModel for SpringDamperMass {
     }
 
     fn do_step(&mut self, _t: f64, h: f64, _diag: &mut Diagnostics) -> Result<(), StepError> {
-        let (mut x, mut v) = (self.position_m, self.velocity_mps);
-        rk4(&mut x, &mut v, h, |x, v| self.accel(x, v));
-        if !(x.is_finite() && v.is_finite()) {
-            return Err(StepError::Discard("state is no longer finite".into()));
-        }
-        self.position_m = x;
-        self.velocity_mps = v;
+        (self.position_m, self.velocity_mps) =
+            rk4_step(self.position_m, self.velocity_mps, h, |x, v| {
+                self.accel(x, v)
+            })?;
         Ok(())
     }
 }
