@@ -415,9 +415,9 @@ fn main() {
 /// median real-time factor of 5 runs of 5 s from a vehicle that has run 2 s.
 fn vehicle_rtf() -> f64 {
     use fmu_vehicle::calibration::{PASSIVE_MAXWELL_C_NS_PER_M, PASSIVE_MAXWELL_K_N_PER_M};
-    use fmu_vehicle::sim::{run_closed_loop, LoopDamper};
+    use fmu_vehicle::sim::{run_closed_loop, LinearDamper};
     use fmu_vehicle::{ModelKind, Vehicle, VehicleParams};
-    let damper = LoopDamper::Maxwell {
+    let damper = LinearDamper::Maxwell {
         k: PASSIVE_MAXWELL_K_N_PER_M,
         c: PASSIVE_MAXWELL_C_NS_PER_M,
     };

@@ -3,7 +3,7 @@
 //! several speeds. Usage: `cargo run --release --example calibration_report [table.csv [k_ssx [conicity [k_grav]]]]`.
 use fmu_bogie2dof::calibration::*;
 use fmu_bogie2dof::eigen::critical_speed;
-use fmu_bogie2dof::sim::{run_closed_loop, LoopDamper};
+use fmu_bogie2dof::sim::{run_closed_loop, LinearDamper};
 use fmu_bogie2dof::{Bogie, Params};
 use wheel_rail::GeometryTable;
 
@@ -29,7 +29,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let (lam, grav) = table.linearise(LINEARISATION_AMPLITUDE_M);
     println!("table: equivalent conicity at 1 mm {lam:.3}, gravity stiffness/P {grav:.2} 1/m");
-    let damper = LoopDamper::Maxwell {
+    let damper = LinearDamper::Maxwell {
         k: PASSIVE_MAXWELL_K_N_PER_M,
         c: PASSIVE_MAXWELL_C_NS_PER_M,
     };

@@ -10,7 +10,7 @@ use model_description::{
     MAX_PARAMETER_FILE_BYTES,
 };
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{InputError, TrackLevel};
+use vehicle_elements::{resource_or_given, InputError, TrackLevel};
 use wheel_rail::GeometryTable;
 
 use crate::model::{Bogie, Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep};
@@ -108,16 +108,7 @@ impl Bogie2Dof {
     fn contact_source(&self) -> ContactSource {
         match ContactSource::from_path_str(&self.contact) {
             ContactSource::File(p) => {
-                let path = PathBuf::from(&p);
-                if path.is_relative() {
-                    if let Some(dir) = &self.resource_dir {
-                        let candidate = dir.join(&path);
-                        if candidate.is_file() {
-                            return ContactSource::File(candidate.to_string_lossy().into_owned());
-                        }
-                    }
-                }
-                ContactSource::File(p)
+                ContactSource::File(resource_or_given(&p, self.resource_dir.as_deref()))
             }
             other => other,
         }

@@ -14,7 +14,7 @@ use std::time::Instant;
 use crate::calibration::{PASSIVE_MAXWELL_C_NS_PER_M, PASSIVE_MAXWELL_K_N_PER_M};
 use crate::model::{Bogie, ModelError, StepError};
 use crate::params::{Params, PsdLevel, TrackSource};
-use crate::sim::{run_closed_loop, LoopDamper};
+use crate::sim::{run_closed_loop, LinearDamper};
 
 /// Communication step of the reference run [s].
 pub const REFERENCE_STEP_S: f64 = 1e-3;
@@ -65,7 +65,7 @@ pub fn reference_bogie(track: ReferenceTrack) -> Result<Bogie, PerfError> {
 /// select it by name (`valgrind --tool=callgrind --toggle-collect='*simulate_reference*'`).
 #[inline(never)]
 pub fn simulate_reference(bogie: &mut Bogie, sim_seconds: f64) -> Result<f64, PerfError> {
-    let damper = LoopDamper::Maxwell {
+    let damper = LinearDamper::Maxwell {
         k: PASSIVE_MAXWELL_K_N_PER_M,
         c: PASSIVE_MAXWELL_C_NS_PER_M,
     };

@@ -3,28 +3,14 @@
 //! step, held over the step). Used by the tests (R7) and handy for the master; the coupled-FMU
 //! check with the hydraulic damper happens elsewhere.
 
-pub use vehicle_elements::LoopDamper;
-use vehicle_elements::{damper, ClosedLoopModel};
+use vehicle_elements::ClosedLoopModel;
+pub use vehicle_elements::{run_closed_loop, LinearDamper};
 
 use crate::model::{Bogie, Inputs, Outputs, StepError};
 
 /// The bogie's two yaw-damper ports (left, right) in the closed loop.
 impl ClosedLoopModel<2> for Bogie {
-    type Inputs = Inputs;
-    type Outputs = Outputs;
-    type Error = StepError;
-
-    fn time_s(&self) -> f64 {
-        Bogie::time_s(self)
-    }
-
-    fn outputs(&self, inputs: &Inputs) -> Result<Outputs, StepError> {
-        Bogie::outputs(self, inputs)
-    }
-
-    fn step(&mut self, h_s: f64, inputs: &Inputs) -> Result<Outputs, StepError> {
-        Bogie::step(self, h_s, inputs)
-    }
+    vehicle_elements::forward_stepping!(Bogie, Inputs, Outputs, StepError);
 
     fn set_track_lateral_m(inputs: &mut Inputs, track_lateral_m: f64) {
         inputs.track_lateral_m = track_lateral_m;
@@ -41,16 +27,4 @@ impl ClosedLoopModel<2> for Bogie {
         inputs.damper_left_force_n = left_n;
         inputs.damper_right_force_n = right_n;
     }
-}
-
-/// Runs `t_end` seconds with communication step h; calls `record` with every output.
-pub fn run_closed_loop(
-    bogie: &mut Bogie,
-    damper: LoopDamper,
-    h: f64,
-    t_end: f64,
-    track_lateral_m: &dyn Fn(f64) -> f64,
-    record: &mut dyn FnMut(&Outputs),
-) -> Result<(), StepError> {
-    damper::run_closed_loop(bogie, damper, h, t_end, track_lateral_m, record)
 }

@@ -7,12 +7,12 @@
 
 use fmu_bogie2dof::calibration::*;
 use fmu_bogie2dof::eigen::*;
-use fmu_bogie2dof::sim::{run_closed_loop, LoopDamper};
+use fmu_bogie2dof::sim::{run_closed_loop, LinearDamper};
 use fmu_bogie2dof::*;
 use wheel_rail::GeometryTable;
 
-fn passive_loop() -> LoopDamper {
-    LoopDamper::Maxwell {
+fn passive_loop() -> LinearDamper {
+    LinearDamper::Maxwell {
         k: PASSIVE_MAXWELL_K_N_PER_M,
         c: PASSIVE_MAXWELL_C_NS_PER_M,
     }
@@ -34,7 +34,7 @@ fn run(
     y0: f64,
     h: f64,
     t_end: f64,
-    damper: LoopDamper,
+    damper: LinearDamper,
 ) -> Vec<(f64, f64, f64)> {
     run_with(kmh, model, y0, h, t_end, damper, default_table())
 }
@@ -45,7 +45,7 @@ fn run_with(
     y0: f64,
     h: f64,
     t_end: f64,
-    damper: LoopDamper,
+    damper: LinearDamper,
     table: GeometryTable,
 ) -> Vec<(f64, f64, f64)> {
     let p = Params {
@@ -382,7 +382,7 @@ fn communication_step_independence_model_alone() {
         };
         let mut b = Bogie::with_table(p, synthetic_table()).unwrap();
         let mut v = Vec::new();
-        run_closed_loop(&mut b, LoopDamper::None, h, 1.55, &|_| 0.0, &mut |o| {
+        run_closed_loop(&mut b, LinearDamper::None, h, 1.55, &|_| 0.0, &mut |o| {
             v.push((o.time_s, o.wheelset_front_lateral_m))
         })
         .unwrap();
@@ -398,7 +398,7 @@ fn communication_step_independence_model_alone() {
         };
         let mut b = Bogie::with_table(p, default_table()).unwrap();
         let mut v = Vec::new();
-        run_closed_loop(&mut b, LoopDamper::None, h, t_end, &|_| 0.0, &mut |o| {
+        run_closed_loop(&mut b, LinearDamper::None, h, t_end, &|_| 0.0, &mut |o| {
             v.push((o.time_s, o.wheelset_front_lateral_m))
         })
         .unwrap();
@@ -778,7 +778,7 @@ fn internal_track_does_not_depend_on_the_communication_step() {
         };
         let mut b = Bogie::with_table(p, default_table()).unwrap();
         let mut v = Vec::new();
-        run_closed_loop(&mut b, LoopDamper::None, h, 1.55, &|_| 0.0, &mut |o| {
+        run_closed_loop(&mut b, LinearDamper::None, h, 1.55, &|_| 0.0, &mut |o| {
             v.push((o.time_s, o.track_front_m, o.wheelset_front_lateral_m))
         })
         .unwrap();

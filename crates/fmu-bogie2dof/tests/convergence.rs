@@ -20,11 +20,11 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use fmu_bogie2dof::calibration::*;
-use fmu_bogie2dof::sim::{run_closed_loop, LoopDamper};
+use fmu_bogie2dof::sim::{run_closed_loop, LinearDamper};
 use fmu_bogie2dof::*;
 
-fn passive_loop() -> LoopDamper {
-    LoopDamper::Maxwell {
+fn passive_loop() -> LinearDamper {
+    LinearDamper::Maxwell {
         k: PASSIVE_MAXWELL_K_N_PER_M,
         c: PASSIVE_MAXWELL_C_NS_PER_M,
     }
@@ -53,7 +53,14 @@ fn params(kmh: f64, y0: f64, track: TrackSource) -> Params {
 }
 
 /// Peak |wheelset displacement relative to the track| over [t0, t_end].
-fn late_peak(p: &Params, damper: LoopDamper, comm_s: f64, h_sub: f64, t0: f64, t_end: f64) -> f64 {
+fn late_peak(
+    p: &Params,
+    damper: LinearDamper,
+    comm_s: f64,
+    h_sub: f64,
+    t0: f64,
+    t_end: f64,
+) -> f64 {
     let mut b = bogie(p, h_sub);
     let mut peak: f64 = 0.0;
     run_closed_loop(&mut b, damper, comm_s, t_end, &|_| 0.0, &mut |o| {
@@ -116,7 +123,7 @@ fn amplitudes(comm_s: f64, h_sub: f64) -> (f64, f64, f64) {
     );
     let flange = late_peak(
         &params(300.0, 3e-3, TrackSource::None),
-        LoopDamper::None,
+        LinearDamper::None,
         comm_s,
         h_sub,
         2.0,

@@ -11,7 +11,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use fmu_vehicle::calibration::{PASSIVE_MAXWELL_C_NS_PER_M, PASSIVE_MAXWELL_K_N_PER_M};
 use fmu_vehicle::fmu::RailVehicle;
-use fmu_vehicle::sim::{run_closed_loop, LoopDamper};
+use fmu_vehicle::sim::{run_closed_loop, LinearDamper};
 use fmu_vehicle::{ModelKind, PsdLevel, TrackSource, Vehicle, VehicleParams};
 use model_description::{rust_component, value_reference, InstanceContext, Status};
 
@@ -58,7 +58,7 @@ fn fmu_bench(c: &mut Criterion) {
 }
 
 fn bench(c: &mut Criterion) {
-    let damper = LoopDamper::Maxwell {
+    let damper = LinearDamper::Maxwell {
         k: PASSIVE_MAXWELL_K_N_PER_M,
         c: PASSIVE_MAXWELL_C_NS_PER_M,
     };

@@ -18,31 +18,9 @@ use serde::{Deserialize, Serialize};
 use crate::layout::{damper_rows, mass_diagonal, N_DAMPERS, N_DOF};
 use crate::params::{ParamError, VehicleParams};
 
-/// Linear representation of one yaw damper (all four identical), values per damper.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum DamperRepresentation {
-    /// No yaw dampers.
-    None,
-    /// Dashpot c [N s/m].
-    Viscous {
-        /// Damping [N s/m].
-        c: f64,
-    },
-    /// Spring k parallel to dashpot c.
-    KelvinVoigt {
-        /// Stiffness [N/m].
-        k: f64,
-        /// Damping [N s/m].
-        c: f64,
-    },
-    /// Spring k in series with dashpot c.
-    Maxwell {
-        /// Series stiffness [N/m].
-        k: f64,
-        /// Damping [N s/m].
-        c: f64,
-    },
-}
+/// Linear representation of one yaw damper (all four identical), values per damper: the law the
+/// closed loop evaluates too.
+pub use vehicle_elements::LinearDamper as DamperRepresentation;
 
 /// A yaw damper as the eigen-analysis sees it: its representation behind an optional mounting
 /// (series) stiffness of the installation.

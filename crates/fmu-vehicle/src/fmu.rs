@@ -9,7 +9,7 @@ use model_description::{
     ModelError, ModelInfo, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{InputError, TrackLevel};
+use vehicle_elements::{resource_or_given, InputError, TrackLevel};
 
 use crate::model::{Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep, Vehicle};
 use crate::params::{ContactSource, Initial, ModelKind, TrackSource, VehicleParams};
@@ -93,18 +93,7 @@ impl RailVehicle {
     fn contact_source(&self) -> ContactSource {
         match self.contact.trim() {
             "" | "worn" => ContactSource::WornSurrogate,
-            p => {
-                let path = PathBuf::from(p);
-                if path.is_relative() {
-                    if let Some(dir) = &self.resource_dir {
-                        let candidate = dir.join(&path);
-                        if candidate.is_file() {
-                            return ContactSource::File(candidate.to_string_lossy().into_owned());
-                        }
-                    }
-                }
-                ContactSource::File(p.to_string())
-            }
+            p => ContactSource::File(resource_or_given(p, self.resource_dir.as_deref())),
         }
     }
 

@@ -8,11 +8,11 @@
 use fmu_vehicle::calibration::*;
 use fmu_vehicle::eigen::{analyse, critical_speed, DamperRepresentation, ModeKind, YawDamperModel};
 use fmu_vehicle::model::worn_surrogate_table;
-use fmu_vehicle::sim::{run_closed_loop, LoopDamper};
+use fmu_vehicle::sim::{run_closed_loop, LinearDamper};
 use fmu_vehicle::{ModelKind, Vehicle, VehicleParams};
 
-fn maxwell() -> LoopDamper {
-    LoopDamper::Maxwell {
+fn maxwell() -> LinearDamper {
+    LinearDamper::Maxwell {
         k: PASSIVE_MAXWELL_K_N_PER_M,
         c: PASSIVE_MAXWELL_C_NS_PER_M,
     }
@@ -140,7 +140,7 @@ fn time_domain_linear_growth_matches_the_eigenvalue() {
         .re;
     let mut v = Vehicle::new(p).unwrap();
     let mut peaks = [0.0_f64; 11];
-    run_closed_loop(&mut v, LoopDamper::None, 1e-3, 11.0, &|_| 0.0, &mut |o| {
+    run_closed_loop(&mut v, LinearDamper::None, 1e-3, 11.0, &|_| 0.0, &mut |o| {
         let k = (o.time_s as usize).min(10);
         peaks[k] = peaks[k].max(o.wheelset[0].lateral_m.abs());
     })

@@ -8,7 +8,7 @@
 
 use fmu_vehicle::calibration::{PASSIVE_MAXWELL_C_NS_PER_M, PASSIVE_MAXWELL_K_N_PER_M};
 use fmu_vehicle::params::Initial;
-use fmu_vehicle::sim::{run_closed_loop, LoopDamper};
+use fmu_vehicle::sim::{run_closed_loop, LinearDamper};
 use fmu_vehicle::{ModelKind, Vehicle, VehicleParams};
 
 fn params(kmh: f64, model: ModelKind, substep_s: f64, y0: f64) -> VehicleParams {
@@ -29,7 +29,7 @@ fn params(kmh: f64, model: ModelKind, substep_s: f64, y0: f64) -> VehicleParams 
 /// largest Y/Q there).
 fn flange_limit_cycle(substep_s: f64, h: f64) -> (f64, f64) {
     let mut v = Vehicle::new(params(320.0, ModelKind::NonLinear, substep_s, 3e-3)).unwrap();
-    let d = LoopDamper::Maxwell {
+    let d = LinearDamper::Maxwell {
         k: PASSIVE_MAXWELL_K_N_PER_M,
         c: 0.3 * PASSIVE_MAXWELL_C_NS_PER_M,
     };
@@ -47,7 +47,7 @@ fn flange_limit_cycle(substep_s: f64, h: f64) -> (f64, f64) {
 /// Envelope growth rate [1/s] of the linear model with the passive Maxwell dampers.
 fn growth_rate(kmh: f64, substep_s: f64, h: f64) -> f64 {
     let mut v = Vehicle::new(params(kmh, ModelKind::Linear, substep_s, 1e-5)).unwrap();
-    let d = LoopDamper::Maxwell {
+    let d = LinearDamper::Maxwell {
         k: PASSIVE_MAXWELL_K_N_PER_M,
         c: PASSIVE_MAXWELL_C_NS_PER_M,
     };

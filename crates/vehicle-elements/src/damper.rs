@@ -1,15 +1,22 @@
-//! The stand-in yaw damper of the closed-loop runs: a linear damper law evaluated beside a
+//! The linear yaw damper law of both models, and the closed loop that evaluates it beside a
 //! vehicle model, co-simulation style (each damper's force from the outputs of the previous
-//! step, held over the step), and the loop itself. The coupled runs with the hydraulic damper
-//! FMUs happen in the master; this loop serves the models' calibration and convergence tests.
+//! step, held over the step). The coupled runs with the hydraulic damper FMUs happen in the
+//! master; this loop serves the models' calibration and convergence tests.
 
 use serde::{Deserialize, Serialize};
 
-/// A yaw damper law, the same for every damper of the model.
+/// A linear yaw damper law, values per damper, the same for every damper of the model: what
+/// the closed loop evaluates beside a model, and how the coach's eigen-analysis takes its
+/// dampers.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum LoopDamper {
+pub enum LinearDamper {
     /// No damper.
     None,
+    /// Dashpot c: F = c e'.
+    Viscous {
+        /// Damping [N s/m].
+        c: f64,
+    },
     /// Spring k parallel to dashpot c: F = k e + c e'.
     KelvinVoigt {
         /// Stiffness [N/m].
@@ -17,18 +24,18 @@ pub enum LoopDamper {
         /// Damping [N s/m].
         c: f64,
     },
-    /// Spring k in series with dashpot c: F' = k (e' - F / c), advanced exactly over a step
-    /// for a constant elongation velocity; the force held over the step is the mean of its
-    /// values at the step ends.
+    /// Spring k in series with dashpot c: F' = k (e' - F / c); in the closed loop advanced
+    /// exactly over a step for a constant elongation velocity, the force held over the step
+    /// the mean of its values at the step ends.
     Maxwell {
-        /// Stiffness [N/m].
+        /// Series stiffness [N/m].
         k: f64,
         /// Damping [N s/m].
         c: f64,
     },
 }
 
-impl LoopDamper {
+impl LinearDamper {
     /// Force of one damper held over the next step of length `h_s`, from its elongation
     /// [m] and elongation velocity [m/s] at the start of the step; `state_n` is the
     /// Maxwell element's force [N], advanced to the end of the step.
@@ -40,9 +47,10 @@ impl LoopDamper {
         h_s: f64,
     ) -> f64 {
         match *self {
-            LoopDamper::None => 0.0,
-            LoopDamper::KelvinVoigt { k, c } => k * elongation_m + c * velocity_mps,
-            LoopDamper::Maxwell { k, c } => {
+            LinearDamper::None => 0.0,
+            LinearDamper::Viscous { c } => c * velocity_mps,
+            LinearDamper::KelvinVoigt { k, c } => k * elongation_m + c * velocity_mps,
+            LinearDamper::Maxwell { k, c } => {
                 let old = *state_n;
                 let a = (-k * h_s / c).exp();
                 *state_n = old * a + c * velocity_mps * (1.0 - a);
@@ -75,12 +83,35 @@ pub trait ClosedLoopModel<const N: usize> {
     fn set_damper_force_n(inputs: &mut Self::Inputs, force_n: [f64; N]);
 }
 
+/// The stepping items of a [`ClosedLoopModel`] impl, forwarded to the model's own `time_s`,
+/// `outputs` and `step`: `forward_stepping!(Model, Inputs, Outputs, Error);` inside the impl.
+#[macro_export]
+macro_rules! forward_stepping {
+    ($model:ty, $inputs:ty, $outputs:ty, $error:ty) => {
+        type Inputs = $inputs;
+        type Outputs = $outputs;
+        type Error = $error;
+
+        fn time_s(&self) -> f64 {
+            <$model>::time_s(self)
+        }
+
+        fn outputs(&self, inputs: &$inputs) -> Result<$outputs, $error> {
+            <$model>::outputs(self, inputs)
+        }
+
+        fn step(&mut self, h_s: f64, inputs: &$inputs) -> Result<$outputs, $error> {
+            <$model>::step(self, h_s, inputs)
+        }
+    };
+}
+
 /// Runs `t_end_s` seconds with communication step `h_s`, the track input from
 /// `track_lateral_m` (time -> alignment), `damper` on every port; calls `record` with every
 /// output, the initial one included.
 pub fn run_closed_loop<M: ClosedLoopModel<N>, const N: usize>(
     model: &mut M,
-    damper: LoopDamper,
+    damper: LinearDamper,
     h_s: f64,
     t_end_s: f64,
     track_lateral_m: &dyn Fn(f64) -> f64,
@@ -112,7 +143,7 @@ mod tests {
 
     #[test]
     fn maxwell_reaches_the_dashpot_force_and_holds_the_step_mean() {
-        let d = LoopDamper::Maxwell { k: 1e6, c: 1e5 };
+        let d = LinearDamper::Maxwell { k: 1e6, c: 1e5 };
         let mut f = 0.0;
         // k h / c = 1: F(h) = c v (1 - e^-1), held force its half.
         let held = d.held_force_n(0.0, 0.1, &mut f, 0.1);
@@ -123,8 +154,10 @@ mod tests {
             d.held_force_n(0.0, 0.1, &mut f, 0.1);
         }
         assert!((f - 1e4).abs() < 1e-6);
-        let kv = LoopDamper::KelvinVoigt { k: 2.0, c: 3.0 };
+        let kv = LinearDamper::KelvinVoigt { k: 2.0, c: 3.0 };
         assert_eq!(kv.held_force_n(5.0, 7.0, &mut f, 0.1), 31.0);
-        assert_eq!(LoopDamper::None.held_force_n(5.0, 7.0, &mut f, 0.1), 0.0);
+        let viscous = LinearDamper::Viscous { c: 3.0 };
+        assert_eq!(viscous.held_force_n(5.0, 7.0, &mut f, 0.1), 21.0);
+        assert_eq!(LinearDamper::None.held_force_n(5.0, 7.0, &mut f, 0.1), 0.0);
     }
 }

@@ -6,17 +6,21 @@
 //! * [`track`]: the FMI-facing choices of the track input (the ERRI B176 level, and the
 //!   source through [`track_choice_enum!`]) and their mapping onto the physics'
 //!   [`wheel_rail::track::TrackSource`];
-//! * [`damper`]: the stand-in yaw damper (none, Kelvin-Voigt, Maxwell) that the closed-loop
-//!   runs evaluate beside a model, co-simulation style, and the loop itself.
+//! * [`resources`]: file parameters looked up under the FMU's `resources/` folder first;
+//! * [`damper`]: the linear yaw damper law (none, viscous, Kelvin-Voigt, Maxwell) that the
+//!   closed-loop runs evaluate beside a model, co-simulation style, and the coach's
+//!   eigen-analysis takes; the loop itself.
 //!
 //! Wheel/rail contact and the track generator are physics of contact and live in `wheel-rail`.
 
 pub mod damper;
 pub mod params;
+pub mod resources;
 pub mod step;
 pub mod track;
 
-pub use damper::{run_closed_loop, ClosedLoopModel, LoopDamper};
+pub use damper::{run_closed_loop, ClosedLoopModel, LinearDamper};
 pub use params::{finite, in_range, non_negative, positive, ParamError};
+pub use resources::resource_or_given;
 pub use step::{check_inputs, check_step, InputError};
 pub use track::TrackLevel;
