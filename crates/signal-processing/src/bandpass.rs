@@ -150,44 +150,20 @@ impl BandPass {
 
     /// Causal filtering of a whole signal from zero state (the filter's own state is untouched).
     pub fn filter(&self, x: &[f64]) -> Vec<f64> {
-        let mut y = x.to_vec();
-        for s in &self.sections {
-            let mut s = Biquad::new(s.b, s.a);
-            for v in y.iter_mut() {
-                *v = s.process(*v);
-            }
-        }
-        y
+        crate::biquad::cascade_filter(&self.sections, x)
     }
 
     /// Zero-phase filtering (forward and backward; gain |H|^2), with odd reflection padding of
     /// `pad` samples at both ends to shorten the start transients.
     pub fn filtfilt(&self, x: &[f64], pad: usize) -> Vec<f64> {
-        let n = x.len();
-        if n == 0 {
-            return Vec::new();
-        }
-        let pad = pad.min(n - 1);
-        let mut ext = Vec::with_capacity(n + 2 * pad);
-        for i in (1..=pad).rev() {
-            ext.push(2.0 * x[0] - x[i]);
-        }
-        ext.extend_from_slice(x);
-        for i in 1..=pad {
-            ext.push(2.0 * x[n - 1] - x[n - 1 - i]);
-        }
-        let mut y = self.filter(&ext);
-        y.reverse();
-        let mut y = self.filter(&y);
-        y.reverse();
-        y[pad..pad + n].to_vec()
+        crate::biquad::cascade_filtfilt(&self.sections, x, pad)
     }
 }
 
 /// Poles of the analogue Butterworth low-pass prototype (unit cut-off) in the upper half plane
 /// and on the real axis, `exp(i pi (2k + n + 1) / (2n))` for `k = 0..n` with angle <= pi; the
 /// real pole of an odd order is exactly -1.
-fn upper_prototype_poles(n: usize) -> Vec<Complex64> {
+pub(crate) fn upper_prototype_poles(n: usize) -> Vec<Complex64> {
     (0..n)
         .filter_map(|k| {
             let num = 2 * k + n + 1;

@@ -51,6 +51,42 @@ impl Biquad {
     }
 }
 
+/// Causal filtering of a whole signal through a cascade of sections, each from zero state
+/// (the sections' own state is untouched).
+pub(crate) fn cascade_filter(sections: &[Biquad], x: &[f64]) -> Vec<f64> {
+    let mut y = x.to_vec();
+    for s in sections {
+        let mut s = Biquad::new(s.b, s.a);
+        for v in y.iter_mut() {
+            *v = s.process(*v);
+        }
+    }
+    y
+}
+
+/// Zero-phase filtering through a cascade (forward and backward; gain |H|^2), with odd
+/// reflection padding of `pad` samples at both ends to shorten the start transients.
+pub(crate) fn cascade_filtfilt(sections: &[Biquad], x: &[f64], pad: usize) -> Vec<f64> {
+    let n = x.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    let pad = pad.min(n - 1);
+    let mut ext = Vec::with_capacity(n + 2 * pad);
+    for i in (1..=pad).rev() {
+        ext.push(2.0 * x[0] - x[i]);
+    }
+    ext.extend_from_slice(x);
+    for i in 1..=pad {
+        ext.push(2.0 * x[n - 1] - x[n - 1 - i]);
+    }
+    let mut y = cascade_filter(sections, &ext);
+    y.reverse();
+    let mut y = cascade_filter(sections, &y);
+    y.reverse();
+    y[pad..pad + n].to_vec()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -7,6 +7,8 @@
 //!   analogue prototype and the bilinear (Tustin) transform with pre-warped edges, as a cascade
 //!   of biquads each scaled to unit gain at the centre; streaming ([`BandPass::process`]),
 //!   causal over a slice ([`BandPass::filter`]) and zero-phase ([`BandPass::filtfilt`]).
+//! * [`LowPass`]: Butterworth low-pass of the same design (the anti-aliasing filter of
+//!   decimated results), causal and zero-phase.
 //! * [`WdWeighting`]: the W_d frequency weighting of horizontal whole-body vibration (EN 12299,
 //!   ISO 2631-1) for the ride-comfort index of the study.
 //! * [`principal_sqrt`]: the complex square root the design uses; [`rms`]; [`sampled`] (test
@@ -17,10 +19,12 @@
 
 mod bandpass;
 mod biquad;
+mod lowpass;
 mod weighting;
 
 pub use bandpass::{BandPass, DesignError, DesignParameter};
 pub use biquad::Biquad;
+pub use lowpass::LowPass;
 pub use num_complex::Complex64;
 pub use weighting::WdWeighting;
 
