@@ -31,11 +31,12 @@ if ! "$VENV/bin/python" -c "import pythonfmu" 2>/dev/null; then
 fi
 
 # The Python package railfmu (python/): maturin builds its wheel from the binding crate; pandas,
-# dask.distributed, tqdm and pytest are what it and its tests use.
-if ! "$VENV/bin/python" -c "import maturin, pandas, distributed, tqdm, pytest" 2>/dev/null; then
-  step "installing maturin, pandas, dask.distributed, tqdm, pytest into $VENV"
-  "$VENV/bin/pip" install -q "maturin==1.16.0" "pandas==3.1.1" "dask==2026.8.0" "distributed==2026.8.0" \
-    "tqdm==4.67.1" "pytest==9.2.0" >/dev/null
+# dask.distributed, tqdm and pytest are what it and its tests use; pyarrow reads the Parquet
+# results (pandas.read_parquet).
+if ! "$VENV/bin/python" -c "import maturin, pandas, distributed, tqdm, pytest, pyarrow" 2>/dev/null; then
+  step "installing maturin, pandas, pyarrow, dask.distributed, tqdm, pytest into $VENV"
+  "$VENV/bin/pip" install -q "maturin==1.16.0" "pandas==3.1.1" "pyarrow==26.0.1" "dask==2026.8.0" \
+    "distributed==2026.8.0" "tqdm==4.67.1" "pytest==9.2.0" >/dev/null
 fi
 
 # SSP hosts for tests/tests/ssp_interop.rs: libcosim (libcosimpy, whose libcosimc needs the

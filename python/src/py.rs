@@ -499,6 +499,7 @@ fn write_run(
                 // computed elsewhere and handed over as numbers: every column Real
                 columns: Vec::new(),
                 strings: Vec::new(),
+                decimation: None,
             })
         }
         _ => Err("internal: a run came back with neither results nor an error".to_string()),

@@ -63,6 +63,7 @@ mod tests {
             },
             columns: vec![],
             strings: vec![],
+            decimation: None,
         }
     }
 

@@ -106,6 +106,7 @@ pub fn simulate(
         data,
         columns: plan.record.iter().map(|r| r.info.clone()).collect(),
         strings,
+        decimation: None,
         summary: Summary {
             terminated,
             steps: steps.min(n_steps),

@@ -11,7 +11,9 @@
 //! * [`coupling`]: Jacobi / Gauss-Seidel fixed-step master over any [`slave::Slave`].
 //! * [`runset`]: parameter sweeps in parallel.
 //! * [`input`]: input files read without hanging (regular files only) or filling memory.
+//! * [`decimation`]: results decimated without aliasing, and the sampling record of a file.
 //! * [`output`]: atomic CSV/JSON output.
+//! * [`results`]: results files, CSV or Parquet ([`parquet_file`]), and their metadata.
 //! * [`cli`]: the generic subcommands (run, sweep, inspect) and the binary's common main.
 //!
 //! A coupled run in a test is three lines:
@@ -25,10 +27,13 @@
 
 pub mod cli;
 pub mod coupling;
+pub mod decimation;
 pub mod fmu;
 pub mod input;
 pub mod model_description;
 pub mod output;
+pub mod parquet_file;
+pub mod results;
 pub mod runset;
 pub mod slave;
 pub mod ssp;

@@ -260,6 +260,7 @@ mod tests {
                 col(ScalarType::String, vec![]),
             ],
             strings: vec!["Set me!".into(), "say \"hi\"".into()],
+            decimation: None,
         };
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("r.csv");

@@ -10,7 +10,11 @@
 //! Every combination of `product` (cartesian, keys in alphabetical order) and every entry of
 //! `runs` is one job; with neither, the base alone is run. Keys are `instance.variable`.
 //! Each job is self-contained (its resolved system description, FMU paths absolute) and is
-//! written to `<outdir>/<run>/system.json`, with `results.csv` and `summary.json` beside it.
+//! written to `<outdir>/<run>/system.json`, with `summary.json` beside it and its results:
+//! as CSV `<outdir>/<run>/results.csv` (metadata in `results.meta.json`), as Parquet
+//! `<outdir>/results/<run>.parquet`, a folder of Parquet files alone that reads as one table
+//! (`pandas.read_parquet("<outdir>/results")`: every run with its name and parameters as
+//! columns; see [`crate::results`]).
 //! The base system is prepared once ([`PreparedSystem`]: FMUs unpacked and loaded once, plan
 //! built once); a job is then its start values and stop time ([`run_job`]). Jobs run on a
 //! rayon pool; each job instantiates its own FMU instances (never shared across threads) and
@@ -25,7 +29,8 @@ use rayon::prelude::*;
 use serde_json::Value;
 
 use crate::coupling::{RunOptions, SimOutput, Summary};
-use crate::output::{write_json_atomic, write_results_csv, OutputError};
+use crate::output::{write_json_atomic, OutputError};
+use crate::results::{constant_kinds, write_results, ConstantKind, ResultsFormat, RunContext};
 use crate::system::{split_ref, LoadedSystem, PreparedSystem, SystemDescription, SystemError};
 
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -99,6 +104,10 @@ fn invalid(file: &str, field: String, reason: String) -> SystemError {
 /// built (a typo such as 1e6 values in one list should not fill the disk).
 pub const MAX_RUNS: usize = 100_000;
 
+/// The folder of a run set's Parquet results (`<outdir>/results/<run>.parquet`), a name no
+/// run may have.
+pub const PARQUET_FOLDER: &str = "results";
+
 /// Longest run name (folder names are limited to 255 bytes on common file systems).
 const MAX_RUN_NAME_LEN: usize = 200;
 
@@ -133,6 +142,11 @@ pub fn run_folder_name(name: &str) -> Result<String, String> {
     if folder.eq_ignore_ascii_case("sweep.json") {
         return Err(format!(
             "run name '{name}' is the name of the sweep's report file"
+        ));
+    }
+    if folder.eq_ignore_ascii_case(PARQUET_FOLDER) {
+        return Err(format!(
+            "run name '{name}' is the name of the folder of the run set's Parquet results"
         ));
     }
     if folder.len() > MAX_RUN_NAME_LEN {
@@ -329,6 +343,45 @@ pub fn run_job(
     system.run(&changes, &opts).map_err(|e| e.to_string())
 }
 
+/// How the runs of a run set write their results.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResultsOptions {
+    pub format: ResultsFormat,
+    /// Constant columns besides the parameters, per run name (e.g. a study's configuration).
+    pub labels: BTreeMap<String, BTreeMap<String, Value>>,
+}
+
+impl Default for ResultsOptions {
+    fn default() -> Self {
+        ResultsOptions {
+            format: ResultsFormat::Csv,
+            labels: BTreeMap::new(),
+        }
+    }
+}
+
+/// Where the results of `job` go in `outdir` in `format`.
+pub fn results_path(outdir: &Path, job_name: &str, format: ResultsFormat) -> PathBuf {
+    match format {
+        ResultsFormat::Csv => outdir.join(job_name).join("results.csv"),
+        ResultsFormat::Parquet => outdir
+            .join(PARQUET_FOLDER)
+            .join(format!("{job_name}.parquet")),
+    }
+}
+
+/// The format chosen by size for the runs of `system` (its longest job): Parquet from
+/// [`crate::results::PARQUET_FROM_VALUES`] values on.
+pub fn format_by_size(system: &PreparedSystem, jobs: &[Job]) -> ResultsFormat {
+    let plan = system.plan();
+    let stop = jobs
+        .iter()
+        .map(|j| j.system.stop_time)
+        .fold(plan.stop_time, f64::max);
+    let rows = ((stop - plan.start_time) / plan.step).max(0.0) as u64 + 1;
+    ResultsFormat::by_size(rows, plan.record.len() as u64 + 1)
+}
+
 /// Prefix of a run folder being written (renamed onto the run's folder when complete).
 const PARTIAL_PREFIX: &str = ".partial-";
 /// Prefix of a previous run folder being replaced (removed right after the swap).
@@ -354,6 +407,33 @@ pub fn execute<F>(
 where
     F: Fn(&Job) -> Result<SimOutput, String> + Sync,
 {
+    execute_with(
+        jobs,
+        outdir,
+        threads,
+        show_progress,
+        &ResultsOptions::default(),
+        runner,
+    )
+}
+
+/// [`execute`] with results written as `results` says.
+pub fn execute_with<F>(
+    jobs: &[Job],
+    outdir: &Path,
+    threads: usize,
+    show_progress: bool,
+    results: &ResultsOptions,
+    runner: F,
+) -> Result<Vec<RunReport>, SweepError>
+where
+    F: Fn(&Job) -> Result<SimOutput, String> + Sync,
+{
+    let kinds = constant_kinds(jobs.iter().flat_map(|j| {
+        j.parameters
+            .iter()
+            .chain(results.labels.get(&j.name).into_iter().flatten())
+    }));
     let dir_err = |source| SweepError::Dir {
         path: outdir.to_path_buf(),
         source,
@@ -391,7 +471,7 @@ where
     let reports: Vec<RunReport> = pool.install(|| {
         jobs.par_iter()
             .map(|job| {
-                let r = run_one(job, outdir, &runner);
+                let r = run_one_with(job, outdir, results, &kinds, &runner);
                 bar.inc(1);
                 if !r.ok {
                     bar.println(format!(
@@ -468,7 +548,30 @@ pub fn run_one<F>(job: &Job, outdir: &Path, runner: &F) -> RunReport
 where
     F: Fn(&Job) -> Result<SimOutput, String>,
 {
+    run_one_with(
+        job,
+        outdir,
+        &ResultsOptions::default(),
+        &BTreeMap::new(),
+        runner,
+    )
+}
+
+/// [`run_one`] with results written as `results` says; `kinds` are the constant columns of
+/// the whole run set. Parquet results go to `<outdir>/results/<job>.parquet`: an earlier
+/// one is removed before the run, so a failed rerun leaves no stale results in the table.
+pub fn run_one_with<F>(
+    job: &Job,
+    outdir: &Path,
+    results: &ResultsOptions,
+    kinds: &BTreeMap<String, ConstantKind>,
+    runner: &F,
+) -> RunReport
+where
+    F: Fn(&Job) -> Result<SimOutput, String>,
+{
     let dest = outdir.join(&job.name);
+    let table_file = results_path(outdir, &job.name, ResultsFormat::Parquet);
     let mut report = RunReport {
         name: job.name.clone(),
         parameters: job.parameters.clone(),
@@ -491,6 +594,17 @@ where
         }
     };
     let dir = partial.path().to_path_buf();
+    match std::fs::remove_file(&table_file) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            report.error = Some(format!(
+                "cannot remove the earlier results '{}': {e}",
+                table_file.display()
+            ));
+            return report;
+        }
+        _ => {}
+    }
+    let final_path = results_path(outdir, &job.name, results.format);
     let result = (|| -> Result<Summary, String> {
         write_json_atomic(&dir.join("system.json"), &job.system).map_err(|e| e.to_string())?;
         let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| runner(job)))
@@ -502,14 +616,30 @@ where
                     .unwrap_or_default();
                 Err(format!("the run panicked: {what}"))
             })?;
-        write_results_csv(&dir.join("results.csv"), &out).map_err(|e| e.to_string())?;
+        let ctx = RunContext {
+            run: Some(job.name.clone()),
+            parameters: job.parameters.clone(),
+            labels: results.labels.get(&job.name).cloned().unwrap_or_default(),
+            system: serde_json::to_value(&job.system).ok(),
+            kinds: kinds.clone(),
+        };
+        let path = match results.format {
+            ResultsFormat::Csv => dir.join("results.csv"),
+            ResultsFormat::Parquet => {
+                let folder = outdir.join(PARQUET_FOLDER);
+                std::fs::create_dir_all(&folder)
+                    .map_err(|e| format!("cannot create '{}': {e}", folder.display()))?;
+                final_path.clone()
+            }
+        };
+        write_results(&path, &out, results.format, &ctx).map_err(|e| e.to_string())?;
         Ok(out.summary)
     })();
     match result {
         Ok(s) => {
             report.ok = true;
             report.summary = Some(s);
-            report.results = Some(dest.join("results.csv"));
+            report.results = Some(final_path.clone());
         }
         Err(e) => report.error = Some(e),
     }
@@ -517,6 +647,7 @@ where
         .map_err(|e| e.to_string())
         .and_then(|()| swap_into_place(partial, &dest, outdir));
     if let Err(e) = finished {
+        let _ = std::fs::remove_file(&table_file);
         report.ok = false;
         report.results = None;
         report.error = Some(match report.error.take() {
@@ -653,5 +784,63 @@ mod tests {
                 .unwrap();
         assert_eq!(sweep.as_array().unwrap().len(), 4);
         assert_eq!(sweep[2]["ok"], serde_json::json!(false));
+    }
+
+    #[test]
+    fn parquet_results_of_a_set_share_one_folder_and_a_failed_rerun_leaves_none() {
+        let j = jobs(r#"{"product": {"ms.k": [50, 100, 200]}}"#).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let runner = |fail: Option<&'static str>| {
+            move |job: &Job| -> Result<SimOutput, String> {
+                if Some(job.name.as_str()) == fail {
+                    return Err("failed this time".into());
+                }
+                let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.05);
+                plan.instances[0].parameters[1].1 = job.parameters["ms.k"].as_f64().unwrap();
+                let mut a = Mock::new("ms", MassSpring::new(1.0, 1.0, 1.0, 0.0));
+                let mut b = Mock::new("sdm", SpringDamperMass::new(1.0, 1.0, 1.0));
+                simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default())
+                    .map_err(|e| e.to_string())
+            }
+        };
+        let opts = ResultsOptions {
+            format: ResultsFormat::Parquet,
+            ..ResultsOptions::default()
+        };
+        let reports = execute_with(&j, dir.path(), 2, false, &opts, runner(None)).unwrap();
+        assert!(reports.iter().all(|r| r.ok));
+        let table = dir.path().join(PARQUET_FOLDER);
+        let mut files: Vec<String> = std::fs::read_dir(&table)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        files.sort();
+        assert_eq!(
+            files,
+            ["run-000.parquet", "run-001.parquet", "run-002.parquet"]
+        );
+        for r in &reports {
+            assert!(!dir.path().join(&r.name).join("results.csv").exists());
+            assert_eq!(
+                r.results.as_deref(),
+                Some(table.join(format!("{}.parquet", r.name)).as_path())
+            );
+            assert!(completed(dir.path(), &j[0]).is_some());
+        }
+        let (columns, meta) =
+            crate::parquet_file::read_parquet(&table.join("run-001.parquet")).unwrap();
+        assert_eq!(meta.unwrap().parameters["ms.k"], serde_json::json!(100));
+        let k = columns.iter().find(|(n, _)| n == "ms.k").unwrap();
+        assert_eq!(
+            k.1,
+            crate::parquet_file::ColumnData::Numbers(vec![Some(100.0); 51])
+        );
+        // a rerun in which run-001 fails leaves no stale results of it in the table
+        let reports =
+            execute_with(&j, dir.path(), 2, false, &opts, runner(Some("run-001"))).unwrap();
+        assert!(!reports[1].ok && reports[0].ok);
+        assert!(!table.join("run-001.parquet").exists());
+        assert!(table.join("run-002.parquet").exists());
+        assert!(run_folder_name("Results").is_err());
     }
 }

@@ -3,7 +3,8 @@
 //! with this one alternately, in pairs (the order swapped from one pair to the next, so a
 //! drifting machine load favours neither), wall and CPU time of each, the ratio per pair and
 //! its median, the load average beside every figure. The first pair also checks that both give
-//! the same runs (every runs/*/results.csv byte for byte).
+//! the same runs (every results.csv byte for byte, every Parquet file's values; a build that
+//! writes the other format is reported, not compared).
 //!
 //! `MASTER_BEFORE=/path/to/earlier/master cargo bench -p rail-study --bench study_wall`;
 //! optional `STUDY_PAIRS` (default 3), `STUDY_JOBS` (default: all cores); needs dist/.
@@ -43,7 +44,7 @@ fn study(binary: &Path, out: &Path, jobs: &str) -> (f64, f64, f64) {
     )
 }
 
-/// Relative paths of every results.csv below `dir/runs`.
+/// Relative paths of every results file (results.csv, *.parquet) below `dir/runs`.
 fn results(dir: &Path) -> Vec<PathBuf> {
     let mut found = Vec::new();
     let mut todo = vec![dir.join("runs")];
@@ -52,7 +53,9 @@ fn results(dir: &Path) -> Vec<PathBuf> {
             let p = e.unwrap().path();
             if p.is_dir() {
                 todo.push(p);
-            } else if p.file_name().is_some_and(|n| n == "results.csv") {
+            } else if p.file_name().is_some_and(|n| n == "results.csv")
+                || p.extension().is_some_and(|e| e == "parquet")
+            {
                 found.push(p.strip_prefix(dir).unwrap().to_path_buf());
             }
         }
@@ -107,17 +110,35 @@ fn main() {
         ratios.push((old.0 / new.0, old.1 / new.1));
         if pair == 0 {
             let files = results(&a);
-            assert_eq!(files, results(&b), "the two builds ran different runs");
-            let differing: Vec<&PathBuf> = files
-                .iter()
-                .filter(|f| std::fs::read(a.join(f)).unwrap() != std::fs::read(b.join(f)).unwrap())
-                .collect();
-            println!(
-                "runs compared: {} results.csv, {} differ {:?}",
-                files.len(),
-                differing.len(),
-                differing
-            );
+            if files != results(&b) {
+                println!(
+                    "runs not compared: the two builds wrote different results files ({} and {})",
+                    files.len(),
+                    results(&b).len()
+                );
+            } else {
+                // a Parquet file holds the run's wall time in its metadata: compare the values
+                let same = |f: &PathBuf| {
+                    if f.extension().is_some_and(|e| e == "parquet") {
+                        let read = |d: &Path| {
+                            master::parquet_file::read_results_parquet(&d.join(f))
+                                .unwrap()
+                                .0
+                        };
+                        let (x, y) = (read(&a), read(&b));
+                        x.header == y.header && x.data == y.data
+                    } else {
+                        std::fs::read(a.join(f)).unwrap() == std::fs::read(b.join(f)).unwrap()
+                    }
+                };
+                let differing: Vec<&PathBuf> = files.iter().filter(|f| !same(f)).collect();
+                println!(
+                    "runs compared: {} results files, {} differ {:?}",
+                    files.len(),
+                    differing.len(),
+                    differing
+                );
+            }
         }
     }
     let median = |mut v: Vec<f64>| {

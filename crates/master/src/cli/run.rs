@@ -1,23 +1,32 @@
-//! `master run SYSTEM.json|SYSTEM.ssp|SYSTEM.ssd [-o results.csv]` or
-//! `master run MODEL.fmu [--stop ..] [--set ..]`: one co-simulation, results as CSV.
+//! `master run SYSTEM.json|SYSTEM.ssp|SYSTEM.ssd [-o results.csv] [--format csv|parquet]` or
+//! `master run MODEL.fmu [--stop ..] [--set ..]`: one co-simulation, results as CSV or
+//! Parquet.
 
 use std::path::PathBuf;
 
 use super::{CommandError, Context};
 use crate::coupling::{Algorithm, RunOptions};
-use crate::output::{write_json_atomic, write_results_csv};
+use crate::output::write_json_atomic;
+use crate::results::{write_results, ResultsFormat, RunContext};
 use crate::ssp::{self, ImportOptions};
 use crate::system::{LoadedSystem, SingleFmuOptions};
 
-/// Run one system description, or one FMU alone, and write the recorded variables as CSV.
+/// Run one system description, or one FMU alone, and write the recorded variables as CSV or
+/// Parquet.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// System description: JSON (FMU paths relative to its folder), an SSP (a .ssp archive,
     /// or a .ssd next to its FMUs), or an .fmu to run alone over its DefaultExperiment.
     pub system: PathBuf,
-    /// Results CSV (time plus recorded variables, units in the header); written atomically.
-    #[arg(short, long, default_value = "results.csv")]
-    pub output: PathBuf,
+    /// Results file (time plus recorded variables, units in the header); written atomically.
+    /// Default: results.csv, or results.parquet for large results (see --format).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Results format; default: by the extension of --output (.csv, .parquet), else Parquet
+    /// from 200000 values (rows x columns) on, CSV below. A CSV has its metadata (units,
+    /// FMU variables, sampling, summary) in <name>.meta.json beside it; Parquet inside.
+    #[arg(long, value_enum)]
+    pub format: Option<ResultsFormat>,
     /// Also write the run summary (steps, wall time, real-time ratio) as JSON.
     #[arg(long)]
     pub summary: Option<PathBuf>,
@@ -131,11 +140,25 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     let out = sys.run(&opts);
     bar.finish_and_clear();
     let out = out?;
-    write_results_csv(&args.output, &out)?;
+    let format = args
+        .format
+        .or_else(|| args.output.as_deref().and_then(ResultsFormat::of_path))
+        .unwrap_or_else(|| {
+            ResultsFormat::by_size(out.rows().count() as u64, out.header.len() as u64)
+        });
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("results.{}", format.extension())));
+    let ctx = RunContext {
+        system: serde_json::to_value(&sys.desc).ok(),
+        ..RunContext::default()
+    };
+    write_results(&output, &out, format, &ctx)?;
     if let Some(p) = &args.summary {
         write_json_atomic(p, &out.summary)?;
     }
-    println!("{}: {}", args.output.display(), out.summary);
+    println!("{}: {}", output.display(), out.summary);
     if let Some(t) = &out.summary.terminated {
         println!(
             "the simulation was ended by instance '{}' (fmi2Terminated) at t = {} s; results up to there",

@@ -5,7 +5,11 @@ use std::path::PathBuf;
 
 use super::{CommandError, Context};
 use crate::output::write_json_atomic;
-use crate::runset::{completed, execute as run_all, run_job, Job, RunReport, RunSet};
+use crate::results::ResultsFormat;
+use crate::runset::{
+    completed, execute_with as run_all, format_by_size, run_job, Job, ResultsOptions, RunReport,
+    RunSet,
+};
 use crate::system::PreparedSystem;
 
 /// Run a base system with parameter variations (cartesian product and/or list) in parallel.
@@ -28,10 +32,22 @@ pub struct Args {
     /// resolved system) and run only the others; sweep.json then lists every run.
     #[arg(long)]
     pub resume: bool,
+    /// Results format: csv (<run>/results.csv) or parquet (results/<run>.parquet, the folder
+    /// reads as one table with each run's name and parameters as columns); default: Parquet
+    /// when a run has 200000 values (rows x columns) or more, else CSV.
+    #[arg(long, value_enum)]
+    pub format: Option<ResultsFormat>,
 }
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     if let Some(address) = &args.dask_scheduler {
+        if args.format == Some(ResultsFormat::Parquet) {
+            return Err(CommandError::Failed(
+                "--format parquet is not available with --dask-scheduler (the cluster's runs \
+                 are written as CSV)"
+                    .into(),
+            ));
+        }
         return on_dask(args, address, ctx);
     }
     let (base, jobs) = RunSet::load(&args.runset)?;
@@ -52,9 +68,20 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             .jobs
             .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
         let cancel = ctx.cancel;
-        fresh = run_all(&todo, &args.output, threads, ctx.progress, |job| {
-            run_job(&system, job, cancel)
-        })?;
+        let results = ResultsOptions {
+            format: args
+                .format
+                .unwrap_or_else(|| format_by_size(&system, &todo)),
+            ..ResultsOptions::default()
+        };
+        fresh = run_all(
+            &todo,
+            &args.output,
+            threads,
+            ctx.progress,
+            &results,
+            |job| run_job(&system, job, cancel),
+        )?;
     }
     let mut fresh = fresh.into_iter();
     let reports: Vec<RunReport> = kept

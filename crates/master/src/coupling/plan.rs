@@ -151,6 +151,9 @@ pub struct SimOutput {
     pub columns: Vec<ColumnInfo>,
     /// Texts of the String values (a String column's values index this list).
     pub strings: Vec<String>,
+    /// How the rows were decimated from the record at every communication point; `None`:
+    /// every communication point is here ([`crate::decimation`]).
+    pub decimation: Option<crate::decimation::Decimation>,
 }
 
 impl SimOutput {

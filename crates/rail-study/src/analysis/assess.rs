@@ -9,7 +9,13 @@
 //! double quotes around names), semicolon, or whitespace. Lines starting with `#` are
 //! comments. A column is selected by its full name or by the name without a trailing
 //! ` [unit]`; a unit in brackets is checked against the criterion (m/s2 for accelerations; N or
-//! kN for forces, kN converted).
+//! kN for forces, kN converted). A Parquet file (`.parquet`, ours or another tool's) is read
+//! column by column, its first column the time.
+//!
+//! The metadata of our results files (inside a Parquet file, `<name>.meta.json` beside a CSV)
+//! records their sampling: [`check_bandwidth`] refuses a signal whose recorded pass band
+//! (Nyquist frequency, or the anti-aliasing filter of a decimated file) does not reach the
+//! upper edge of the band the assessment filters.
 
 use std::path::{Path, PathBuf};
 
@@ -18,6 +24,9 @@ use crate::en14363::{
     assess_guiding_forces, assess_lateral_acceleration, AssessError, Assessment, StabilitySettings,
 };
 use crate::plot::Chart;
+use master::decimation::Sampling;
+use master::parquet_file::{read_parquet, ColumnData};
+use master::results::{read_metadata, ResultsFormat};
 
 /// Which EN 14363 quantity the signals are.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,6 +45,10 @@ pub struct ResultsTable {
     pub names: Vec<String>,
     /// Column-major values.
     pub columns: Vec<Vec<f64>>,
+    /// The sampling the file's metadata records; `None` without metadata (a host's export).
+    pub sampling: Option<Sampling>,
+    /// Whether the file has our metadata.
+    pub described: bool,
 }
 
 fn bad_file(path: &Path, line: usize, reason: String) -> AnalysisError {
@@ -124,14 +137,63 @@ impl ResultsTable {
             path: path.to_path_buf(),
             names,
             columns,
+            sampling: None,
+            described: false,
         })
     }
 
-    /// Reads and parses a file.
+    /// Reads a file: Parquet by its extension, else text; with the sampling of its metadata.
     pub fn load(path: &Path) -> Result<Self, AnalysisError> {
+        let input = |e: &dyn std::fmt::Display| AnalysisError::Input(e.to_string());
+        if ResultsFormat::of_path(path) == Some(ResultsFormat::Parquet) {
+            return Self::load_parquet(path);
+        }
         let text = std::fs::read_to_string(path)
             .map_err(|e| AnalysisError::Input(format!("{}: {e}", path.display())))?;
-        Self::parse(&text, path)
+        let mut table = Self::parse(&text, path)?;
+        let meta = read_metadata(path).map_err(|e| input(&e))?;
+        table.described = meta.is_some();
+        table.sampling = meta.and_then(|m| m.sampling);
+        Ok(table)
+    }
+
+    /// A Parquet file's numeric columns without nulls (texts and empty parameters left out).
+    fn load_parquet(path: &Path) -> Result<Self, AnalysisError> {
+        let (columns, meta) =
+            read_parquet(path).map_err(|e| AnalysisError::Input(e.to_string()))?;
+        let mut names = Vec::new();
+        let mut values = Vec::new();
+        for (name, data) in columns {
+            if let ColumnData::Numbers(x) = data {
+                if let Some(x) = x.into_iter().collect::<Option<Vec<f64>>>() {
+                    names.push(name);
+                    values.push(x);
+                }
+            }
+        }
+        if names.len() < 2 {
+            return Err(AnalysisError::Input(format!(
+                "{}: the file needs a time column and at least one numeric signal",
+                path.display()
+            )));
+        }
+        if let Some((name, _)) = names
+            .iter()
+            .zip(&values)
+            .find(|(_, x)| x.iter().any(|v| !v.is_finite()))
+        {
+            return Err(AnalysisError::Input(format!(
+                "{}: column '{name}' has values that are not finite",
+                path.display()
+            )));
+        }
+        Ok(ResultsTable {
+            path: path.to_path_buf(),
+            names,
+            columns: values,
+            described: meta.is_some(),
+            sampling: meta.and_then(|m| m.sampling),
+        })
     }
 
     /// Index of a column by full name or by name without its ` [unit]`.
@@ -330,6 +392,58 @@ fn check_unit(
             }
         ))
     })
+}
+
+/// Whether the recorded band of `table` covers what `report` assessed: `Err` names each
+/// signal whose assessed band reaches above the pass band its metadata records (decimated
+/// with too low a rate, or through too narrow an anti-aliasing filter); `Ok(Some(note))`
+/// when the file records no sampling (its band cannot be checked).
+pub fn check_bandwidth(
+    table: &ResultsTable,
+    report: &AssessReport,
+) -> Result<Option<String>, AnalysisError> {
+    let Some(s) = &table.sampling else {
+        return Ok(Some(format!(
+            "{}: no record of how the signals were sampled ({}); if they were decimated \
+             without an anti-aliasing filter, content above their Nyquist frequency is folded \
+             into the assessed band and the rms is wrong",
+            table.path.display(),
+            if table.described {
+                "its metadata has no sampling"
+            } else {
+                "no metadata"
+            }
+        )));
+    };
+    let narrow: Vec<String> = report
+        .signals
+        .iter()
+        .filter(|(_, a)| a.band_hz.1 > s.passband_hz)
+        .map(|(name, a)| {
+            format!(
+                "'{name}' is assessed in {:.2}-{:.2} Hz",
+                a.band_hz.0, a.band_hz.1
+            )
+        })
+        .collect();
+    if narrow.is_empty() {
+        return Ok(None);
+    }
+    let how = match &s.decimation {
+        Some(d) => format!(
+            "decimated by {} from {} Hz through a low-pass of cut-off {} Hz",
+            d.factor, d.source_rate_hz, d.cutoff_hz
+        ),
+        None => "not decimated".to_string(),
+    };
+    Err(AnalysisError::Input(format!(
+        "{}: the signals are recorded at {} Hz ({how}) and carry {:.2} Hz at most, but {}: \
+         record at a higher rate (or pass --accept-narrow-band to assess anyway)",
+        table.path.display(),
+        s.rate_hz,
+        s.passband_hz,
+        narrow.join(", ")
+    )))
 }
 
 /// Assesses each named signal of `table` at a constant `speed_kmh`.

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use super::{failed, write_analysis};
-use crate::analysis::assess::{assess_table, Criterion, ResultsTable};
+use crate::analysis::assess::{assess_table, check_bandwidth, Criterion, ResultsTable};
 use crate::en14363::StabilitySettings;
 use master::cli::{CommandError, Context};
 
@@ -20,10 +20,10 @@ pub enum Quantity {
 /// Options of `master assess`.
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Applies the EN 14363 rms stability criterion as the seed does (section 4.2): band-pass +-2 Hz around the dominant frequency of each signal, rms over 100 m of track in 10 m steps at the given constant speed, maximum compared with the limit. Works on our results CSV (`master run`, the study's runs) or on a host's export (Simpack, ...): first column the time in seconds, uniformly sampled; separators comma, semicolon or whitespace; '#' comment lines.\n\nFiles: assess.csv (rms per window), assess_summary.csv (per signal), assess.svg (rms along the track with the limit). Exit status 0 whether or not the limit is exceeded (read the verdict line); 1 when the input cannot be assessed (nothing is written then)."
+    after_help = "Applies the EN 14363 rms stability criterion as the seed does (section 4.2): band-pass +-2 Hz around the dominant frequency of each signal, rms over 100 m of track in 10 m steps at the given constant speed, maximum compared with the limit. Works on our results (`master run`, the study's runs; CSV or Parquet) or on a host's export (Simpack, ...): first column the time in seconds, uniformly sampled; separators comma, semicolon or whitespace; '#' comment lines; or a Parquet file. Our files record their sampling (Parquet inside, CSV in <name>.meta.json): a signal whose recorded band (Nyquist frequency, or the anti-aliasing filter of a decimated file) does not cover the assessed band is refused.\n\nFiles: assess.csv (rms per window), assess_summary.csv (per signal), assess.svg (rms along the track with the limit). Exit status 0 whether or not the limit is exceeded (read the verdict line); 1 when the input cannot be assessed (nothing is written then)."
 )]
 pub struct Args {
-    /// Results table (CSV or whitespace separated).
+    /// Results table (CSV, whitespace separated, or Parquet).
     pub table: PathBuf,
     /// Signal to assess: column name, with or without its " [unit]"; repeat for several
     /// (e.g. front and rear wheelset), the verdict takes the largest rms.
@@ -47,6 +47,10 @@ pub struct Args {
     /// Dominant frequency [Hz] instead of the spectrum's peak (searched in 0.5-20 Hz).
     #[arg(long, value_name = "HZ")]
     pub f0: Option<f64>,
+    /// Assess even when the file's metadata records a pass band narrower than the assessed
+    /// band (a loud warning is printed instead of the refusal).
+    #[arg(long)]
+    pub accept_narrow_band: bool,
     /// Output folder (created if needed; files are written only once everything is computed).
     #[arg(long, value_name = "DIR", default_value = "results/assess")]
     pub out: PathBuf,
@@ -69,6 +73,14 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     let table = ResultsTable::load(&args.table).map_err(failed)?;
     let report =
         assess_table(&table, &args.signals, args.speed, criterion, &settings).map_err(failed)?;
+    match check_bandwidth(&table, &report) {
+        Ok(None) => {}
+        Ok(Some(note)) => eprintln!("note: {note}"),
+        Err(e) if args.accept_narrow_band => {
+            eprintln!("WARNING: {e}\nWARNING: assessed anyway (--accept-narrow-band): the rms below may be wrong");
+        }
+        Err(e) => return Err(failed(e)),
+    }
     write_analysis(&args.out, ctx.cancel, &report.summary(), |f| {
         report.add_artefacts(f)
     })

@@ -11,6 +11,7 @@ use crate::study::{
     VehicleModel,
 };
 use master::cli::{CommandError, Context};
+use master::results::ResultsFormat;
 
 /// Run the stability study and write REPORT.md, plots and CSVs.
 #[derive(Debug, clap::Args)]
@@ -35,6 +36,12 @@ pub struct Args {
     /// ones (the coach's generated systems, the bogie's systems/*.json).
     #[arg(long)]
     pub systems: Option<PathBuf>,
+    /// Format of each run's stored results: parquet (full rate, runs/<batch>/results/) or
+    /// csv (runs/<batch>/<run>/results.csv, decimated to 100 Hz through an anti-aliasing
+    /// low-pass, about a tenth of the size). The numbers come from the full-rate signals
+    /// either way.
+    #[arg(long, value_enum, default_value = "parquet")]
+    pub format: ResultsFormat,
 }
 
 impl From<StudyError> for CommandError {
@@ -58,11 +65,12 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     if log::max_level() == log::LevelFilter::Info {
         log::set_max_level(log::LevelFilter::Error);
     }
-    let settings = if args.quick {
+    let mut settings = if args.quick {
         StudySettings::quick(args.vehicle)
     } else {
         StudySettings::full(args.vehicle)
     };
+    settings.stored_format = args.format;
     let threads = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))

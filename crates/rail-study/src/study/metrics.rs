@@ -224,25 +224,6 @@ pub fn run_metrics(
     })
 }
 
-/// Keeps every `factor`-th row (the first always), for compact results files.
-pub fn decimate(out: &SimOutput, factor: usize) -> SimOutput {
-    let factor = factor.max(1);
-    let w = out.header.len().max(1);
-    let data: Vec<f64> = out
-        .data
-        .chunks(w)
-        .step_by(factor)
-        .flat_map(|r| r.iter().copied())
-        .collect();
-    SimOutput {
-        header: out.header.clone(),
-        data,
-        summary: out.summary.clone(),
-        columns: out.columns.clone(),
-        strings: out.strings.clone(),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -301,6 +282,7 @@ mod tests {
             },
             columns: vec![],
             strings: vec![],
+            decimation: None,
         }
     }
 
@@ -403,14 +385,5 @@ mod tests {
             .push("vehicle.carbody.lateral_acceleration_front".into());
         let e = run_metrics(&out, &spec, &signals).unwrap_err().to_string();
         assert!(e.contains("lateral_acceleration_front"), "{e}");
-    }
-
-    #[test]
-    fn decimation_keeps_every_nth_row() {
-        let out = synthetic(1.0, 4.0, 1.0, false);
-        let d = decimate(&out, 5);
-        assert_eq!(d.rows().count(), 101);
-        assert!((sample_rate(&d).unwrap() - 100.0).abs() < 1e-9);
-        assert_eq!(decimate(&out, 0).data, out.data);
     }
 }

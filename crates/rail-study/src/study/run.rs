@@ -1,11 +1,14 @@
 //! Running the study: each configuration's system is prepared once for the whole study
 //! ([`PreparedSystem`]: its FMUs opened, checked, unpacked and loaded once, its plan built
 //! once), and every batch of runs goes through the master's run sets
-//! ([`master::runset::execute`]: parallel on a rayon pool, one folder per run with
-//! system.json / results.csv / summary.json, failures kept); a run is its start values and
-//! stop time ([`master::runset::run_job`]). The numbers of each run are computed from its
-//! full-rate output inside the worker, and the stored results.csv is decimated to
-//! [`StudySettings::stored_rate_hz`].
+//! ([`master::runset::execute_with`]: parallel on a rayon pool, one folder per run with
+//! system.json / summary.json, failures kept); a run is its start values and stop time
+//! ([`master::runset::run_job`]). The numbers of each run are computed from its full-rate
+//! output inside the worker. Its results are stored at the full rate as Parquet
+//! (`runs/<batch>/results/<run>.parquet`, with the configuration, speed and seed as
+//! columns), or as CSV decimated to [`StudySettings::stored_rate_hz`] through an
+//! anti-aliasing low-pass ([`master::decimation`]); the time histories the plots draw are
+//! decimated the same way.
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -19,11 +22,13 @@ use crate::study::config::{
     configuration, required_fmus, Configuration, Family, RunRequest, Sources,
 };
 use crate::study::critical::{Critical, CurvePoint};
-use crate::study::metrics::{decimate, run_metrics, MetricSpec, RunMetrics, BOGIE_MASS_T};
+use crate::study::metrics::{run_metrics, MetricSpec, RunMetrics, BOGIE_MASS_T};
 use crate::study::settings::StudySettings;
 use crate::study::vehicle::{Signals, VehicleModel};
 use master::coupling::SimOutput;
-use master::runset::{execute, run_job, Job, SweepError};
+use master::decimation::{decimate, factor_for_rate};
+use master::results::ResultsFormat;
+use master::runset::{execute_with, run_job, Job, ResultsOptions, SweepError};
 use master::system::{PreparedSystem, RunError, SystemError};
 
 /// Why the study stopped.
@@ -163,7 +168,7 @@ pub struct StudyResults {
     pub simulated_s: f64,
     /// Sum of the runs' own wall times (CPU-side effort) [s].
     pub run_wall_s: f64,
-    /// Stored (decimated) outputs of the runs the plots need, by run name.
+    /// Outputs of the runs the plots need, decimated to the stored rate, by run name.
     #[serde(skip)]
     pub kept: BTreeMap<String, SimOutput>,
 }
@@ -230,11 +235,27 @@ impl Executor<'_> {
         let prepared = &self.prepared;
         let mut jobs: Vec<Job> = Vec::with_capacity(planned.len());
         let mut specs: HashMap<String, (MetricSpec, bool, &PreparedSystem)> = HashMap::new();
+        let mut results = ResultsOptions {
+            format: self.settings.stored_format,
+            ..ResultsOptions::default()
+        };
         for p in &planned {
             let Some(system) = prepared.get(p.request.config.id) else {
                 return Err(StudyError::UnknownConfiguration(p.request.config.id.into()));
             };
             jobs.push(p.request.job(system.system())?);
+            let r = &p.request;
+            results.labels.insert(
+                r.name.clone(),
+                BTreeMap::from([
+                    ("configuration".to_string(), Value::from(r.config.id)),
+                    ("speed_kmh".to_string(), Value::from(r.speed_kmh)),
+                    (
+                        "track_seed".to_string(),
+                        r.seed.map_or(Value::Null, Value::from),
+                    ),
+                ]),
+            );
             specs.insert(
                 p.request.name.clone(),
                 (
@@ -260,6 +281,7 @@ impl Executor<'_> {
         let kept: Mutex<BTreeMap<String, SimOutput>> = Mutex::new(BTreeMap::new());
         let cancel = self.opts.cancel;
         let rate = self.settings.stored_rate_hz;
+        let full_rate = self.settings.stored_format == ResultsFormat::Parquet;
         let signals = &self.signals;
         let runner = |job: &Job| -> Result<SimOutput, String> {
             let Some((spec, keep, system)) = specs.get(&job.name) else {
@@ -268,16 +290,24 @@ impl Executor<'_> {
             let out = run_job(system, job, cancel)?;
             let m = run_metrics(&out, spec, signals).map_err(|e| e.to_string());
             lock(&metrics).insert(job.name.clone(), m);
-            let factor = crate::study::metrics::sample_rate(&out)
-                .map_or(1, |fs| (fs / rate).round().max(1.0) as usize);
-            let small = decimate(&out, factor);
+            if !*keep && full_rate {
+                return Ok(out);
+            }
+            let small = decimate(&out, factor_for_rate(&out, rate)).map_err(|e| e.to_string())?;
             if *keep {
                 lock(&kept).insert(job.name.clone(), small.clone());
             }
-            Ok(small)
+            Ok(if full_rate { out } else { small })
         };
         let dir = self.opts.out.join("runs").join(batch);
-        let reports = execute(&jobs, &dir, self.opts.threads, self.opts.progress, runner)?;
+        let reports = execute_with(
+            &jobs,
+            &dir,
+            self.opts.threads,
+            self.opts.progress,
+            &results,
+            runner,
+        )?;
         if cancel.load(Ordering::SeqCst) {
             return Err(StudyError::Cancelled);
         }

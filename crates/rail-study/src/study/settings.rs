@@ -3,6 +3,7 @@
 
 use crate::study::config::CONFIGURATIONS;
 use crate::study::vehicle::VehicleModel;
+use master::results::ResultsFormat;
 
 /// Everything that sizes the study.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -44,8 +45,11 @@ pub struct StudySettings {
     pub hil_initial_command_v: f64,
     /// Length of the scenario runs (histories, MPPT, HIL) [s].
     pub scenario_stop_s: f64,
-    /// Sampling rate of the stored results.csv of every run [Hz] (the numbers are computed
-    /// from the full-rate signals before decimation).
+    /// Format of every run's stored results: Parquet at the full rate, or CSV decimated to
+    /// `stored_rate_hz` through an anti-aliasing low-pass.
+    pub stored_format: ResultsFormat,
+    /// Sampling rate of a run's results when stored as CSV, and of the time histories the
+    /// plots draw [Hz] (the numbers are computed from the full-rate signals).
     pub stored_rate_hz: f64,
 }
 
@@ -91,6 +95,7 @@ impl StudySettings {
             hil_speed_kmh: 260.0,
             hil_initial_command_v: 8.0,
             scenario_stop_s: 40.0,
+            stored_format: ResultsFormat::Parquet,
             stored_rate_hz: 100.0,
         }
     }

@@ -331,9 +331,18 @@ pub fn report_markdown(r: &StudyResults, timing: &Timing, figures: &[(String, &s
     let _ = writeln!(
         m,
         "* `cv_sensitivity.csv`: the c_v table; `rms_vs_speed.csv`: every sweep and bisection point per seed; \
-         `study.json`: all numbers; `runs/<batch>/<run>/`: each run's system.json, summary.json and results.csv \
-         (decimated to {:.0} Hz; the numbers above come from the full-rate signals).",
-        s.stored_rate_hz
+         `study.json`: all numbers; `runs/<batch>/<run>/`: each run's system.json and summary.json; {}",
+        match s.stored_format {
+            master::results::ResultsFormat::Parquet => "`runs/<batch>/results/<run>.parquet`: each run's \
+                results at the full rate, with its configuration, speed and track seed as columns (the folder \
+                reads as one table: `pandas.read_parquet(\"runs/main/results\")`)."
+                .to_string(),
+            master::results::ResultsFormat::Csv => format!(
+                "`runs/<batch>/<run>/results.csv`: each run's results decimated to {:.0} Hz through an \
+                 anti-aliasing low-pass (the numbers above come from the full-rate signals).",
+                s.stored_rate_hz
+            ),
+        }
     );
     if !r.failures.is_empty() {
         let _ = writeln!(m, "\n## Failed runs ({})\n", r.failures.len());
