@@ -645,7 +645,8 @@ impl Component {
         }
         self.time = target;
         self.last_successful_time = target;
-        self.outputs_dirty = true;
+        // a model whose step computed its outputs needs no second computation before a read
+        self.outputs_dirty = !(effective > 0.0 && self.model.step_computes_outputs());
         self.flush_diagnostics()
     }
 

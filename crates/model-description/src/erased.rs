@@ -24,6 +24,7 @@ pub trait ErasedModel: Send {
     fn exit_initialization(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError>;
     fn update_outputs(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError>;
     fn do_step(&mut self, time: f64, step: f64, diag: &mut Diagnostics) -> Result<(), StepError>;
+    fn step_computes_outputs(&self) -> bool;
     fn snapshot(&self) -> Box<dyn Any + Send>;
     /// Restore from a snapshot taken from an instance of the same model.
     fn restore(&mut self, snapshot: &(dyn Any + Send)) -> bool;
@@ -150,6 +151,10 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
 
     fn do_step(&mut self, time: f64, step: f64, diag: &mut Diagnostics) -> Result<(), StepError> {
         self.model.do_step(time, step, diag)
+    }
+
+    fn step_computes_outputs(&self) -> bool {
+        self.model.step_computes_outputs()
     }
 
     fn snapshot(&self) -> Box<dyn Any + Send> {

@@ -112,4 +112,12 @@ pub trait FmuModel: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// Advance from `time` to `time + step`. On error the model must be left as it was before
     /// the call (so a host can retry after fmi2Discard).
     fn do_step(&mut self, time: f64, step: f64, diag: &mut Diagnostics) -> Result<(), StepError>;
+
+    /// Whether a successful [`Self::do_step`] leaves the outputs exactly as
+    /// [`Self::update_outputs`] would compute them at the new time with the held inputs. Then
+    /// the outputs read after a step are not computed a second time (a co-simulation master
+    /// reads them after every step); setting an input or parameter still recomputes them.
+    fn step_computes_outputs(&self) -> bool {
+        false
+    }
 }

@@ -86,12 +86,8 @@ impl SemiShell {
         let Some(d) = &mut self.damper else {
             return Err(not_initialised());
         };
-        // Step a copy (plain data, no allocation) and commit on success only.
-        let mut next = d.clone();
-        let out = next
-            .step(h, &self.inputs)
-            .map_err(|e| step_error::<M>(&e))?;
-        *d = next;
+        // The physics' step is atomic (it steps a copy and commits on success only).
+        let out = d.step(h, &self.inputs).map_err(|e| step_error::<M>(&e))?;
         self.out = out;
         self.report_clamp(diag);
         Ok(())
@@ -130,6 +126,12 @@ macro_rules! delegate_to_shell {
             diag: &mut Diagnostics,
         ) -> Result<(), StepError> {
             self.s.do_step::<Self>(step, diag)
+        }
+
+        /// The physics' step returns the outputs at its end with the held inputs, as
+        /// `update_outputs` would compute them.
+        fn step_computes_outputs(&self) -> bool {
+            true
         }
     };
 }
