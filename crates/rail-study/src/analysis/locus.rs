@@ -213,16 +213,12 @@ impl LocusResults {
             mode: "hunting mode",
             mode_column: "hunting mode",
             frequency_title: "Hunting frequency vs speed (linear bogie)".into(),
-            speeds: self
-                .speeds_kmh
-                .iter()
-                .zip(&self.results)
-                .map(|(v, r)| LocusSpeed {
-                    speed_kmh: *v,
-                    eigenvalues: &r.eigenvalues,
-                    mode: r.hunting.map(|h| (h.re, h.im)),
-                })
-                .collect(),
+            speeds: LocusSpeed::over(
+                &self.speeds_kmh,
+                self.results
+                    .iter()
+                    .map(|r| (r.eigenvalues.as_slice(), r.hunting.map(|h| (h.re, h.im)))),
+            ),
         }
     }
 

@@ -32,6 +32,25 @@ pub struct LocusSpeed<'a> {
     pub mode: Option<(f64, f64)>,
 }
 
+impl<'a> LocusSpeed<'a> {
+    /// The speeds of a locus from its grid and, per speed, every eigenvalue and the followed
+    /// mode.
+    pub fn over(
+        speeds_kmh: &[f64],
+        per_speed: impl IntoIterator<Item = (&'a [(f64, f64)], Option<(f64, f64)>)>,
+    ) -> Vec<Self> {
+        speeds_kmh
+            .iter()
+            .zip(per_speed)
+            .map(|(v, (eigenvalues, mode))| LocusSpeed {
+                speed_kmh: *v,
+                eigenvalues,
+                mode,
+            })
+            .collect()
+    }
+}
+
 /// A root locus to draw: the model and damper it is of, the mode it follows, its speeds.
 #[derive(Debug, Clone)]
 pub struct LocusFigures<'a> {

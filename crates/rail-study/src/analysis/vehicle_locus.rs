@@ -120,16 +120,15 @@ impl VehicleLocus {
             mode: "least-damped mode",
             mode_column: "least damped",
             frequency_title: "Frequency of the least-damped mode vs speed (linear coach)".into(),
-            speeds: self
-                .speeds_kmh
-                .iter()
-                .zip(&self.results)
-                .map(|(v, r)| LocusSpeed {
-                    speed_kmh: *v,
-                    eigenvalues: &r.eigenvalues,
-                    mode: r.least_damped.map(|m| (m.re, m.im)),
-                })
-                .collect(),
+            speeds: LocusSpeed::over(
+                &self.speeds_kmh,
+                self.results.iter().map(|r| {
+                    (
+                        r.eigenvalues.as_slice(),
+                        r.least_damped.map(|m| (m.re, m.im)),
+                    )
+                }),
+            ),
         }
     }
 
