@@ -4,47 +4,10 @@
 
 use fmu_bogie2dof::fmu::{Bogie2Dof, FMU_DEFAULT_INITIAL_LATERAL_M, FMU_DEFAULT_SPEED_MPS};
 use fmu_bogie2dof::{Bogie, Inputs, Params, PsdLevel, TrackSource};
-use model_description::{
-    rust_component, value_reference, Causality, CollectLog, Component, FmuModel, InstanceContext,
-    Status, VarType,
-};
+use model_description::testing::{get, initialising, logged, real_outputs, set, vr};
+use model_description::{rust_component, Causality, FmuModel, InstanceContext, Status};
 
 type M = Bogie2Dof;
-
-fn vr(name: &str) -> u32 {
-    value_reference::<M>(name).unwrap_or_else(|| panic!("no variable {name}"))
-}
-
-fn new() -> (Component, CollectLog) {
-    let (mut c, log) = rust_component::<M>(InstanceContext::default()).unwrap();
-    assert_eq!(c.setup_experiment(0.0, None), Status::Ok);
-    assert_eq!(c.enter_initialization_mode(), Status::Ok);
-    (c, log)
-}
-
-fn set(c: &mut Component, name: &str, x: f64) -> Status {
-    c.set_real(&[vr(name)], &[x])
-}
-
-fn get(c: &mut Component, name: &str) -> f64 {
-    let mut out = [f64::NAN];
-    let s = c.get_real(&[vr(name)], &mut out);
-    assert!(s <= Status::Warning, "get {name}: {s:?}");
-    out[0]
-}
-
-fn logged(log: &[(Status, String, String)], status: Status, needle: &str) -> bool {
-    log.iter()
-        .any(|(s, _, m)| *s == status && m.contains(needle))
-}
-
-fn real_outputs() -> Vec<String> {
-    M::variables()
-        .iter()
-        .filter(|v| v.meta.causality == Causality::Output && v.meta.var_type == VarType::Real)
-        .map(|v| v.meta.name.clone())
-        .collect()
-}
 
 #[test]
 fn default_experiment_is_finite_and_hunts() {
@@ -56,7 +19,7 @@ fn default_experiment_is_finite_and_hunts() {
     );
     assert_eq!(c.enter_initialization_mode(), Status::Ok);
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
-    let names = real_outputs();
+    let names = real_outputs::<M>();
     let n = ((e.stop_time - e.start_time) / e.step_size).round() as usize;
     let mut t = e.start_time;
     let mut peak: f64 = 0.0;
@@ -65,11 +28,11 @@ fn default_experiment_is_finite_and_hunts() {
         assert_eq!(c.do_step(t, target - t), Status::Ok, "{:?}", log.take());
         t = target;
         for name in &names {
-            let x = get(&mut c, name);
+            let x = get::<M>(&mut c, name);
             assert!(x.is_finite(), "{name} = {x} at t = {t}");
         }
         if t > 2.0 {
-            peak = peak.max(get(&mut c, "wheelset_front.lateral_displacement").abs());
+            peak = peak.max(get::<M>(&mut c, "wheelset_front.lateral_displacement").abs());
         }
     }
     assert!(log.take().is_empty());
@@ -84,16 +47,16 @@ fn default_experiment_is_finite_and_hunts() {
 /// Same parameters, same inputs -> the FMU outputs equal the physics bit for bit.
 #[test]
 fn fmu_equals_plain_physics_bit_for_bit() {
-    let (mut c, log) = new();
-    assert_eq!(set(&mut c, "vehicle.speed", 280.0 / 3.6), Status::Ok);
+    let (mut c, log) = initialising::<M>();
+    assert_eq!(set::<M>(&mut c, "vehicle.speed", 280.0 / 3.6), Status::Ok);
     assert_eq!(
-        c.set_integer(&[vr("track.source")], &[2]),
+        c.set_integer(&[vr::<M>("track.source")], &[2]),
         Status::Ok,
         "{:?}",
         log.take()
     );
-    assert_eq!(c.set_integer(&[vr("track.level")], &[1]), Status::Ok);
-    assert_eq!(c.set_integer(&[vr("track.seed")], &[7]), Status::Ok);
+    assert_eq!(c.set_integer(&[vr::<M>("track.level")], &[1]), Status::Ok);
+    assert_eq!(c.set_integer(&[vr::<M>("track.seed")], &[7]), Status::Ok);
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
     let p = Params {
         speed_mps: 280.0 / 3.6,
@@ -117,7 +80,7 @@ fn fmu_equals_plain_physics_bit_for_bit() {
         };
         assert_eq!(
             c.set_real(
-                &[vr("damper_left.force"), vr("damper_right.force")],
+                &[vr::<M>("damper_left.force"), vr::<M>("damper_right.force")],
                 &[i.damper_left_force_n, i.damper_right_force_n]
             ),
             Status::Ok
@@ -147,7 +110,11 @@ fn fmu_equals_plain_physics_bit_for_bit() {
             ("track.alignment_rear", o.track_rear_m),
         ];
         for (name, x) in pairs {
-            assert_eq!(get(&mut c, name).to_bits(), x.to_bits(), "{name} step {k}");
+            assert_eq!(
+                get::<M>(&mut c, name).to_bits(),
+                x.to_bits(),
+                "{name} step {k}"
+            );
         }
     }
 }
@@ -157,8 +124,8 @@ fn fmu_equals_plain_physics_bit_for_bit() {
 #[test]
 fn bad_parameters_are_rejected_by_name() {
     fn at_init(name: &str, x: f64) {
-        let (mut c, log) = new();
-        assert_eq!(set(&mut c, name, x), Status::Ok, "{name} = {x}");
+        let (mut c, log) = initialising::<M>();
+        assert_eq!(set::<M>(&mut c, name, x), Status::Ok, "{name} = {x}");
         assert_eq!(c.exit_initialization_mode(), Status::Error, "{name} = {x}");
         let msgs = log.take();
         assert!(
@@ -167,8 +134,8 @@ fn bad_parameters_are_rejected_by_name() {
         );
     }
     fn at_set(name: &str, x: f64) {
-        let (mut c, log) = new();
-        assert_eq!(set(&mut c, name, x), Status::Error, "{name} = {x}");
+        let (mut c, log) = initialising::<M>();
+        assert_eq!(set::<M>(&mut c, name, x), Status::Error, "{name} = {x}");
         let msgs = log.take();
         assert!(
             logged(&msgs, Status::Error, &format!("'{name}'")),
@@ -201,16 +168,19 @@ fn bad_parameters_are_rejected_by_name() {
     at_set("vehicle.speed", -10.0);
     at_set("inertia.mass", f64::NAN);
     // a contact table that does not exist
-    let (mut c, log) = new();
+    let (mut c, log) = initialising::<M>();
     assert_eq!(
-        c.set_string(&[vr("contact.table")], &["/nonexistent/table.csv"]),
+        c.set_string(&[vr::<M>("contact.table")], &["/nonexistent/table.csv"]),
         Status::Ok
     );
     assert_eq!(c.exit_initialization_mode(), Status::Error);
     assert!(logged(&log.take(), Status::Error, "'contact.table'"));
     // an out-of-range choice
-    let (mut c, log) = new();
-    assert_eq!(c.set_integer(&[vr("contact.model")], &[2]), Status::Error);
+    let (mut c, log) = initialising::<M>();
+    assert_eq!(
+        c.set_integer(&[vr::<M>("contact.model")], &[2]),
+        Status::Error
+    );
     assert!(logged(
         &log.take(),
         Status::Error,
@@ -222,7 +192,7 @@ fn bad_parameters_are_rejected_by_name() {
 /// elongations do not (from the states; declared without feedthrough).
 #[test]
 fn outputs_without_stepping_feedthrough_is_real() {
-    let (mut c, _log) = new();
+    let (mut c, _log) = initialising::<M>();
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
     let names = [
         "frame.lateral_acceleration_front",
@@ -234,9 +204,9 @@ fn outputs_without_stepping_feedthrough_is_real() {
         "damper_right.elongation_velocity",
         "bogie.yaw_angle",
     ];
-    let before: Vec<f64> = names.iter().map(|n| get(&mut c, n)).collect();
-    assert_eq!(set(&mut c, "damper_left.force", 10e3), Status::Ok);
-    let after: Vec<f64> = names.iter().map(|n| get(&mut c, n)).collect();
+    let before: Vec<f64> = names.iter().map(|n| get::<M>(&mut c, n)).collect();
+    assert_eq!(set::<M>(&mut c, "damper_left.force", 10e3), Status::Ok);
+    let after: Vec<f64> = names.iter().map(|n| get::<M>(&mut c, n)).collect();
     let p = Params::default();
     // left tension -> moment -b F_L -> sigma'' = -b F/J
     let sdd = -p.damper_arm_m * 10e3 / p.bogie_yaw_inertia_kgm2;
@@ -250,7 +220,7 @@ fn outputs_without_stepping_feedthrough_is_real() {
         assert_eq!(before[k].to_bits(), after[k].to_bits(), "{}", names[k]);
     }
     // initial elongation from the start values: e_L = b sigma0 = 0, y0 = 3 mm
-    assert_eq!(get(&mut c, "bogie.lateral_displacement"), 3e-3);
+    assert_eq!(get::<M>(&mut c, "bogie.lateral_displacement"), 3e-3);
     // the declared feedthrough matches
     for v in M::variables() {
         if v.meta.causality == Causality::Output {
@@ -263,11 +233,11 @@ fn outputs_without_stepping_feedthrough_is_real() {
 
 #[test]
 fn start_values_and_contact_tables() {
-    let (mut c, _log) = new();
-    assert_eq!(get(&mut c, "vehicle.speed"), FMU_DEFAULT_SPEED_MPS);
+    let (mut c, _log) = initialising::<M>();
+    assert_eq!(get::<M>(&mut c, "vehicle.speed"), FMU_DEFAULT_SPEED_MPS);
     let mut model = [0];
     assert_eq!(
-        c.get_integer(&[vr("contact.model")], &mut model),
+        c.get_integer(&[vr::<M>("contact.model")], &mut model),
         Status::Ok
     );
     assert_eq!(model[0], 1);
@@ -281,7 +251,10 @@ fn start_values_and_contact_tables() {
         let (mut c, log) = rust_component::<M>(ctx.clone()).unwrap();
         assert_eq!(c.setup_experiment(0.0, None), Status::Ok);
         assert_eq!(c.enter_initialization_mode(), Status::Ok);
-        assert_eq!(c.set_string(&[vr("contact.table")], &[table]), Status::Ok);
+        assert_eq!(
+            c.set_string(&[vr::<M>("contact.table")], &[table]),
+            Status::Ok
+        );
         assert_eq!(
             c.exit_initialization_mode(),
             Status::Ok,
@@ -291,7 +264,7 @@ fn start_values_and_contact_tables() {
         for k in 0..200 {
             assert_eq!(c.do_step(k as f64 * 1e-3, 1e-3), Status::Ok);
         }
-        get(&mut c, "wheelset_front.guiding_force")
+        get::<M>(&mut c, "wheelset_front.guiding_force")
     };
     let aa_file = run("wheel_rail_A_A.csv");
     let aa_kw = run("AA");

@@ -4,47 +4,10 @@
 use fmu_vehicle::fmu::{RailVehicle, FMU_DEFAULT_INITIAL_LATERAL_M, FMU_DEFAULT_SPEED_MPS};
 use fmu_vehicle::params::Initial;
 use fmu_vehicle::{Inputs, PsdLevel, TrackSource, Vehicle, VehicleParams};
-use model_description::{
-    rust_component, value_reference, Causality, CollectLog, Component, FmuModel, InstanceContext,
-    Status, VarType,
-};
+use model_description::testing::{get, initialising, logged, real_outputs, set, vr};
+use model_description::{rust_component, FmuModel, InstanceContext, Status};
 
 type M = RailVehicle;
-
-fn vr(name: &str) -> u32 {
-    value_reference::<M>(name).unwrap_or_else(|| panic!("no variable {name}"))
-}
-
-fn new() -> (Component, CollectLog) {
-    let (mut c, log) = rust_component::<M>(InstanceContext::default()).unwrap();
-    assert_eq!(c.setup_experiment(0.0, None), Status::Ok);
-    assert_eq!(c.enter_initialization_mode(), Status::Ok);
-    (c, log)
-}
-
-fn set(c: &mut Component, name: &str, x: f64) -> Status {
-    c.set_real(&[vr(name)], &[x])
-}
-
-fn get(c: &mut Component, name: &str) -> f64 {
-    let mut out = [f64::NAN];
-    let s = c.get_real(&[vr(name)], &mut out);
-    assert!(s <= Status::Warning, "get {name}: {s:?}");
-    out[0]
-}
-
-fn logged(log: &[(Status, String, String)], status: Status, needle: &str) -> bool {
-    log.iter()
-        .any(|(s, _, m)| *s == status && m.contains(needle))
-}
-
-fn real_outputs() -> Vec<String> {
-    M::variables()
-        .iter()
-        .filter(|v| v.meta.causality == Causality::Output && v.meta.var_type == VarType::Real)
-        .map(|v| v.meta.name.clone())
-        .collect()
-}
 
 #[test]
 fn names_are_structured() {
@@ -81,7 +44,7 @@ fn names_are_structured() {
         "frame_rear.lateral_acceleration_trailing_axle",
         "wheelset_4.y_over_q",
     ] {
-        vr(name);
+        vr::<M>(name);
     }
 }
 
@@ -95,7 +58,7 @@ fn default_experiment_is_finite_and_hunts() {
     );
     assert_eq!(c.enter_initialization_mode(), Status::Ok);
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
-    let names = real_outputs();
+    let names = real_outputs::<M>();
     let n = ((e.stop_time - e.start_time) / e.step_size).round() as usize;
     let mut t = e.start_time;
     let (mut peak, mut yq): (f64, f64) = (0.0, 0.0);
@@ -105,13 +68,13 @@ fn default_experiment_is_finite_and_hunts() {
         t = target;
         if k % 10 == 0 {
             for name in &names {
-                let x = get(&mut c, name);
+                let x = get::<M>(&mut c, name);
                 assert!(x.is_finite(), "{name} = {x} at t = {t}");
             }
         }
         if t > 2.0 {
-            peak = peak.max(get(&mut c, "wheelset_1.lateral_displacement").abs());
-            yq = yq.max(get(&mut c, "wheelset_1.y_over_q"));
+            peak = peak.max(get::<M>(&mut c, "wheelset_1.lateral_displacement").abs());
+            yq = yq.max(get::<M>(&mut c, "wheelset_1.y_over_q"));
         }
     }
     assert!(log.take().is_empty());
@@ -123,16 +86,16 @@ fn default_experiment_is_finite_and_hunts() {
 /// Same parameters, same inputs: the FMU outputs equal the physics bit for bit.
 #[test]
 fn fmu_equals_plain_physics_bit_for_bit() {
-    let (mut c, log) = new();
-    assert_eq!(set(&mut c, "running.speed", 280.0 / 3.6), Status::Ok);
+    let (mut c, log) = initialising::<M>();
+    assert_eq!(set::<M>(&mut c, "running.speed", 280.0 / 3.6), Status::Ok);
     assert_eq!(
-        c.set_integer(&[vr("track.source")], &[2]),
+        c.set_integer(&[vr::<M>("track.source")], &[2]),
         Status::Ok,
         "{:?}",
         log.take()
     );
-    assert_eq!(c.set_integer(&[vr("track.level")], &[1]), Status::Ok);
-    assert_eq!(c.set_integer(&[vr("track.seed")], &[7]), Status::Ok);
+    assert_eq!(c.set_integer(&[vr::<M>("track.level")], &[1]), Status::Ok);
+    assert_eq!(c.set_integer(&[vr::<M>("track.seed")], &[7]), Status::Ok);
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
     let p = VehicleParams {
         speed_mps: 280.0 / 3.6,
@@ -153,7 +116,7 @@ fn fmu_equals_plain_physics_bit_for_bit() {
         "damper_rear_left.force",
         "damper_rear_right.force",
     ]
-    .map(vr);
+    .map(vr::<M>);
     let h = 1e-3;
     let mut t = 0.0;
     for k in 0..1000 {
@@ -168,23 +131,23 @@ fn fmu_equals_plain_physics_bit_for_bit() {
         let o = v.step((t + h) - t, &i).unwrap();
         t += h;
         assert_eq!(
-            get(&mut c, "wheelset_3.lateral_displacement"),
+            get::<M>(&mut c, "wheelset_3.lateral_displacement"),
             o.wheelset[2].lateral_m
         );
         assert_eq!(
-            get(&mut c, "frame_rear.lateral_acceleration_leading_axle"),
+            get::<M>(&mut c, "frame_rear.lateral_acceleration_leading_axle"),
             o.frame[1].lateral_acc_leading_axle_mps2
         );
         assert_eq!(
-            get(&mut c, "carbody.lateral_acceleration_mid"),
+            get::<M>(&mut c, "carbody.lateral_acceleration_mid"),
             o.carbody.lateral_acc_mid_mps2
         );
         assert_eq!(
-            get(&mut c, "damper_rear_right.carbody_end_acceleration"),
+            get::<M>(&mut c, "damper_rear_right.carbody_end_acceleration"),
             o.damper[3].carbody_end_acc_mps2
         );
         assert_eq!(
-            get(&mut c, "wheelset_4.track_alignment"),
+            get::<M>(&mut c, "wheelset_4.track_alignment"),
             o.wheelset[3].track_m
         );
     }
@@ -193,8 +156,8 @@ fn fmu_equals_plain_physics_bit_for_bit() {
 #[test]
 fn impossible_parameters_are_named() {
     // the glue refuses values outside the declared range at once
-    let (mut c, log) = new();
-    assert_eq!(set(&mut c, "carbody.mass", -1.0), Status::Error);
+    let (mut c, log) = initialising::<M>();
+    assert_eq!(set::<M>(&mut c, "carbody.mass", -1.0), Status::Error);
     assert!(logged(&log.take(), Status::Error, "carbody.mass"));
     // the physics' own checks at fmi2ExitInitializationMode, under the FMI names
     for (name, value, needle) in [
@@ -202,8 +165,8 @@ fn impossible_parameters_are_named() {
         ("primary.longitudinal_stiffness", 0.0, "> 0"),
         ("frame.yaw_inertia", 0.0, "> 0"),
     ] {
-        let (mut c, log) = new();
-        assert_eq!(set(&mut c, name, value), Status::Ok);
+        let (mut c, log) = initialising::<M>();
+        assert_eq!(set::<M>(&mut c, name, value), Status::Ok);
         assert_eq!(c.exit_initialization_mode(), Status::Error, "{name}");
         let l = log.take();
         assert!(logged(&l, Status::Error, name), "{name}: {l:?}");
@@ -218,10 +181,10 @@ fn a_contact_table_without_flange_is_refused() {
     let file = dir.join("tread_only.csv");
     let t = wheel_rail::GeometryTable::synthetic(0.2, 7e-3, 5e-4, 0.5).unwrap();
     std::fs::write(&file, t.to_csv(wheel_rail::CsvNumbers::Scientific)).unwrap();
-    let (mut c, log) = new();
+    let (mut c, log) = initialising::<M>();
     let path = file.to_string_lossy().into_owned();
     assert_eq!(
-        c.set_string(&[vr("contact.table")], &[path.as_str()]),
+        c.set_string(&[vr::<M>("contact.table")], &[path.as_str()]),
         Status::Ok
     );
     assert_eq!(c.exit_initialization_mode(), Status::Error);
@@ -233,11 +196,11 @@ fn a_contact_table_without_flange_is_refused() {
 
 #[test]
 fn bad_input_and_derailment_are_errors_naming_the_cause() {
-    let (mut c, log) = new();
+    let (mut c, log) = initialising::<M>();
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
     // NaN is refused by the glue at fmi2SetReal
     assert_eq!(
-        set(&mut c, "damper_front_right.force", f64::NAN),
+        set::<M>(&mut c, "damper_front_right.force", f64::NAN),
         Status::Error
     );
     assert!(logged(
@@ -246,9 +209,9 @@ fn bad_input_and_derailment_are_errors_naming_the_cause() {
         "damper_front_right.force"
     ));
     // linear model far above its critical speed without dampers: derails
-    let (mut c, log) = new();
-    assert_eq!(c.set_integer(&[vr("contact.model")], &[0]), Status::Ok);
-    assert_eq!(set(&mut c, "running.speed", 90.0), Status::Ok);
+    let (mut c, log) = initialising::<M>();
+    assert_eq!(c.set_integer(&[vr::<M>("contact.model")], &[0]), Status::Ok);
+    assert_eq!(set::<M>(&mut c, "running.speed", 90.0), Status::Ok);
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
     let mut t = 0.0;
     let mut status = Status::Ok;
@@ -258,7 +221,7 @@ fn bad_input_and_derailment_are_errors_naming_the_cause() {
             break;
         }
         t += 1e-3;
-        assert!(get(&mut c, "wheelset_1.lateral_displacement").is_finite());
+        assert!(get::<M>(&mut c, "wheelset_1.lateral_displacement").is_finite());
     }
     assert_eq!(status, Status::Error);
     let l = log.take();
@@ -267,22 +230,22 @@ fn bad_input_and_derailment_are_errors_naming_the_cause() {
 
 #[test]
 fn start_values_are_the_fmu_defaults() {
-    let (mut c, _log) = new();
-    assert_eq!(get(&mut c, "running.speed"), FMU_DEFAULT_SPEED_MPS);
+    let (mut c, _log) = initialising::<M>();
+    assert_eq!(get::<M>(&mut c, "running.speed"), FMU_DEFAULT_SPEED_MPS);
     assert_eq!(
-        get(&mut c, "initial.lateral_displacement"),
+        get::<M>(&mut c, "initial.lateral_displacement"),
         FMU_DEFAULT_INITIAL_LATERAL_M
     );
     assert_eq!(
-        get(&mut c, "primary.longitudinal_stiffness"),
+        get::<M>(&mut c, "primary.longitudinal_stiffness"),
         VehicleParams::default().primary.kx_n_per_m
     );
 }
 
 #[test]
 fn serialised_fmu_state_continues_bit_for_bit_in_another_instance() {
-    let (mut a, _la) = new();
-    assert_eq!(a.set_integer(&[vr("track.source")], &[2]), Status::Ok);
+    let (mut a, _la) = initialising::<M>();
+    assert_eq!(a.set_integer(&[vr::<M>("track.source")], &[2]), Status::Ok);
     assert_eq!(a.exit_initialization_mode(), Status::Ok);
     let mut t = 0.0;
     for _ in 0..300 {
@@ -291,11 +254,11 @@ fn serialised_fmu_state_continues_bit_for_bit_in_another_instance() {
     }
     let snap = a.get_fmu_state().unwrap();
     let bytes = a.serialize_fmu_state(&snap).unwrap();
-    let (mut b, _lb) = new();
+    let (mut b, _lb) = initialising::<M>();
     assert_eq!(b.exit_initialization_mode(), Status::Ok);
     let restored = b.deserialize_fmu_state(&bytes).unwrap();
     assert_eq!(b.set_fmu_state(&restored), Status::Ok);
-    let outs: Vec<u32> = real_outputs().iter().map(|n| vr(n)).collect();
+    let outs: Vec<u32> = real_outputs::<M>().iter().map(|n| vr::<M>(n)).collect();
     let (mut va, mut vb) = (vec![0.0; outs.len()], vec![0.0; outs.len()]);
     for _ in 0..300 {
         assert_eq!(a.do_step(t, 1e-3), Status::Ok);

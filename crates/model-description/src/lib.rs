@@ -25,6 +25,8 @@ pub mod files;
 pub mod finite;
 pub mod model;
 pub mod package;
+#[cfg(feature = "testing")]
+pub mod testing;
 pub mod units;
 pub mod variable;
 pub mod xml;

@@ -1,0 +1,53 @@
+//! Helpers for an FMU crate's own tests (feature `testing`, for dev-dependencies only): its
+//! component driven through the glue's state machine by variable name, as the C API would
+//! drive it. They panic on a name the model does not declare or a refused read, which is what
+//! a test wants and what no code inside a host may do, hence the feature.
+
+#![allow(clippy::panic, clippy::unwrap_used, clippy::expect_used)]
+
+use crate::{
+    rust_component, value_reference, Causality, CollectLog, Component, FmuModel, InstanceContext,
+    Status, VarType,
+};
+
+/// The value reference of a declared variable.
+pub fn vr<M: FmuModel>(name: &str) -> u32 {
+    value_reference::<M>(name).unwrap_or_else(|| panic!("no variable {name}"))
+}
+
+/// A fresh component of `M` in initialisation mode (experiment from t = 0, no stop time).
+pub fn initialising<M: FmuModel>() -> (Component, CollectLog) {
+    let (mut c, log) = rust_component::<M>(InstanceContext::default())
+        .unwrap_or_else(|e| panic!("instantiate: {e}"));
+    assert_eq!(c.setup_experiment(0.0, None), Status::Ok);
+    assert_eq!(c.enter_initialization_mode(), Status::Ok);
+    (c, log)
+}
+
+/// Sets one Real variable by name.
+pub fn set<M: FmuModel>(c: &mut Component, name: &str, x: f64) -> Status {
+    c.set_real(&[vr::<M>(name)], &[x])
+}
+
+/// Reads one Real variable by name (a refused read fails the test).
+pub fn get<M: FmuModel>(c: &mut Component, name: &str) -> f64 {
+    let mut out = [f64::NAN];
+    let s = c.get_real(&[vr::<M>(name)], &mut out);
+    assert!(s <= Status::Warning, "get {name}: {s:?}");
+    out[0]
+}
+
+/// Whether a logged message of `status` contains `needle`.
+pub fn logged(log: &[(Status, String, String)], status: Status, needle: &str) -> bool {
+    log.iter()
+        .any(|(s, _, m)| *s == status && m.contains(needle))
+}
+
+/// The names of every Real output of `M`.
+pub fn real_outputs<M: FmuModel>() -> Vec<String> {
+    M::variables()
+        .iter()
+        .filter(|v| v.meta.causality == Causality::Output && v.meta.var_type == VarType::Real)
+        .map(|v| v.meta.name.clone())
+        .collect()
+}
