@@ -1,0 +1,58 @@
+"""Parquet results of a run set: the folder `<out>/results` reads as one table with pandas,
+every run with its name and parameters as columns, the units and FMU variables in the file
+metadata, and the same values as the CSV of the same runs."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
+
+from conftest import bits, run_master, speed_set
+
+
+def test_a_parquet_run_set_folder_is_one_table_with_units_and_parameters(dist, master_cmd, tmp_path):
+    set_file = tmp_path / "set.json"
+    set_file.write_text(json.dumps(speed_set(dist, [50.0, 60.0], seeds=[1, 2], stop_time=0.5)))
+    r = run_master(master_cmd, "sweep", set_file, "-o", tmp_path / "pq", "--jobs", "2", "--format", "parquet")
+    assert r.returncode == 0, r.stderr
+    folder = tmp_path / "pq" / "results"
+    table = pd.read_parquet(folder)
+    # four runs of 501 rows each, in one call
+    assert len(table) == 4 * 501
+    runs = table.groupby("run")
+    assert sorted(runs.groups) == ["run-000", "run-001", "run-002", "run-003"]
+    # the run parameters are columns: each run has its speed and track seed
+    params = runs[["bogie.vehicle.speed", "bogie.track.seed"]].first()
+    assert sorted(map(tuple, params.to_numpy().tolist())) == [(50.0, 1.0), (50.0, 2.0), (60.0, 1.0), (60.0, 2.0)]
+    # units, FMU variables and sampling in the file metadata
+    meta = json.loads(pq.read_schema(folder / "run-000.parquet").metadata[b"railfmu.results"])
+    columns = {c["name"]: c for c in meta["columns"]}
+    force = columns["damper_left.damper.force"]
+    assert force["unit"] == "N" and force["instance"] == "damper_left" and force["fmu_guid"]
+    assert force["causality"] == "output"
+    assert meta["sampling"]["rate_hz"] == 1000.0 and meta["sampling"]["decimation"] is None
+    assert meta["parameters"]["bogie.vehicle.speed"] in (50.0, 60.0)
+    assert meta["system"]["instances"][0]["name"] == "bogie"
+    # the same runs as CSV carry the same values
+    r = run_master(master_cmd, "sweep", set_file, "-o", tmp_path / "csv", "--jobs", "2", "--format", "csv")
+    assert r.returncode == 0, r.stderr
+    csv = pd.read_csv(tmp_path / "csv" / "run-002" / "results.csv")
+    one = table[table["run"] == "run-002"]
+    for label in csv.columns:
+        assert np.array_equal(bits(one[label].to_numpy()), bits(csv[label].to_numpy())), label
+    csv_meta = json.loads((tmp_path / "csv" / "run-002" / "results.meta.json").read_text())
+    assert csv_meta["columns"] == meta["columns"]
+
+
+def test_master_run_writes_parquet_by_extension(passive_file, master_cmd, tmp_path):
+    out = tmp_path / "one.parquet"
+    r = run_master(master_cmd, "run", passive_file, "-o", out)
+    assert r.returncode == 0, r.stderr
+    table = pd.read_parquet(out)
+    assert table.columns[0] == "time [s]" and len(table) == 1001
+    assert "run" not in table.columns
+    assert Path(out).with_suffix(".meta.json").exists() is False
