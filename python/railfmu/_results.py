@@ -58,6 +58,25 @@ class Results:
         header, data = _railfmu.read_csv(os.fspath(path))
         return cls._from_bytes(header, data)
 
+    @classmethod
+    def read_parquet(cls, path: PathLike) -> "Results":
+        """Reads a Parquet results file written by the master (needs pyarrow): time and the
+        recorded numeric columns (Reals, Integers, Booleans as 0/1, Enumerations as integers),
+        every value as written; the run statistics from the file's metadata."""
+        import pyarrow.parquet as pq
+
+        try:
+            table = pq.read_table(os.fspath(path))
+        except (OSError, ValueError) as e:
+            raise _railfmu.OutputError(f"cannot read '{path}': {e}") from None
+        raw = (table.schema.metadata or {}).get(b"railfmu.results")
+        if raw is None:
+            raise _railfmu.OutputError(f"'{path}' has no railfmu.results metadata: not written by the master")
+        meta = json.loads(raw)
+        header = [table.column_names[0]] + [c["label"] for c in meta["columns"] if c.get("ty") != "String"]
+        values = np.column_stack([table.column(h).to_numpy().astype(np.float64) for h in header])
+        return cls(header, values, meta.get("summary"))
+
     @property
     def time(self) -> np.ndarray:
         """The communication points [s]."""
@@ -108,8 +127,8 @@ class Results:
 
 class RunSetResults(Mapping[str, Results]):
     """A run-set folder: ``sweep.json`` plus one folder per run (``system.json``,
-    ``results.csv``, ``summary.json``). A mapping from run name to its :class:`Results`
-    (read when first asked for; failed runs have none)."""
+    ``results.csv``, ``summary.json``; Parquet results in ``results/<run>.parquet``). A mapping
+    from run name to its :class:`Results` (read when first asked for; failed runs have none)."""
 
     def __init__(self, folder: PathLike, reports: Optional[List[Dict[str, Any]]] = None):
         self.folder: Path = Path(folder)
@@ -148,7 +167,11 @@ class RunSetResults(Mapping[str, Results]):
             if r["name"] == name:
                 if not r["ok"]:
                     raise KeyError(f"run '{name}' failed: {r.get('error')}")
-                res = Results.read_csv(self.folder / name / "results.csv")
+                parquet = self.folder / "results" / f"{name}.parquet"
+                if parquet.is_file():
+                    res = Results.read_parquet(parquet)
+                else:
+                    res = Results.read_csv(self.folder / name / "results.csv")
                 res.summary = dict(r.get("summary") or {})
                 self._cache[name] = res
                 return res
@@ -191,6 +214,8 @@ def read_results(path: PathLike) -> Union[Results, RunSetResults]:
     p = Path(path)
     if p.is_dir() and (p / "sweep.json").is_file():
         return RunSetResults(p)
+    if p.suffix == ".parquet":
+        return Results.read_parquet(p)
     csv = p / "results.csv" if p.is_dir() else p
     if not csv.is_file():
         raise _railfmu.OutputError(f"'{p}' holds neither sweep.json nor results.csv")

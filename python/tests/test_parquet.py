@@ -11,6 +11,8 @@ import numpy as np
 import pandas as pd
 import pyarrow.parquet as pq
 
+import railfmu
+
 from conftest import bits, run_master, speed_set
 
 
@@ -46,6 +48,11 @@ def test_a_parquet_run_set_folder_is_one_table_with_units_and_parameters(dist, m
         assert np.array_equal(bits(one[label].to_numpy()), bits(csv[label].to_numpy())), label
     csv_meta = json.loads((tmp_path / "csv" / "run-002" / "results.meta.json").read_text())
     assert csv_meta["columns"] == meta["columns"]
+    # the Python package reads either run set to the same bits
+    pq_set, csv_set = railfmu.read_results(tmp_path / "pq"), railfmu.read_results(tmp_path / "csv")
+    assert np.array_equal(bits(pq_set["run-002"].values), bits(csv_set["run-002"].values))
+    assert pq_set["run-002"].units["damper_left.damper.force"] == "N"
+    assert pq_set["run-002"].summary["steps"] == 500
 
 
 def test_master_run_writes_parquet_by_extension(passive_file, master_cmd, tmp_path):
