@@ -12,10 +12,13 @@
 //! 4. A run set of 4 runs of that system on 2 worker threads against 1.
 //! 5. The studies' wall time (`master study` on 2 cores), when `BENCH_STUDY` names the study
 //!    options (scripts/bench.sh sets it).
+//! 6. Results files of one full-rate 15 s study run (the coach with four passive dampers):
+//!    size and read time of Parquet against CSV, and the CSV decimated to 100 Hz.
 //!
 //! `bash scripts/bench.sh` builds what it needs and runs this; it writes docs/BENCHMARKS.md.
 //! By hand: `cargo bench -p tests --bench ratios` (needs dist/). `BENCH_ONLY=coupled,fmpy`
-//! measures only the named sections (`models`, `coupled`, `fmpy`, `runset`, `studies`) and
+//! measures only the named sections (`models`, `coupled`, `fmpy`, `runset`, `studies`,
+//! `results`) and
 //! writes to target/BENCHMARKS.md unless `BENCH_OUT` is set.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // benchmark code
@@ -395,6 +398,10 @@ fn main() {
         }
     }
 
+    if wanted("results") {
+        results_files(&mut r);
+    }
+
     let mut md = String::from(
         "# Benchmarks\n\nWritten by `bash scripts/bench.sh` (tests/benches/ratios.rs); every figure \
          below comes from one run on one machine, with the load average beside it.\n\n",
@@ -443,4 +450,86 @@ fn vehicle_rtf() -> f64 {
         .collect();
     f.sort_by(f64::total_cmp);
     f[2]
+}
+
+/// Size and read time of the results of one full-rate 15 s run of the coach study
+/// (passive, 300 km/h, track seed 1) as Parquet and as CSV, and of the CSV decimated to
+/// 100 Hz through the anti-aliasing filter; read as `master assess` reads them
+/// ([`rail_study::analysis::assess::ResultsTable::load`]), best of 5.
+fn results_files(r: &mut Report) {
+    use master::decimation::decimate;
+    use master::results::{write_results, ResultsFormat, RunContext};
+    use rail_study::analysis::assess::ResultsTable;
+    use rail_study::study::config::{configuration, RunRequest, Sources};
+    use rail_study::study::VehicleModel;
+    let sources = Sources {
+        fmus: repo().join("dist"),
+        systems: None,
+    };
+    let Some(passive) = configuration("passive") else {
+        return r.line("- results files: no passive configuration".into());
+    };
+    let system = match sources.system(VehicleModel::Coach, passive) {
+        Ok(s) => s,
+        Err(e) => return r.line(format!("- results files: not measured ({e})")),
+    };
+    let prepared = PreparedSystem::prepare(&system).unwrap();
+    let job = RunRequest::new("", VehicleModel::Coach, passive, 300.0, Some(1), 15.0)
+        .job(&system)
+        .unwrap();
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    let out = run_job(&prepared, &job, &cancel).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let ctx = RunContext::default();
+    let files = [
+        (
+            "Parquet, full rate",
+            "full.parquet",
+            ResultsFormat::Parquet,
+            1,
+        ),
+        ("CSV, full rate", "full.csv", ResultsFormat::Csv, 1),
+        (
+            "CSV, 100 Hz (anti-aliased)",
+            "small.csv",
+            ResultsFormat::Csv,
+            10,
+        ),
+    ];
+    r.line(String::new());
+    r.line(format!(
+        "## Results files of one 15 s run (coach, passive, 300 km/h: {} rows x {} columns at 1 kHz)",
+        out.rows().count(),
+        out.header.len()
+    ));
+    r.line(String::new());
+    r.line("| file | size | read time (best of 5) | load average |".into());
+    r.line("|---|---|---|---|".into());
+    let mut sizes = Vec::new();
+    for (what, name, format, factor) in files {
+        let path = dir.path().join(name);
+        write_results(&path, &decimate(&out, factor).unwrap(), format, &ctx).unwrap();
+        let bytes = std::fs::metadata(&path).unwrap().len();
+        let best = (0..5)
+            .map(|_| {
+                let started = Instant::now();
+                let t = ResultsTable::load(&path).unwrap();
+                std::hint::black_box(t.columns.len());
+                started.elapsed().as_secs_f64()
+            })
+            .fold(f64::INFINITY, f64::min);
+        sizes.push((bytes, best));
+        r.line(format!(
+            "| {what} | {:.2} MB | {:.1} ms | {} |",
+            bytes as f64 / 1e6,
+            best * 1e3,
+            load_average()
+        ));
+    }
+    r.line(format!(
+        "- full rate: Parquet / CSV size {:.2}, read time {:.2}; Parquet at the full rate / CSV at 100 Hz size {:.2}",
+        sizes[0].0 as f64 / sizes[1].0 as f64,
+        sizes[0].1 / sizes[1].1,
+        sizes[0].0 as f64 / sizes[2].0 as f64
+    ));
 }
