@@ -10,7 +10,7 @@ use model_description::{
     MAX_PARAMETER_FILE_BYTES,
 };
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{resource_or_given, InputError, TrackLevel};
+use vehicle_elements::{host_step, resource_or_given, InputError, TrackLevel};
 use wheel_rail::GeometryTable;
 
 use crate::model::{Bogie, Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep};
@@ -377,21 +377,7 @@ impl FmuModel for Bogie2Dof {
             }
             other => StepError::Error(ModelError::Other(other.to_string())),
         };
-        if step <= 1.0 {
-            // The physics leaves itself unchanged when a step fails: step in place.
-            self.out = b.step(step, &self.inputs).map_err(map)?;
-        } else {
-            // Longer host steps (the physics takes up to 1 s) on a copy, committed on success.
-            let n = step.ceil() as usize;
-            let h = step / n as f64;
-            let mut next = b.clone();
-            let mut out = self.out;
-            for _ in 0..n {
-                out = next.step(h, &self.inputs).map_err(map)?;
-            }
-            *b = next;
-            self.out = out;
-        }
+        self.out = host_step(b, step, |p, h| p.step(h, &self.inputs)).map_err(map)?;
         Ok(())
     }
 

@@ -9,7 +9,7 @@ use model_description::{
     ModelError, ModelInfo, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{resource_or_given, InputError, TrackLevel};
+use vehicle_elements::{host_step, resource_or_given, InputError, TrackLevel};
 
 use crate::model::{Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep, Vehicle};
 use crate::params::{ContactSource, Initial, ModelKind, TrackSource, VehicleParams};
@@ -516,20 +516,7 @@ impl FmuModel for RailVehicle {
             }
             other => StepError::Error(ModelError::Other(other.to_string())),
         };
-        if step <= 1.0 {
-            self.out = v.step(step, &self.inputs).map_err(map)?;
-        } else {
-            // Longer host steps (the physics takes up to 1 s) on a copy, committed on success.
-            let n = step.ceil() as usize;
-            let h = step / n as f64;
-            let mut next = v.clone();
-            let mut out = self.out;
-            for _ in 0..n {
-                out = next.step(h, &self.inputs).map_err(map)?;
-            }
-            *v = next;
-            self.out = out;
-        }
+        self.out = host_step(v, step, |p, h| p.step(h, &self.inputs)).map_err(map)?;
         Ok(())
     }
 }

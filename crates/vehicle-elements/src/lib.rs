@@ -2,7 +2,8 @@
 //! each other:
 //! * [`params`]: the parameter error that names the rejected physics field, and the range
 //!   checks (finite, positive, non-negative, within bounds) that produce it;
-//! * [`step`]: the checks of a step's size and inputs, and the error that names the input;
+//! * [`step`]: the checks of a step's size and inputs, the error that names the input, and a
+//!   host step of any length on the physics;
 //! * [`track`]: the FMI-facing choices of the track input (the ERRI B176 level, and the
 //!   source through [`track_choice_enum!`]) and their mapping onto the physics'
 //!   [`wheel_rail::track::TrackSource`];
@@ -22,5 +23,5 @@ pub mod track;
 pub use damper::{run_closed_loop, ClosedLoopModel, LinearDamper};
 pub use params::{finite, in_range, non_negative, positive, ParamError};
 pub use resources::resource_or_given;
-pub use step::{check_inputs, check_step, InputError};
+pub use step::{check_inputs, check_step, host_step, InputError};
 pub use track::TrackLevel;
