@@ -260,6 +260,10 @@ pub enum ColumnData {
 /// the file's metadata (`None` when it is not ours).
 pub type ParquetTable = (Vec<(String, ColumnData)>, Option<ResultsMetadata>);
 
+/// Records read per call: memory grows with what the file holds, not with the row count
+/// its metadata claims (a hostile file may claim any).
+const READ_BATCH: usize = 1 << 16;
+
 fn read_column<T: parquet::data_type::DataType>(
     mut r: parquet::column::reader::ColumnReaderImpl<T>,
     rows: usize,
@@ -268,11 +272,11 @@ fn read_column<T: parquet::data_type::DataType>(
 where
     T::T: Clone,
 {
-    let mut values: Vec<T::T> = Vec::with_capacity(rows);
-    let mut defs: Vec<i16> = Vec::with_capacity(rows);
+    let mut values: Vec<T::T> = Vec::with_capacity(rows.min(READ_BATCH));
+    let mut defs: Vec<i16> = Vec::with_capacity(rows.min(READ_BATCH));
     loop {
         let (records, _, _) = r.read_records(
-            rows.max(1),
+            READ_BATCH,
             (max_def > 0).then_some(&mut defs),
             None,
             &mut values,
