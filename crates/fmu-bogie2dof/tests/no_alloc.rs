@@ -1,27 +1,11 @@
-//! The step path of the bogie (1000 steps of 1 ms, non-linear, ideal and internal irregular track) allocates nothing: counted with a global allocator (one test in this
-//! binary, so no other test allocates meanwhile).
+//! The step path of the bogie (1000 steps of 1 ms, non-linear, ideal and internal irregular track) allocates nothing: counted with a global allocator on this thread.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use fmu_bogie2dof::perf::{reference_bogie, simulate_reference, ReferenceTrack};
-
-struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        System.alloc(layout)
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        System.dealloc(ptr, layout)
-    }
-}
+use model_description::testing::{allocations_during, CountingAllocator};
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: CountingAllocator = CountingAllocator;
 
 #[test]
 fn step_path_does_not_allocate() {
@@ -29,8 +13,8 @@ fn step_path_does_not_allocate() {
     for track in [ReferenceTrack::Ideal, ReferenceTrack::InternalIrregular] {
         let mut bogie = reference_bogie(track).unwrap();
         simulate_reference(&mut bogie, 0.1).unwrap();
-        let before = ALLOCATIONS.load(Ordering::SeqCst);
-        simulate_reference(&mut bogie, 1.0).unwrap();
-        assert_eq!(ALLOCATIONS.load(Ordering::SeqCst), before, "{track:?}");
+        let (allocations, run) = allocations_during(|| simulate_reference(&mut bogie, 1.0));
+        run.unwrap();
+        assert_eq!(allocations, 0, "{track:?}");
     }
 }

@@ -1,28 +1,14 @@
 //! The glue allocates nothing on the communication-step path (fmi2SetReal, fmi2DoStep,
-//! fmi2GetReal): counted with a global allocator around calls into the exported C functions.
+//! fmi2GetReal): counted with a global allocator (on this thread) around calls into the exported C
+//! functions.
 #![cfg(feature = "fmi-export")]
-
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use fmu_examples::__fmi2_exports as fmi;
 use model_description::capi::ffi;
-
-struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        System.alloc(layout)
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        System.dealloc(ptr, layout)
-    }
-}
+use model_description::testing::{allocations_during, CountingAllocator};
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: CountingAllocator = CountingAllocator;
 
 #[test]
 fn communication_step_path_does_not_allocate() {
@@ -58,17 +44,17 @@ fn communication_step_path_does_not_allocate() {
             model_description::value_reference::<fmu_examples::MassSpring>("velocity").unwrap(),
         ];
         let mut out = [0.0; 2];
-        let before = ALLOCATIONS.load(Ordering::SeqCst);
         let h = 1.0e-3;
-        for k in 0..1000 {
-            let t = k as f64 * h;
-            let f = [t.sin()];
-            assert_eq!(fmi::fmi2SetReal(c, force_vr.as_ptr(), 1, f.as_ptr()), 0);
-            assert_eq!(fmi::fmi2DoStep(c, t, h, 1), 0);
-            assert_eq!(fmi::fmi2GetReal(c, out_vr.as_ptr(), 2, out.as_mut_ptr()), 0);
-        }
-        let after = ALLOCATIONS.load(Ordering::SeqCst);
-        assert_eq!(after - before, 0, "allocations on the step path");
+        let (allocations, ()) = allocations_during(|| {
+            for k in 0..1000 {
+                let t = k as f64 * h;
+                let f = [t.sin()];
+                assert_eq!(fmi::fmi2SetReal(c, force_vr.as_ptr(), 1, f.as_ptr()), 0);
+                assert_eq!(fmi::fmi2DoStep(c, t, h, 1), 0);
+                assert_eq!(fmi::fmi2GetReal(c, out_vr.as_ptr(), 2, out.as_mut_ptr()), 0);
+            }
+        });
+        assert_eq!(allocations, 0, "allocations on the step path");
         assert!(out[0].is_finite());
         fmi::fmi2FreeInstance(c);
     }

@@ -51,3 +51,43 @@ pub fn real_outputs<M: FmuModel>() -> Vec<String> {
         .map(|v| v.meta.name.clone())
         .collect()
 }
+
+/// A global allocator that counts the allocations made on a thread while it counts there (the
+/// test harness allocates on its own threads meanwhile). Install it in a test binary with
+/// `#[global_allocator] static GLOBAL: CountingAllocator = CountingAllocator;` and measure
+/// with [`allocations_during`].
+pub struct CountingAllocator;
+
+static ALLOCATIONS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+thread_local! {
+    static COUNTING: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+// SAFETY: every call is passed on to the system allocator unchanged; the count is a side
+// effect that does not allocate (an atomic and a const-initialised thread-local).
+unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
+        if COUNTING.with(std::cell::Cell::get) {
+            ALLOCATIONS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        }
+        std::alloc::System.alloc(layout)
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
+        std::alloc::System.dealloc(ptr, layout)
+    }
+}
+
+/// How many allocations `f` makes on this thread (with [`CountingAllocator`] installed as the
+/// global allocator; without it, always 0), and what it returns.
+pub fn allocations_during<T>(f: impl FnOnce() -> T) -> (usize, T) {
+    let before = ALLOCATIONS.load(std::sync::atomic::Ordering::SeqCst);
+    COUNTING.with(|c| c.set(true));
+    let out = f();
+    COUNTING.with(|c| c.set(false));
+    (
+        ALLOCATIONS.load(std::sync::atomic::Ordering::SeqCst) - before,
+        out,
+    )
+}
