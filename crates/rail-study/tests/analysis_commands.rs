@@ -759,3 +759,90 @@ fn assess_reports_the_en14363_verdict_and_refuses_bad_input() {
     assert!(!r.ok && r.stderr.contains("bad.csv:5"), "{}", r.stderr);
     assert!(!none.exists(), "nothing may be written on error");
 }
+
+/// `master assess` reads our Parquet files, and refuses a file whose recorded pass band
+/// (from its metadata) does not reach the assessed band unless told to assess anyway.
+#[test]
+fn assess_reads_parquet_and_checks_the_recorded_band() {
+    use master::coupling::{SimOutput, Summary};
+    use master::decimation::decimate;
+    use master::results::{write_results, ResultsFormat, RunContext};
+    let dir = tempfile::tempdir().unwrap();
+    // 20 s at 1 kHz of a 4 Hz sine of amplitude 5 m/s2 (rms 3.54)
+    let n = 20_001;
+    let data: Vec<f64> = (0..n)
+        .flat_map(|k| {
+            let t = k as f64 / 1000.0;
+            [t, 5.0 * (2.0 * std::f64::consts::PI * 4.0 * t).sin()]
+        })
+        .collect();
+    let out = SimOutput {
+        header: vec!["time [s]".into(), "frame.a [m/s2]".into()],
+        data,
+        summary: Summary {
+            steps: n as u64 - 1,
+            rejected_steps: 0,
+            simulated_time_s: 20.0,
+            wall_time_s: 0.1,
+            realtime_ratio: 200.0,
+            terminated: None,
+        },
+        columns: vec![],
+        strings: vec![],
+        decimation: None,
+    };
+    let ctx = RunContext::default();
+    let full = dir.path().join("full.parquet");
+    write_results(&full, &out, ResultsFormat::Parquet, &ctx).unwrap();
+    // every 50th sample: 20 Hz, the anti-aliasing filter's pass band ends at 4.5 Hz < 6 Hz
+    let narrow = dir.path().join("narrow.csv");
+    write_results(
+        &narrow,
+        &decimate(&out, 50).unwrap(),
+        ResultsFormat::Csv,
+        &ctx,
+    )
+    .unwrap();
+    let out_dir = dir.path().join("out");
+    let o = out_dir.to_str().unwrap();
+    let assess = |file: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "assess",
+            file.to_str().unwrap(),
+            "--signal",
+            "frame.a",
+            "--speed",
+            "300",
+            "--f0",
+            "4",
+            "--out",
+            o,
+        ];
+        args.extend_from_slice(extra);
+        master(&args)
+    };
+    let r = assess(&full, &[]);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(r.stdout.contains("max rms 3.5"), "{}", r.stdout);
+    assert!(
+        !r.stderr.contains("note:") && !r.stderr.contains("WARNING"),
+        "{}",
+        r.stderr
+    );
+    std::fs::remove_dir_all(&out_dir).unwrap();
+    let r = assess(&narrow, &[]);
+    assert!(!r.ok);
+    assert!(
+        r.stderr.contains("4.50 Hz at most") && r.stderr.contains("--accept-narrow-band"),
+        "{}",
+        r.stderr
+    );
+    assert!(!out_dir.exists(), "a refused assessment wrote files");
+    let r = assess(&narrow, &["--accept-narrow-band"]);
+    assert!(r.ok && r.stderr.contains("WARNING"), "{}", r.stderr);
+    // a CSV without metadata (a host's export): assessed, with a note
+    let bare = dir.path().join("bare.csv");
+    std::fs::copy(&narrow, &bare).unwrap();
+    let r = assess(&bare, &[]);
+    assert!(r.ok && r.stderr.contains("note:"), "{}", r.stderr);
+}
