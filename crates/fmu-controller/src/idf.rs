@@ -32,8 +32,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::{
-    check_finite_nonneg, check_finite_pos, check_sign, finite_out, NanPolicy, ParamError,
-    SampleClock, StepError,
+    check_finite_nonneg, check_finite_pos, check_outputs, check_sign, screen_step, NanPolicy,
+    ParamError, SampleClock, StepError,
 };
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -148,19 +148,14 @@ impl Idf {
     }
 
     pub fn step(&mut self, h: f64, inputs: &IdfInputs) -> Result<IdfOutputs, StepError> {
-        if !h.is_finite() || h < 0.0 {
-            return Err(StepError::InvalidStep(h));
-        }
-        let bad = [
-            ("elongation_velocity_mps", inputs.elongation_velocity_mps),
-            ("measured_force_n", inputs.measured_force_n),
-        ]
-        .into_iter()
-        .find(|(_, v)| !v.is_finite());
-        if let (Some((name, value)), NanPolicy::Error) = (bad, self.params.nan_policy) {
-            return Err(StepError::NonFiniteInput { name, value });
-        }
-        let valid = bad.is_none();
+        let valid = screen_step(
+            h,
+            &[
+                ("elongation_velocity_mps", inputs.elongation_velocity_mps),
+                ("measured_force_n", inputs.measured_force_n),
+            ],
+            self.params.nan_policy,
+        )?;
         let n = self.clock.advance(h)?;
         for _ in 0..n {
             self.out = self.pending;
@@ -175,13 +170,11 @@ impl Idf {
         }
         self.out.input_fault = !valid;
         self.out.dropped_samples = self.dropped_samples;
-        for (name, v) in [
+        check_outputs(&[
             ("spool_command_m", self.out.spool_command_m),
             ("force_ref_n", self.out.force_ref_n),
             ("force_error_n", self.out.force_error_n),
-        ] {
-            finite_out(name, v)?;
-        }
+        ])?;
         Ok(self.out)
     }
 }

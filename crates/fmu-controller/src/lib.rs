@@ -124,11 +124,30 @@ pub(crate) fn check_sign(name: &'static str, v: f64) -> Result<(), ParamError> {
     }
 }
 
-pub(crate) fn finite_out(name: &'static str, value: f64) -> Result<f64, StepError> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(StepError::NonFiniteOutput { name, value })
+/// The first check of every board step: the communication step `h` must be finite and
+/// non-negative, and the inputs the law uses finite. `Ok(false)`: an input is not, and the
+/// sample is dropped ([`NanPolicy::HoldAndWarn`]); with [`NanPolicy::Error`] that is an error
+/// naming the input.
+pub(crate) fn screen_step(
+    h: f64,
+    inputs: &[(&'static str, f64)],
+    policy: NanPolicy,
+) -> Result<bool, StepError> {
+    if !h.is_finite() || h < 0.0 {
+        return Err(StepError::InvalidStep(h));
+    }
+    match (inputs.iter().find(|(_, v)| !v.is_finite()), policy) {
+        (None, _) => Ok(true),
+        (Some(&(name, value)), NanPolicy::Error) => Err(StepError::NonFiniteInput { name, value }),
+        (Some(_), NanPolicy::HoldAndWarn) => Ok(false),
+    }
+}
+
+/// The last check of every board step: its real outputs are finite (guards the host).
+pub(crate) fn check_outputs(outputs: &[(&'static str, f64)]) -> Result<(), StepError> {
+    match outputs.iter().find(|(_, v)| !v.is_finite()) {
+        None => Ok(()),
+        Some(&(name, value)) => Err(StepError::NonFiniteOutput { name, value }),
     }
 }
 

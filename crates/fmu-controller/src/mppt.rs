@@ -38,8 +38,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::signal::{band_pass, BandPass, RmsWindow};
 use crate::{
-    check_finite_nonneg, check_finite_pos, check_sign, finite_out, NanPolicy, ParamError,
-    SampleClock, StepError,
+    check_finite_nonneg, check_finite_pos, check_outputs, check_sign, screen_step, NanPolicy,
+    ParamError, SampleClock, StepError,
 };
 
 /// EN 14363 lateral acceleration limit of the seed's bogie, a_lim = (12 - m/5)/2 (section 4.2).
@@ -319,19 +319,14 @@ impl Mppt {
 
     /// Advance over `[t, t+h)` with the inputs held.
     pub fn step(&mut self, h: f64, inputs: &MpptInputs) -> Result<MpptOutputs, StepError> {
-        if !h.is_finite() || h < 0.0 {
-            return Err(StepError::InvalidStep(h));
-        }
-        let bad = [
-            ("bogie_accel_mps2", inputs.bogie_accel_mps2),
-            ("damper_force_n", inputs.damper_force_n),
-        ]
-        .into_iter()
-        .find(|(_, v)| !v.is_finite());
-        if let (Some((name, value)), NanPolicy::Error) = (bad, self.params.nan_policy) {
-            return Err(StepError::NonFiniteInput { name, value });
-        }
-        let valid = bad.is_none();
+        let valid = screen_step(
+            h,
+            &[
+                ("bogie_accel_mps2", inputs.bogie_accel_mps2),
+                ("damper_force_n", inputs.damper_force_n),
+            ],
+            self.params.nan_policy,
+        )?;
         let n = self.clock.advance(h)?;
         for _ in 0..n {
             // The command computed at the previous sample is applied now.
@@ -343,15 +338,13 @@ impl Mppt {
         }
         self.out.input_fault = !valid;
         self.out.dropped_samples = self.dropped_samples;
-        for (name, v) in [
+        check_outputs(&[
             ("command_v", self.out.command_v),
             ("cost", self.out.cost),
             ("rms_accel_mps2", self.out.rms_accel_mps2),
             ("rms_force_n", self.out.rms_force_n),
             ("filtered_accel_mps2", self.out.filtered_accel_mps2),
-        ] {
-            finite_out(name, v)?;
-        }
+        ])?;
         Ok(self.out)
     }
 

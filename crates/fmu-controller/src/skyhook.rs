@@ -42,8 +42,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::signal::VelocityEstimator;
 use crate::{
-    check_finite_nonneg, check_finite_pos, check_sign, finite_out, NanPolicy, ParamError,
-    SampleClock, StepError,
+    check_finite_nonneg, check_finite_pos, check_outputs, check_sign, screen_step, NanPolicy,
+    ParamError, SampleClock, StepError,
 };
 
 /// Equivalent damping (N s/m) vs valve opening (0..1) of the project's semi-active damper at
@@ -346,25 +346,20 @@ impl SkyHook {
     }
 
     pub fn step(&mut self, h: f64, inputs: &SkyHookInputs) -> Result<SkyHookOutputs, StepError> {
-        if !h.is_finite() || h < 0.0 {
-            return Err(StepError::InvalidStep(h));
-        }
         let abs_in = match self.params.velocity_source {
             VelocitySource::EstimatedFromAcceleration => {
                 ("sensor_accel_mps2", inputs.sensor_accel_mps2)
             }
             VelocitySource::Ideal => ("abs_velocity_mps", inputs.abs_velocity_mps),
         };
-        let bad = [
-            abs_in,
-            ("elongation_velocity_mps", inputs.elongation_velocity_mps),
-        ]
-        .into_iter()
-        .find(|(_, v)| !v.is_finite());
-        if let (Some((name, value)), NanPolicy::Error) = (bad, self.params.nan_policy) {
-            return Err(StepError::NonFiniteInput { name, value });
-        }
-        let valid = bad.is_none();
+        let valid = screen_step(
+            h,
+            &[
+                abs_in,
+                ("elongation_velocity_mps", inputs.elongation_velocity_mps),
+            ],
+            self.params.nan_policy,
+        )?;
         let n = self.clock.advance(h)?;
         for _ in 0..n {
             // The command computed at the previous sample is applied now.
@@ -396,13 +391,11 @@ impl SkyHook {
         }
         self.out.input_fault = !valid;
         self.out.dropped_samples = self.dropped_samples;
-        for (name, v) in [
+        check_outputs(&[
             ("command_v", self.out.command_v),
             ("abs_velocity_mps", self.out.abs_velocity_mps),
             ("condition", self.out.condition),
-        ] {
-            finite_out(name, v)?;
-        }
+        ])?;
         Ok(self.out)
     }
 }

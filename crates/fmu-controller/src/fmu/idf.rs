@@ -107,11 +107,11 @@ impl FmuModel for IdealDamperForceController {
             output "force_loop.error" [unit = "N", display_unit = "kN", discrete = true] => out.force_error_n;
             /// True if the spool command is clamped at +-u_max
             output "spool.command_saturated" => out.saturated;
-            /// True if an input of the last step was not finite (sample dropped, command held)
-            output "board.input_fault" => out.input_fault;
-            /// Board samples dropped because of non-finite inputs since the start
-            output "board.dropped_samples" => out.dropped_samples;
         }
+        declare_board_status!(
+            v,
+            " True if an input of the last step was not finite (sample dropped, command held)"
+        );
         v
     }
 

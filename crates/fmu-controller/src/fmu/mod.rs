@@ -59,6 +59,19 @@ macro_rules! board_life_cycle {
     };
 }
 
+/// The two status outputs every board declares last, after its own (inside `variables()`):
+/// `$fault_doc` describes `board.input_fault` for that board.
+macro_rules! declare_board_status {
+    ($v:ident, $fault_doc:literal) => {
+        model_description::declare! { $v;
+            #[doc = $fault_doc]
+            output "board.input_fault" => out.input_fault;
+            /// Board samples dropped because of non-finite inputs since the start
+            output "board.dropped_samples" => out.dropped_samples;
+        }
+    };
+}
+
 mod idf;
 mod mppt;
 mod skyhook;

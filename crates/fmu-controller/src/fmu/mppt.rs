@@ -182,11 +182,11 @@ impl FmuModel for MpptController {
             output "override.active" => out.override_active;
             /// Number of valve updates performed
             output "hill_climb.updates" => out.updates;
-            /// True if an input of the last step was not finite (sample dropped, command held)
-            output "board.input_fault" => out.input_fault;
-            /// Board samples dropped because of non-finite inputs since the start
-            output "board.dropped_samples" => out.dropped_samples;
         }
+        declare_board_status!(
+            v,
+            " True if an input of the last step was not finite (sample dropped, command held)"
+        );
         v
     }
 

@@ -262,11 +262,11 @@ impl FmuModel for SkyHookController {
             output "sensor.absolute_velocity" [unit = "m/s", discrete = true] => out.abs_velocity_mps;
             /// True when the condition function is >= 0 (damping demanded)
             output "control.on_state" => out.on_state;
-            /// True if a used input of the last step was not finite (sample dropped, command held)
-            output "board.input_fault" => out.input_fault;
-            /// Board samples dropped because of non-finite inputs since the start
-            output "board.dropped_samples" => out.dropped_samples;
         }
+        declare_board_status!(
+            v,
+            " True if a used input of the last step was not finite (sample dropped, command held)"
+        );
         v
     }
 
