@@ -65,10 +65,12 @@ fn passive_critical_speed_280_to_310() {
 
 /// R9: MPPT raises the critical speed by about +70 km/h (accepted +40..+100). The lower bound
 /// holds for both weightings; the coach with MPPT stays within the limit to the end of the
-/// quick grid (420 km/h), so the measured gain is at least 420 - passive, more than +100: in
-/// the coach as in the bogie a nearly closed valve (about 330 kNs/m at 4 Hz against 100 for
-/// the 30 % passive damper) has nothing in series that limits it but the oil and the primary
-/// suspension (the seed names the mounting stiffness; ours is rigid by default).
+/// quick grid (420 km/h), so the measured gain is at least 420 - passive, more than +100. A
+/// nearly closed valve gives about 330 kNs/m at 4 Hz against 100 for the 30 % passive damper,
+/// and our coach's critical speed rises more steeply with yaw damping than the seed's (the
+/// ideal 210 kNs/m damper keeps it within the limit at 380 km/h, the seed's exceeds it, Table
+/// 4-3); a 10 MN/m damper mounting (MPE 2019) leaves MPPT stable through 420 km/h too
+/// (docs/VALIDATION.md).
 #[test]
 fn mppt_raises_the_critical_speed() {
     let p = STUDY.vcr("passive");
@@ -88,31 +90,36 @@ fn mppt_raises_the_critical_speed() {
     }
 }
 
-/// R11: the seed's sky-hook (ideal valve) is within 30 km/h of MPPT. NOT met by the textbook
-/// sky-hook on the coach: its velocity x' is the car-body attachment point's, which barely
-/// moves at the 4 Hz hunting frequency and is in quadrature with the damper's elongation
-/// velocity, so the condition x' (x' - x0') changes sign twice per cycle and the damper is
-/// switched to minimum damping for about half of each cycle: the bogie sees less yaw damping
-/// than with the passive damper. Measured: on/off 280 km/h, continuous 260 km/h, passive 305.
-/// Asserted: both below passive by 10-60 km/h, far below MPPT.
+/// R11: the sky-hook with an ideal valve is within 30 km/h of MPPT. The textbook sky-hook of
+/// (3.6) hooks the bogie to the sky: x' is the frame attachment point's absolute velocity, x0'
+/// the car body's. The car body barely moves at the 4 Hz hunting frequency, so the condition
+/// x' (x' - x0') is mostly positive and the damper mostly closed, as MPPT1 keeps it (quick
+/// study: both stable through 420 km/h, passive 305). Asserted: within 30 km/h of the lower
+/// MPPT, at least +40 km/h over passive, and the valve mostly closed at 300 km/h (mean command
+/// over the last 3 s: measured 0.87 V of 10 V).
 #[test]
-fn textbook_skyhook_lowers_the_critical_speed() {
+fn textbook_skyhook_about_like_mppt() {
     let p = STUDY.vcr("passive");
     let m = STUDY.vcr("mppt1").min(STUDY.vcr("mppt2"));
     for id in ["skyhook_onoff", "skyhook_continuous"] {
         let s = STUDY.vcr(id);
         assert!(
-            (10.0..=60.0).contains(&(p - s)),
-            "{id}: {s} km/h vs passive {p} (measured 25-45 km/h below)"
+            (s - m).abs() <= 30.0,
+            "{id}: {s} km/h vs MPPT {m} ({})",
+            STUDY.critical(id).describe()
         );
-        assert!(m - s > 60.0, "{id}: {s} vs MPPT {m}");
+        assert!(s - p >= 40.0, "{id}: {s} km/h vs passive {p}");
     }
+    let h = STUDY.scenario_metrics(&scenario::history("skyhook_onoff"));
+    let mean = h.tail_command_v.expect("sky-hook command recorded");
+    assert!(mean < 3.0, "sky-hook at 300 km/h: mean command {mean:.2} V");
 }
 
 /// R11/R12, the seed's accelerometer-based on/off sky-hook (x' from the frame acceleration over
 /// the axle box, as on the bogie): with the ideal valve it raises the critical speed above
 /// passive (quick study: 330 vs 305 km/h) but stays well below MPPT (> 420); the slow valve
-/// takes that gain away (285 km/h, at or below passive).
+/// takes that gain away (285 km/h, at or below passive). Its x' is the frame's lateral motion,
+/// in quadrature with the damper's elongation, so it switches twice per hunting cycle.
 #[test]
 fn accelerometer_skyhook_between_passive_and_mppt_and_broken_by_the_slow_valve() {
     let p = STUDY.vcr("passive");
@@ -128,21 +135,25 @@ fn accelerometer_skyhook_between_passive_and_mppt_and_broken_by_the_slow_valve()
         slow <= p + 5.0 && ideal - slow >= 20.0,
         "slow valve: {slow} km/h vs passive {p}, ideal {ideal} (measured 285)"
     );
-    // and the textbook sky-hook stays below it
-    assert!(STUDY.vcr("skyhook_onoff") < ideal);
+    // and the textbook sky-hook, mostly closed, stays above it
+    assert!(STUDY.vcr("skyhook_onoff") > ideal + 20.0);
 }
 
 /// R12: the slow valve (lag 0.15 s) does not break MPPT: from an 8 V command and a 3 mm
 /// perturbation at 260 km/h on ideal track the coach comes to rest, and in the sweep the
-/// slow-valve MPPT keeps its gain over passive. The sky-hook with the slow valve does not
-/// stabilise the coach either: its sweep critical speed stays at or below passive, and the
-/// continuous law keeps a limit cycle of more than 4 mm from the perturbation (measured
-/// 6.7 mm). The on/off law with the slow valve decays there (the valve averages the switching
-/// to a mean opening, i.e. a passive damper), while with the ideal valve it keeps 6.7 mm.
+/// slow-valve MPPT keeps its gain over passive. The seed's accelerometer sky-hook loses its
+/// gain with the slow valve (previous test). The textbook sky-hook is mostly closed on the
+/// coach, so the valve lag does not matter to it: with the slow valve it keeps its gain and
+/// damps the 260 km/h perturbation out (measured: > 420 km/h, 0.00 mm).
 #[test]
-fn slow_valve_keeps_mppt_and_not_the_skyhook() {
+fn slow_valve_keeps_mppt_and_the_mostly_closed_skyhook() {
     let p = STUDY.vcr("passive");
-    for id in ["mppt1_slow", "mppt2_slow"] {
+    for id in [
+        "mppt1_slow",
+        "mppt2_slow",
+        "skyhook_onoff_slow",
+        "skyhook_continuous_slow",
+    ] {
         let m = STUDY.scenario_metrics(&scenario::hil(id));
         assert!(
             m.tail_amplitude_m < 1e-3,
@@ -155,25 +166,6 @@ fn slow_valve_keeps_mppt_and_not_the_skyhook() {
             STUDY.critical(id).describe()
         );
     }
-    for id in ["skyhook_onoff_slow", "skyhook_continuous_slow"] {
-        assert!(
-            STUDY.vcr(id) <= p,
-            "{id}: {} vs passive {p}",
-            STUDY.critical(id).describe()
-        );
-    }
-    let cont = STUDY.scenario_metrics(&scenario::hil("skyhook_continuous_slow"));
-    assert!(
-        cont.tail_amplitude_m >= 4e-3,
-        "continuous slow sky-hook: {:.2} mm",
-        cont.tail_amplitude_m * 1e3
-    );
-    let ideal = STUDY.scenario_metrics(&scenario::hil("skyhook_onoff"));
-    assert!(
-        ideal.tail_amplitude_m >= 4e-3,
-        "on/off ideal sky-hook: {:.2} mm",
-        ideal.tail_amplitude_m * 1e3
-    );
 }
 
 /// R13: full-active IDF (c_v = 330 kNs/m) stable to at least 380 km/h (measured: through the

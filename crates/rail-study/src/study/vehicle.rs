@@ -13,12 +13,17 @@
 //!   nearest to its damper's side, as on the bogie (left damper: leading axle, right damper:
 //!   trailing axle), and its own damper's force; band-pass 2-8 Hz and threshold a_lim/2 as on
 //!   the bogie.
-//! * Sky-hook: the textbook law. Its velocity x' of (3.6) is the absolute velocity of the car-body
-//!   attachment point along the damper axis (`vehicle.damper_*.carbody_end_velocity`, the
-//!   controller's `sensor.velocity_source = ideal`). The vehicle gives that velocity positive
-//!   from the frame end towards the car-body end and the elongation velocity as car-body end
-//!   minus frame end, so the condition x' (x' - x0') of (3.11)/(3.13) needs `sensor.sign = +1`
-//!   on every damper: the damper then pushes the car body as a damper to the sky would.
+//! * Sky-hook: the textbook law of (3.6)-(3.13). Its velocity x' is "the velocity response of
+//!   the bogie", the body hooked to the sky, and x0' that of the "ground" the damper is mounted
+//!   on, here the car body (seed Fig. 3.5): x' is the absolute velocity of the frame attachment
+//!   point along the damper axis (`vehicle.damper_*.frame_end_velocity`, the controller's
+//!   `sensor.velocity_source = ideal`). The vehicle gives that velocity positive from the frame
+//!   end towards the car-body end, i.e. positive when the frame end shortens the damper, and
+//!   the elongation velocity as car-body end minus frame end; the controller's x' - x0' is the
+//!   elongation velocity, so x' is the frame end's velocity towards extension: `sensor.sign =
+//!   -1` on every damper. With the car body still, x' = x' - x0' and the damper stays on, as the
+//!   seed says of a bogie whose car body does not move; it switches off when the car-body end
+//!   moves faster than the frame end in the same direction.
 //! * Accelerometer-based sky-hook (the seed's, beside the textbook one): wired as on the bogie,
 //!   x' estimated from the frame lateral acceleration over the axle box of the position's MPPT
 //!   board (`sensor.velocity_source = estimated`), `sensor.sign` -1 on the left dampers and +1
@@ -282,7 +287,7 @@ pub fn coach_system(c: &Configuration) -> Value {
         })
     };
     let sky =
-        |mode: i64| json!({"control.mode": mode, "sensor.velocity_source": 1, "sensor.sign": 1});
+        |mode: i64| json!({"control.mode": mode, "sensor.velocity_source": 1, "sensor.sign": -1});
     for p in v.positions() {
         let port = |q: &str| format!("{COACH}.damper_{}.{q}", p.name);
         let damper = format!("damper_{}", p.name);
@@ -323,7 +328,7 @@ pub fn coach_system(c: &Configuration) -> Value {
                     0
                 };
                 connections.push(connect(
-                    port("carbody_end_velocity"),
+                    port("frame_end_velocity"),
                     format!("{controller}.sensor.velocity"),
                 ));
                 connections.push(connect(
@@ -448,19 +453,19 @@ mod tests {
                 assert!(rec.contains(s), "{}: {s} not recorded", c.id);
             }
             if matches!(c.family, Family::SkyHookOnOff | Family::SkyHookContinuous) {
-                // the textbook sky-hook: car-body end velocity, sign +1 on every damper
+                // the textbook sky-hook: frame end velocity, sign -1 on every damper
                 let k = d
                     .connections
                     .iter()
                     .find(|k| k.to == "controller_rear_right.sensor.velocity")
                     .unwrap();
-                assert_eq!(k.from, "vehicle.damper_rear_right.carbody_end_velocity");
+                assert_eq!(k.from, "vehicle.damper_rear_right.frame_end_velocity");
                 for i in d
                     .instances
                     .iter()
                     .filter(|i| i.name.starts_with("controller_"))
                 {
-                    assert_eq!(i.parameters["sensor.sign"], json!(1));
+                    assert_eq!(i.parameters["sensor.sign"], json!(-1));
                     assert_eq!(i.parameters["sensor.velocity_source"], json!(1));
                 }
             }
