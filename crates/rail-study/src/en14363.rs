@@ -11,8 +11,9 @@
 //!
 //! Interpretations: the filter is a zero-phase (forward-backward) Butterworth band-pass
 //! [`signal_processing::BandPass`] of prototype order 2 per pass, edges f0 - 2 Hz and f0 + 2 Hz
-//! (lower edge clamped to 0.1 Hz); the dominant frequency comes from a Welch spectrum
-//! searched between 0.5 and 20 Hz unless given. The speed is taken as constant over the run.
+//! (lower edge clamped to 0.1 Hz); the dominant frequency comes from a Welch spectrum of
+//! 8.192 s segments (at any sampling rate, [`crate::signal::DOMINANT_SEGMENT_S`]) searched
+//! between 0.5 and 20 Hz unless given. The speed is taken as constant over the run.
 
 use signal_processing::BandPass;
 

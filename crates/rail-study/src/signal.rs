@@ -94,57 +94,91 @@ pub fn fft(x: &mut [Complex64]) {
 /// rounded up to a power of two, mean removed per segment). Returns (frequencies [Hz], PSD
 /// [unit^2/Hz], one-sided).
 pub fn welch(x: &[f64], fs: f64, seg_len: usize) -> Result<(Vec<f64>, Vec<f64>), SignalError> {
+    welch_padded(x, fs, seg_len.max(8).next_power_of_two())
+}
+
+/// Welch power spectral density over segments of exactly `seg_len` samples (at least 8; Hann
+/// window over the segment, 50 % overlap, mean removed per segment), each zero-padded to the
+/// next power of two for the FFT. The resolution follows the segment's duration, the padding
+/// only samples the same spectrum more finely. Returns (frequencies [Hz], PSD [unit^2/Hz],
+/// one-sided).
+pub fn welch_padded(
+    x: &[f64],
+    fs: f64,
+    seg_len: usize,
+) -> Result<(Vec<f64>, Vec<f64>), SignalError> {
     check("fs", fs, fs > 0.0, "sampling rate must be > 0")?;
     check_finite(x)?;
-    let n = seg_len.max(8).next_power_of_two();
-    if x.len() < n {
+    let len = seg_len.max(8);
+    let n = len.next_power_of_two();
+    if x.len() < len {
         return Err(SignalError::TooShort {
             samples: x.len(),
-            needed: n,
+            needed: len,
             what: "one Welch segment",
         });
     }
-    let win: Vec<f64> = (0..n)
-        .map(|i| 0.5 - 0.5 * (2.0 * PI * i as f64 / n as f64).cos())
+    let win: Vec<f64> = (0..len)
+        .map(|i| 0.5 - 0.5 * (2.0 * PI * i as f64 / len as f64).cos())
         .collect();
     let wss: f64 = win.iter().map(|w| w * w).sum();
     let mut psd = vec![0.0; n / 2 + 1];
     let mut segments = 0usize;
     let mut buf = vec![Complex64::default(); n];
     let mut start = 0;
-    while start + n <= x.len() {
-        let seg = &x[start..start + n];
-        let mean = seg.iter().sum::<f64>() / n as f64;
+    while start + len <= x.len() {
+        let seg = &x[start..start + len];
+        let mean = seg.iter().sum::<f64>() / len as f64;
         for (b, (s, w)) in buf.iter_mut().zip(seg.iter().zip(&win)) {
             *b = Complex64::new((s - mean) * w, 0.0);
         }
+        buf[len..].fill(Complex64::default());
         fft(&mut buf);
         for (k, p) in psd.iter_mut().enumerate() {
             let scale = if k == 0 || k == n / 2 { 1.0 } else { 2.0 };
             *p += scale * buf[k].norm().powi(2) / (fs * wss);
         }
         segments += 1;
-        start += n / 2;
+        start += len / 2;
     }
     psd.iter_mut().for_each(|p| *p /= segments as f64);
     let freqs = (0..=n / 2).map(|k| k as f64 * fs / n as f64).collect();
     Ok((freqs, psd))
 }
 
+/// Duration of the Welch segments that find the dominant frequency [s]: 8192 samples at
+/// 1 kHz. A duration, not a number of samples: the frequency resolution, and so the peak
+/// found, is the same at any sampling rate (a 100 Hz file gives the full-rate frequency).
+pub const DOMINANT_SEGMENT_S: f64 = 8.192;
+
+/// Samples of one Welch segment for [`dominant_frequency`]: [`DOMINANT_SEGMENT_S`], halved
+/// until it fits in `samples` (at least 8 samples). At 1 kHz this is the largest power of
+/// two of samples that fits, up to 8192.
+pub fn dominant_segment_len(samples: usize, fs: f64) -> usize {
+    let mut duration_s = DOMINANT_SEGMENT_S;
+    let mut len = (duration_s * fs).round() as usize;
+    while len > samples && len > 8 {
+        duration_s /= 2.0;
+        len = (duration_s * fs).round() as usize;
+    }
+    len.max(8)
+}
+
 /// Frequency of the largest Welch-PSD peak in `[f_min, f_max]`, refined by a parabola through
-/// the peak bin and its neighbours. Segments of about 10 s (or the whole signal if shorter).
+/// the peak bin and its neighbours (of the log PSD). Segments of [`DOMINANT_SEGMENT_S`] (or
+/// the longest halving of it that fits in a shorter signal).
 pub fn dominant_frequency(x: &[f64], fs: f64, f_min: f64, f_max: f64) -> Result<f64, SignalError> {
+    check("fs", fs, fs > 0.0, "sampling rate must be > 0")?;
     check("f_min", f_min, f_min >= 0.0, "must be >= 0")?;
     check("f_max", f_max, f_max > f_min, "must be > f_min")?;
-    let seg = ((10.0 * fs) as usize).min(x.len()).max(8);
-    // largest power of two not above the signal length, so at least one segment fits
-    let seg = if seg.is_power_of_two() {
-        seg
-    } else {
-        seg.next_power_of_two() / 2
-    };
-    let (f, p) = welch(x, fs, seg)?;
-    let best = (1..p.len() - 1)
+    let (f, p) = welch_padded(x, fs, dominant_segment_len(x.len(), fs))?;
+    spectral_peak(&f, &p, f_min, f_max)
+}
+
+/// The largest peak of a spectrum `p` at frequencies `f` in `[f_min, f_max]`, refined by a
+/// parabola through the log of the peak bin and its neighbours.
+fn spectral_peak(f: &[f64], p: &[f64], f_min: f64, f_max: f64) -> Result<f64, SignalError> {
+    let best = (1..p.len().saturating_sub(1))
         .filter(|&k| f[k] >= f_min && f[k] <= f_max)
         .max_by(|&a, &b| p[a].total_cmp(&p[b]))
         .filter(|&k| p[k] > 0.0)
@@ -256,6 +290,39 @@ mod tests {
         // restricting the search range finds the other one
         let f = dominant_frequency(&x, fs, 8.0, 20.0).unwrap();
         assert!((f - 11.0).abs() < 0.05, "{f}");
+    }
+
+    #[test]
+    fn the_dominant_segment_is_a_duration() {
+        assert_eq!(dominant_segment_len(15_000, 1000.0), 8192);
+        assert_eq!(dominant_segment_len(8_192, 1000.0), 8192);
+        assert_eq!(dominant_segment_len(8_191, 1000.0), 4096);
+        assert_eq!(dominant_segment_len(1_500, 100.0), 819);
+        assert_eq!(dominant_segment_len(500, 100.0), 410);
+        assert_eq!(dominant_segment_len(5, 100.0), 8);
+    }
+
+    #[test]
+    fn the_dominant_frequency_does_not_depend_on_the_sampling_rate() {
+        // two peaks 0.25 Hz apart: 2 bins apart in 8.192 s segments, 1.3 bins in the 5.12 s
+        // that 512 samples last at 100 Hz
+        let two = |fs: f64| {
+            let mut x = sine(1.0, 4.0, fs, 14.0, 0.0);
+            let y = sine(0.8, 4.25, fs, 14.0, 1.0);
+            x.iter_mut().zip(&y).for_each(|(a, b)| *a += b);
+            x
+        };
+        let full = dominant_frequency(&two(1000.0), 1000.0, 0.5, 20.0).unwrap();
+        let low = dominant_frequency(&two(100.0), 100.0, 0.5, 20.0).unwrap();
+        let (f, p) = welch(&two(100.0), 100.0, 512).unwrap();
+        let samples = spectral_peak(&f, &p, 0.5, 20.0).unwrap();
+        // measured: 4.0315 at 1 kHz, 4.0136 at 100 Hz (the padded bins lie elsewhere), 4.0798
+        // at 100 Hz over 512 samples
+        assert!((low - full).abs() < 0.02, "100 Hz {low} vs 1 kHz {full}");
+        assert!(
+            (samples - full).abs() > 0.04,
+            "512 samples {samples} vs 1 kHz {full}"
+        );
     }
 
     #[test]
