@@ -2,6 +2,7 @@
 local threads or on a Dask cluster.
 
     railfmu sweep RUNSET.json -o OUTDIR [--jobs N] [--dask-scheduler ADDRESS] [--resume]
+                  [--format csv|parquet]
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ def _sweep(args: argparse.Namespace) -> int:
             progress=not args.quiet and sys.stderr.isatty(),
             resume=args.resume,
             ship_fmus=not args.shared_fmus,
+            format=args.format,
         )
     finally:
         if client is not None:
@@ -57,6 +59,13 @@ def main(argv: Optional[List[str]] = None) -> int:
     s.add_argument("--resume", action="store_true", help="keep runs already complete in the output folder")
     s.add_argument(
         "--shared-fmus", action="store_true", help="workers read the FMUs from their paths (shared file system) instead of receiving copies"
+    )
+    s.add_argument(
+        "--format",
+        choices=("csv", "parquet"),
+        default=None,
+        help="results format: csv (<run>/results.csv) or parquet (results/<run>.parquet, one table with the "
+        "run parameters); default: parquet from 200000 values per run on, as master sweep",
     )
     s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     args = p.parse_args(argv)

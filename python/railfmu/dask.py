@@ -1,10 +1,11 @@
 """Run sets on a Dask cluster (``dask.distributed``): one task per run.
 
 Each task is self-contained: the base system's resolved description and one job (its name,
-parameters and resolved system) go in, the run's table (or its error) comes out. The client
-writes the run's folder with the master's own writer, so a run-set folder made on a cluster is
-the one ``master sweep`` makes, value for value, and the workers need no access to the output
-folder.
+parameters and resolved system) go in, the run's table with its units and FMU variables (or its
+error) comes out. The client writes the run's folder with the master's own writer, in CSV or
+Parquet (``<out>/results/<run>.parquet`` with the run parameters as columns; by default chosen
+by size as ``master sweep`` does), so a run-set folder made on a cluster is the one ``master
+sweep`` makes, value for value, and the workers need no access to the output folder.
 
 FMUs reach the workers in one of two ways:
 
@@ -83,18 +84,36 @@ def _prepared(base_json: str, label: str) -> "_railfmu.PreparedSystem":
         return system
 
 
+def _localised_base(base_json: str, fmus: Optional[Dict[str, Tuple[str, str, bytes]]]) -> Tuple[str, Dict[str, str]]:
+    if not fmus:
+        return base_json, {}
+    paths = {p: _local_copy(digest, name, data) for p, (digest, name, data) in fmus.items()}
+    return json.dumps(_localise(json.loads(base_json), paths)), paths
+
+
+def format_task(base_json: str, label: str, jobs_json: List[str], fmus: Optional[Dict[str, Tuple[str, str, bytes]]] = None) -> str:
+    """The results format chosen by size, from a worker's copies of the FMUs (when the client
+    cannot read them). FMUs no one can read make every run fail on its own: no results file,
+    so the format does not matter then."""
+    base_json, _ = _localised_base(base_json, fmus)
+    try:
+        return _railfmu.results_format_by_size(base_json, label, jobs_json)
+    except _railfmu.Error:
+        return "csv"
+
+
 def run_task(base_json: str, label: str, job_json: str, fmus: Optional[Dict[str, Tuple[str, str, bytes]]] = None) -> Dict[str, Any]:
     """The task a worker runs: one job of a run set. ``fmus`` maps each FMU path of the
     description to (SHA-256, file name, bytes) when the FMUs are shipped. Returns the run's
-    ``header``, ``data`` (float64 bytes) and ``summary_json``, or its ``error``."""
-    if fmus:
-        paths = {p: _local_copy(digest, name, data) for p, (digest, name, data) in fmus.items()}
-        base_json = json.dumps(_localise(json.loads(base_json), paths))
+    ``header``, ``data`` (float64 bytes), ``summary_json`` and ``columns_json`` (the columns'
+    units and FMU variables), or its ``error``."""
+    base_json, paths = _localised_base(base_json, fmus)
+    if paths:
         job = json.loads(job_json)
         job["system"] = _localise(job["system"], paths)
         job_json = json.dumps(job)
-    header, data, summary_json, error = _prepared(base_json, label).run_job(job_json)
-    return {"header": header, "data": data, "summary_json": summary_json, "error": error}
+    header, data, summary_json, columns_json, error = _prepared(base_json, label).run_job(job_json)
+    return {"header": header, "data": data, "summary_json": summary_json, "columns_json": columns_json, "error": error}
 
 
 def _read_fmus(base_json: str) -> Dict[str, Tuple[str, str, bytes]]:
@@ -121,11 +140,15 @@ def run_jobs_on_cluster(
     *,
     ship_fmus: bool = True,
     retries: int = 3,
+    format: Optional[str] = None,
 ) -> List[str]:
     """Submits one task per job to ``client``, writes each run's folder as its result arrives
-    and returns the reports (JSON) in job order. A task that raises (even after its retries,
-    e.g. every worker running it died) gives a failed run carrying the exception's message."""
+    and returns the reports (JSON) in job order. ``format``: "csv" or "parquet"; None chooses
+    by size as a local run set does (from the FMUs' model descriptions, read on this client).
+    A task that raises (even after its retries, e.g. every worker running it died) gives a
+    failed run carrying the exception's message."""
     from distributed import as_completed
+
 
     fmus_arg: Any = None
     if ship_fmus:
@@ -136,6 +159,13 @@ def run_jobs_on_cluster(
         paths = list(fmus)
         scattered = client.scatter([fmus[p][2] for p in paths], broadcast=True, hash=False)
         fmus_arg = {p: (fmus[p][0], fmus[p][1], f) for p, f in zip(paths, scattered)}
+    if format is None:
+        try:
+            format = _railfmu.results_format_by_size(base_json, label, jobs_json)
+        except _railfmu.Error:
+            # the FMUs are not readable here (e.g. on the workers' file system only)
+            format = client.submit(format_task, base_json, label, jobs_json, fmus_arg, retries=retries, pure=False).result()
+    writer = _railfmu.RunWriter(os.fspath(outdir), jobs_json, format)
     # keys unique per submission: a key resubmitted while the scheduler still releases it from
     # an earlier set would be cancelled
     token = uuid.uuid4().hex[:16]
@@ -152,11 +182,11 @@ def run_jobs_on_cluster(
             i, name, job_json = futures[fut]
             try:
                 r = fut.result()
-                report = _railfmu.write_run(os.fspath(outdir), job_json, r["header"], r["data"], r["summary_json"], r["error"])
+                report = writer.write(job_json, r["header"], r["data"], r["summary_json"], r["columns_json"], r["error"])
                 error = r["error"]
             except Exception as e:  # the task failed: the run's error, the set goes on
                 error = f"run '{name}' failed on the cluster: {type(e).__name__}: {e}"
-                report = _railfmu.write_run(os.fspath(outdir), job_json, error=error)
+                report = writer.write(job_json, error=error)
             reports[i] = report
             on_done(name, error)
     finally:

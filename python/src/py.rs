@@ -12,14 +12,17 @@ use std::sync::mpsc::{self, RecvTimeoutError, Sender};
 use std::sync::Mutex;
 use std::time::Duration;
 
-use pyo3::exceptions::{PyException, PyTypeError};
+use pyo3::exceptions::{PyException, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyString};
 use serde_json::Value;
 
 use master::coupling::{RunOptions, SimError, SimOutput, Summary};
 use master::output::write_csv_atomic;
-use master::runset::{execute, run_job, Job, RunReport, RunSet, SweepError};
+use master::results::ResultsFormat;
+use master::runset::{
+    execute_with, format_by_size, run_job, Job, ResultsOptions, RunReport, RunSet, SweepError,
+};
 use master::system::{LoadedSystem, PreparedSystem, RunError, SystemError};
 
 use crate::{error_message, f64_bytes, f64_from_bytes, results, runs};
@@ -344,8 +347,8 @@ impl PySystem {
     }
 
     /// Runs one job of this system's run set (JSON, as from `load_run_set`), as a run set's
-    /// worker does; returns (header, data bytes, summary JSON, None) or (None, None, None,
-    /// error): a failed simulation is the run's result, not an exception.
+    /// worker does; returns (header, data bytes, summary JSON, columns JSON, None) or (None,
+    /// None, None, None, error): a failed simulation is the run's result, not an exception.
     #[allow(clippy::type_complexity)]
     fn run_job<'py>(
         &self,
@@ -354,6 +357,7 @@ impl PySystem {
     ) -> PyResult<(
         Option<Vec<String>>,
         Option<Bound<'py, PyBytes>>,
+        Option<String>,
         Option<String>,
         Option<String>,
     )> {
@@ -371,16 +375,19 @@ impl PySystem {
         match out {
             Ok(out) => {
                 let (h, d, s) = table(py, &out)?;
-                Ok((Some(h), Some(d), Some(s), None))
+                let c = serde_json::to_string(&runs::ColumnsWire::of(&out))
+                    .map_err(|e| Error::new_err(format!("internal: columns: {e}")))?;
+                Ok((Some(h), Some(d), Some(s), Some(c), None))
             }
-            Err(e) => Ok((None, None, None, Some(e))),
+            Err(e) => Ok((None, None, None, None, Some(e))),
         }
     }
 
     /// Runs jobs of this system's run set on `threads` threads, writing `<outdir>/<run>/` per
-    /// job and `<outdir>/sweep.json` (the master's run-set folder); `on_done(name, error)` is
+    /// job and `<outdir>/sweep.json` (the master's run-set folder), the results in `format`
+    /// ("csv" or "parquet"; None: by size, as `master sweep`); `on_done(name, error)` is
     /// called as each run finishes. Returns each job's report as JSON, in job order.
-    #[pyo3(signature = (jobs_json, outdir, threads, on_done=None))]
+    #[pyo3(signature = (jobs_json, outdir, threads, on_done=None, format=None))]
     fn run_jobs(
         &self,
         py: Python<'_>,
@@ -388,21 +395,26 @@ impl PySystem {
         outdir: PathBuf,
         threads: usize,
         on_done: Option<Py<PyAny>>,
+        format: Option<&str>,
     ) -> PyResult<Vec<String>> {
-        let jobs = jobs_json
-            .iter()
-            .map(|j| serde_json::from_str::<Job>(j).map_err(|e| json_err("job", &e)))
-            .collect::<PyResult<Vec<Job>>>()?;
+        let jobs = parse_jobs(&jobs_json)?;
+        let results = ResultsOptions {
+            format: match format {
+                Some(f) => parse_format(f)?,
+                None => format_by_size(&self.prepared, &jobs),
+            },
+            ..ResultsOptions::default()
+        };
         let cancel = AtomicBool::new(false);
         let prepared = &self.prepared;
         let cancel_ref = &cancel;
-        let (jobs_ref, outdir_ref) = (&jobs, &outdir);
+        let (jobs_ref, outdir_ref, results_ref) = (&jobs, &outdir, &results);
         let reports = in_background(
             py,
             &cancel,
             move |tx| {
                 let tx = Mutex::new(tx.clone());
-                execute(jobs_ref, outdir_ref, threads, false, |job| {
+                execute_with(jobs_ref, outdir_ref, threads, false, results_ref, |job| {
                     let r = run_job(prepared, job, cancel_ref);
                     if let Ok(tx) = tx.lock() {
                         let _ = tx.send(Event::Done(job.name.clone(), r.as_ref().err().cloned()));
@@ -473,40 +485,97 @@ fn write_sweep(outdir: PathBuf, reports_json: Vec<String>) -> PyResult<()> {
     runs::write_sweep(&outdir, &reports).map_err(|e| OutputError::new_err(error_message(&e)))
 }
 
-/// Writes the folder of a job from results computed elsewhere (header, data bytes, summary
-/// JSON) or from its error; returns the report as JSON.
+fn parse_jobs(jobs_json: &[String]) -> PyResult<Vec<Job>> {
+    jobs_json
+        .iter()
+        .map(|j| serde_json::from_str::<Job>(j).map_err(|e| json_err("job", &e)))
+        .collect()
+}
+
+fn parse_format(format: &str) -> PyResult<ResultsFormat> {
+    match format {
+        "csv" => Ok(ResultsFormat::Csv),
+        "parquet" => Ok(ResultsFormat::Parquet),
+        other => Err(PyValueError::new_err(format!(
+            "results format '{other}': expected 'csv' or 'parquet'"
+        ))),
+    }
+}
+
+/// The results format ("csv" or "parquet") a local run set of the base system (resolved JSON)
+/// chooses by size for these jobs, read from the FMUs' model descriptions (nothing loaded).
 #[pyfunction]
-#[pyo3(signature = (outdir, job_json, header=None, data=None, summary_json=None, error=None))]
-fn write_run(
-    outdir: PathBuf,
-    job_json: &str,
-    header: Option<Vec<String>>,
-    data: Option<&[u8]>,
-    summary_json: Option<&str>,
-    error: Option<String>,
+fn results_format_by_size(
+    base_json: &str,
+    label: &str,
+    jobs_json: Vec<String>,
 ) -> PyResult<String> {
-    let job: Job = serde_json::from_str(job_json).map_err(|e| json_err("job", &e))?;
-    let result = match (error, header, data, summary_json) {
-        (Some(e), ..) => Err(e),
-        (None, Some(header), Some(data), Some(summary)) => {
-            let data = f64_from_bytes(data).map_err(OutputError::new_err)?;
-            let summary: Summary =
-                serde_json::from_str(summary).map_err(|e| json_err("summary", &e))?;
-            Ok(SimOutput {
-                header,
-                data,
-                summary,
-                // computed elsewhere and handed over as numbers: every column Real
-                columns: Vec::new(),
-                strings: Vec::new(),
-                decimation: None,
-            })
-        }
-        _ => Err("internal: a run came back with neither results nor an error".to_string()),
-    };
-    std::fs::create_dir_all(&outdir)
-        .map_err(|e| OutputError::new_err(format!("cannot create '{}': {e}", outdir.display())))?;
-    report_json(&runs::write_run(&outdir, &job, result))
+    let base =
+        LoadedSystem::from_json_str(base_json, Path::new(""), label).map_err(|e| system_err(&e))?;
+    let jobs = parse_jobs(&jobs_json)?;
+    let format = runs::format_by_size(&base, &jobs).map_err(|e| system_err(&e))?;
+    Ok(format.extension().to_string())
+}
+
+/// Writes the folders of a run set's jobs from results computed elsewhere, one at a time, as
+/// a local run set writes them (the same format; in Parquet every file with the constant
+/// columns of all `jobs_json`).
+#[pyclass(frozen, module = "railfmu._railfmu", name = "RunWriter")]
+struct PyRunWriter {
+    writer: runs::RunSetWriter,
+}
+
+#[pymethods]
+impl PyRunWriter {
+    #[new]
+    fn new(outdir: PathBuf, jobs_json: Vec<String>, format: &str) -> PyResult<Self> {
+        let jobs = parse_jobs(&jobs_json)?;
+        std::fs::create_dir_all(&outdir).map_err(|e| {
+            OutputError::new_err(format!("cannot create '{}': {e}", outdir.display()))
+        })?;
+        Ok(PyRunWriter {
+            writer: runs::RunSetWriter::new(&outdir, &jobs, parse_format(format)?),
+        })
+    }
+
+    /// Writes the folder of a job from its results (header, data bytes, summary JSON,
+    /// columns JSON, as `PreparedSystem.run_job` returns them) or from its error; returns the
+    /// report as JSON.
+    #[pyo3(signature = (job_json, header=None, data=None, summary_json=None, columns_json=None, error=None))]
+    fn write(
+        &self,
+        job_json: &str,
+        header: Option<Vec<String>>,
+        data: Option<&[u8]>,
+        summary_json: Option<&str>,
+        columns_json: Option<&str>,
+        error: Option<String>,
+    ) -> PyResult<String> {
+        let job: Job = serde_json::from_str(job_json).map_err(|e| json_err("job", &e))?;
+        let result = match (error, header, data, summary_json) {
+            (Some(e), ..) => Err(e),
+            (None, Some(header), Some(data), Some(summary)) => {
+                let data = f64_from_bytes(data).map_err(OutputError::new_err)?;
+                let summary: Summary =
+                    serde_json::from_str(summary).map_err(|e| json_err("summary", &e))?;
+                // without columns: every column Real, no FMU variable in the metadata
+                let wire: runs::ColumnsWire = match columns_json {
+                    Some(c) => serde_json::from_str(c).map_err(|e| json_err("columns", &e))?,
+                    None => runs::ColumnsWire::default(),
+                };
+                Ok(SimOutput {
+                    header,
+                    data,
+                    summary,
+                    columns: wire.columns,
+                    strings: wire.strings,
+                    decimation: None,
+                })
+            }
+            _ => Err("internal: a run came back with neither results nor an error".to_string()),
+        };
+        report_json(&self.writer.write(&job, result))
+    }
 }
 
 /// Reads a results CSV: (header, data bytes), every value exactly as written.
@@ -551,7 +620,8 @@ fn _railfmu(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_set_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(completed_report, m)?)?;
     m.add_function(wrap_pyfunction!(write_sweep, m)?)?;
-    m.add_function(wrap_pyfunction!(write_run, m)?)?;
+    m.add_function(wrap_pyfunction!(results_format_by_size, m)?)?;
+    m.add_class::<PyRunWriter>()?;
     m.add_function(wrap_pyfunction!(read_csv, m)?)?;
     m.add_function(wrap_pyfunction!(write_csv, m)?)?;
     Ok(())

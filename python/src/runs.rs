@@ -1,30 +1,79 @@
-//! Run-set bookkeeping of the Python package: `sweep.json` over all runs of a resumed set, and a
-//! run's folder written from results computed in another process. Which runs are complete is
-//! the master's rule ([`completed`], re-exported).
+//! Run-set bookkeeping of the Python package: `sweep.json` over all runs of a resumed set, and
+//! the folders of runs computed in another process ([`RunSetWriter`]). Which runs are complete
+//! is the master's rule ([`completed`], re-exported).
 
-use std::path::Path;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
-use master::coupling::SimOutput;
+use master::coupling::{ColumnInfo, SimOutput};
 use master::output::{write_json_atomic, OutputError};
+use master::results::{constant_kinds, ConstantKind, ResultsFormat};
 pub use master::runset::completed;
-use master::runset::{run_one, Job, RunReport};
+use master::runset::{format_by_plan, run_one_with, Job, ResultsOptions, RunReport};
+use master::system::{LoadedSystem, SystemError};
 
 /// Writes `<outdir>/sweep.json`, the reports in job order (the master's format).
 pub fn write_sweep(outdir: &Path, reports: &[RunReport]) -> Result<(), OutputError> {
     write_json_atomic(&outdir.join("sweep.json"), &reports)
 }
 
-/// Writes the folder of `job` from its outcome `result` (e.g. computed by a cluster worker),
-/// exactly as a local run set writes it.
-pub fn write_run(outdir: &Path, job: &Job, result: Result<SimOutput, String>) -> RunReport {
-    let result = std::sync::Mutex::new(Some(result));
-    run_one(job, outdir, &|_: &Job| {
-        result
-            .lock()
-            .ok()
-            .and_then(|mut r| r.take())
-            .unwrap_or_else(|| Err("internal: results handed over twice".into()))
-    })
+/// The results format a local run set of `base` chooses by size for `jobs`, from the FMUs'
+/// model descriptions alone (no FMU is unpacked or loaded).
+pub fn format_by_size(base: &LoadedSystem, jobs: &[Job]) -> Result<ResultsFormat, SystemError> {
+    let archives = base.open_fmus()?;
+    let models: Vec<_> = archives.iter().map(|a| &a.model).collect();
+    Ok(format_by_plan(&base.plan(&models)?, jobs))
+}
+
+/// What a run's table carries besides its numbers (each column's FMU variable, the texts of
+/// String values), sent along with the numbers when a run is computed in another process.
+#[derive(Debug, Default, serde::Serialize, serde::Deserialize)]
+pub struct ColumnsWire {
+    pub columns: Vec<ColumnInfo>,
+    pub strings: Vec<String>,
+}
+
+impl ColumnsWire {
+    pub fn of(out: &SimOutput) -> Self {
+        ColumnsWire {
+            columns: out.columns.clone(),
+            strings: out.strings.clone(),
+        }
+    }
+}
+
+/// Writes the folders of a run set's jobs from outcomes computed elsewhere (e.g. by cluster
+/// workers), one at a time as they arrive, exactly as a local run set writes them: the same
+/// format, and in Parquet the constant columns of the whole set in every file.
+pub struct RunSetWriter {
+    outdir: PathBuf,
+    results: ResultsOptions,
+    kinds: BTreeMap<String, ConstantKind>,
+}
+
+impl RunSetWriter {
+    pub fn new(outdir: &Path, jobs: &[Job], format: ResultsFormat) -> Self {
+        RunSetWriter {
+            outdir: outdir.to_path_buf(),
+            results: ResultsOptions {
+                format,
+                ..ResultsOptions::default()
+            },
+            kinds: constant_kinds(jobs.iter().flat_map(|j| &j.parameters)),
+        }
+    }
+
+    /// Writes the folder of `job` from its outcome `result`; returns its report.
+    pub fn write(&self, job: &Job, result: Result<SimOutput, String>) -> RunReport {
+        let result = std::sync::Mutex::new(Some(result));
+        run_one_with(job, &self.outdir, &self.results, &self.kinds, &|_: &Job| {
+            result
+                .lock()
+                .ok()
+                .and_then(|mut r| r.take())
+                .unwrap_or_else(|| Err("internal: results handed over twice".into()))
+        })
+    }
 }
 
 #[cfg(test)]
@@ -72,7 +121,8 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let j = job("run-000", 100.0);
         assert!(completed(dir.path(), &j).is_none());
-        let report = write_run(dir.path(), &j, Ok(output()));
+        let writer = RunSetWriter::new(dir.path(), std::slice::from_ref(&j), ResultsFormat::Csv);
+        let report = writer.write(&j, Ok(output()));
         assert!(report.ok, "{report:?}");
         let csv = std::fs::read_to_string(dir.path().join("run-000/results.csv")).unwrap();
         assert_eq!(csv, "time [s],ms.x [m]\n0,1\n0.001,0.5\n0.002,0.25\n");
@@ -91,10 +141,35 @@ mod tests {
     }
 
     #[test]
+    fn runs_written_one_by_one_as_parquet_carry_the_constant_columns_of_the_set() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = job("run-000", 100.0);
+        let mut b = job("run-001", 200.0);
+        b.parameters
+            .insert("ms.label".to_string(), serde_json::json!("stiff"));
+        let writer = RunSetWriter::new(dir.path(), &[a.clone(), b], ResultsFormat::Parquet);
+        let report = writer.write(&a, Ok(output()));
+        assert!(report.ok, "{report:?}");
+        let file = dir.path().join("results/run-000.parquet");
+        assert_eq!(report.results.as_deref(), Some(file.as_path()));
+        assert!(!dir.path().join("run-000/results.csv").exists());
+        assert_eq!(completed(dir.path(), &a), Some(report));
+        let (columns, _) = master::parquet_file::read_parquet(&file).unwrap();
+        let names: Vec<&str> = columns.iter().map(|(n, _)| n.as_str()).collect();
+        // the other run's parameter is a column here too (null), so the files make one table
+        assert_eq!(
+            names,
+            ["time [s]", "ms.x [m]", "run", "ms.k", "ms.label"],
+            "{names:?}"
+        );
+    }
+
+    #[test]
     fn a_failed_run_is_written_and_never_complete() {
         let dir = tempfile::tempdir().unwrap();
         let j = job("bad", -1.0);
-        let report = write_run(dir.path(), &j, Err("negative stiffness".into()));
+        let writer = RunSetWriter::new(dir.path(), std::slice::from_ref(&j), ResultsFormat::Csv);
+        let report = writer.write(&j, Err("negative stiffness".into()));
         assert!(!report.ok);
         assert_eq!(report.error.as_deref(), Some("negative stiffness"));
         assert!(dir.path().join("bad/summary.json").is_file());

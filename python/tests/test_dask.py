@@ -1,6 +1,7 @@
 """Run sets on a dask.distributed LocalCluster of 2 worker processes: the same results as the
-local run set bit for bit, a killed worker does not lose the set, bad input fails its own run
-only, and the command line reaches the cluster too."""
+local run set bit for bit (CSV and Parquet, the format chosen by size as locally), a killed
+worker does not lose the set, bad input fails its own run only, and the command line reaches
+the cluster too."""
 
 from __future__ import annotations
 
@@ -11,10 +12,13 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
 import pytest
 
 import railfmu
-from conftest import ROOT, speed_set
+from conftest import ROOT, bits, speed_set
 
 distributed = pytest.importorskip("distributed")
 
@@ -63,6 +67,56 @@ def test_a_cluster_run_set_equals_the_local_one_bit_for_bit(dist, client, tmp_pa
     # the same with the FMUs read from their (shared) paths
     rs.run(tmp_path / "shared", client=client, ship_fmus=False)
     assert csv_bytes(tmp_path / "shared") == csv_bytes(tmp_path / "local")
+
+
+def parquet_meta(path: Path) -> dict:
+    return json.loads(pq.read_schema(path).metadata[b"railfmu.results"])
+
+
+def test_a_cluster_run_set_writes_the_parquet_table_of_the_local_one(dist, client, tmp_path):
+    rs = railfmu.RunSet.from_dict(speed_set(dist, [50.0, 60.0], seeds=[1, 2], stop_time=0.5))
+    local = rs.run(tmp_path / "local", threads=2, format="parquet")
+    remote = rs.run(tmp_path / "dask", client=client, format="parquet")
+    assert local.ok and remote.ok and len(remote) == 4
+    assert not list((tmp_path / "dask").glob("*/results.csv"))
+    # the folder is one table in one call: every run with its name and parameters
+    folder = tmp_path / "dask" / "results"
+    table = pd.read_parquet(folder)
+    assert len(table) == 4 * 501
+    params = table.groupby("run")[["bogie.vehicle.speed", "bogie.track.seed"]].first()
+    assert sorted(map(tuple, params.to_numpy().tolist())) == [(50.0, 1.0), (50.0, 2.0), (60.0, 1.0), (60.0, 2.0)]
+    # units and FMU variables came back from the workers
+    meta = parquet_meta(folder / "run-001.parquet")
+    force = {c["name"]: c for c in meta["columns"]}["damper_left.damper.force"]
+    assert force["unit"] == "N" and force["causality"] == "output" and force["instance"] == "damper_left"
+    assert force["fmu_guid"]
+    # the local run set's table and metadata, value for value (wall times aside)
+    mine = parquet_meta(tmp_path / "local" / "results" / "run-001.parquet")
+    for key in ("columns", "sampling", "run", "parameters", "system"):
+        assert meta[key] == mine[key], key
+    assert meta["summary"]["steps"] == mine["summary"]["steps"] == 500
+    expected = pd.read_parquet(tmp_path / "local" / "results")
+    assert list(table.columns) == list(expected.columns)
+    a, b = (t.sort_values(["run", "time [s]"], kind="stable") for t in (table, expected))
+    for label in table.columns:
+        if label == "run":
+            assert list(a[label]) == list(b[label])
+        else:
+            assert np.array_equal(bits(a[label].to_numpy()), bits(b[label].to_numpy())), label
+    # the Python package reads it back as a run set
+    assert railfmu.read_results(tmp_path / "dask")["run-001"].units["damper_left.damper.force"] == "N"
+
+
+def test_the_cluster_chooses_the_format_by_size_as_a_local_run_set(dist, client, tmp_path):
+    # 8 columns: Parquet from 25 000 rows (25 s at 1 kHz) on, CSV below
+    for stop_time, layout in ((24.99, "{run}/results.csv"), (25.0, "results/{run}.parquet")):
+        rs = railfmu.RunSet.from_dict(speed_set(dist, [50.0], stop_time=stop_time))
+        for where, options in (("local", {"threads": 1}), ("dask", {"client": client})):
+            out = tmp_path / f"{where}-{stop_time}"
+            res = rs.run(out, **options)
+            assert res.ok, res.failed
+            assert (out / layout.format(run="run-000")).is_file(), (where, stop_time, sorted(out.rglob("*")))
+            assert res.reports[0]["results"] == str(out / layout.format(run="run-000"))
 
 
 def test_bad_input_fails_its_own_run_and_no_worker(dist, client, tmp_path):
@@ -136,6 +190,15 @@ def test_the_command_line_runs_a_set_on_the_cluster(dist, client, master_cmd, tm
     )
     assert r.returncode == 0, r.stderr
     assert csv_bytes(tmp_path / "master") == csv_bytes(tmp_path / "local")
+    # and its results format: Parquet, one table with the run parameters
+    r = subprocess.run(
+        [str(master_cmd), "sweep", str(set_file), "-o", str(tmp_path / "pq"), "--dask-scheduler", addr, "--format", "parquet"],
+        capture_output=True, text=True, check=False, env=env,
+    )
+    assert r.returncode == 0, r.stderr
+    assert not list((tmp_path / "pq").glob("*/results.csv"))
+    table = pd.read_parquet(tmp_path / "pq" / "results")
+    assert sorted(table.groupby("run")["bogie.vehicle.speed"].first().tolist()) == [50.0, 70.0]
     env["RAILFMU_PYTHON"] = str(tmp_path / "no-python")
     r = subprocess.run(
         [str(master_cmd), "sweep", str(set_file), "-o", str(tmp_path / "none"), "--dask-scheduler", addr],

@@ -28,7 +28,7 @@ use std::sync::atomic::AtomicBool;
 use rayon::prelude::*;
 use serde_json::Value;
 
-use crate::coupling::{RunOptions, SimOutput, Summary};
+use crate::coupling::{CouplingPlan, RunOptions, SimOutput, Summary};
 use crate::output::{write_json_atomic, OutputError};
 use crate::results::{constant_kinds, write_results, ConstantKind, ResultsFormat, RunContext};
 use crate::system::{split_ref, LoadedSystem, PreparedSystem, SystemDescription, SystemError};
@@ -373,7 +373,13 @@ pub fn results_path(outdir: &Path, job_name: &str, format: ResultsFormat) -> Pat
 /// The format chosen by size for the runs of `system` (its longest job): Parquet from
 /// [`crate::results::PARQUET_FROM_VALUES`] values on.
 pub fn format_by_size(system: &PreparedSystem, jobs: &[Job]) -> ResultsFormat {
-    let plan = system.plan();
+    format_by_plan(system.plan(), jobs)
+}
+
+/// [`format_by_size`] from the coupling plan alone, which the model descriptions give
+/// ([`LoadedSystem::plan`]): a process that hands the runs to others chooses as a local run
+/// set does without loading the FMUs.
+pub fn format_by_plan(plan: &CouplingPlan, jobs: &[Job]) -> ResultsFormat {
     let stop = jobs
         .iter()
         .map(|j| j.system.stop_time)

@@ -41,13 +41,6 @@ pub struct Args {
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     if let Some(address) = &args.dask_scheduler {
-        if args.format == Some(ResultsFormat::Parquet) {
-            return Err(CommandError::Failed(
-                "--format parquet is not available with --dask-scheduler (the cluster's runs \
-                 are written as CSV)"
-                    .into(),
-            ));
-        }
         return on_dask(args, address, ctx);
     }
     let (base, jobs) = RunSet::load(&args.runset)?;
@@ -124,7 +117,8 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
 }
 
 /// `--dask-scheduler`: the same run set through the Python package, which writes the same
-/// run-set folder; its output and exit status are this command's.
+/// run-set folder (the same format, chosen by size there when not given); its output and exit
+/// status are this command's.
 fn on_dask(args: &Args, address: &str, ctx: &Context) -> Result<(), CommandError> {
     let python = std::env::var_os("RAILFMU_PYTHON").unwrap_or_else(|| "python3".into());
     let mut cmd = std::process::Command::new(&python);
@@ -135,6 +129,9 @@ fn on_dask(args: &Args, address: &str, ctx: &Context) -> Result<(), CommandError
         .args(["--dask-scheduler", address]);
     if args.resume {
         cmd.arg("--resume");
+    }
+    if let Some(format) = args.format {
+        cmd.args(["--format", format.extension()]);
     }
     if !ctx.progress {
         cmd.arg("--quiet");
