@@ -13,7 +13,8 @@
 //! 5. The studies' wall time (`master study` on 2 cores), when `BENCH_STUDY` names the study
 //!    options (scripts/bench.sh sets it).
 //! 6. Results files of one full-rate 15 s study run (the coach with four passive dampers):
-//!    size and read time of Parquet against CSV, and the CSV decimated to 100 Hz.
+//!    size and read time of Parquet against CSV, and the CSV decimated to 100 Hz; where the
+//!    Parquet file's bytes go (time, signals, constant columns, footer).
 //!
 //! `bash scripts/bench.sh` builds what it needs and runs this; it writes docs/BENCHMARKS.md.
 //! By hand: `cargo bench -p tests --bench ratios` (needs dist/). `BENCH_ONLY=coupled,fmpy`
@@ -480,7 +481,12 @@ fn results_files(r: &mut Report) {
     let cancel = std::sync::atomic::AtomicBool::new(false);
     let out = run_job(&prepared, &job, &cancel).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let ctx = RunContext::default();
+    // as a run set stores it: the run's name and parameters as constant columns
+    let ctx = RunContext {
+        run: Some("sweep-passive_v300_s1".into()),
+        parameters: job.parameters.clone(),
+        ..RunContext::default()
+    };
     let files = [
         (
             "Parquet, full rate",
@@ -531,5 +537,68 @@ fn results_files(r: &mut Report) {
         sizes[0].0 as f64 / sizes[1].0 as f64,
         sizes[0].1 / sizes[1].1,
         sizes[0].0 as f64 / sizes[2].0 as f64
+    ));
+    parquet_columns(r, &dir.path().join("full.parquet"), &out.header, sizes[2].0);
+}
+
+/// Where the bytes of a full-rate Parquet results file go: the compressed size of each
+/// column chunk (from the file's footer), grouped as the time, the recorded signals and the
+/// constant columns (run name and parameters), against the CSV at 100 Hz (`csv_100hz_bytes`).
+fn parquet_columns(r: &mut Report, path: &Path, header: &[String], csv_100hz_bytes: u64) {
+    use parquet::file::reader::{FileReader, SerializedFileReader};
+    let reader = SerializedFileReader::new(std::fs::File::open(path).unwrap()).unwrap();
+    let meta = reader.metadata();
+    let rows = meta.file_metadata().num_rows() as f64;
+    let mut time = 0i64;
+    let mut signals: Vec<(String, i64)> = Vec::new();
+    let mut constants = (0usize, 0i64);
+    for g in meta.row_groups() {
+        for c in g.columns() {
+            let name = c.column_path().string();
+            let bytes = c.compressed_size();
+            if name == header[0] {
+                time += bytes;
+            } else if header.contains(&name) {
+                match signals.iter_mut().find(|(n, _)| *n == name) {
+                    Some(s) => s.1 += bytes,
+                    None => signals.push((name, bytes)),
+                }
+            } else {
+                constants.0 += 1;
+                constants.1 += bytes;
+            }
+        }
+    }
+    let file = std::fs::metadata(path).unwrap().len() as i64;
+    let signal_bytes: i64 = signals.iter().map(|s| s.1).sum();
+    let mut per_value: Vec<f64> = signals.iter().map(|s| s.1 as f64 / rows).collect();
+    per_value.sort_by(f64::total_cmp);
+    let rest = file - time - signal_bytes - constants.1;
+    r.line(String::new());
+    r.line("Where the full-rate Parquet file's bytes go (compressed column chunks; float64, zstd level 3, byte-stream split):".into());
+    r.line(String::new());
+    r.line("| columns | count | bytes | bytes per row and column |".into());
+    r.line("|---|---|---|---|".into());
+    r.line(format!("| time | 1 | {time} | {:.2} |", time as f64 / rows));
+    if let (Some(lo), Some(hi)) = (per_value.first(), per_value.last()) {
+        r.line(format!(
+            "| signals | {} | {signal_bytes} | {:.2} ({lo:.2} to {hi:.2}) |",
+            signals.len(),
+            signal_bytes as f64 / rows / signals.len() as f64
+        ));
+    }
+    r.line(format!(
+        "| run name and parameters (constant) | {} | {} | {:.3} |",
+        constants.0,
+        constants.1,
+        constants.1 as f64 / rows / constants.0.max(1) as f64
+    ));
+    r.line(format!(
+        "| footer and metadata (units, FMU variables, system) | | {rest} | |"
+    ));
+    r.line(format!(
+        "- the CSV at 100 Hz is {:.2} bytes per full-rate row and column; the full-rate signals alone take {:.2} times the whole 100 Hz CSV",
+        csv_100hz_bytes as f64 / rows / header.len() as f64,
+        signal_bytes as f64 / csv_100hz_bytes as f64
     ));
 }
