@@ -461,7 +461,8 @@ fn results_files(r: &mut Report) {
     use master::decimation::decimate;
     use master::results::{write_results, ResultsFormat, RunContext};
     use rail_study::analysis::assess::ResultsTable;
-    use rail_study::study::config::{configuration, RunRequest, Sources};
+    use rail_study::study::config::{RunRequest, Sources};
+    use rail_study::study::configurations::configuration;
     use rail_study::study::VehicleModel;
     let sources = Sources {
         fmus: repo().join("dist"),

@@ -15,7 +15,8 @@ use master::coupling::{RunOptions, SimOutput};
 use master::fmu::extraction_count;
 use master::runset::{execute, run_job, Job, RunSet};
 use master::system::{LoadedSystem, PreparedSystem};
-use rail_study::study::config::{configuration, RunRequest, Sources};
+use rail_study::study::config::{RunRequest, Sources};
+use rail_study::study::configurations::configuration;
 use rail_study::study::VehicleModel;
 
 fn dist() -> PathBuf {

@@ -5,7 +5,8 @@
 //! lateral acceleration and ride comfort (EN 12299) on the coach.
 //!
 //! * [`vehicle`]: the two vehicle models, their signal names and the coach's generated systems.
-//! * [`config`]: the configurations (system descriptions in `systems/*.json`) and run requests.
+//! * [`configurations`]: the configurations (bogie system descriptions in `systems/*.json`).
+//! * [`config`]: system descriptions on a vehicle model and run requests.
 //! * [`settings`]: the full and the `--quick` study.
 //! * [`metrics`]: numbers of one run (EN 14363 rms, oscillation amplitude, peak force...).
 //! * [`critical`]: critical speed from an rms curve, bisection.
@@ -15,6 +16,7 @@
 //! From a test: `run_study(&StudySettings::quick(VehicleModel::Coach), &opts)` gives [`run::StudyResults`].
 
 pub mod config;
+pub mod configurations;
 pub mod critical;
 pub mod metrics;
 pub mod report;
@@ -22,7 +24,8 @@ pub mod run;
 pub mod settings;
 pub mod vehicle;
 
-pub use config::{Configuration, Sources, CONFIGURATIONS};
+pub use config::Sources;
+pub use configurations::{Configuration, CONFIGURATIONS};
 pub use critical::Critical;
 pub use report::{write_outputs, Timing};
 pub use run::{run_study, StudyError, StudyOptions, StudyResults};

@@ -18,9 +18,8 @@ use std::sync::Mutex;
 use serde_json::Value;
 
 use crate::en14363::acceleration_limit;
-use crate::study::config::{
-    configuration, required_fmus, Configuration, Family, RunRequest, Sources,
-};
+use crate::study::config::{required_fmus, RunRequest, Sources};
+use crate::study::configurations::{configuration, Configuration, Family};
 use crate::study::critical::{Critical, CurvePoint};
 use crate::study::metrics::{run_metrics, MetricSpec, RunMetrics, BOGIE_MASS_T};
 use crate::study::settings::StudySettings;

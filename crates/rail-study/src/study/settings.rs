@@ -1,7 +1,7 @@
 //! What the study runs: the full default study and the reduced `--quick` one, on either
 //! vehicle model.
 
-use crate::study::config::CONFIGURATIONS;
+use crate::study::configurations::CONFIGURATIONS;
 use crate::study::vehicle::VehicleModel;
 use master::results::ResultsFormat;
 
@@ -10,7 +10,7 @@ use master::results::ResultsFormat;
 pub struct StudySettings {
     /// The vehicle the dampers act on.
     pub vehicle: VehicleModel,
-    /// Configuration ids (see [`crate::study::config::CONFIGURATIONS`]).
+    /// Configuration ids (see [`crate::study::configurations::CONFIGURATIONS`]).
     pub configurations: Vec<&'static str>,
     /// Speeds of the rms sweep [km/h].
     pub speeds_kmh: Vec<f64>,

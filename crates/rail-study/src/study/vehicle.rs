@@ -33,7 +33,7 @@
 
 use serde_json::{json, Value};
 
-use crate::study::config::{Configuration, Family, Valve};
+use crate::study::configurations::{Configuration, Family, Valve};
 
 /// Which vehicle the study runs on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
@@ -410,7 +410,7 @@ pub fn coach_system(c: &Configuration) -> Value {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::study::config::{assert_valve_model, CONFIGURATIONS};
+    use crate::study::configurations::{assert_valve_model, CONFIGURATIONS};
     use master::system::SystemDescription;
 
     #[test]

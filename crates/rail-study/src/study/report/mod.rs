@@ -4,7 +4,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::plot::Chart;
-use crate::study::config::configuration;
+use crate::study::configurations::configuration;
 use crate::study::critical::Critical;
 use crate::study::run::{
     scenario, ConfigResult, SpeedPoint, StudyError, StudyResults, HIL_CONFIGS, HISTORY_CONFIGS,
