@@ -10,7 +10,7 @@ use model_description::{
     MAX_PARAMETER_FILE_BYTES,
 };
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{host_step, resource_or_given, InputError, TrackLevel};
+use vehicle_elements::{resource_or_given, InputError, Shell, ShellPhysics, TrackLevel};
 use wheel_rail::GeometryTable;
 
 use crate::model::{Bogie, Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep};
@@ -65,24 +65,47 @@ impl FieldError for ContactFileError {
     }
 }
 
-impl FieldError for PStep {
-    fn field(&self) -> Option<&str> {
-        match self {
-            PStep::Input(i) => i.field(),
+impl ShellPhysics for Bogie {
+    type Params = Params;
+    type Inputs = Inputs;
+    type Outputs = Outputs;
+    type BuildError = PhysicsModelError;
+    type StepError = PStep;
+
+    fn preview_params(params: &Params) -> Params {
+        Params {
+            track: TrackSource::None,
+            contact: ContactSource::WornSurrogate,
+            ..params.clone()
+        }
+    }
+
+    fn build(params: Params) -> Result<Self, PhysicsModelError> {
+        Bogie::new(params)
+    }
+
+    fn outputs(&self, inputs: &Inputs) -> Result<Outputs, PStep> {
+        Bogie::outputs(self, inputs)
+    }
+
+    fn step(&mut self, h: f64, inputs: &Inputs) -> Result<Outputs, PStep> {
+        Bogie::step(self, h, inputs)
+    }
+
+    fn input_error(e: &PStep) -> Option<&InputError> {
+        match e {
+            PStep::Input(i) => Some(i),
             _ => None,
         }
     }
 
-    fn reason(&self) -> String {
-        match self {
-            PStep::Input(i) => i.reason(),
-            other => other.to_string(),
-        }
+    fn diverged(e: &PStep) -> bool {
+        matches!(e, PStep::Diverged { .. })
     }
 }
 
 /// The bogie FMU: parameters, current inputs, the physics (built at initialisation) and its
-/// last outputs.
+/// last outputs (the last three in [`Shell`]).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Bogie2Dof {
     params: Params,
@@ -92,15 +115,13 @@ pub struct Bogie2Dof {
     /// The contact-table parameter as set: a keyword or a file (see [`Self::contact_source`]).
     contact: String,
     resource_dir: Option<PathBuf>,
-    inputs: Inputs,
-    bogie: Option<Bogie>,
-    out: Outputs,
+    shell: Shell<Bogie>,
 }
 
 impl Bogie2Dof {
     /// Outputs (read-only view, for tests and tools).
     pub fn outputs(&self) -> &Outputs {
-        &self.out
+        &self.shell.out
     }
 
     /// The contact-table parameter resolved: keywords, then a file under the FMU's
@@ -111,21 +132,6 @@ impl Bogie2Dof {
                 ContactSource::File(resource_or_given(&p, self.resource_dir.as_deref()))
             }
             other => other,
-        }
-    }
-
-    /// Outputs before initialisation (state of the start values, built-in table, no track):
-    /// indicative only; parameters are validated at fmi2ExitInitializationMode.
-    fn preview_outputs(&mut self) {
-        let p = Params {
-            track: TrackSource::None,
-            contact: ContactSource::WornSurrogate,
-            ..self.params.clone()
-        };
-        if let Ok(b) = Bogie::new(p) {
-            if let Ok(o) = b.outputs(&self.inputs) {
-                self.out = o;
-            }
         }
     }
 
@@ -242,69 +248,69 @@ impl FmuModel for Bogie2Dof {
             parameter "track.seed" [range = 0.0..=2147483647.0] => track_seed;
 
             /// Left yaw damper force, positive in tension
-            input "damper_left.force" [unit = "N", display_unit = "kN"] => inputs.damper_left_force_n;
+            input "damper_left.force" [unit = "N", display_unit = "kN"] => shell.inputs.damper_left_force_n;
             /// Right yaw damper force, positive in tension
-            input "damper_right.force" [unit = "N", display_unit = "kN"] => inputs.damper_right_force_n;
+            input "damper_right.force" [unit = "N", display_unit = "kN"] => shell.inputs.damper_right_force_n;
             /// Lateral track alignment at the front wheelset, positive right (track.source = external)
-            input "track.lateral_alignment" [unit = "m", display_unit = "mm"] => inputs.track_lateral_m;
+            input "track.lateral_alignment" [unit = "m", display_unit = "mm"] => shell.inputs.track_lateral_m;
 
             /// Left damper elongation e_L = +b sigma (extension positive), from the state
-            output "damper_left.elongation" [unit = "m", display_unit = "mm"] => out.damper_left_elongation_m;
+            output "damper_left.elongation" [unit = "m", display_unit = "mm"] => shell.out.damper_left_elongation_m;
             /// Left damper elongation velocity +b sigma'
-            output "damper_left.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper_left_velocity_mps;
+            output "damper_left.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper_left_velocity_mps;
             /// Right damper elongation e_R = -b sigma (extension positive), from the state
-            output "damper_right.elongation" [unit = "m", display_unit = "mm"] => out.damper_right_elongation_m;
+            output "damper_right.elongation" [unit = "m", display_unit = "mm"] => shell.out.damper_right_elongation_m;
             /// Right damper elongation velocity -b sigma'
-            output "damper_right.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper_right_velocity_mps;
+            output "damper_right.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper_right_velocity_mps;
             /// Absolute velocity of the bogie-side end of the left damper along its axis, positive
             /// in the direction that extends the damper (+b sigma'; the car body does not move)
-            output "damper_left.end_absolute_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper_left_velocity_mps;
+            output "damper_left.end_absolute_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper_left_velocity_mps;
             /// Same for the right damper (-b sigma')
-            output "damper_right.end_absolute_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper_right_velocity_mps;
+            output "damper_right.end_absolute_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper_right_velocity_mps;
             /// Absolute acceleration of the bogie-side end of the left damper along its axis,
             /// positive towards extension (+b sigma''), for the sky-hook accelerometer
             output "damper_left.end_absolute_acceleration" [unit = "m/s2", depends_on = FT_ACC]
-                => |m| m.params.damper_arm_m * m.out.yaw_acc_radps2;
+                => |m| m.params.damper_arm_m * m.shell.out.yaw_acc_radps2;
             /// Same for the right damper (-b sigma'')
             output "damper_right.end_absolute_acceleration" [unit = "m/s2", depends_on = FT_ACC]
-                => |m| -m.params.damper_arm_m * m.out.yaw_acc_radps2;
+                => |m| -m.params.damper_arm_m * m.shell.out.yaw_acc_radps2;
             /// Bogie frame lateral acceleration above the front wheelset y'' - p sigma'' (EN 14363
             /// stability quantity)
-            output "frame.lateral_acceleration_front" [unit = "m/s2", depends_on = FT_ACC] => out.frame_acc_front_mps2;
+            output "frame.lateral_acceleration_front" [unit = "m/s2", depends_on = FT_ACC] => shell.out.frame_acc_front_mps2;
             /// Bogie frame lateral acceleration above the rear wheelset y'' + p sigma''
-            output "frame.lateral_acceleration_rear" [unit = "m/s2", depends_on = FT_ACC] => out.frame_acc_rear_mps2;
+            output "frame.lateral_acceleration_rear" [unit = "m/s2", depends_on = FT_ACC] => shell.out.frame_acc_rear_mps2;
             /// Lateral displacement of the front (leading, at +p) wheelset, y -+ p sigma
-            output "wheelset_front.lateral_displacement" [unit = "m", display_unit = "mm"] => out.wheelset_front_lateral_m;
+            output "wheelset_front.lateral_displacement" [unit = "m", display_unit = "mm"] => shell.out.wheelset_front_lateral_m;
             /// Lateral displacement of the front (leading, at +p) wheelset relative to the track
-            output "wheelset_front.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.wheelset_front_rel_track_m;
+            output "wheelset_front.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => shell.out.wheelset_front_rel_track_m;
             /// Lateral acceleration of the front (leading, at +p) wheelset (rigid primary
             /// suspension: that of the frame above it)
-            output "wheelset_front.lateral_acceleration" [unit = "m/s2", depends_on = FT_ACC] => out.wheelset_front_acc_mps2;
+            output "wheelset_front.lateral_acceleration" [unit = "m/s2", depends_on = FT_ACC] => shell.out.wheelset_front_acc_mps2;
             /// Sum Y of the lateral wheel/rail forces on the front (leading, at +p) wheelset
             /// (force of the rails on the wheelset, positive right)
-            output "wheelset_front.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => out.guiding_force_front_n;
+            output "wheelset_front.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => shell.out.guiding_force_front_n;
             /// Lateral displacement of the rear (at -p) wheelset, y -+ p sigma
-            output "wheelset_rear.lateral_displacement" [unit = "m", display_unit = "mm"] => out.wheelset_rear_lateral_m;
+            output "wheelset_rear.lateral_displacement" [unit = "m", display_unit = "mm"] => shell.out.wheelset_rear_lateral_m;
             /// Lateral displacement of the rear (at -p) wheelset relative to the track
-            output "wheelset_rear.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.wheelset_rear_rel_track_m;
+            output "wheelset_rear.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => shell.out.wheelset_rear_rel_track_m;
             /// Lateral acceleration of the rear (at -p) wheelset (rigid primary suspension: that
             /// of the frame above it)
-            output "wheelset_rear.lateral_acceleration" [unit = "m/s2", depends_on = FT_ACC] => out.wheelset_rear_acc_mps2;
+            output "wheelset_rear.lateral_acceleration" [unit = "m/s2", depends_on = FT_ACC] => shell.out.wheelset_rear_acc_mps2;
             /// Sum Y of the lateral wheel/rail forces on the rear (at -p) wheelset (force of the
             /// rails on the wheelset, positive right)
-            output "wheelset_rear.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => out.guiding_force_rear_n;
+            output "wheelset_rear.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => shell.out.guiding_force_rear_n;
             /// Bogie yaw angle sigma (positive nose-left)
-            output "bogie.yaw_angle" [unit = "rad", display_unit = "deg"] => out.yaw_rad;
+            output "bogie.yaw_angle" [unit = "rad", display_unit = "deg"] => shell.out.yaw_rad;
             /// Bogie yaw rate sigma'
-            output "bogie.yaw_rate" [unit = "rad/s", display_unit = "deg/s"] => out.yaw_rate_radps;
+            output "bogie.yaw_rate" [unit = "rad/s", display_unit = "deg/s"] => shell.out.yaw_rate_radps;
             /// Lateral displacement y of the bogie centre (positive right)
-            output "bogie.lateral_displacement" [unit = "m", display_unit = "mm"] => out.bogie_lateral_m;
+            output "bogie.lateral_displacement" [unit = "m", display_unit = "mm"] => shell.out.bogie_lateral_m;
             /// Lateral velocity y' of the bogie centre
-            output "bogie.lateral_velocity" [unit = "m/s", display_unit = "mm/s"] => out.bogie_lateral_velocity_mps;
+            output "bogie.lateral_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.bogie_lateral_velocity_mps;
             /// Track lateral alignment under the front wheelset (input or internal generator)
-            output "track.alignment_front" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.track_front_m;
+            output "track.alignment_front" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => shell.out.track_front_m;
             /// Track lateral alignment under the rear wheelset (delayed by 2p/V)
-            output "track.alignment_rear" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.track_rear_m;
+            output "track.alignment_rear" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => shell.out.track_rear_m;
         }
         v
     }
@@ -315,19 +321,15 @@ impl FmuModel for Bogie2Dof {
             initial_lateral_m: FMU_DEFAULT_INITIAL_LATERAL_M,
             ..Params::default()
         };
-        let mut me = Self {
+        Ok(Self {
+            shell: Shell::new(&params),
             params,
             track_source: TrackChoice::External,
             track_level: TrackLevel::Low,
             track_seed: 1,
             contact: String::new(),
             resource_dir: ctx.resource_dir.clone(),
-            inputs: Inputs::default(),
-            bogie: None,
-            out: Outputs::default(),
-        };
-        me.preview_outputs();
-        Ok(me)
+        })
     }
 
     fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
@@ -346,46 +348,23 @@ impl FmuModel for Bogie2Dof {
             _ => Bogie::new(params),
         }
         .map_err(|e| field_error::<Self>(&e))?;
-        self.out = b
-            .outputs(&self.inputs)
-            .map_err(|e| field_error::<Self>(&e))?;
-        self.bogie = Some(b);
-        Ok(())
+        self.shell.initialize::<Self>(b)
     }
 
     fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-        match &self.bogie {
-            Some(b) => {
-                self.out = b
-                    .outputs(&self.inputs)
-                    .map_err(|e| field_error::<Self>(&e))?
-            }
-            None => self.preview_outputs(),
-        }
-        Ok(())
+        self.shell.update_outputs::<Self>(&self.params)
     }
 
     fn do_step(&mut self, _time: f64, step: f64, _diag: &mut Diagnostics) -> Result<(), StepError> {
-        let Some(b) = &mut self.bogie else {
-            return Err(StepError::Error(ModelError::Other(
-                "the physics is built in fmi2ExitInitializationMode; no step before it".into(),
-            )));
-        };
-        let map = |e: PStep| match e {
-            PStep::Diverged { .. } | PStep::Input(InputError::InvalidStep { .. }) => {
-                StepError::Discard(e.to_string())
-            }
-            other => StepError::Error(ModelError::Other(other.to_string())),
-        };
-        self.out = host_step(b, step, |p, h| p.step(h, &self.inputs)).map_err(map)?;
-        Ok(())
+        self.shell.do_step::<Self>(step)
     }
 
     /// The physics' step returns the outputs at its end with the held inputs, as
     /// `update_outputs` would compute them, except on the external track: there the rear
     /// wheelset's alignment of a step is the delayed input at the step's start.
     fn step_computes_outputs(&self) -> bool {
-        self.bogie
+        self.shell
+            .physics
             .as_ref()
             .is_some_and(|b| b.params().track != TrackSource::External)
     }

@@ -9,7 +9,7 @@ use model_description::{
     ModelError, ModelInfo, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{host_step, resource_or_given, InputError, TrackLevel};
+use vehicle_elements::{resource_or_given, InputError, Shell, ShellPhysics, TrackLevel};
 
 use crate::model::{Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep, Vehicle};
 use crate::params::{ContactSource, Initial, ModelKind, TrackSource, VehicleParams};
@@ -50,24 +50,48 @@ impl FieldError for PhysicsModelError {
     }
 }
 
-impl FieldError for PStep {
-    fn field(&self) -> Option<&str> {
-        match self {
-            PStep::Input(i) => i.field(),
+impl ShellPhysics for Vehicle {
+    type Params = VehicleParams;
+    type Inputs = Inputs;
+    type Outputs = Outputs;
+    type BuildError = PhysicsModelError;
+    type StepError = PStep;
+
+    fn preview_params(params: &VehicleParams) -> VehicleParams {
+        VehicleParams {
+            track: TrackSource::None,
+            contact: ContactSource::WornSurrogate,
+            ..params.clone()
+        }
+    }
+
+    fn build(params: VehicleParams) -> Result<Self, PhysicsModelError> {
+        Vehicle::new(params)
+    }
+
+    fn outputs(&self, inputs: &Inputs) -> Result<Outputs, PStep> {
+        Vehicle::outputs(self, inputs)
+    }
+
+    fn step(&mut self, h: f64, inputs: &Inputs) -> Result<Outputs, PStep> {
+        Vehicle::step(self, h, inputs)
+    }
+
+    fn input_error(e: &PStep) -> Option<&InputError> {
+        match e {
+            PStep::Input(i) => Some(i),
             _ => None,
         }
     }
 
-    fn reason(&self) -> String {
-        match self {
-            PStep::Input(i) => i.reason(),
-            other => other.to_string(),
-        }
+    /// A derailment is not a diverged state: a smaller step does not avoid it.
+    fn diverged(e: &PStep) -> bool {
+        matches!(e, PStep::Diverged { .. })
     }
 }
 
 /// The coach FMU: parameters, current inputs, the physics (built at initialisation) and its
-/// last outputs.
+/// last outputs (the last three in [`Shell`]).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RailVehicle {
     params: VehicleParams,
@@ -77,15 +101,13 @@ pub struct RailVehicle {
     /// The contact-table parameter as set: a keyword or a file (see [`Self::contact_source`]).
     contact: String,
     resource_dir: Option<PathBuf>,
-    inputs: Inputs,
-    vehicle: Option<Vehicle>,
-    out: Outputs,
+    shell: Shell<Vehicle>,
 }
 
 impl RailVehicle {
     /// Outputs (read-only view, for tests and tools).
     pub fn outputs(&self) -> &Outputs {
-        &self.out
+        &self.shell.out
     }
 
     /// The contact-table parameter resolved: "" or "worn" is the built-in table, a relative
@@ -94,21 +116,6 @@ impl RailVehicle {
         match self.contact.trim() {
             "" | "worn" => ContactSource::WornSurrogate,
             p => ContactSource::File(resource_or_given(p, self.resource_dir.as_deref())),
-        }
-    }
-
-    /// Outputs before initialisation (the start values on ideal track with the built-in
-    /// table): indicative only; parameters are validated at fmi2ExitInitializationMode.
-    fn preview_outputs(&mut self) {
-        let p = VehicleParams {
-            track: TrackSource::None,
-            contact: ContactSource::WornSurrogate,
-            ..self.params.clone()
-        };
-        if let Ok(v) = Vehicle::new(p) {
-            if let Ok(o) = v.outputs(&self.inputs) {
-                self.out = o;
-            }
         }
     }
 
@@ -282,173 +289,173 @@ impl FmuModel for RailVehicle {
         // it within the compiler's recursion limit)
         model_description::declare! { v;
             /// Force of the front left yaw damper, positive in tension
-            input "damper_front_left.force" [unit = "N", display_unit = "kN"] => inputs.damper_force_n[0];
+            input "damper_front_left.force" [unit = "N", display_unit = "kN"] => shell.inputs.damper_force_n[0];
             /// Force of the front right yaw damper, positive in tension
-            input "damper_front_right.force" [unit = "N", display_unit = "kN"] => inputs.damper_force_n[1];
+            input "damper_front_right.force" [unit = "N", display_unit = "kN"] => shell.inputs.damper_force_n[1];
             /// Force of the rear left yaw damper, positive in tension
-            input "damper_rear_left.force" [unit = "N", display_unit = "kN"] => inputs.damper_force_n[2];
+            input "damper_rear_left.force" [unit = "N", display_unit = "kN"] => shell.inputs.damper_force_n[2];
             /// Force of the rear right yaw damper, positive in tension
-            input "damper_rear_right.force" [unit = "N", display_unit = "kN"] => inputs.damper_force_n[3];
+            input "damper_rear_right.force" [unit = "N", display_unit = "kN"] => shell.inputs.damper_force_n[3];
             /// Lateral track alignment under the leading wheelset, positive right (track.source = external)
-            input "track.lateral_alignment" [unit = "m", display_unit = "mm"] => inputs.track_lateral_m;
+            input "track.lateral_alignment" [unit = "m", display_unit = "mm"] => shell.inputs.track_lateral_m;
 
             /// Elongation of the front left yaw damper (extension positive), from the state
-            output "damper_front_left.elongation" [unit = "m", display_unit = "mm"] => out.damper[0].elongation_m;
+            output "damper_front_left.elongation" [unit = "m", display_unit = "mm"] => shell.out.damper[0].elongation_m;
             /// Elongation velocity of the front left yaw damper
-            output "damper_front_left.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper[0].elongation_velocity_mps;
+            output "damper_front_left.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[0].elongation_velocity_mps;
             /// Absolute velocity of the car-body end of the front left damper along its axis, positive
             /// forward (towards the car-body end); for a sky-hook
-            output "damper_front_left.carbody_end_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper[0].carbody_end_velocity_mps;
+            output "damper_front_left.carbody_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[0].carbody_end_velocity_mps;
             /// Absolute acceleration of the car-body end of the front left damper along its axis
-            output "damper_front_left.carbody_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => out.damper[0].carbody_end_acc_mps2;
+            output "damper_front_left.carbody_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[0].carbody_end_acc_mps2;
             /// Absolute velocity of the frame end of the front left damper along its axis, positive forward
-            output "damper_front_left.frame_end_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper[0].frame_end_velocity_mps;
+            output "damper_front_left.frame_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[0].frame_end_velocity_mps;
             /// Absolute acceleration of the frame end of the front left damper along its axis
-            output "damper_front_left.frame_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => out.damper[0].frame_end_acc_mps2;
+            output "damper_front_left.frame_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[0].frame_end_acc_mps2;
             /// Elongation of the front right yaw damper (extension positive), from the state
-            output "damper_front_right.elongation" [unit = "m", display_unit = "mm"] => out.damper[1].elongation_m;
+            output "damper_front_right.elongation" [unit = "m", display_unit = "mm"] => shell.out.damper[1].elongation_m;
             /// Elongation velocity of the front right yaw damper
-            output "damper_front_right.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper[1].elongation_velocity_mps;
+            output "damper_front_right.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[1].elongation_velocity_mps;
             /// Absolute velocity of the car-body end of the front right damper along its axis, positive
             /// forward (towards the car-body end); for a sky-hook
-            output "damper_front_right.carbody_end_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper[1].carbody_end_velocity_mps;
+            output "damper_front_right.carbody_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[1].carbody_end_velocity_mps;
             /// Absolute acceleration of the car-body end of the front right damper along its axis
-            output "damper_front_right.carbody_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => out.damper[1].carbody_end_acc_mps2;
+            output "damper_front_right.carbody_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[1].carbody_end_acc_mps2;
             /// Absolute velocity of the frame end of the front right damper along its axis, positive forward
-            output "damper_front_right.frame_end_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper[1].frame_end_velocity_mps;
+            output "damper_front_right.frame_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[1].frame_end_velocity_mps;
             /// Absolute acceleration of the frame end of the front right damper along its axis
-            output "damper_front_right.frame_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => out.damper[1].frame_end_acc_mps2;
+            output "damper_front_right.frame_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[1].frame_end_acc_mps2;
             /// Elongation of the rear left yaw damper (extension positive), from the state
-            output "damper_rear_left.elongation" [unit = "m", display_unit = "mm"] => out.damper[2].elongation_m;
+            output "damper_rear_left.elongation" [unit = "m", display_unit = "mm"] => shell.out.damper[2].elongation_m;
             /// Elongation velocity of the rear left yaw damper
-            output "damper_rear_left.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper[2].elongation_velocity_mps;
+            output "damper_rear_left.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[2].elongation_velocity_mps;
             /// Absolute velocity of the car-body end of the rear left damper along its axis, positive
             /// forward (towards the car-body end); for a sky-hook
-            output "damper_rear_left.carbody_end_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper[2].carbody_end_velocity_mps;
+            output "damper_rear_left.carbody_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[2].carbody_end_velocity_mps;
             /// Absolute acceleration of the car-body end of the rear left damper along its axis
-            output "damper_rear_left.carbody_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => out.damper[2].carbody_end_acc_mps2;
+            output "damper_rear_left.carbody_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[2].carbody_end_acc_mps2;
             /// Absolute velocity of the frame end of the rear left damper along its axis, positive forward
-            output "damper_rear_left.frame_end_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper[2].frame_end_velocity_mps;
+            output "damper_rear_left.frame_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[2].frame_end_velocity_mps;
             /// Absolute acceleration of the frame end of the rear left damper along its axis
-            output "damper_rear_left.frame_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => out.damper[2].frame_end_acc_mps2;
+            output "damper_rear_left.frame_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[2].frame_end_acc_mps2;
             /// Elongation of the rear right yaw damper (extension positive), from the state
-            output "damper_rear_right.elongation" [unit = "m", display_unit = "mm"] => out.damper[3].elongation_m;
+            output "damper_rear_right.elongation" [unit = "m", display_unit = "mm"] => shell.out.damper[3].elongation_m;
             /// Elongation velocity of the rear right yaw damper
-            output "damper_rear_right.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper[3].elongation_velocity_mps;
+            output "damper_rear_right.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[3].elongation_velocity_mps;
             /// Absolute velocity of the car-body end of the rear right damper along its axis, positive
             /// forward (towards the car-body end); for a sky-hook
-            output "damper_rear_right.carbody_end_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper[3].carbody_end_velocity_mps;
+            output "damper_rear_right.carbody_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[3].carbody_end_velocity_mps;
             /// Absolute acceleration of the car-body end of the rear right damper along its axis
-            output "damper_rear_right.carbody_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => out.damper[3].carbody_end_acc_mps2;
+            output "damper_rear_right.carbody_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[3].carbody_end_acc_mps2;
             /// Absolute velocity of the frame end of the rear right damper along its axis, positive forward
-            output "damper_rear_right.frame_end_velocity" [unit = "m/s", display_unit = "mm/s"] => out.damper[3].frame_end_velocity_mps;
+            output "damper_rear_right.frame_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[3].frame_end_velocity_mps;
             /// Absolute acceleration of the frame end of the rear right damper along its axis
-            output "damper_rear_right.frame_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => out.damper[3].frame_end_acc_mps2;
+            output "damper_rear_right.frame_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[3].frame_end_acc_mps2;
         }
         // Wheelsets, leading first
         model_description::declare! { v;
             /// Lateral displacement of wheelset 1 (leading wheelset of the front bogie), positive right
-            output "wheelset_1.lateral_displacement" [unit = "m", display_unit = "mm"] => out.wheelset[0].lateral_m;
+            output "wheelset_1.lateral_displacement" [unit = "m", display_unit = "mm"] => shell.out.wheelset[0].lateral_m;
             /// Lateral displacement of wheelset 1 relative to the track
-            output "wheelset_1.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.wheelset[0].lateral_rel_track_m;
+            output "wheelset_1.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => shell.out.wheelset[0].lateral_rel_track_m;
             /// Lateral velocity of wheelset 1
-            output "wheelset_1.lateral_velocity" [unit = "m/s", display_unit = "mm/s"] => out.wheelset[0].lateral_velocity_mps;
+            output "wheelset_1.lateral_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.wheelset[0].lateral_velocity_mps;
             /// Lateral acceleration of wheelset 1
-            output "wheelset_1.lateral_acceleration" [unit = "m/s2", depends_on = FT_TRACK] => out.wheelset[0].lateral_acc_mps2;
+            output "wheelset_1.lateral_acceleration" [unit = "m/s2", depends_on = FT_TRACK] => shell.out.wheelset[0].lateral_acc_mps2;
             /// Yaw angle of wheelset 1, positive nose-left
-            output "wheelset_1.yaw_angle" [unit = "rad", display_unit = "deg"] => out.wheelset[0].yaw_rad;
+            output "wheelset_1.yaw_angle" [unit = "rad", display_unit = "deg"] => shell.out.wheelset[0].yaw_rad;
             /// Guiding force of wheelset 1: sum of the lateral forces of the rails on it, positive right
-            output "wheelset_1.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => out.wheelset[0].guiding_force_n;
+            output "wheelset_1.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => shell.out.wheelset[0].guiding_force_n;
             /// Y/Q of wheelset 1: larger lateral wheel force over the static wheel load
-            output "wheelset_1.y_over_q" [unit = "1", depends_on = FT_TRACK] => out.wheelset[0].y_over_q;
+            output "wheelset_1.y_over_q" [unit = "1", depends_on = FT_TRACK] => shell.out.wheelset[0].y_over_q;
             /// Track lateral alignment under wheelset 1
-            output "wheelset_1.track_alignment" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.wheelset[0].track_m;
+            output "wheelset_1.track_alignment" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => shell.out.wheelset[0].track_m;
             /// Lateral displacement of wheelset 2 (trailing wheelset of the front bogie), positive right
-            output "wheelset_2.lateral_displacement" [unit = "m", display_unit = "mm"] => out.wheelset[1].lateral_m;
+            output "wheelset_2.lateral_displacement" [unit = "m", display_unit = "mm"] => shell.out.wheelset[1].lateral_m;
             /// Lateral displacement of wheelset 2 relative to the track
-            output "wheelset_2.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.wheelset[1].lateral_rel_track_m;
+            output "wheelset_2.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => shell.out.wheelset[1].lateral_rel_track_m;
             /// Lateral velocity of wheelset 2
-            output "wheelset_2.lateral_velocity" [unit = "m/s", display_unit = "mm/s"] => out.wheelset[1].lateral_velocity_mps;
+            output "wheelset_2.lateral_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.wheelset[1].lateral_velocity_mps;
             /// Lateral acceleration of wheelset 2
-            output "wheelset_2.lateral_acceleration" [unit = "m/s2", depends_on = FT_TRACK] => out.wheelset[1].lateral_acc_mps2;
+            output "wheelset_2.lateral_acceleration" [unit = "m/s2", depends_on = FT_TRACK] => shell.out.wheelset[1].lateral_acc_mps2;
             /// Yaw angle of wheelset 2, positive nose-left
-            output "wheelset_2.yaw_angle" [unit = "rad", display_unit = "deg"] => out.wheelset[1].yaw_rad;
+            output "wheelset_2.yaw_angle" [unit = "rad", display_unit = "deg"] => shell.out.wheelset[1].yaw_rad;
             /// Guiding force of wheelset 2: sum of the lateral forces of the rails on it, positive right
-            output "wheelset_2.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => out.wheelset[1].guiding_force_n;
+            output "wheelset_2.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => shell.out.wheelset[1].guiding_force_n;
             /// Y/Q of wheelset 2: larger lateral wheel force over the static wheel load
-            output "wheelset_2.y_over_q" [unit = "1", depends_on = FT_TRACK] => out.wheelset[1].y_over_q;
+            output "wheelset_2.y_over_q" [unit = "1", depends_on = FT_TRACK] => shell.out.wheelset[1].y_over_q;
             /// Track lateral alignment under wheelset 2
-            output "wheelset_2.track_alignment" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.wheelset[1].track_m;
+            output "wheelset_2.track_alignment" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => shell.out.wheelset[1].track_m;
             /// Lateral displacement of wheelset 3 (leading wheelset of the rear bogie), positive right
-            output "wheelset_3.lateral_displacement" [unit = "m", display_unit = "mm"] => out.wheelset[2].lateral_m;
+            output "wheelset_3.lateral_displacement" [unit = "m", display_unit = "mm"] => shell.out.wheelset[2].lateral_m;
             /// Lateral displacement of wheelset 3 relative to the track
-            output "wheelset_3.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.wheelset[2].lateral_rel_track_m;
+            output "wheelset_3.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => shell.out.wheelset[2].lateral_rel_track_m;
             /// Lateral velocity of wheelset 3
-            output "wheelset_3.lateral_velocity" [unit = "m/s", display_unit = "mm/s"] => out.wheelset[2].lateral_velocity_mps;
+            output "wheelset_3.lateral_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.wheelset[2].lateral_velocity_mps;
             /// Lateral acceleration of wheelset 3
-            output "wheelset_3.lateral_acceleration" [unit = "m/s2", depends_on = FT_TRACK] => out.wheelset[2].lateral_acc_mps2;
+            output "wheelset_3.lateral_acceleration" [unit = "m/s2", depends_on = FT_TRACK] => shell.out.wheelset[2].lateral_acc_mps2;
             /// Yaw angle of wheelset 3, positive nose-left
-            output "wheelset_3.yaw_angle" [unit = "rad", display_unit = "deg"] => out.wheelset[2].yaw_rad;
+            output "wheelset_3.yaw_angle" [unit = "rad", display_unit = "deg"] => shell.out.wheelset[2].yaw_rad;
             /// Guiding force of wheelset 3: sum of the lateral forces of the rails on it, positive right
-            output "wheelset_3.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => out.wheelset[2].guiding_force_n;
+            output "wheelset_3.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => shell.out.wheelset[2].guiding_force_n;
             /// Y/Q of wheelset 3: larger lateral wheel force over the static wheel load
-            output "wheelset_3.y_over_q" [unit = "1", depends_on = FT_TRACK] => out.wheelset[2].y_over_q;
+            output "wheelset_3.y_over_q" [unit = "1", depends_on = FT_TRACK] => shell.out.wheelset[2].y_over_q;
             /// Track lateral alignment under wheelset 3
-            output "wheelset_3.track_alignment" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.wheelset[2].track_m;
+            output "wheelset_3.track_alignment" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => shell.out.wheelset[2].track_m;
             /// Lateral displacement of wheelset 4 (trailing wheelset of the rear bogie), positive right
-            output "wheelset_4.lateral_displacement" [unit = "m", display_unit = "mm"] => out.wheelset[3].lateral_m;
+            output "wheelset_4.lateral_displacement" [unit = "m", display_unit = "mm"] => shell.out.wheelset[3].lateral_m;
             /// Lateral displacement of wheelset 4 relative to the track
-            output "wheelset_4.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.wheelset[3].lateral_rel_track_m;
+            output "wheelset_4.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => shell.out.wheelset[3].lateral_rel_track_m;
             /// Lateral velocity of wheelset 4
-            output "wheelset_4.lateral_velocity" [unit = "m/s", display_unit = "mm/s"] => out.wheelset[3].lateral_velocity_mps;
+            output "wheelset_4.lateral_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.wheelset[3].lateral_velocity_mps;
             /// Lateral acceleration of wheelset 4
-            output "wheelset_4.lateral_acceleration" [unit = "m/s2", depends_on = FT_TRACK] => out.wheelset[3].lateral_acc_mps2;
+            output "wheelset_4.lateral_acceleration" [unit = "m/s2", depends_on = FT_TRACK] => shell.out.wheelset[3].lateral_acc_mps2;
             /// Yaw angle of wheelset 4, positive nose-left
-            output "wheelset_4.yaw_angle" [unit = "rad", display_unit = "deg"] => out.wheelset[3].yaw_rad;
+            output "wheelset_4.yaw_angle" [unit = "rad", display_unit = "deg"] => shell.out.wheelset[3].yaw_rad;
             /// Guiding force of wheelset 4: sum of the lateral forces of the rails on it, positive right
-            output "wheelset_4.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => out.wheelset[3].guiding_force_n;
+            output "wheelset_4.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => shell.out.wheelset[3].guiding_force_n;
             /// Y/Q of wheelset 4: larger lateral wheel force over the static wheel load
-            output "wheelset_4.y_over_q" [unit = "1", depends_on = FT_TRACK] => out.wheelset[3].y_over_q;
+            output "wheelset_4.y_over_q" [unit = "1", depends_on = FT_TRACK] => shell.out.wheelset[3].y_over_q;
             /// Track lateral alignment under wheelset 4
-            output "wheelset_4.track_alignment" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => out.wheelset[3].track_m;
+            output "wheelset_4.track_alignment" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => shell.out.wheelset[3].track_m;
         }
         // Frames and car body
         model_description::declare! { v;
             /// Lateral acceleration of the front bogie frame over its leading axle boxes, at the frame's
             /// centre height (EN 14363 stability quantity)
-            output "frame_front.lateral_acceleration_leading_axle" [unit = "m/s2", depends_on = FT_DAMPERS] => out.frame[0].lateral_acc_leading_axle_mps2;
+            output "frame_front.lateral_acceleration_leading_axle" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.frame[0].lateral_acc_leading_axle_mps2;
             /// Lateral acceleration of the front bogie frame over its trailing axle boxes
-            output "frame_front.lateral_acceleration_trailing_axle" [unit = "m/s2", depends_on = FT_DAMPERS] => out.frame[0].lateral_acc_trailing_axle_mps2;
+            output "frame_front.lateral_acceleration_trailing_axle" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.frame[0].lateral_acc_trailing_axle_mps2;
             /// Lateral displacement of the front frame centre, positive right
-            output "frame_front.lateral_displacement" [unit = "m", display_unit = "mm"] => out.frame[0].lateral_m;
+            output "frame_front.lateral_displacement" [unit = "m", display_unit = "mm"] => shell.out.frame[0].lateral_m;
             /// Yaw angle of the front frame, positive nose-left
-            output "frame_front.yaw_angle" [unit = "rad", display_unit = "deg"] => out.frame[0].yaw_rad;
+            output "frame_front.yaw_angle" [unit = "rad", display_unit = "deg"] => shell.out.frame[0].yaw_rad;
             /// Roll angle of the front frame, positive with the top moving right
-            output "frame_front.roll_angle" [unit = "rad", display_unit = "deg"] => out.frame[0].roll_rad;
+            output "frame_front.roll_angle" [unit = "rad", display_unit = "deg"] => shell.out.frame[0].roll_rad;
             /// Lateral acceleration of the rear bogie frame over its leading axle boxes, at the frame's
             /// centre height (EN 14363 stability quantity)
-            output "frame_rear.lateral_acceleration_leading_axle" [unit = "m/s2", depends_on = FT_DAMPERS] => out.frame[1].lateral_acc_leading_axle_mps2;
+            output "frame_rear.lateral_acceleration_leading_axle" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.frame[1].lateral_acc_leading_axle_mps2;
             /// Lateral acceleration of the rear bogie frame over its trailing axle boxes
-            output "frame_rear.lateral_acceleration_trailing_axle" [unit = "m/s2", depends_on = FT_DAMPERS] => out.frame[1].lateral_acc_trailing_axle_mps2;
+            output "frame_rear.lateral_acceleration_trailing_axle" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.frame[1].lateral_acc_trailing_axle_mps2;
             /// Lateral displacement of the rear frame centre, positive right
-            output "frame_rear.lateral_displacement" [unit = "m", display_unit = "mm"] => out.frame[1].lateral_m;
+            output "frame_rear.lateral_displacement" [unit = "m", display_unit = "mm"] => shell.out.frame[1].lateral_m;
             /// Yaw angle of the rear frame, positive nose-left
-            output "frame_rear.yaw_angle" [unit = "rad", display_unit = "deg"] => out.frame[1].yaw_rad;
+            output "frame_rear.yaw_angle" [unit = "rad", display_unit = "deg"] => shell.out.frame[1].yaw_rad;
             /// Roll angle of the rear frame, positive with the top moving right
-            output "frame_rear.roll_angle" [unit = "rad", display_unit = "deg"] => out.frame[1].roll_rad;
+            output "frame_rear.roll_angle" [unit = "rad", display_unit = "deg"] => shell.out.frame[1].roll_rad;
             /// Car-body lateral acceleration at floor height above the front bogie centre (ride comfort;
             /// kinematic, without the g roll component of a tilting accelerometer)
-            output "carbody.lateral_acceleration_front" [unit = "m/s2", depends_on = FT_DAMPERS] => out.carbody.lateral_acc_front_mps2;
+            output "carbody.lateral_acceleration_front" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.carbody.lateral_acc_front_mps2;
             /// Car-body lateral acceleration at floor height at mid-length
-            output "carbody.lateral_acceleration_mid" [unit = "m/s2", depends_on = FT_DAMPERS] => out.carbody.lateral_acc_mid_mps2;
+            output "carbody.lateral_acceleration_mid" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.carbody.lateral_acc_mid_mps2;
             /// Car-body lateral acceleration at floor height above the rear bogie centre
-            output "carbody.lateral_acceleration_rear" [unit = "m/s2", depends_on = FT_DAMPERS] => out.carbody.lateral_acc_rear_mps2;
+            output "carbody.lateral_acceleration_rear" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.carbody.lateral_acc_rear_mps2;
             /// Lateral displacement of the car body's centre of gravity, positive right
-            output "carbody.lateral_displacement" [unit = "m", display_unit = "mm"] => out.carbody.lateral_m;
+            output "carbody.lateral_displacement" [unit = "m", display_unit = "mm"] => shell.out.carbody.lateral_m;
             /// Car-body yaw angle, positive nose-left
-            output "carbody.yaw_angle" [unit = "rad", display_unit = "deg"] => out.carbody.yaw_rad;
+            output "carbody.yaw_angle" [unit = "rad", display_unit = "deg"] => shell.out.carbody.yaw_rad;
             /// Car-body roll angle, positive with the top moving right
-            output "carbody.roll_angle" [unit = "rad", display_unit = "deg"] => out.carbody.roll_rad;
+            output "carbody.roll_angle" [unit = "rad", display_unit = "deg"] => shell.out.carbody.roll_rad;
         }
         v
     }
@@ -462,62 +469,29 @@ impl FmuModel for RailVehicle {
             },
             ..VehicleParams::default()
         };
-        let mut me = Self {
+        Ok(Self {
+            shell: Shell::new(&params),
             params,
             track_source: TrackChoice::External,
             track_level: TrackLevel::Low,
             track_seed: 1,
             contact: String::new(),
             resource_dir: ctx.resource_dir.clone(),
-            inputs: Inputs::default(),
-            vehicle: None,
-            out: Outputs::default(),
-        };
-        me.preview_outputs();
-        Ok(me)
+        })
     }
 
     fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
         let params = self.build_params();
         let v = Vehicle::new(params).map_err(|e| field_error::<Self>(&e))?;
-        self.out = v
-            .outputs(&self.inputs)
-            .map_err(|e| field_error::<Self>(&e))?;
-        self.vehicle = Some(v);
-        Ok(())
+        self.shell.initialize::<Self>(v)
     }
 
     fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
-        match &self.vehicle {
-            Some(v) => {
-                self.out = v
-                    .outputs(&self.inputs)
-                    .map_err(|e| field_error::<Self>(&e))?
-            }
-            None => self.preview_outputs(),
-        }
-        Ok(())
+        self.shell.update_outputs::<Self>(&self.params)
     }
 
     fn do_step(&mut self, _time: f64, step: f64, _diag: &mut Diagnostics) -> Result<(), StepError> {
-        let Some(v) = &mut self.vehicle else {
-            return Err(StepError::Error(ModelError::Other(
-                "the physics is built in fmi2ExitInitializationMode; no step before it".into(),
-            )));
-        };
-        // A diverged state may be avoided with a smaller step (fmi2Discard); a derailment or a
-        // bad input cannot (fmi2Error). The physics is unchanged after either.
-        let map = |e: PStep| match e {
-            PStep::Diverged { .. } | PStep::Input(InputError::InvalidStep { .. }) => {
-                StepError::Discard(e.to_string())
-            }
-            PStep::Input(InputError::NonFiniteInput { .. }) => {
-                StepError::Error(field_error::<Self>(&e))
-            }
-            other => StepError::Error(ModelError::Other(other.to_string())),
-        };
-        self.out = host_step(v, step, |p, h| p.step(h, &self.inputs)).map_err(map)?;
-        Ok(())
+        self.shell.do_step::<Self>(step)
     }
 }
 

@@ -8,6 +8,8 @@
 //!   source through [`track_choice_enum!`]) and their mapping onto the physics'
 //!   [`wheel_rail::track::TrackSource`];
 //! * [`resources`]: file parameters looked up under the FMU's `resources/` folder first;
+//! * [`shell`]: what both FMU shells do alike (inputs, physics built at initialisation and
+//!   previewed before, outputs, host step, the physics' step errors under FMI names);
 //! * [`damper`]: the linear yaw damper law (none, viscous, Kelvin-Voigt, Maxwell) that the
 //!   closed-loop runs evaluate beside a model, co-simulation style, and the coach's
 //!   eigen-analysis takes; the loop itself.
@@ -17,11 +19,13 @@
 pub mod damper;
 pub mod params;
 pub mod resources;
+pub mod shell;
 pub mod step;
 pub mod track;
 
 pub use damper::{run_closed_loop, ClosedLoopModel, LinearDamper};
 pub use params::{finite, in_range, non_negative, positive, ParamError};
 pub use resources::resource_or_given;
+pub use shell::{Shell, ShellPhysics};
 pub use step::{check_inputs, check_step, host_step, InputError};
 pub use track::TrackLevel;
