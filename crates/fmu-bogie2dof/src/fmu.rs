@@ -5,28 +5,20 @@
 use std::path::{Path, PathBuf};
 
 use model_description::{
-    field_error, fmi_enum, read_parameter_file, DefaultExperiment, Diagnostics, FieldError,
-    FmuModel, InstanceContext, ModelError, ModelInfo, StepError, Variable,
-    MAX_PARAMETER_FILE_BYTES,
+    field_error, read_parameter_file, DefaultExperiment, Diagnostics, FieldError, FmuModel,
+    InstanceContext, ModelError, ModelInfo, StepError, Variable, MAX_PARAMETER_FILE_BYTES,
 };
 use serde::{Deserialize, Serialize};
 use vehicle_elements::{resource_or_given, InputError, Shell, ShellPhysics, TrackLevel};
 use wheel_rail::GeometryTable;
 
 use crate::model::{Bogie, Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep};
-use crate::params::{ContactSource, ModelKind, Params, TrackSource};
+use crate::params::{ContactSource, Params, TrackSource};
 
 /// Speed of the FMU's start values (default experiment: hunting with flange contact) [m/s].
 pub const FMU_DEFAULT_SPEED_MPS: f64 = 300.0 / 3.6;
 /// Initial lateral displacement of the FMU's start values [m].
 pub const FMU_DEFAULT_INITIAL_LATERAL_M: f64 = 3e-3;
-
-fmi_enum! {
-    ModelKind as "WheelRailForceLaw", "Wheel/rail force law of the time-domain model" {
-        Linear = 0, "linear", "(5.1)-(5.18): Kalker linear creep, constant conicity and gravitational stiffness";
-        NonLinear = 1, "nonlinear", "(5.19)-(5.27): contact table, Vermeulen-Johnson saturation, wheelset spin dofs";
-    }
-}
 
 // The FMI Enumeration `TrackSource`, with where this model applies the external input.
 vehicle_elements::track_choice_enum!(

@@ -47,16 +47,10 @@ pub const CALIBRATED_K_SSX_N_PER_M: f64 = 0.390e6;
 /// Wheel/rail friction coefficient [-] (dry rail 0.3-0.4).
 pub const CALIBRATED_FRICTION: f64 = 0.35;
 
-/// Which wheel/rail force law the time-domain model uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-pub enum ModelKind {
-    /// (5.1)-(5.18): Kalker linear creep, constant conicity, no spin dofs.
-    Linear,
-    /// (5.19)-(5.27): tabulated rolling radii and contact angles, Vermeulen-Johnson
-    /// saturation, gravitational/flange forces, two wheelset spin perturbation dofs.
-    #[default]
-    NonLinear,
-}
+vehicle_elements::force_law_enum!(
+    "(5.1)-(5.18): Kalker linear creep, constant conicity and gravitational stiffness",
+    "(5.19)-(5.27): contact table, Vermeulen-Johnson saturation, wheelset spin dofs"
+);
 
 pub use wheel_rail::track::{PsdLevel, TrackSource};
 

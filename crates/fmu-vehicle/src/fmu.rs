@@ -5,26 +5,19 @@
 use std::path::PathBuf;
 
 use model_description::{
-    field_error, fmi_enum, DefaultExperiment, Diagnostics, FieldError, FmuModel, InstanceContext,
-    ModelError, ModelInfo, StepError, Variable,
+    field_error, DefaultExperiment, Diagnostics, FieldError, FmuModel, InstanceContext, ModelError,
+    ModelInfo, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
 use vehicle_elements::{resource_or_given, InputError, Shell, ShellPhysics, TrackLevel};
 
 use crate::model::{Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep, Vehicle};
-use crate::params::{ContactSource, Initial, ModelKind, TrackSource, VehicleParams};
+use crate::params::{ContactSource, Initial, TrackSource, VehicleParams};
 
 /// Speed of the FMU's start values (default experiment: hunting into flange contact) [m/s].
 pub const FMU_DEFAULT_SPEED_MPS: f64 = 300.0 / 3.6;
 /// Initial lateral displacement of both bogies in the FMU's start values [m].
 pub const FMU_DEFAULT_INITIAL_LATERAL_M: f64 = 3e-3;
-
-fmi_enum! {
-    ModelKind as "WheelRailForceLaw", "Wheel/rail force law of the time-domain model" {
-        Linear = 0, "linear", "Kalker linear creep, constant conicity and gravitational stiffness, no spin dofs";
-        NonLinear = 1, "nonlinear", "Contact table, Vermeulen-Johnson saturation, flange contact, wheelset spin dofs";
-    }
-}
 
 // The FMI Enumeration `TrackSource`, with where this model applies the external input.
 vehicle_elements::track_choice_enum!(

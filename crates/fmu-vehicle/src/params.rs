@@ -63,17 +63,10 @@ pub const BOGIE_F11_N: f64 = 11.5e6;
 /// Kalker f22 at [`BOGIE_WHEEL_LOAD_N`] [N].
 pub const BOGIE_F22_N: f64 = 10.4e6;
 
-/// Which wheel/rail force law the time-domain model uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-pub enum ModelKind {
-    /// Kalker linear creep, constant equivalent conicity, linear gravitational stiffness, no
-    /// spin dofs (the seed's (5.1)-(5.18) per wheelset).
-    Linear,
-    /// Contact table per wheelset (rolling radii, contact angles, flange), Vermeulen-Johnson
-    /// saturation, wheelset spin dofs (the seed's (5.19)-(5.27) per wheelset).
-    #[default]
-    NonLinear,
-}
+vehicle_elements::force_law_enum!(
+    "Kalker linear creep, constant conicity and gravitational stiffness, no spin dofs",
+    "Contact table, Vermeulen-Johnson saturation, flange contact, wheelset spin dofs"
+);
 
 pub use wheel_rail::track::{PsdLevel, TrackSource};
 

@@ -88,6 +88,41 @@ macro_rules! track_choice_enum {
     };
 }
 
+/// Declares, in the model crate that uses it, `ModelKind`: which wheel/rail force law the
+/// time-domain model uses (default: the non-linear one), with the FMI Enumeration
+/// `WheelRailForceLaw` behind the parameter `contact.model`. `$linear` and `$nonlinear`
+/// describe the two laws as that model implements them (docs and enumeration items):
+///
+/// ```ignore
+/// vehicle_elements::force_law_enum!(
+///     "Kalker linear creep, constant conicity and gravitational stiffness",
+///     "Contact table, Vermeulen-Johnson saturation, wheelset spin dofs"
+/// );
+/// ```
+#[macro_export]
+macro_rules! force_law_enum {
+    ($linear:literal, $nonlinear:literal) => {
+        /// Which wheel/rail force law the time-domain model uses.
+        #[derive(
+            Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default,
+        )]
+        pub enum ModelKind {
+            #[doc = $linear]
+            Linear,
+            #[doc = $nonlinear]
+            #[default]
+            NonLinear,
+        }
+
+        $crate::track::__fmi_enum! {
+            ModelKind as "WheelRailForceLaw", "Wheel/rail force law of the time-domain model" {
+                Linear = 0, "linear", $linear;
+                NonLinear = 1, "nonlinear", $nonlinear;
+            }
+        }
+    };
+}
+
 /// The internal generator at `level` with `seed` (an FMI Integer, taken by magnitude).
 pub fn internal_source(level: TrackLevel, seed: i32) -> TrackSource {
     TrackSource::Internal {
