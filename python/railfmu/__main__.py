@@ -56,7 +56,12 @@ def main(argv: Optional[List[str]] = None) -> int:
     s.add_argument("-o", "--output", default="sweep-out", help="output folder (default: sweep-out)")
     s.add_argument("-j", "--jobs", type=int, default=None, help="local threads (default: all cores)")
     s.add_argument("--dask-scheduler", metavar="ADDRESS", help="run on this Dask scheduler (e.g. tcp://host:8786)")
-    s.add_argument("--resume", action="store_true", help="keep runs already complete in the output folder")
+    s.add_argument(
+        "--resume",
+        action="store_true",
+        help="keep runs already complete in the output folder in the results format of this sweep "
+        "(--format, else by size); runs in the other format run again",
+    )
     s.add_argument(
         "--shared-fmus", action="store_true", help="workers read the FMUs from their paths (shared file system) instead of receiving copies"
     )

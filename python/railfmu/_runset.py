@@ -86,16 +86,21 @@ class RunSet:
         * ``client=None``: on ``threads`` local threads (default: all cores), the GIL released.
         * ``client=dask.distributed.Client(...)``: one Dask task per run (see
           :mod:`railfmu.dask`); the results come back to this process, which writes the folder.
-        * ``resume=True``: runs already complete in ``output_dir`` (ok, results present, same
-          resolved system) are kept and not run again.
+        * ``resume=True``: runs already complete in ``output_dir`` (ok, results present in the
+          results format of this call, same resolved system) are kept and not run again. The
+          format is decided first (``format``, else by size over every job, as a fresh run
+          set): runs kept in the other format are run again, so the folder stays in one format.
         * ``progress``: True for a bar, or ``f(done, total, run_name, error_or_None)``.
         """
         out = Path(output_dir)
         out.mkdir(parents=True, exist_ok=True)
         reports: List[Optional[str]] = [None] * len(self)
         if resume:
+            # decided over every job before the kept runs, as a fresh run set decides it
+            if format is None:
+                format = self._format_by_size(client, ship_fmus, retries)
             for i, j in enumerate(self._jobs_json):
-                reports[i] = _railfmu.completed_report(os.fspath(out), j)
+                reports[i] = _railfmu.completed_report(os.fspath(out), j, format)
         todo = [i for i, r in enumerate(reports) if r is None]
         total, done = len(self), len(self) - len(todo)
         with bar(progress, "runs") as cb:
@@ -133,6 +138,14 @@ class RunSet:
         final = [r for r in reports if r is not None]
         _railfmu.write_sweep(os.fspath(out), final)
         return RunSetResults(out, [json.loads(r) for r in final])
+
+    def _format_by_size(self, client: Any, ship_fmus: bool, retries: int) -> str:
+        """The results format a fresh run of every job chooses by size ("csv" or "parquet")."""
+        if client is None:
+            return _railfmu.results_format_by_size(self._base_json, self._label, self._jobs_json)
+        from .dask import results_format
+
+        return results_format(client, self._base_json, self._label, self._jobs_json, ship_fmus=ship_fmus, retries=retries)
 
 
 def run_set(

@@ -130,6 +130,34 @@ def _read_fmus(base_json: str) -> Dict[str, Tuple[str, str, bytes]]:
     return out
 
 
+def _scatter_fmus(client: Any, base_json: str) -> Dict[str, Tuple[str, str, Any]]:
+    """The FMUs of the description sent to every worker: path -> (SHA-256, file name, future)."""
+    fmus = _read_fmus(base_json)
+    # hash=False: keys new to this set. A key derived from the content would be the one an
+    # earlier set scattered, which the scheduler may still be releasing (its tasks would
+    # then fail with "lost dependencies").
+    paths = list(fmus)
+    scattered = client.scatter([fmus[p][2] for p in paths], broadcast=True, hash=False)
+    return {p: (fmus[p][0], fmus[p][1], f) for p, f in zip(paths, scattered)}
+
+
+def results_format(
+    client: Any, base_json: str, label: str, jobs_json: List[str], *, fmus_arg: Any = None, ship_fmus: bool = False, retries: int = 3
+) -> str:
+    """The results format ("csv" or "parquet") a run set of ``jobs_json`` chooses by size, as a
+    local run set does: from the FMUs' model descriptions read on this client, else on a worker
+    (``fmus_arg``: FMUs already scattered; ``ship_fmus``: scatter them for this). A resumed run
+    set decides it over every job before it keeps any run."""
+    try:
+        return _railfmu.results_format_by_size(base_json, label, jobs_json)
+    except _railfmu.Error:
+        pass
+    # the FMUs are not readable here (e.g. on the workers' file system only)
+    if fmus_arg is None and ship_fmus:
+        fmus_arg = _scatter_fmus(client, base_json)
+    return client.submit(format_task, base_json, label, jobs_json, fmus_arg, retries=retries, pure=False).result()
+
+
 def run_jobs_on_cluster(
     client: Any,
     base_json: str,
@@ -150,21 +178,9 @@ def run_jobs_on_cluster(
     from distributed import as_completed
 
 
-    fmus_arg: Any = None
-    if ship_fmus:
-        fmus = _read_fmus(base_json)
-        # hash=False: keys new to this set. A key derived from the content would be the one an
-        # earlier set scattered, which the scheduler may still be releasing (its tasks would
-        # then fail with "lost dependencies").
-        paths = list(fmus)
-        scattered = client.scatter([fmus[p][2] for p in paths], broadcast=True, hash=False)
-        fmus_arg = {p: (fmus[p][0], fmus[p][1], f) for p, f in zip(paths, scattered)}
+    fmus_arg = _scatter_fmus(client, base_json) if ship_fmus else None
     if format is None:
-        try:
-            format = _railfmu.results_format_by_size(base_json, label, jobs_json)
-        except _railfmu.Error:
-            # the FMUs are not readable here (e.g. on the workers' file system only)
-            format = client.submit(format_task, base_json, label, jobs_json, fmus_arg, retries=retries, pure=False).result()
+        format = results_format(client, base_json, label, jobs_json, fmus_arg=fmus_arg, retries=retries)
     writer = _railfmu.RunWriter(os.fspath(outdir), jobs_json, format)
     # keys unique per submission: a key resubmitted while the scheduler still releases it from
     # an earlier set would be cancelled

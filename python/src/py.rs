@@ -465,11 +465,12 @@ fn run_set_parts(base: &LoadedSystem, jobs: &[Job]) -> PyResult<(String, String,
     Ok((desc, base.file.clone(), jobs))
 }
 
-/// The report (JSON) of a job whose run is complete in `outdir`, else None.
+/// The report (JSON) of a job whose run is complete in `outdir` in `format` ("csv" or
+/// "parquet"), else None (also when its results are in the other format).
 #[pyfunction]
-fn completed_report(outdir: PathBuf, job_json: &str) -> PyResult<Option<String>> {
+fn completed_report(outdir: PathBuf, job_json: &str, format: &str) -> PyResult<Option<String>> {
     let job: Job = serde_json::from_str(job_json).map_err(|e| json_err("job", &e))?;
-    runs::completed(&outdir, &job)
+    runs::completed(&outdir, &job, parse_format(format)?)
         .as_ref()
         .map(report_json)
         .transpose()

@@ -1,6 +1,7 @@
 //! Run-set bookkeeping of the Python package: `sweep.json` over all runs of a resumed set, and
 //! the folders of runs computed in another process ([`RunSetWriter`]). Which runs are complete
-//! is the master's rule ([`completed`], re-exported).
+//! in a format, and which format a run set chooses by size, are the master's rules
+//! ([`completed`], [`format_by_size`], re-exported).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -8,21 +9,12 @@ use std::path::{Path, PathBuf};
 use master::coupling::{ColumnInfo, SimOutput};
 use master::output::{write_json_atomic, OutputError};
 use master::results::{constant_kinds, ConstantKind, ResultsFormat};
-pub use master::runset::completed;
-use master::runset::{format_by_plan, run_one_with, Job, ResultsOptions, RunReport};
-use master::system::{LoadedSystem, SystemError};
+pub use master::runset::{completed, format_by_description as format_by_size};
+use master::runset::{run_one_with, Job, ResultsOptions, RunReport};
 
 /// Writes `<outdir>/sweep.json`, the reports in job order (the master's format).
 pub fn write_sweep(outdir: &Path, reports: &[RunReport]) -> Result<(), OutputError> {
     write_json_atomic(&outdir.join("sweep.json"), &reports)
-}
-
-/// The results format a local run set of `base` chooses by size for `jobs`, from the FMUs'
-/// model descriptions alone (no FMU is unpacked or loaded).
-pub fn format_by_size(base: &LoadedSystem, jobs: &[Job]) -> Result<ResultsFormat, SystemError> {
-    let archives = base.open_fmus()?;
-    let models: Vec<_> = archives.iter().map(|a| &a.model).collect();
-    Ok(format_by_plan(&base.plan(&models)?, jobs))
 }
 
 /// What a run's table carries besides its numbers (each column's FMU variable, the texts of
@@ -120,18 +112,23 @@ mod tests {
     fn a_written_run_is_complete_until_its_inputs_change() {
         let dir = tempfile::tempdir().unwrap();
         let j = job("run-000", 100.0);
-        assert!(completed(dir.path(), &j).is_none());
+        assert!(completed(dir.path(), &j, ResultsFormat::Csv).is_none());
         let writer = RunSetWriter::new(dir.path(), std::slice::from_ref(&j), ResultsFormat::Csv);
         let report = writer.write(&j, Ok(output()));
         assert!(report.ok, "{report:?}");
         let csv = std::fs::read_to_string(dir.path().join("run-000/results.csv")).unwrap();
         assert_eq!(csv, "time [s],ms.x [m]\n0,1\n0.001,0.5\n0.002,0.25\n");
-        assert_eq!(completed(dir.path(), &j), Some(report.clone()));
+        assert_eq!(
+            completed(dir.path(), &j, ResultsFormat::Csv),
+            Some(report.clone())
+        );
+        // complete in CSV only: a Parquet run set runs it again
+        assert!(completed(dir.path(), &j, ResultsFormat::Parquet).is_none());
         // another stiffness under the same name is another run
-        assert!(completed(dir.path(), &job("run-000", 200.0)).is_none());
+        assert!(completed(dir.path(), &job("run-000", 200.0), ResultsFormat::Csv).is_none());
         // a lost results file makes the run incomplete
         std::fs::remove_file(dir.path().join("run-000/results.csv")).unwrap();
-        assert!(completed(dir.path(), &j).is_none());
+        assert!(completed(dir.path(), &j, ResultsFormat::Csv).is_none());
         write_sweep(dir.path(), &[report]).unwrap();
         let sweep: Vec<RunReport> =
             serde_json::from_str(&std::fs::read_to_string(dir.path().join("sweep.json")).unwrap())
@@ -153,7 +150,11 @@ mod tests {
         let file = dir.path().join("results/run-000.parquet");
         assert_eq!(report.results.as_deref(), Some(file.as_path()));
         assert!(!dir.path().join("run-000/results.csv").exists());
-        assert_eq!(completed(dir.path(), &a), Some(report));
+        assert_eq!(
+            completed(dir.path(), &a, ResultsFormat::Parquet),
+            Some(report)
+        );
+        assert!(completed(dir.path(), &a, ResultsFormat::Csv).is_none());
         let (columns, _) = master::parquet_file::read_parquet(&file).unwrap();
         let names: Vec<&str> = columns.iter().map(|(n, _)| n.as_str()).collect();
         // the other run's parameter is a column here too (null), so the files make one table
@@ -174,6 +175,6 @@ mod tests {
         assert_eq!(report.error.as_deref(), Some("negative stiffness"));
         assert!(dir.path().join("bad/summary.json").is_file());
         assert!(!dir.path().join("bad/results.csv").exists());
-        assert!(completed(dir.path(), &j).is_none());
+        assert!(completed(dir.path(), &j, ResultsFormat::Csv).is_none());
     }
 }

@@ -205,3 +205,34 @@ def test_the_command_line_runs_a_set_on_the_cluster(dist, client, master_cmd, tm
         capture_output=True, text=True, check=False, env=env,
     )
     assert r.returncode == 1 and "needs the Python package railfmu" in r.stderr
+
+
+def test_a_set_resumed_on_the_cluster_in_another_format_runs_again_into_one_format(dist, client, master_cmd, tmp_path):
+    spec = speed_set(dist, [50.0, 70.0], stop_time=0.2)
+    set_file = tmp_path / "set.json"
+    set_file.write_text(json.dumps(spec))
+    rs = railfmu.RunSet.from_dict(spec)
+    out = tmp_path / "out"
+    assert rs.run(out, threads=1, format="csv").ok
+    env = dict(os.environ, RAILFMU_PYTHON=sys.executable)
+    addr = client.scheduler.address
+
+    def resume(*options):
+        return subprocess.run(
+            [str(master_cmd), "--quiet", "sweep", str(set_file), "-o", str(out), "--dask-scheduler", addr, "--resume", *options],
+            capture_output=True, text=True, check=False, env=env,
+        )
+
+    r = resume("--format", "parquet")
+    assert r.returncode == 0, r.stderr
+    assert not list(out.glob("*/results.csv"))
+    assert sorted(p.stem for p in (out / "results").glob("*.parquet")) == rs.names
+    assert sorted(pd.read_parquet(out / "results")["run"].unique()) == rs.names
+    summaries = {n: (out / n / "summary.json").read_bytes() for n in rs.names}
+    assert resume("--format", "parquet").returncode == 0
+    assert {n: (out / n / "summary.json").read_bytes() for n in rs.names} == summaries  # kept
+    # no format: by size over every job as a fresh set (CSV for these short runs), all again
+    ran = []
+    again = rs.run(out, client=client, resume=True, progress=lambda d, t, n, e: ran.append(n))
+    assert again.ok and sorted(n for n in ran if n) == rs.names
+    assert sorted(csv_bytes(out)) == rs.names and not (out / "results").exists()

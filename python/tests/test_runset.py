@@ -114,3 +114,55 @@ def test_master_sweep_resume_keeps_complete_runs(dist, master_cmd, tmp_path):
     assert [s["name"] for s in json.loads((out / "sweep.json").read_text())] == sorted(before)
     r = run_master(master_cmd, "sweep", set_file, "-o", out, "--resume")
     assert "4 complete run(s) kept, 0 run" in r.stdout
+
+
+def parquet_names(out: Path) -> list:
+    return sorted(p.stem for p in (out / "results").glob("*.parquet"))
+
+
+def test_a_run_set_resumed_in_another_format_runs_again_into_one_format(dist, master_cmd, tmp_path):
+    pd = pytest.importorskip("pandas")
+    pytest.importorskip("pyarrow")
+    spec = speed_set(dist, [50.0, 60.0, 70.0], stop_time=0.3)
+    rs = railfmu.RunSet.from_dict(spec)
+    out = tmp_path / "py"
+    rs.run(out, threads=2, format="csv")
+    assert sorted(csv_bytes(out)) == rs.names
+    ran = []
+    rs.run(out, threads=2, resume=True, format="parquet", progress=lambda d, t, n, e: ran.append(n))
+    # every run again, each in results/ and none left as CSV: the folder is one table
+    assert sorted(n for n in ran if n) == rs.names
+    assert parquet_names(out) == rs.names and csv_bytes(out) == {}
+    assert not list(out.glob("*/results.meta.json"))
+    table = pd.read_parquet(out / "results")
+    assert sorted(table["run"].unique()) == rs.names
+    assert [s["results"] for s in json.loads((out / "sweep.json").read_text())] == [
+        str(out / "results" / f"{n}.parquet") for n in rs.names
+    ]
+    # the same format keeps every run
+    ran.clear()
+    rs.run(out, threads=2, resume=True, format="parquet", progress=lambda d, t, n, e: ran.append(n))
+    assert [n for n in ran if n] == []
+    # by size (short runs: CSV) as a fresh run set: every run again, no Parquet file left
+    rs.run(out, threads=2, resume=True, progress=lambda d, t, n, e: ran.append(n))
+    assert sorted(n for n in ran if n) == rs.names
+    assert sorted(csv_bytes(out)) == rs.names and not (out / "results").exists()
+
+    # master sweep: the same rule
+    set_file = tmp_path / "set.json"
+    set_file.write_text(json.dumps(spec))
+    cli = tmp_path / "cli"
+    r = run_master(master_cmd, "sweep", set_file, "-o", cli, "--format", "csv")
+    assert r.returncode == 0, r.stderr
+    r = run_master(master_cmd, "sweep", set_file, "-o", cli, "--resume", "--format", "parquet")
+    assert r.returncode == 0, r.stderr
+    assert "0 complete run(s) kept, 3 run" in r.stdout
+    assert parquet_names(cli) == rs.names and csv_bytes(cli) == {}
+    assert sorted(pd.read_parquet(cli / "results")["run"].unique()) == rs.names
+    r = run_master(master_cmd, "sweep", set_file, "-o", cli, "--resume", "--format", "parquet")
+    assert "3 complete run(s) kept, 0 run" in r.stdout
+    # without --format the sweep decides by size first (CSV here) and runs every run again
+    r = run_master(master_cmd, "sweep", set_file, "-o", cli, "--resume")
+    assert r.returncode == 0, r.stderr
+    assert "0 complete run(s) kept, 3 run" in r.stdout
+    assert sorted(csv_bytes(cli)) == rs.names and not (cli / "results").exists()

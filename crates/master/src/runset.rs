@@ -376,6 +376,17 @@ pub fn format_by_size(system: &PreparedSystem, jobs: &[Job]) -> ResultsFormat {
     format_by_plan(system.plan(), jobs)
 }
 
+/// [`format_by_size`] from the FMUs' model descriptions alone (no FMU is unpacked or
+/// loaded): the format a fresh sweep of `base` chooses for `jobs`, decided before any run.
+pub fn format_by_description(
+    base: &LoadedSystem,
+    jobs: &[Job],
+) -> Result<ResultsFormat, SystemError> {
+    let archives = base.open_fmus()?;
+    let models: Vec<_> = archives.iter().map(|a| &a.model).collect();
+    Ok(format_by_plan(&base.plan(&models)?, jobs))
+}
+
 /// [`format_by_size`] from the coupling plan alone, which the model descriptions give
 /// ([`LoadedSystem::plan`]): a process that hands the runs to others chooses as a local run
 /// set does without loading the FMUs.
@@ -610,6 +621,11 @@ where
         }
         _ => {}
     }
+    if results.format == ResultsFormat::Csv {
+        // a CSV run set rerun over a Parquet one leaves no empty table folder behind (only
+        // an empty folder is removed: other runs' files stay)
+        let _ = std::fs::remove_dir(outdir.join(PARQUET_FOLDER));
+    }
     let final_path = results_path(outdir, &job.name, results.format);
     let result = (|| -> Result<Summary, String> {
         write_json_atomic(&dir.join("system.json"), &job.system).map_err(|e| e.to_string())?;
@@ -664,22 +680,33 @@ where
     report
 }
 
-/// The report of `job` in `outdir` if that run is complete and is the same run: its
-/// `summary.json` says ok, its `results.csv` is there and its `system.json` is the job's
-/// resolved system (same FMUs, start values, timing). A failed, unfinished or changed run
-/// gives `None` and is run again.
-pub fn completed(outdir: &Path, job: &Job) -> Option<RunReport> {
+/// The report of `job` in `outdir` if that run is complete in `format` and is the same run:
+/// its `summary.json` says ok, its results are there in `format` (and not in the other
+/// format) and its `system.json` is the job's resolved system (same FMUs, start values,
+/// timing). A failed, unfinished or changed run, or one whose results are in the other format,
+/// gives `None` and is run again: a resumed run set stays in one format, so the Parquet folder
+/// (or the CSV files) hold every run. The sweep decides `format` before (explicit, else
+/// [`format_by_description`] over all its jobs, as a fresh sweep does).
+pub fn completed(outdir: &Path, job: &Job, format: ResultsFormat) -> Option<RunReport> {
     let dir = outdir.join(&job.name);
-    let report: RunReport =
+    let mut report: RunReport =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).ok()?).ok()?;
     let system: SystemDescription =
         serde_json::from_str(&std::fs::read_to_string(dir.join("system.json")).ok()?).ok()?;
-    let results = report.results.as_deref()?;
+    let results = results_path(outdir, &job.name, format);
+    let other = match format {
+        ResultsFormat::Csv => ResultsFormat::Parquet,
+        ResultsFormat::Parquet => ResultsFormat::Csv,
+    };
+    let other = results_path(outdir, &job.name, other);
     let complete = report.ok
         && report.name == job.name
         && report.parameters == job.parameters
         && system == job.system
-        && results.is_file();
+        && report.results.as_deref().and_then(Path::file_name) == results.file_name()
+        && results.is_file()
+        && other.symlink_metadata().is_err();
+    report.results = Some(results);
     complete.then_some(report)
 }
 
@@ -831,7 +858,8 @@ mod tests {
                 r.results.as_deref(),
                 Some(table.join(format!("{}.parquet", r.name)).as_path())
             );
-            assert!(completed(dir.path(), &j[0]).is_some());
+            assert!(completed(dir.path(), &j[0], ResultsFormat::Parquet).is_some());
+            assert!(completed(dir.path(), &j[0], ResultsFormat::Csv).is_none());
         }
         let (columns, meta) =
             crate::parquet_file::read_parquet(&table.join("run-001.parquet")).unwrap();
@@ -848,5 +876,103 @@ mod tests {
         assert!(!table.join("run-001.parquet").exists());
         assert!(table.join("run-002.parquet").exists());
         assert!(run_folder_name("Results").is_err());
+    }
+
+    /// Resumes a run set as `master sweep --resume` does: keeps the runs complete in `format`,
+    /// runs the others; returns the names run.
+    fn resume(j: &[Job], outdir: &Path, format: ResultsFormat) -> Vec<String> {
+        let todo: Vec<Job> = j
+            .iter()
+            .filter(|job| completed(outdir, job, format).is_none())
+            .cloned()
+            .collect();
+        let opts = ResultsOptions {
+            format,
+            ..ResultsOptions::default()
+        };
+        let reports = execute_with(&todo, outdir, 2, false, &opts, |job: &Job| {
+            let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.02);
+            plan.instances[0].parameters[1].1 = job.parameters["ms.k"].as_f64().unwrap();
+            let mut a = Mock::new("ms", MassSpring::new(1.0, 1.0, 1.0, 0.0));
+            let mut b = Mock::new("sdm", SpringDamperMass::new(1.0, 1.0, 1.0));
+            simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default())
+                .map_err(|e| e.to_string())
+        })
+        .unwrap();
+        assert!(reports.iter().all(|r| r.ok), "{reports:?}");
+        reports.into_iter().map(|r| r.name).collect()
+    }
+
+    fn files_under(dir: &Path) -> Vec<String> {
+        let mut out = Vec::new();
+        for e in std::fs::read_dir(dir).unwrap().flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if e.file_type().unwrap().is_dir() {
+                out.extend(
+                    files_under(&e.path())
+                        .into_iter()
+                        .map(|f| format!("{name}/{f}")),
+                );
+            } else {
+                out.push(name);
+            }
+        }
+        out.sort();
+        out
+    }
+
+    #[test]
+    fn a_run_set_resumed_in_the_other_format_reruns_every_run_into_one_format() {
+        let j = jobs(r#"{"product": {"ms.k": [50, 100, 200]}}"#).unwrap();
+        let names: Vec<String> = j.iter().map(|r| r.name.clone()).collect();
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path();
+        assert_eq!(resume(&j, out, ResultsFormat::Csv), names);
+        assert!(out.join("run-001/results.csv").is_file());
+        // the same format keeps every run
+        assert!(resume(&j, out, ResultsFormat::Csv).is_empty());
+        // CSV runs resumed as Parquet: every run again, all in results/, no CSV left
+        assert_eq!(resume(&j, out, ResultsFormat::Parquet), names);
+        let files = files_under(out);
+        let expected: Vec<String> = names
+            .iter()
+            .flat_map(|n| {
+                [
+                    format!("results/{n}.parquet"),
+                    format!("{n}/summary.json"),
+                    format!("{n}/system.json"),
+                ]
+            })
+            .chain(["sweep.json".to_string()])
+            .collect();
+        let mut expected = expected;
+        expected.sort();
+        assert_eq!(files, expected);
+        for job in &j {
+            let r = completed(out, job, ResultsFormat::Parquet).unwrap();
+            assert_eq!(
+                r.results,
+                Some(results_path(out, &job.name, ResultsFormat::Parquet))
+            );
+        }
+        assert!(resume(&j, out, ResultsFormat::Parquet).is_empty());
+        // and back to CSV: every run again, no Parquet file (nor an empty results/) left
+        assert_eq!(resume(&j, out, ResultsFormat::Csv), names);
+        let files = files_under(out);
+        assert!(
+            files.iter().all(|f| !f.ends_with(".parquet")) && !out.join("results").exists(),
+            "{files:?}"
+        );
+        assert_eq!(
+            files.iter().filter(|f| f.ends_with("/results.csv")).count(),
+            3
+        );
+        // a run with results in both formats (e.g. an interrupted rerun) is complete in neither
+        std::fs::create_dir_all(out.join("results")).unwrap();
+        std::fs::write(results_path(out, "run-000", ResultsFormat::Parquet), b"x").unwrap();
+        assert!(completed(out, &j[0], ResultsFormat::Csv).is_none());
+        assert!(completed(out, &j[0], ResultsFormat::Parquet).is_none());
+        assert_eq!(resume(&j, out, ResultsFormat::Csv), ["run-000"]);
+        assert!(!out.join("results").exists());
     }
 }

@@ -7,8 +7,8 @@ use super::{CommandError, Context};
 use crate::output::write_json_atomic;
 use crate::results::ResultsFormat;
 use crate::runset::{
-    completed, execute_with as run_all, format_by_size, run_job, Job, ResultsOptions, RunReport,
-    RunSet,
+    completed, execute_with as run_all, format_by_description, run_job, Job, ResultsOptions,
+    RunReport, RunSet,
 };
 use crate::system::PreparedSystem;
 
@@ -28,8 +28,10 @@ pub struct Args {
     /// for the Python in $RAILFMU_PYTHON (default: python3), with dask.distributed.
     #[arg(long, value_name = "ADDRESS")]
     pub dask_scheduler: Option<String>,
-    /// Keep the runs already complete in the output folder (summary ok, results present, same
-    /// resolved system) and run only the others; sweep.json then lists every run.
+    /// Keep the runs already complete in the output folder (summary ok, results present in the
+    /// results format of this sweep, same resolved system) and run only the others; sweep.json
+    /// then lists every run. The format is decided first (--format, else by size as a fresh
+    /// sweep): runs kept in the other format are run again, so the folder stays in one format.
     #[arg(long)]
     pub resume: bool,
     /// Results format: csv (<run>/results.csv) or parquet (results/<run>.parquet, the folder
@@ -44,9 +46,19 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         return on_dask(args, address, ctx);
     }
     let (base, jobs) = RunSet::load(&args.runset)?;
+    // decided before the kept runs, over every job, so a resumed sweep writes the format a
+    // fresh one would and keeps only runs complete in it
+    let format = match args.format {
+        Some(f) => f,
+        None => format_by_description(&base, &jobs)?,
+    };
     let kept: Vec<Option<RunReport>> = jobs
         .iter()
-        .map(|j| args.resume.then(|| completed(&args.output, j)).flatten())
+        .map(|j| {
+            args.resume
+                .then(|| completed(&args.output, j, format))
+                .flatten()
+        })
         .collect();
     let todo: Vec<Job> = jobs
         .iter()
@@ -62,9 +74,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
         let cancel = ctx.cancel;
         let results = ResultsOptions {
-            format: args
-                .format
-                .unwrap_or_else(|| format_by_size(&system, &todo)),
+            format,
             ..ResultsOptions::default()
         };
         fresh = run_all(
