@@ -1,13 +1,13 @@
 //! `IdealDamperForceController` FMU: the IDF board of [`crate::idf`].
 
 use model_description::{
-    field_error, DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo,
-    Sign, StepError, Variable,
+    DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo, Sign,
+    StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
 
-use super::{report_input_fault, AUTHOR};
-use crate::idf::{Idf, IdfInputs, IdfOutputs, IdfParams};
+use super::{report_input_fault, Board, AUTHOR};
+use crate::idf::{Idf, IdfOutputs, IdfParams};
 
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 struct Reported {
@@ -19,18 +19,12 @@ struct Reported {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct IdealDamperForceController {
     params: IdfParams,
-    inputs: IdfInputs,
-    ctrl: Idf,
-    out: IdfOutputs,
-    initialized: bool,
-    reported: Reported,
+    board: Board<Idf, Reported>,
 }
 
 impl IdealDamperForceController {
     fn build(&mut self) -> Result<(), ModelError> {
-        self.ctrl = Idf::new(self.params.clone()).map_err(|e| field_error::<Self>(&e))?;
-        self.out = self.ctrl.outputs();
-        Ok(())
+        self.board.build::<Self>(&self.params)
     }
 
     fn reported_after_init(&self) -> Reported {
@@ -38,7 +32,7 @@ impl IdealDamperForceController {
     }
 
     fn report(&mut self, t_end: f64, o: &IdfOutputs, diag: &mut Diagnostics) {
-        let r = &mut self.reported;
+        let r = &mut self.board.reported;
         if o.saturated != r.saturated {
             if o.saturated {
                 diag.warn(format!(
@@ -95,18 +89,18 @@ impl FmuModel for IdealDamperForceController {
             parameter "board.sample_time" [unit = "s", display_unit = "ms", min = 0.0] => params.sample_time_s;
 
             /// Damper (actuator rod) elongation velocity, positive = extension
-            input "damper.elongation_velocity" [unit = "m/s"] => inputs.elongation_velocity_mps;
+            input "damper.elongation_velocity" [unit = "m/s"] => board.inputs.elongation_velocity_mps;
             /// Measured actuator force, tension positive
-            input "damper.force" [unit = "N", display_unit = "kN"] => inputs.measured_force_n;
+            input "damper.force" [unit = "N", display_unit = "kN"] => board.inputs.measured_force_n;
 
             /// Spool position command u (3.15), saturated to +-u_max
-            output "spool.command" [unit = "m", display_unit = "mm", discrete = true] => out.spool_command_m;
+            output "spool.command" [unit = "m", display_unit = "mm", discrete = true] => board.out.spool_command_m;
             /// Reference force F_ref = c_v v (3.14), tension positive
-            output "reference.force" [unit = "N", display_unit = "kN", discrete = true] => out.force_ref_n;
+            output "reference.force" [unit = "N", display_unit = "kN", discrete = true] => board.out.force_ref_n;
             /// Force error F_ref - F
-            output "force_loop.error" [unit = "N", display_unit = "kN", discrete = true] => out.force_error_n;
+            output "force_loop.error" [unit = "N", display_unit = "kN", discrete = true] => board.out.force_error_n;
             /// True if the spool command is clamped at +-u_max
-            output "spool.command_saturated" => out.saturated;
+            output "spool.command_saturated" => board.out.saturated;
         }
         declare_board_status!(
             v,
@@ -117,15 +111,9 @@ impl FmuModel for IdealDamperForceController {
 
     fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
         let params = IdfParams::default();
-        let ctrl = Idf::new(params.clone()).map_err(|e| field_error::<Self>(&e))?;
-        let out = ctrl.outputs();
         Ok(Self {
+            board: Board::new::<Self>(&params)?,
             params,
-            inputs: IdfInputs::default(),
-            ctrl,
-            out,
-            initialized: false,
-            reported: Reported::default(),
         })
     }
 

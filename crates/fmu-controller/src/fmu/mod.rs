@@ -19,16 +19,16 @@
 //!   reported when they start or stop, never once per sample.
 
 /// `exit_initialization`, `update_outputs` and `do_step` of a board FMU, the same for the three
-/// controllers (inside `impl FmuModel`). The model provides the fields `ctrl` (with
-/// `step(h, &inputs)`), `inputs`, `out`, `initialized`, `reported` and the methods `build()`
-/// (controller and outputs from the parameters), `reported_after_init()` (what the log counts as
-/// already reported at the start) and `report(t_end, &out, diag)` (log changes).
+/// controllers (inside `impl FmuModel`). The model provides the field `board` (a [`Board`]) and
+/// the methods `build()` (controller and outputs from the parameters), `reported_after_init()`
+/// (what the log counts as already reported at the start) and `report(t_end, &out, diag)` (log
+/// changes).
 macro_rules! board_life_cycle {
     () => {
         fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
             self.build()?;
-            self.reported = self.reported_after_init();
-            self.initialized = true;
+            self.board.reported = self.reported_after_init();
+            self.board.initialized = true;
             Ok(())
         }
 
@@ -36,7 +36,7 @@ macro_rules! board_life_cycle {
             // No output depends on the current inputs (one-sample board delay). In
             // initialization mode, preview the initial outputs of the parameters set so far;
             // invalid values are reported by exit_initialization.
-            if !self.initialized {
+            if !self.board.initialized {
                 let _ = self.build();
             }
             Ok(())
@@ -48,12 +48,13 @@ macro_rules! board_life_cycle {
             step: f64,
             diag: &mut Diagnostics,
         ) -> Result<(), StepError> {
-            let out = self
+            let board = &mut self.board;
+            let out = board
                 .ctrl
-                .step(step, &self.inputs)
+                .step(step, &board.inputs)
                 .map_err(|e| $crate::fmu::step_error::<Self>(&e))?;
             self.report(time + step, &out, diag);
-            self.out = out;
+            self.board.out = out;
             Ok(())
         }
     };
@@ -65,9 +66,9 @@ macro_rules! declare_board_status {
     ($v:ident, $fault_doc:literal) => {
         model_description::declare! { $v;
             #[doc = $fault_doc]
-            output "board.input_fault" => out.input_fault;
+            output "board.input_fault" => board.out.input_fault;
             /// Board samples dropped because of non-finite inputs since the start
-            output "board.dropped_samples" => out.dropped_samples;
+            output "board.dropped_samples" => board.out.dropped_samples;
         }
     };
 }
@@ -80,9 +81,96 @@ pub use idf::IdealDamperForceController;
 pub use mppt::MpptController;
 pub use skyhook::SkyHookController;
 
-use model_description::{field_error, Diagnostics, FieldError, FmuModel, StepError};
+use model_description::{field_error, Diagnostics, FieldError, FmuModel, ModelError, StepError};
+use serde::{Deserialize, Serialize};
 
 use crate::{ParamError, StepError as PhysicsStepError};
+
+/// A board's control law as its FMU builds it: from its parameters, with its outputs at the
+/// start (its step is the law's own `step(h, &inputs)`).
+trait BoardLaw: Sized {
+    type Params: Clone;
+    type Inputs: Default;
+    type Outputs;
+    fn new(params: Self::Params) -> Result<Self, ParamError>;
+    fn outputs(&self) -> Self::Outputs;
+}
+
+/// [`BoardLaw`] for a law whose inherent `new` and `outputs` have its types.
+macro_rules! board_law {
+    ($law:ty, $params:ty, $inputs:ty, $outputs:ty) => {
+        impl BoardLaw for $law {
+            type Params = $params;
+            type Inputs = $inputs;
+            type Outputs = $outputs;
+            fn new(params: $params) -> Result<Self, ParamError> {
+                <$law>::new(params)
+            }
+            fn outputs(&self) -> $outputs {
+                <$law>::outputs(self)
+            }
+        }
+    };
+}
+
+board_law!(
+    crate::Idf,
+    crate::IdfParams,
+    crate::IdfInputs,
+    crate::IdfOutputs
+);
+board_law!(
+    crate::Mppt,
+    crate::MpptParams,
+    crate::MpptInputs,
+    crate::MpptOutputs
+);
+board_law!(
+    crate::SkyHook,
+    crate::SkyHookParams,
+    crate::SkyHookInputs,
+    crate::SkyHookOutputs
+);
+
+/// What a board FMU holds beside its parameters: the sampled inputs, the law `L`, its last
+/// outputs, whether initialisation is over, and `R`, what its log last reported.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(bound(
+    serialize = "L: Serialize, L::Inputs: Serialize, L::Outputs: Serialize, R: Serialize",
+    deserialize = "L: Deserialize<'de>, L::Inputs: Deserialize<'de>, L::Outputs: Deserialize<'de>, \
+                   R: Deserialize<'de>"
+))]
+struct Board<L: BoardLaw, R> {
+    inputs: L::Inputs,
+    ctrl: L,
+    out: L::Outputs,
+    /// Set by exit_initialization; before it the outputs preview the parameters being set.
+    initialized: bool,
+    reported: R,
+}
+
+impl<L: BoardLaw, R: Default> Board<L, R> {
+    /// The law of FMU `M` from `params` with its initial outputs, default inputs, nothing
+    /// reported yet.
+    fn new<M: FmuModel>(params: &L::Params) -> Result<Self, ModelError> {
+        let ctrl = L::new(params.clone()).map_err(|e| field_error::<M>(&e))?;
+        Ok(Self {
+            inputs: L::Inputs::default(),
+            out: ctrl.outputs(),
+            ctrl,
+            initialized: false,
+            reported: R::default(),
+        })
+    }
+
+    /// The law rebuilt from `params` with its initial outputs; a refused parameter is reported
+    /// under FMU `M`'s variable.
+    fn build<M: FmuModel>(&mut self, params: &L::Params) -> Result<(), ModelError> {
+        self.ctrl = L::new(params.clone()).map_err(|e| field_error::<M>(&e))?;
+        self.out = self.ctrl.outputs();
+        Ok(())
+    }
+}
 
 /// Author string written to every modelDescription.xml of this crate.
 const AUTHOR: &str = "rail-fmu project (fmu-controller)";

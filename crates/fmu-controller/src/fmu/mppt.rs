@@ -1,13 +1,13 @@
 //! `MpptController` FMU: the MPPT board of [`crate::mppt`].
 
 use model_description::{
-    field_error, fmi_enum, DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError,
-    ModelInfo, Sign, StepError, Variable,
+    fmi_enum, DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo,
+    Sign, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
 
-use super::{report_input_fault, AUTHOR};
-use crate::mppt::{ForceNormaliser, Mppt, MpptInputs, MpptOutputs, MpptParams};
+use super::{report_input_fault, Board, AUTHOR};
+use crate::mppt::{ForceNormaliser, Mppt, MpptOutputs, MpptParams};
 
 fmi_enum! {
     ForceNormaliser as "ForceNormaliser", "Force normaliser of the MPPT cost (3.2)" {
@@ -29,19 +29,12 @@ struct Reported {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct MpptController {
     params: MpptParams,
-    inputs: MpptInputs,
-    ctrl: Mppt,
-    out: MpptOutputs,
-    /// Set by exit_initialization; before it the outputs preview the parameters being set.
-    initialized: bool,
-    reported: Reported,
+    board: Board<Mppt, Reported>,
 }
 
 impl MpptController {
     fn build(&mut self) -> Result<(), ModelError> {
-        self.ctrl = Mppt::new(self.params.clone()).map_err(|e| field_error::<Self>(&e))?;
-        self.out = self.ctrl.outputs();
-        Ok(())
+        self.board.build::<Self>(&self.params)
     }
 
     fn at_limit(&self, o: &MpptOutputs) -> bool {
@@ -51,14 +44,14 @@ impl MpptController {
     /// A command starting at its limit is not news.
     fn reported_after_init(&self) -> Reported {
         Reported {
-            at_limit: self.at_limit(&self.out),
+            at_limit: self.at_limit(&self.board.out),
             ..Reported::default()
         }
     }
 
     /// Log what changed in this step (never once per sample).
     fn report(&mut self, t_end: f64, o: &MpptOutputs, diag: &mut Diagnostics) {
-        let r = &mut self.reported;
+        let r = &mut self.board.reported;
         if o.updates > r.updates {
             diag.event(format!(
                 "t = {t_end:.6} s: valve update #{}: J = {:.6} (rms a = {:.4} m/s2, rms F = {:.1} N), \
@@ -89,7 +82,7 @@ impl MpptController {
             diag,
         );
         let at_limit = self.at_limit(o);
-        if at_limit != self.reported.at_limit {
+        if at_limit != self.board.reported.at_limit {
             diag.event(if at_limit {
                 format!(
                     "t = {t_end:.6} s: valve command saturated at {} V",
@@ -98,7 +91,7 @@ impl MpptController {
             } else {
                 format!("t = {t_end:.6} s: valve command left its limit")
             });
-            self.reported.at_limit = at_limit;
+            self.board.reported.at_limit = at_limit;
         }
     }
 }
@@ -160,28 +153,28 @@ impl FmuModel for MpptController {
             parameter "band_pass.high" [unit = "Hz", min = 0.0] => params.band_high_hz;
 
             /// Bogie frame lateral acceleration (band-passed on the board)
-            input "bogie.lateral_acceleration" [unit = "m/s2"] => inputs.bogie_accel_mps2;
+            input "bogie.lateral_acceleration" [unit = "m/s2"] => board.inputs.bogie_accel_mps2;
             /// Yaw damper force, tension positive (only its rms is used)
-            input "damper.force" [unit = "N", display_unit = "kN"] => inputs.damper_force_n;
+            input "damper.force" [unit = "N", display_unit = "kN"] => board.inputs.damper_force_n;
 
             /// By-pass valve command, 0 V = closed (maximum damping) .. 10 V = open
-            output "valve.command" [unit = "V", discrete = true] => out.command_v;
+            output "valve.command" [unit = "V", discrete = true] => board.out.command_v;
             /// Valve opening = command / 10 V
-            output "valve.opening" [unit = "1", display_unit = "%", discrete = true] => out.opening;
+            output "valve.opening" [unit = "1", display_unit = "%", discrete = true] => board.out.opening;
             /// Cost J at the last update (3.2)
-            output "cost.value" [unit = "1", discrete = true] => out.cost;
+            output "cost.value" [unit = "1", discrete = true] => board.out.cost;
             /// rms of the band-passed bogie acceleration at the last update
-            output "cost.rms_acceleration" [unit = "m/s2", discrete = true] => out.rms_accel_mps2;
+            output "cost.rms_acceleration" [unit = "m/s2", discrete = true] => board.out.rms_accel_mps2;
             /// rms of the damper force at the last update
-            output "cost.rms_force" [unit = "N", display_unit = "kN", discrete = true] => out.rms_force_n;
+            output "cost.rms_force" [unit = "N", display_unit = "kN", discrete = true] => board.out.rms_force_n;
             /// Latest band-passed acceleration sample
-            output "band_pass.acceleration" [unit = "m/s2", discrete = true] => out.filtered_accel_mps2;
+            output "band_pass.acceleration" [unit = "m/s2", discrete = true] => board.out.filtered_accel_mps2;
             /// Hill-climb direction (3.4): +1 opening, -1 closing
-            output "hill_climb.direction" => out.direction as Sign;
+            output "hill_climb.direction" => board.out.direction as Sign;
             /// True if the last update was the instability override (3.5)
-            output "override.active" => out.override_active;
+            output "override.active" => board.out.override_active;
             /// Number of valve updates performed
-            output "hill_climb.updates" => out.updates;
+            output "hill_climb.updates" => board.out.updates;
         }
         declare_board_status!(
             v,
@@ -193,15 +186,9 @@ impl FmuModel for MpptController {
     fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
         // Single source of the start values: the physics crate's MPPT2 defaults.
         let params = MpptParams::default();
-        let ctrl = Mppt::new(params.clone()).map_err(|e| field_error::<Self>(&e))?;
-        let out = ctrl.outputs();
         Ok(Self {
+            board: Board::new::<Self>(&params)?,
             params,
-            inputs: MpptInputs::default(),
-            ctrl,
-            out,
-            initialized: false,
-            reported: Reported::default(),
         })
     }
 

@@ -7,10 +7,10 @@ use model_description::{
 };
 use serde::{Deserialize, Serialize};
 
-use super::{report_input_fault, AUTHOR};
+use super::{report_input_fault, Board, AUTHOR};
 use crate::skyhook::{
-    DampingTable, SkyHook, SkyHookInputs, SkyHookMode, SkyHookOutputs, SkyHookParams,
-    VelocitySource, DAMPING_TABLE_4HZ,
+    DampingTable, SkyHook, SkyHookMode, SkyHookOutputs, SkyHookParams, VelocitySource,
+    DAMPING_TABLE_4HZ,
 };
 
 /// Number of points of the damping table parameters (that of the measured default table).
@@ -62,11 +62,7 @@ pub struct SkyHookController {
     params: SkyHookParams,
     table_opening: [f64; TABLE_LEN],
     table_damping: [f64; TABLE_LEN],
-    inputs: SkyHookInputs,
-    ctrl: SkyHook,
-    out: SkyHookOutputs,
-    initialized: bool,
-    reported: Reported,
+    board: Board<SkyHook, Reported>,
 }
 
 impl SkyHookController {
@@ -119,21 +115,19 @@ impl SkyHookController {
 
     fn build(&mut self) -> Result<(), ModelError> {
         self.params.damping_table = self.table().map_err(|e| field_error::<Self>(&e))?;
-        self.ctrl = SkyHook::new(self.params.clone()).map_err(|e| field_error::<Self>(&e))?;
-        self.out = self.ctrl.outputs();
-        Ok(())
+        self.board.build::<Self>(&self.params)
     }
 
     /// The switching state at the start is not news.
     fn reported_after_init(&self) -> Reported {
         Reported {
-            on_state: self.out.on_state,
+            on_state: self.board.out.on_state,
             input_fault: false,
         }
     }
 
     fn report(&mut self, t_end: f64, o: &SkyHookOutputs, diag: &mut Diagnostics) {
-        let r = &mut self.reported;
+        let r = &mut self.board.reported;
         if o.on_state != r.on_state {
             diag.event(format!(
                 "t = {t_end:.6} s: sky-hook {} (condition {:.3e} m2/s2, desired damping {:.0} N.s/m, \
@@ -244,24 +238,24 @@ impl FmuModel for SkyHookController {
             /// Accelerometer whose integral (x sensor.sign) is the sky-hook velocity x' of (3.6):
             /// the bogie's lateral acceleration as in the seed's co-simulation (4.4), or the
             /// damper end's along its axis; used with sensor.velocity_source = estimated
-            input "sensor.acceleration" [unit = "m/s2"] => inputs.sensor_accel_mps2;
+            input "sensor.acceleration" [unit = "m/s2"] => board.inputs.sensor_accel_mps2;
             /// Velocity of the same sensor (ideal x'); used with sensor.velocity_source = ideal
-            input "sensor.velocity" [unit = "m/s"] => inputs.abs_velocity_mps;
+            input "sensor.velocity" [unit = "m/s"] => board.inputs.abs_velocity_mps;
             /// Damper elongation velocity x' - x0', positive = extension
-            input "damper.elongation_velocity" [unit = "m/s"] => inputs.elongation_velocity_mps;
+            input "damper.elongation_velocity" [unit = "m/s"] => board.inputs.elongation_velocity_mps;
 
             /// By-pass valve command, 0 V = closed (maximum damping) .. 10 V = open
-            output "valve.command" [unit = "V", discrete = true] => out.command_v;
+            output "valve.command" [unit = "V", discrete = true] => board.out.command_v;
             /// Valve opening = command / 10 V (table inverse of damping.desired)
-            output "valve.opening" [unit = "1", display_unit = "%", discrete = true] => out.opening;
+            output "valve.opening" [unit = "1", display_unit = "%", discrete = true] => board.out.opening;
             /// Desired damping from (3.11) or (3.13)
-            output "damping.desired" [unit = "N.s/m", display_unit = "kN.s/m", discrete = true] => out.c_desired_nspm;
+            output "damping.desired" [unit = "N.s/m", display_unit = "kN.s/m", discrete = true] => board.out.c_desired_nspm;
             /// Condition function x' (x' - x0') = x' v_e (3.11), (3.13)
-            output "control.condition" [unit = "m2/s2", discrete = true] => out.condition;
+            output "control.condition" [unit = "m2/s2", discrete = true] => board.out.condition;
             /// Sky-hook velocity x' used by the law (estimated or ideal, times sensor.sign)
-            output "sensor.absolute_velocity" [unit = "m/s", discrete = true] => out.abs_velocity_mps;
+            output "sensor.absolute_velocity" [unit = "m/s", discrete = true] => board.out.abs_velocity_mps;
             /// True when the condition function is >= 0 (damping demanded)
-            output "control.on_state" => out.on_state;
+            output "control.on_state" => board.out.on_state;
         }
         declare_board_status!(
             v,
@@ -280,17 +274,11 @@ impl FmuModel for SkyHookController {
                 table_damping[i] = c;
             }
         }
-        let ctrl = SkyHook::new(params.clone()).map_err(|e| field_error::<Self>(&e))?;
-        let out = ctrl.outputs();
         Ok(Self {
+            board: Board::new::<Self>(&params)?,
             params,
             table_opening,
             table_damping,
-            inputs: SkyHookInputs::default(),
-            ctrl,
-            out,
-            initialized: false,
-            reported: Reported::default(),
         })
     }
 
