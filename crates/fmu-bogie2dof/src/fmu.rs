@@ -9,7 +9,7 @@ use model_description::{
     InstanceContext, ModelError, ModelInfo, StepError, Variable, MAX_PARAMETER_FILE_BYTES,
 };
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{resource_or_given, InputError, Shell, ShellPhysics, TrackLevel};
+use vehicle_elements::{resource_or_given, Shell, TrackLevel};
 use wheel_rail::GeometryTable;
 
 use crate::model::{Bogie, Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep};
@@ -57,44 +57,10 @@ impl FieldError for ContactFileError {
     }
 }
 
-impl ShellPhysics for Bogie {
-    type Params = Params;
-    type Inputs = Inputs;
-    type Outputs = Outputs;
-    type BuildError = PhysicsModelError;
-    type StepError = PStep;
-
-    fn preview_params(params: &Params) -> Params {
-        Params {
-            track: TrackSource::None,
-            contact: ContactSource::WornSurrogate,
-            ..params.clone()
-        }
-    }
-
-    fn build(params: Params) -> Result<Self, PhysicsModelError> {
-        Bogie::new(params)
-    }
-
-    fn outputs(&self, inputs: &Inputs) -> Result<Outputs, PStep> {
-        Bogie::outputs(self, inputs)
-    }
-
-    fn step(&mut self, h: f64, inputs: &Inputs) -> Result<Outputs, PStep> {
-        Bogie::step(self, h, inputs)
-    }
-
-    fn input_error(e: &PStep) -> Option<&InputError> {
-        match e {
-            PStep::Input(i) => Some(i),
-            _ => None,
-        }
-    }
-
-    fn diverged(e: &PStep) -> bool {
-        matches!(e, PStep::Diverged { .. })
-    }
-}
+// The physics as the shell core drives it.
+vehicle_elements::shell_physics!(
+    Bogie: Params, Inputs, Outputs, PhysicsModelError, PStep, ContactSource
+);
 
 /// The bogie FMU: parameters, current inputs, the physics (built at initialisation) and its
 /// last outputs (the last three in [`Shell`]).

@@ -9,10 +9,10 @@ use model_description::{
     ModelInfo, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{resource_or_given, InputError, Shell, ShellPhysics, TrackLevel};
+use vehicle_elements::{resource_or_given, Shell, TrackLevel};
 
 use crate::model::{Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep, Vehicle};
-use crate::params::{ContactSource, Initial, TrackSource, VehicleParams};
+use crate::params::{ContactSource, Initial, VehicleParams};
 
 /// Speed of the FMU's start values (default experiment: hunting into flange contact) [m/s].
 pub const FMU_DEFAULT_SPEED_MPS: f64 = 300.0 / 3.6;
@@ -43,45 +43,10 @@ impl FieldError for PhysicsModelError {
     }
 }
 
-impl ShellPhysics for Vehicle {
-    type Params = VehicleParams;
-    type Inputs = Inputs;
-    type Outputs = Outputs;
-    type BuildError = PhysicsModelError;
-    type StepError = PStep;
-
-    fn preview_params(params: &VehicleParams) -> VehicleParams {
-        VehicleParams {
-            track: TrackSource::None,
-            contact: ContactSource::WornSurrogate,
-            ..params.clone()
-        }
-    }
-
-    fn build(params: VehicleParams) -> Result<Self, PhysicsModelError> {
-        Vehicle::new(params)
-    }
-
-    fn outputs(&self, inputs: &Inputs) -> Result<Outputs, PStep> {
-        Vehicle::outputs(self, inputs)
-    }
-
-    fn step(&mut self, h: f64, inputs: &Inputs) -> Result<Outputs, PStep> {
-        Vehicle::step(self, h, inputs)
-    }
-
-    fn input_error(e: &PStep) -> Option<&InputError> {
-        match e {
-            PStep::Input(i) => Some(i),
-            _ => None,
-        }
-    }
-
-    /// A derailment is not a diverged state: a smaller step does not avoid it.
-    fn diverged(e: &PStep) -> bool {
-        matches!(e, PStep::Diverged { .. })
-    }
-}
+// The physics as the shell core drives it.
+vehicle_elements::shell_physics!(
+    Vehicle: VehicleParams, Inputs, Outputs, PhysicsModelError, PStep, ContactSource
+);
 
 /// The coach FMU: parameters, current inputs, the physics (built at initialisation) and its
 /// last outputs (the last three in [`Shell`]).

@@ -35,6 +35,58 @@ pub trait ShellPhysics: Clone + Sized {
     fn diverged(e: &Self::StepError) -> bool;
 }
 
+/// Implements [`ShellPhysics`] in a model crate whose physics has the inherent `new(params)`,
+/// `outputs(&inputs)` and `step(h, &inputs)`, whose parameters have the fields `track` and
+/// `contact` (the built-in table being `$contact::WornSurrogate`) and whose step error has the
+/// variants `Input(InputError)` and `Diverged { .. }`:
+///
+/// ```ignore
+/// vehicle_elements::shell_physics!(Bogie: Params, Inputs, Outputs, ModelError, StepError, ContactSource);
+/// ```
+#[macro_export]
+macro_rules! shell_physics {
+    ($physics:ident: $params:ident, $inputs:ty, $outputs:ty, $build_error:ty, $step_error:ident, $contact:ident) => {
+        impl $crate::ShellPhysics for $physics {
+            type Params = $params;
+            type Inputs = $inputs;
+            type Outputs = $outputs;
+            type BuildError = $build_error;
+            type StepError = $step_error;
+
+            fn preview_params(params: &$params) -> $params {
+                $params {
+                    track: $crate::track::TrackSource::None,
+                    contact: $contact::WornSurrogate,
+                    ..params.clone()
+                }
+            }
+
+            fn build(params: $params) -> Result<Self, $build_error> {
+                $physics::new(params)
+            }
+
+            fn outputs(&self, inputs: &$inputs) -> Result<$outputs, $step_error> {
+                $physics::outputs(self, inputs)
+            }
+
+            fn step(&mut self, h: f64, inputs: &$inputs) -> Result<$outputs, $step_error> {
+                $physics::step(self, h, inputs)
+            }
+
+            fn input_error(e: &$step_error) -> Option<&$crate::InputError> {
+                match e {
+                    $step_error::Input(i) => Some(i),
+                    _ => None,
+                }
+            }
+
+            fn diverged(e: &$step_error) -> bool {
+                matches!(e, $step_error::Diverged { .. })
+            }
+        }
+    };
+}
+
 /// A failed evaluation or step, reported under the FMI input it names (if any).
 struct StepFault<'a, P: ShellPhysics>(&'a P::StepError);
 

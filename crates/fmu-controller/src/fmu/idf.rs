@@ -102,22 +102,11 @@ impl FmuModel for IdealDamperForceController {
             /// True if the spool command is clamped at +-u_max
             output "spool.command_saturated" => board.out.saturated;
         }
-        declare_board_status!(
-            v,
-            " True if an input of the last step was not finite (sample dropped, command held)"
-        );
+        declare_board_status!(v);
         v
     }
 
-    fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
-        let params = IdfParams::default();
-        Ok(Self {
-            board: Board::new::<Self>(&params)?,
-            params,
-        })
-    }
-
-    board_life_cycle!();
+    board_life_cycle!(instantiate);
 }
 
 const DOC: &str = r#"

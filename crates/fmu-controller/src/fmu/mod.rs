@@ -23,7 +23,21 @@
 /// the methods `build()` (controller and outputs from the parameters), `reported_after_init()`
 /// (what the log counts as already reported at the start) and `report(t_end, &out, diag)` (log
 /// changes).
+///
+/// `board_life_cycle!(instantiate)` also writes `instantiate`: the law's default parameters
+/// (the single source of the start values), for a model whose fields are `params` and `board`.
 macro_rules! board_life_cycle {
+    (instantiate) => {
+        fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
+            let params = Default::default();
+            Ok(Self {
+                board: $crate::fmu::Board::new::<Self>(&params)?,
+                params,
+            })
+        }
+
+        board_life_cycle!();
+    };
     () => {
         fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
             self.build()?;
@@ -61,8 +75,14 @@ macro_rules! board_life_cycle {
 }
 
 /// The two status outputs every board declares last, after its own (inside `variables()`):
-/// `$fault_doc` describes `board.input_fault` for that board.
+/// `$fault_doc` describes `board.input_fault` for that board (default: any input).
 macro_rules! declare_board_status {
+    ($v:ident) => {
+        declare_board_status!(
+            $v,
+            " True if an input of the last step was not finite (sample dropped, command held)"
+        );
+    };
     ($v:ident, $fault_doc:literal) => {
         model_description::declare! { $v;
             #[doc = $fault_doc]

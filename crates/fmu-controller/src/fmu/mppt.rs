@@ -176,23 +176,12 @@ impl FmuModel for MpptController {
             /// Number of valve updates performed
             output "hill_climb.updates" => board.out.updates;
         }
-        declare_board_status!(
-            v,
-            " True if an input of the last step was not finite (sample dropped, command held)"
-        );
+        declare_board_status!(v);
         v
     }
 
-    fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
-        // Single source of the start values: the physics crate's MPPT2 defaults.
-        let params = MpptParams::default();
-        Ok(Self {
-            board: Board::new::<Self>(&params)?,
-            params,
-        })
-    }
-
-    board_life_cycle!();
+    // The start values are the physics crate's MPPT2 defaults.
+    board_life_cycle!(instantiate);
 }
 
 const DOC: &str = r#"
