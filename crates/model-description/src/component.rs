@@ -82,10 +82,59 @@ struct SnapshotHeader {
 
 const MAGIC: [u8; 4] = *b"RFM2";
 
+/// What decides whether a value may be set, per variable (FMI 2.0 rules for co-simulation),
+/// computed once per instance so that the checks of every fmi2Set* call are a lookup and a few
+/// comparisons; a refused value is reported by the full checks ([`Component::check_settable`],
+/// [`Component::check_range`]).
+#[derive(Clone, Copy, Debug)]
+struct SetRule {
+    /// Settable in Instantiated and InitializationMode.
+    before_step: bool,
+    /// Settable in StepComplete.
+    in_step: bool,
+    /// The declared range (infinite when none).
+    min: f64,
+    max: f64,
+    /// An enumeration's value is checked against its items (the full check).
+    enumerated: bool,
+}
+
+impl SetRule {
+    fn of(meta: &crate::variable::VarMeta) -> Self {
+        let (c, v) = (meta.causality, meta.variability);
+        SetRule {
+            before_step: matches!(c, Causality::Parameter | Causality::Input)
+                && v != Variability::Constant,
+            in_step: c == Causality::Input
+                || (c == Causality::Parameter && v == Variability::Tunable),
+            min: meta.min.unwrap_or(f64::NEG_INFINITY),
+            max: meta.max.unwrap_or(f64::INFINITY),
+            enumerated: meta.enumeration.is_some(),
+        }
+    }
+
+    /// Whether the variable may be set in `state` (as [`Component::check_settable`] decides).
+    fn settable(&self, state: FmiState) -> bool {
+        match state {
+            FmiState::Instantiated | FmiState::InitializationMode => self.before_step,
+            FmiState::StepComplete => self.in_step,
+            _ => false,
+        }
+    }
+
+    /// Whether `value` passes [`Component::check_range`] without looking further: finite and
+    /// within the range of a variable that is no enumeration.
+    fn accepts(&self, value: f64) -> bool {
+        !self.enumerated && value.is_finite() && value >= self.min && value <= self.max
+    }
+}
+
 /// An FMU instance.
 pub struct Component {
     model: Box<dyn ErasedModel>,
     index: VrIndex,
+    /// By declaration index.
+    rules: Vec<SetRule>,
     ctx: InstanceContext,
     sink: Box<dyn LogSink>,
     logging_on: bool,
@@ -121,9 +170,11 @@ impl Component {
         logging_on: bool,
     ) -> Self {
         let index = VrIndex::new(model.metas());
+        let rules = model.metas().iter().map(SetRule::of).collect();
         Component {
             model,
             index,
+            rules,
             ctx,
             sink,
             logging_on,
@@ -163,15 +214,21 @@ impl Component {
     }
 
     /// Trace an FMI call in the `logCalls` category (only when enabled: it formats a string).
+    #[inline]
     pub fn trace(&mut self, call: &str) {
         if self.logging_on && self.log_calls {
-            let msg = format!(
-                "{call} (state {}, t = {})",
-                state_name(self.state),
-                self.time
-            );
-            self.sink.log(Status::Ok, "logCalls", &msg);
+            self.trace_call(call);
         }
+    }
+
+    #[cold]
+    fn trace_call(&mut self, call: &str) {
+        let msg = format!(
+            "{call} (state {}, t = {})",
+            state_name(self.state),
+            self.time
+        );
+        self.sink.log(Status::Ok, "logCalls", &msg);
     }
 
     fn wrong_state(&mut self, call: &str) -> Status {
@@ -183,10 +240,16 @@ impl Component {
     }
 
     /// Forward what the model reported; returns Warning if it warned.
+    #[inline]
     fn flush_diagnostics(&mut self) -> Status {
         if self.diag.is_empty() {
-            return Status::Ok;
+            Status::Ok
+        } else {
+            self.forward_diagnostics()
         }
+    }
+
+    fn forward_diagnostics(&mut self) -> Status {
         let mut status = Status::Ok;
         let warnings = std::mem::take(&mut self.diag.warnings);
         for w in &warnings {
@@ -329,14 +392,17 @@ impl Component {
     fn resolve(&mut self, call: &str, var_type: VarType, vr: u32) -> Result<usize, Status> {
         match self.index.lookup(var_type, vr) {
             Some(i) => Ok(i),
-            None => {
-                let msg = format!(
-                    "{call}: unknown value reference {vr} for type {}",
-                    var_type.xml_name()
-                );
-                Err(self.error(&msg))
-            }
+            None => Err(self.unknown(call, var_type, vr)),
         }
+    }
+
+    #[cold]
+    fn unknown(&mut self, call: &str, var_type: VarType, vr: u32) -> Status {
+        let msg = format!(
+            "{call}: unknown value reference {vr} for type {}",
+            var_type.xml_name()
+        );
+        self.error(&msg)
     }
 
     fn check_get(&mut self, call: &str, nvr: usize, nvalue: usize) -> Status {
@@ -351,21 +417,15 @@ impl Component {
     }
 
     pub fn get_real(&mut self, vrs: &[u32], values: &mut [f64]) -> Status {
-        let status = self.check_get("fmi2GetReal", vrs.len(), values.len());
+        const CALL: &str = "fmi2GetReal";
+        let status = self.check_get(CALL, vrs.len(), values.len());
         if status > Status::Warning {
             return status;
         }
-        for (vr, out) in vrs.iter().zip(values.iter_mut()) {
-            let i = match self.resolve("fmi2GetReal", VarType::Real, *vr) {
-                Ok(i) => i,
-                Err(s) => return s,
-            };
-            match self.model.get_real(i) {
-                Some(v) => *out = v,
-                None => return self.error("fmi2GetReal: internal type mismatch"),
-            }
+        match self.model.get_reals(vrs, values) {
+            Ok(()) => status,
+            Err(vr) => self.unknown(CALL, VarType::Real, vr),
         }
-        status
     }
 
     pub fn get_integer(&mut self, vrs: &[u32], values: &mut [i32]) -> Status {
@@ -424,24 +484,17 @@ impl Component {
 
     /// Whether variable `i` may be set now (FMI 2.0 rules for co-simulation).
     fn check_settable(&mut self, call: &str, i: usize) -> Result<(), Status> {
-        let meta = &self.model.metas()[i];
-        let (causality, variability) = (meta.causality, meta.variability);
-        let allowed = match self.state {
-            FmiState::Instantiated | FmiState::InitializationMode => {
-                matches!(causality, Causality::Parameter | Causality::Input)
-                    && variability != Variability::Constant
-            }
-            FmiState::StepComplete => {
-                causality == Causality::Input
-                    || (causality == Causality::Parameter && variability == Variability::Tunable)
-            }
-            _ => {
-                return Err(self.wrong_state(call));
-            }
-        };
-        if allowed {
+        if !matches!(
+            self.state,
+            FmiState::Instantiated | FmiState::InitializationMode | FmiState::StepComplete
+        ) {
+            return Err(self.wrong_state(call));
+        }
+        if self.rules.get(i).is_some_and(|r| r.settable(self.state)) {
             return Ok(());
         }
+        let meta = &self.model.metas()[i];
+        let (causality, variability) = (meta.causality, meta.variability);
         let name = self.model.metas()[i].name.clone();
         let msg = match (causality, variability, self.state) {
             (Causality::Parameter, Variability::Fixed, FmiState::StepComplete) => format!(
@@ -505,21 +558,29 @@ impl Component {
             return s;
         }
         for (vr, v) in vrs.iter().zip(values) {
-            let checked = self
-                .resolve(CALL, VarType::Real, *vr)
-                .and_then(|i| self.check_settable(CALL, i).map(|_| i))
-                .and_then(|i| self.check_range(CALL, i, *v));
-            if let Err(s) = checked {
-                return s;
-            }
-        }
-        for (vr, v) in vrs.iter().zip(values) {
-            if let Some(i) = self.index.lookup(VarType::Real, *vr) {
-                self.model.set_real(i, *v);
+            let i = match self.resolve(CALL, VarType::Real, *vr) {
+                Ok(i) => i,
+                Err(s) => return s,
+            };
+            // the rule decides the common case; the full checks name what is refused
+            let passes = self
+                .rules
+                .get(i)
+                .is_some_and(|r| r.settable(self.state) && r.accepts(*v));
+            if !passes {
+                let checked = self
+                    .check_settable(CALL, i)
+                    .and_then(|()| self.check_range(CALL, i, *v));
+                if let Err(s) = checked {
+                    return s;
+                }
             }
         }
         self.outputs_dirty = true;
-        Status::Ok
+        match self.model.set_reals(vrs, values) {
+            Ok(()) => Status::Ok,
+            Err(vr) => self.error(&format!("{CALL}: internal: no setter for Real {vr}")),
+        }
     }
 
     pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> Status {

@@ -11,15 +11,21 @@ use crate::variable::{Access, VarMeta, VarType, Variable};
 /// What the component needs from a model, without knowing its type.
 pub trait ErasedModel: Send {
     fn metas(&self) -> &[VarMeta];
-    fn get_real(&self, index: usize) -> Option<f64>;
     fn get_integer(&self, index: usize) -> Option<i32>;
     fn get_boolean(&self, index: usize) -> Option<bool>;
     fn get_string(&self, index: usize) -> Option<String>;
+    /// Reads the Reals with value references `vrs` into `out` (as many): one call for a whole
+    /// fmi2GetReal. `Err(vr)`: the first value reference that is no Real (values before it
+    /// are written).
+    fn get_reals(&self, vrs: &[u32], out: &mut [f64]) -> Result<(), u32>;
     /// Returns false if the variable has no setter of that type.
-    fn set_real(&mut self, index: usize, value: f64) -> bool;
     fn set_integer(&mut self, index: usize, value: i32) -> bool;
     fn set_boolean(&mut self, index: usize, value: bool) -> bool;
     fn set_string(&mut self, index: usize, value: &str) -> bool;
+    /// Writes the Reals with value references `vrs` (the caller checked every one): one call
+    /// for a whole fmi2SetReal. `Err(vr)`: the first value reference with no Real setter
+    /// (values before it are written).
+    fn set_reals(&mut self, vrs: &[u32], values: &[f64]) -> Result<(), u32>;
     fn reset(&mut self, ctx: &InstanceContext) -> Result<(), ModelError>;
     fn exit_initialization(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError>;
     fn update_outputs(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError>;
@@ -36,21 +42,37 @@ pub trait ErasedModel: Send {
     fn deserialize(&self, bytes: &[u8]) -> Result<Box<dyn Any + Send>, String>;
 }
 
+/// The setter of a Real variable (None: not settable).
+type RealSetter<M> = Option<fn(&mut M, f64)>;
+
 /// A model value plus its variable table.
 pub struct Typed<M: FmuModel> {
     pub model: M,
     vars: Vec<Variable<M>>,
     metas: Vec<VarMeta>,
+    /// The Real accessors by value reference (Real value references are 0, 1, ... in
+    /// declaration order, see [`VrIndex`]): a read or write is one index and one call.
+    real_get: Vec<fn(&M) -> f64>,
+    real_set: Vec<RealSetter<M>>,
 }
 
 impl<M: FmuModel> Typed<M> {
     pub fn new(ctx: &InstanceContext) -> Result<Self, ModelError> {
         let vars = M::variables();
         let metas = vars.iter().map(|v| v.meta.clone()).collect();
+        let (mut real_get, mut real_set) = (Vec::new(), Vec::new());
+        for v in &vars {
+            if let Access::Real { get, set } = &v.access {
+                real_get.push(*get);
+                real_set.push(*set);
+            }
+        }
         Ok(Typed {
             model: M::instantiate(ctx)?,
             vars,
             metas,
+            real_get,
+            real_set,
         })
     }
 }
@@ -66,13 +88,6 @@ struct Tagged<M> {
 impl<M: FmuModel> ErasedModel for Typed<M> {
     fn metas(&self) -> &[VarMeta] {
         &self.metas
-    }
-
-    fn get_real(&self, index: usize) -> Option<f64> {
-        match &self.vars.get(index)?.access {
-            Access::Real { get, .. } => Some(get(&self.model)),
-            _ => None,
-        }
     }
 
     fn get_integer(&self, index: usize) -> Option<i32> {
@@ -96,14 +111,25 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
         }
     }
 
-    fn set_real(&mut self, index: usize, value: f64) -> bool {
-        match self.vars.get(index).map(|v| &v.access) {
-            Some(Access::Real { set: Some(set), .. }) => {
-                set(&mut self.model, value);
-                true
-            }
-            _ => false,
+    fn get_reals(&self, vrs: &[u32], out: &mut [f64]) -> Result<(), u32> {
+        for (&vr, x) in vrs.iter().zip(out) {
+            let get = self.real_get.get(vr as usize).ok_or(vr)?;
+            *x = get(&self.model);
         }
+        Ok(())
+    }
+
+    fn set_reals(&mut self, vrs: &[u32], values: &[f64]) -> Result<(), u32> {
+        for (&vr, &x) in vrs.iter().zip(values) {
+            let set = self
+                .real_set
+                .get(vr as usize)
+                .copied()
+                .flatten()
+                .ok_or(vr)?;
+            set(&mut self.model, x);
+        }
+        Ok(())
     }
 
     fn set_integer(&mut self, index: usize, value: i32) -> bool {

@@ -37,6 +37,10 @@ pub(super) struct Engine<'p, 's, 'd, 'o> {
     pending: Vec<usize>,
     /// Scratch: each instance's window of the current macro step.
     windows: Vec<Option<(f64, f64)>>,
+    /// The first slave without canGetAndSetFMUstate, and the first without
+    /// canHandleVariableCommunicationStepSize (capabilities do not change during a run).
+    lacking_state: Option<usize>,
+    fixed_step: Option<usize>,
 }
 
 /// How a macro step ended.
@@ -71,6 +75,8 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         n_steps: u64,
     ) -> Self {
         let n = slaves.len();
+        let lacking_state = slaves.iter().position(|s| !s.can_save_state());
+        let fixed_step = slaves.iter().position(|s| !s.can_vary_step());
         Engine {
             plan,
             exchange,
@@ -91,6 +97,8 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             refreshed: vec![false; n],
             pending: Vec::new(),
             windows: Vec::with_capacity(n),
+            lacking_state,
+            fixed_step,
         }
     }
 
@@ -311,24 +319,33 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let exchange = self.exchange;
         let mut values = std::mem::take(&mut self.recorded);
         for g in &exchange.record {
-            values.resize(g.vars.len(), 0.0);
-            if let Err(e) = self.get_batch(g.instance, &g.vars, &mut values) {
+            let read = match g.first_column {
+                // consecutive columns: read straight into the row
+                Some(c) => {
+                    let at = row + 1 + c;
+                    self.get_batch(g.instance, &g.vars, &mut out[at..at + g.vars.len()])
+                }
+                None => {
+                    values.resize(g.vars.len(), 0.0);
+                    let r = self.get_batch(g.instance, &g.vars, &mut values);
+                    for (&c, &x) in g.columns.iter().zip(&values) {
+                        out[row + 1 + c] = x;
+                    }
+                    r
+                }
+            };
+            if let Err(e) = read {
                 self.recorded = values;
                 return Err(self.slave_err(time, g.instance, e));
             }
-            for (&c, &x) in g.columns.iter().zip(&values) {
-                out[row + 1 + c] = x;
-            }
         }
         self.recorded = values;
-        for (r, &x) in self.plan.record.iter().zip(&out[row + 1..]) {
-            if !x.is_finite() {
-                return Err(SimError::NonFinite {
-                    time,
-                    label: r.label.clone(),
-                    value: x,
-                });
-            }
+        if let Some(k) = out[row + 1..].iter().position(|x| !x.is_finite()) {
+            return Err(SimError::NonFinite {
+                time,
+                label: self.plan.record[k].label.clone(),
+                value: out[row + 1 + k],
+            });
         }
         Ok(())
     }
@@ -511,9 +528,9 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let t = self.t(k);
         let h = self.t(k + 1) - t;
         let retry = self.plan.max_step_halvings > 0;
-        let lacking = self.slaves.iter().position(|s| !s.can_save_state());
+        let lacking = self.lacking_state;
         // sub-steps change every active slave's step size
-        let fixed = self.slaves.iter().position(|s| !s.can_vary_step());
+        let fixed = self.fixed_step;
         let can_retry = retry && lacking.is_none() && fixed.is_none();
         if can_retry {
             for i in 0..self.slaves.len() {

@@ -35,6 +35,9 @@ pub(super) struct RecordGroup {
     pub vars: VarBatch,
     /// Result column (0-based, after time) of each variable.
     pub columns: Vec<usize>,
+    /// The first column when `columns` are consecutive (then the slave writes into the row
+    /// itself).
+    pub first_column: Option<usize>,
 }
 
 /// The whole exchange of a plan.
@@ -140,6 +143,12 @@ impl Exchange {
         .map(|g| RecordGroup {
             instance: g.instance,
             vars: g.vars,
+            first_column: g
+                .payload
+                .windows(2)
+                .all(|w| w[1] == w[0] + 1)
+                .then(|| g.payload.first().copied())
+                .flatten(),
             columns: g.payload,
         })
         .collect();
