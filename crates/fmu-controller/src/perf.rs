@@ -8,7 +8,8 @@
 //! 10 kN in phase with the velocity.
 
 use std::f64::consts::PI;
-use std::time::Instant;
+
+use model_description::timing::median_ns_per_step;
 
 use crate::idf::{Idf, IdfInputs, IdfParams};
 use crate::mppt::{Mppt, MpptInputs, MpptParams};
@@ -156,14 +157,7 @@ pub const WARM_UP_STEPS: u64 = 2000;
 pub fn ns_per_step(case: ControllerCase, steps: u64, repeats: usize) -> Result<f64, PerfError> {
     let mut board = ControllerWorkload::new(case)?;
     board.run_steps(0, WARM_UP_STEPS)?;
-    let mut k0 = WARM_UP_STEPS;
-    let mut per_step = Vec::with_capacity(repeats.max(1));
-    for _ in 0..repeats.max(1) {
-        let start = Instant::now();
-        std::hint::black_box(board.run_steps(k0, steps)?);
-        per_step.push(start.elapsed().as_secs_f64() * 1e9 / steps.max(1) as f64);
-        k0 += steps;
-    }
-    per_step.sort_by(f64::total_cmp);
-    Ok(per_step[per_step.len() / 2])
+    median_ns_per_step(WARM_UP_STEPS, steps, repeats, |k0, n| {
+        board.run_steps(k0, n)
+    })
 }

@@ -9,7 +9,8 @@
 //! IDF-like spool command of 0.6 mm in phase with the velocity.
 
 use std::f64::consts::PI;
-use std::time::Instant;
+
+use model_description::timing::median_ns_per_step;
 
 use crate::full_active::{Actuator, ActuatorInputs, ActuatorModel, ActuatorParams};
 use crate::semi_active::{SemiActiveDamper, SemiActiveInputs, SemiActiveParams};
@@ -175,14 +176,7 @@ pub const WARM_UP_STEPS: u64 = 1000;
 pub fn ns_per_step(case: DamperCase, steps: u64, repeats: usize) -> Result<f64, PerfError> {
     let mut model = DamperWorkload::new(case)?;
     model.run_steps(0, WARM_UP_STEPS)?;
-    let mut k0 = WARM_UP_STEPS;
-    let mut per_step = Vec::with_capacity(repeats.max(1));
-    for _ in 0..repeats.max(1) {
-        let start = Instant::now();
-        std::hint::black_box(model.run_steps(k0, steps)?);
-        per_step.push(start.elapsed().as_secs_f64() * 1e9 / steps.max(1) as f64);
-        k0 += steps;
-    }
-    per_step.sort_by(f64::total_cmp);
-    Ok(per_step[per_step.len() / 2])
+    median_ns_per_step(WARM_UP_STEPS, steps, repeats, |k0, n| {
+        model.run_steps(k0, n)
+    })
 }

@@ -13,6 +13,8 @@
 //! - the C API ([`capi`]) with the FMI state machine ([`component::Component`]), value checks,
 //!   logging through the host's callback, FMU state save/restore/serialisation;
 //! - the packaged `.fmu` ([`package`], binary `package-fmus`).
+//!
+//! Beside the glue, [`timing`] times the FMU crates' benchmark workloads per step.
 
 pub mod capi;
 pub mod codec;
@@ -27,6 +29,7 @@ pub mod model;
 pub mod package;
 #[cfg(feature = "testing")]
 pub mod testing;
+pub mod timing;
 pub mod units;
 pub mod variable;
 pub mod xml;
