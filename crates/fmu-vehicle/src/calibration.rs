@@ -66,7 +66,10 @@
 //! a source: the seed gives no yaw-damper arm (1.35 m is the published arm of the bogie data
 //! both models use), and the creep reduction 0.6 is the shared contact's value on which the
 //! bogie's R1-R7 rest. Choosing them for the target would be tuning, so the model stays as it
-//! is. The proxy also overstates the study: its closed-valve gain (+411 km/h) is far above the
+//! is. It would also break R16: with those values (factor 2.25) the hydraulic passive damper's
+//! run at 280 km/h ends in a 6.71 mm flange-contact limit cycle (Y/Q 2.18, on the flange 6 %
+//! of the time) instead of a small one on the tread (240: decays; 300: 6.81 mm, Y/Q 2.36).
+//! The proxy also overstates the study: its closed-valve gain (+411 km/h) is far above the
 //! study's MPPT gain, so the hydraulic valve at hunting amplitudes is not a 330 kNs/m Maxwell
 //! element (which part of the damper model limits it is not measured here).
 //!
