@@ -9,7 +9,7 @@ use model_description::{
     InstanceContext, ModelError, ModelInfo, StepError, Variable, MAX_PARAMETER_FILE_BYTES,
 };
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{resource_or_given, Shell, TrackLevel};
+use vehicle_elements::{resource_or_given, Shell, TrackSetting};
 use wheel_rail::GeometryTable;
 
 use crate::model::{Bogie, Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep};
@@ -67,9 +67,7 @@ vehicle_elements::shell_physics!(
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Bogie2Dof {
     params: Params,
-    track_source: TrackChoice,
-    track_level: TrackLevel,
-    track_seed: i32,
+    track: TrackSetting<TrackChoice>,
     /// The contact-table parameter as set: a keyword or a file (see [`Self::contact_source`]).
     contact: String,
     resource_dir: Option<PathBuf>,
@@ -94,11 +92,8 @@ impl Bogie2Dof {
     }
 
     fn build_params(&self) -> Params {
-        let track = self
-            .track_source
-            .track_source(self.track_level, self.track_seed);
         Params {
-            track,
+            track: self.track.source(),
             contact: self.contact_source(),
             ..self.params.clone()
         }
@@ -198,12 +193,12 @@ impl FmuModel for Bogie2Dof {
             /// Lateral track alignment: none (ideal track), external input
             /// track.lateral_alignment (at the front wheelset; the rear sees it 2p/V later), or
             /// the internal ERRI B176 generator (track.level, track.seed)
-            parameter "track.source" => track_source;
+            parameter "track.source" => track.source;
             /// ERRI B176 spectrum level of the internal generator: low (A = 2.119e-7 m rad) or
             /// high (A = 6.125e-7 m rad)
-            parameter "track.level" => track_level;
+            parameter "track.level" => track.level;
             /// Random seed of the internal generator's phases (reproducible)
-            parameter "track.seed" [range = 0.0..=2147483647.0] => track_seed;
+            parameter "track.seed" [range = 0.0..=2147483647.0] => track.seed;
 
             /// Left yaw damper force, positive in tension
             input "damper_left.force" [unit = "N", display_unit = "kN"] => shell.inputs.damper_left_force_n;
@@ -282,9 +277,7 @@ impl FmuModel for Bogie2Dof {
         Ok(Self {
             shell: Shell::new(&params),
             params,
-            track_source: TrackChoice::External,
-            track_level: TrackLevel::Low,
-            track_seed: 1,
+            track: TrackSetting::external(),
             contact: String::new(),
             resource_dir: ctx.resource_dir.clone(),
         })

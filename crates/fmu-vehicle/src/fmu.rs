@@ -9,7 +9,7 @@ use model_description::{
     ModelInfo, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{resource_or_given, Shell, TrackLevel};
+use vehicle_elements::{resource_or_given, Shell, TrackSetting};
 
 use crate::model::{Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep, Vehicle};
 use crate::params::{ContactSource, Initial, VehicleParams};
@@ -53,9 +53,7 @@ vehicle_elements::shell_physics!(
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RailVehicle {
     params: VehicleParams,
-    track_source: TrackChoice,
-    track_level: TrackLevel,
-    track_seed: i32,
+    track: TrackSetting<TrackChoice>,
     /// The contact-table parameter as set: a keyword or a file (see [`Self::contact_source`]).
     contact: String,
     resource_dir: Option<PathBuf>,
@@ -78,11 +76,8 @@ impl RailVehicle {
     }
 
     fn build_params(&self) -> VehicleParams {
-        let track = self
-            .track_source
-            .track_source(self.track_level, self.track_seed);
         VehicleParams {
-            track,
+            track: self.track.source(),
             contact: self.contact_source(),
             ..self.params.clone()
         }
@@ -233,11 +228,11 @@ impl FmuModel for RailVehicle {
             /// Lateral track alignment: none (ideal track), the external input track.lateral_alignment
             /// (under the leading wheelset; the others see it delayed by their distance behind it over V),
             /// or the internal ERRI B176 generator (track.level, track.seed)
-            parameter "track.source" => track_source;
+            parameter "track.source" => track.source;
             /// ERRI B176 spectrum level of the internal generator
-            parameter "track.level" => track_level;
+            parameter "track.level" => track.level;
             /// Random seed of the internal generator's phases (reproducible)
-            parameter "track.seed" [range = 0.0..=2147483647.0] => track_seed;
+            parameter "track.seed" [range = 0.0..=2147483647.0] => track.seed;
             /// Largest internal RK4 sub-step (convergence study: 1 ms; lowered automatically where
             /// stability needs it)
             parameter "solver.max_substep" [unit = "s", display_unit = "ms", range = 1e-6..=1e-2] => params.solver_substep_s;
@@ -430,9 +425,7 @@ impl FmuModel for RailVehicle {
         Ok(Self {
             shell: Shell::new(&params),
             params,
-            track_source: TrackChoice::External,
-            track_level: TrackLevel::Low,
-            track_seed: 1,
+            track: TrackSetting::external(),
             contact: String::new(),
             resource_dir: ctx.resource_dir.clone(),
         })

@@ -28,4 +28,4 @@ pub use params::{finite, in_range, non_negative, positive, ParamError};
 pub use resources::resource_or_given;
 pub use shell::{Shell, ShellPhysics};
 pub use step::{check_inputs, check_step, host_step, InputError};
-pub use track::TrackLevel;
+pub use track::{TrackChoiceSource, TrackLevel, TrackSetting};

@@ -70,10 +70,10 @@ macro_rules! track_choice_enum {
             }
         }
 
-        impl TrackChoice {
-            /// The physics' track source of this choice with the generator's `level` and
-            /// `seed` (an FMI Integer, taken by magnitude).
-            pub fn track_source(
+        impl $crate::track::TrackChoiceSource for TrackChoice {
+            const EXTERNAL: Self = TrackChoice::External;
+
+            fn track_source(
                 self,
                 level: $crate::TrackLevel,
                 seed: i32,
@@ -121,6 +121,44 @@ macro_rules! force_law_enum {
             }
         }
     };
+}
+
+/// A model's FMI choice of track source (declared by [`track_choice_enum!`]).
+pub trait TrackChoiceSource: Copy {
+    /// The choice of the model's track input.
+    const EXTERNAL: Self;
+
+    /// The physics' track source of this choice with the generator's `level` and `seed` (an
+    /// FMI Integer, taken by magnitude).
+    fn track_source(self, level: TrackLevel, seed: i32) -> TrackSource;
+}
+
+/// The track parameters of a model's FMU: the source `C` (its `TrackChoice`), and the level
+/// and seed of the internal generator.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct TrackSetting<C> {
+    /// Where the lateral alignment comes from.
+    pub source: C,
+    /// ERRI B176 level of the internal generator.
+    pub level: TrackLevel,
+    /// Seed of the internal generator's phases.
+    pub seed: i32,
+}
+
+impl<C: TrackChoiceSource> TrackSetting<C> {
+    /// The FMU's start values: the external input (level low, seed 1 for the generator).
+    pub fn external() -> Self {
+        Self {
+            source: C::EXTERNAL,
+            level: TrackLevel::Low,
+            seed: 1,
+        }
+    }
+
+    /// The physics' track source of these parameters.
+    pub fn source(&self) -> TrackSource {
+        self.source.track_source(self.level, self.seed)
+    }
 }
 
 /// The internal generator at `level` with `seed` (an FMI Integer, taken by magnitude).
