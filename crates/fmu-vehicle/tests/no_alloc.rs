@@ -46,3 +46,28 @@ fn the_counter_sees_an_allocation() {
     assert!(allocations >= 1);
     assert_eq!(v.len(), 16);
 }
+
+/// Another thread's allocations are not counted here: the tests of this binary run on
+/// parallel threads, and each must see its own allocations only.
+#[test]
+fn another_threads_allocations_are_not_counted() {
+    let started = std::sync::Barrier::new(2);
+    let done = std::sync::Barrier::new(2);
+    std::thread::scope(|s| {
+        s.spawn(|| {
+            let (own, ()) = allocations_during(|| {
+                started.wait();
+                for n in 0..100 {
+                    std::hint::black_box(vec![0u8; n + 1]);
+                }
+                done.wait();
+            });
+            assert_eq!(own, 100);
+        });
+        let (here, ()) = allocations_during(|| {
+            started.wait();
+            done.wait();
+        });
+        assert_eq!(here, 0);
+    });
+}

@@ -58,18 +58,19 @@ pub fn real_outputs<M: FmuModel>() -> Vec<String> {
 /// with [`allocations_during`].
 pub struct CountingAllocator;
 
-static ALLOCATIONS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-
+// Both the switch and the count are per thread: tests of one binary run on parallel threads,
+// and a shared count would add another test's allocations to this one's.
 thread_local! {
     static COUNTING: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    static ALLOCATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
 }
 
 // SAFETY: every call is passed on to the system allocator unchanged; the count is a side
-// effect that does not allocate (an atomic and a const-initialised thread-local).
+// effect that does not allocate (const-initialised thread-locals).
 unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
     unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
         if COUNTING.with(std::cell::Cell::get) {
-            ALLOCATIONS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+            ALLOCATIONS.with(|n| n.set(n.get() + 1));
         }
         std::alloc::System.alloc(layout)
     }
@@ -82,12 +83,9 @@ unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
 /// How many allocations `f` makes on this thread (with [`CountingAllocator`] installed as the
 /// global allocator; without it, always 0), and what it returns.
 pub fn allocations_during<T>(f: impl FnOnce() -> T) -> (usize, T) {
-    let before = ALLOCATIONS.load(std::sync::atomic::Ordering::SeqCst);
+    let before = ALLOCATIONS.with(std::cell::Cell::get);
     COUNTING.with(|c| c.set(true));
     let out = f();
     COUNTING.with(|c| c.set(false));
-    (
-        ALLOCATIONS.load(std::sync::atomic::Ordering::SeqCst) - before,
-        out,
-    )
+    (ALLOCATIONS.with(std::cell::Cell::get) - before, out)
 }
