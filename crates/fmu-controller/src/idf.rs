@@ -32,8 +32,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::{
-    check_finite_nonneg, check_finite_pos, check_outputs, check_sign, screen_step, NanPolicy,
-    ParamError, SampleClock, StepError,
+    check_finite_nonneg, check_finite_pos, check_outputs, check_sign, finish_step, screen_step,
+    BoardOutputs, NanPolicy, ParamError, SampleClock, StepError,
 };
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -165,17 +165,28 @@ impl Idf {
                 self.dropped_samples += 1;
             }
         }
-        if self.clock.at_sample_instant() {
-            self.out = self.pending;
-        }
-        self.out.input_fault = !valid;
-        self.out.dropped_samples = self.dropped_samples;
+        finish_step(
+            &self.clock,
+            &self.pending,
+            &mut self.out,
+            valid,
+            self.dropped_samples,
+        )
+    }
+}
+
+impl BoardOutputs for IdfOutputs {
+    fn set_input_status(&mut self, input_fault: bool, dropped_samples: u64) {
+        self.input_fault = input_fault;
+        self.dropped_samples = dropped_samples;
+    }
+
+    fn check_finite(&self) -> Result<(), StepError> {
         check_outputs(&[
-            ("spool_command_m", self.out.spool_command_m),
-            ("force_ref_n", self.out.force_ref_n),
-            ("force_error_n", self.out.force_error_n),
-        ])?;
-        Ok(self.out)
+            ("spool_command_m", self.spool_command_m),
+            ("force_ref_n", self.force_ref_n),
+            ("force_error_n", self.force_error_n),
+        ])
     }
 }
 

@@ -151,6 +151,31 @@ pub(crate) fn check_outputs(outputs: &[(&'static str, f64)]) -> Result<(), StepE
     }
 }
 
+/// What the common end of a board step needs of a controller's outputs.
+pub(crate) trait BoardOutputs: Copy {
+    /// Records the screening of the step's inputs.
+    fn set_input_status(&mut self, input_fault: bool, dropped_samples: u64);
+    /// The last check of the step: the real outputs are finite ([`check_outputs`]).
+    fn check_finite(&self) -> Result<(), StepError>;
+}
+
+/// The common end of every board step: the command of the previous sample is applied if its
+/// instant is now, the input screening is recorded, and the outputs are checked.
+pub(crate) fn finish_step<O: BoardOutputs>(
+    clock: &SampleClock,
+    pending: &O,
+    out: &mut O,
+    valid: bool,
+    dropped_samples: u64,
+) -> Result<O, StepError> {
+    if clock.at_sample_instant() {
+        *out = *pending;
+    }
+    out.set_input_status(!valid, dropped_samples);
+    out.check_finite()?;
+    Ok(*out)
+}
+
 /// Relative tolerance (in sample times) on sample instants.
 const TIME_TOL: f64 = 1e-6;
 

@@ -38,8 +38,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::signal::{band_pass, BandPass, RmsWindow};
 use crate::{
-    check_finite_nonneg, check_finite_pos, check_outputs, check_sign, screen_step, NanPolicy,
-    ParamError, SampleClock, StepError,
+    check_finite_nonneg, check_finite_pos, check_outputs, check_sign, finish_step, screen_step,
+    BoardOutputs, NanPolicy, ParamError, SampleClock, StepError,
 };
 
 /// EN 14363 lateral acceleration limit of the seed's bogie, a_lim = (12 - m/5)/2 (section 4.2).
@@ -333,19 +333,13 @@ impl Mppt {
             self.out = self.pending;
             self.sample(valid, inputs);
         }
-        if self.clock.at_sample_instant() {
-            self.out = self.pending;
-        }
-        self.out.input_fault = !valid;
-        self.out.dropped_samples = self.dropped_samples;
-        check_outputs(&[
-            ("command_v", self.out.command_v),
-            ("cost", self.out.cost),
-            ("rms_accel_mps2", self.out.rms_accel_mps2),
-            ("rms_force_n", self.out.rms_force_n),
-            ("filtered_accel_mps2", self.out.filtered_accel_mps2),
-        ])?;
-        Ok(self.out)
+        finish_step(
+            &self.clock,
+            &self.pending,
+            &mut self.out,
+            valid,
+            self.dropped_samples,
+        )
     }
 
     fn sample(&mut self, valid: bool, inputs: &MpptInputs) {
@@ -419,6 +413,23 @@ impl Mppt {
         self.pending.rms_force_n = rms_force_n;
         self.pending.updates += 1;
         self.pending
+    }
+}
+
+impl BoardOutputs for MpptOutputs {
+    fn set_input_status(&mut self, input_fault: bool, dropped_samples: u64) {
+        self.input_fault = input_fault;
+        self.dropped_samples = dropped_samples;
+    }
+
+    fn check_finite(&self) -> Result<(), StepError> {
+        check_outputs(&[
+            ("command_v", self.command_v),
+            ("cost", self.cost),
+            ("rms_accel_mps2", self.rms_accel_mps2),
+            ("rms_force_n", self.rms_force_n),
+            ("filtered_accel_mps2", self.filtered_accel_mps2),
+        ])
     }
 }
 

@@ -42,8 +42,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::signal::VelocityEstimator;
 use crate::{
-    check_finite_nonneg, check_finite_pos, check_outputs, check_sign, screen_step, NanPolicy,
-    ParamError, SampleClock, StepError,
+    check_finite_nonneg, check_finite_pos, check_outputs, check_sign, finish_step, screen_step,
+    BoardOutputs, NanPolicy, ParamError, SampleClock, StepError,
 };
 
 /// Equivalent damping (N s/m) vs valve opening (0..1) of the project's semi-active damper at
@@ -386,17 +386,28 @@ impl SkyHook {
             pd.opening = opening;
             pd.command_v = 10.0 * opening;
         }
-        if self.clock.at_sample_instant() {
-            self.out = self.pending;
-        }
-        self.out.input_fault = !valid;
-        self.out.dropped_samples = self.dropped_samples;
+        finish_step(
+            &self.clock,
+            &self.pending,
+            &mut self.out,
+            valid,
+            self.dropped_samples,
+        )
+    }
+}
+
+impl BoardOutputs for SkyHookOutputs {
+    fn set_input_status(&mut self, input_fault: bool, dropped_samples: u64) {
+        self.input_fault = input_fault;
+        self.dropped_samples = dropped_samples;
+    }
+
+    fn check_finite(&self) -> Result<(), StepError> {
         check_outputs(&[
-            ("command_v", self.out.command_v),
-            ("abs_velocity_mps", self.out.abs_velocity_mps),
-            ("condition", self.out.condition),
-        ])?;
-        Ok(self.out)
+            ("command_v", self.command_v),
+            ("abs_velocity_mps", self.abs_velocity_mps),
+            ("condition", self.condition),
+        ])
     }
 }
 
