@@ -75,6 +75,61 @@ fn first_harmonic(samples: &[f64], times: &[f64], omega: f64) -> Complex64 {
     acc.scale(2.0 / n)
 }
 
+/// The last period of a harmonic measurement.
+struct HarmonicResponse {
+    /// End time of each communication step, from the start of the period, s.
+    time_s: Vec<f64>,
+    /// Response at the end of each step.
+    response: Vec<f64>,
+    /// First harmonic of the response over that of the input `A sin(wt)`.
+    transfer: Complex64,
+}
+
+/// Drives a model with `A sin(2 pi f t)`, `steps_per_period` communication steps per period,
+/// until the transfer of one period differs from the previous one's by at most
+/// `relative |H| + absolute` (at least `MIN_PERIODS`, at most `MAX_PERIODS` periods).
+/// `step(h, t_mid)` advances the model over a step of length `h` whose middle is `t_mid`
+/// (where the input is sampled) and returns the response at its end.
+fn harmonic_response(
+    freq_hz: f64,
+    amplitude: f64,
+    steps_per_period: usize,
+    relative: f64,
+    absolute: f64,
+    mut step: impl FnMut(f64, f64) -> Result<f64, StepError>,
+) -> Result<HarmonicResponse, StepError> {
+    let omega = 2.0 * PI * freq_hz;
+    let n = steps_per_period;
+    let h = 1.0 / (freq_hz * n as f64);
+    let mut time = vec![0.0; n];
+    let mut response = vec![0.0; n];
+    let mut prev: Option<Complex64> = None;
+    let mut transfer = Complex64::default();
+    let input1 = Complex64::new(0.0, -amplitude); // phasor of A sin(wt)
+    for period in 0..MAX_PERIODS {
+        let t0 = period as f64 / freq_hz;
+        for k in 0..n {
+            let tm = t0 + (k as f64 + 0.5) * h;
+            response[k] = step(h, tm)?;
+            time[k] = (k as f64 + 1.0) * h;
+        }
+        transfer = first_harmonic(&response, &time, omega) / input1;
+        if let Some(p) = prev {
+            if period + 1 >= MIN_PERIODS
+                && (transfer - p).norm() <= relative * transfer.norm() + absolute
+            {
+                break;
+            }
+        }
+        prev = Some(transfer);
+    }
+    Ok(HarmonicResponse {
+        time_s: time,
+        response,
+        transfer,
+    })
+}
+
 /// Runs the damper with the valve fixed at `opening` under `x = X sin(2 pi f t)` to a
 /// periodic steady state and returns the last period.
 pub fn hysteresis_loop(
@@ -88,39 +143,30 @@ pub fn hysteresis_loop(
     positive_input("amplitude_m", amplitude_m)?;
     let mut damper = SemiActiveDamper::new(params.with_fixed_opening(opening))?;
     let omega = 2.0 * PI * freq_hz;
-    let n = STEPS_PER_PERIOD;
-    let h = 1.0 / (freq_hz * n as f64);
-    let mut time = vec![0.0; n];
-    let mut xs = vec![0.0; n];
-    let mut vs = vec![0.0; n];
-    let mut fs = vec![0.0; n];
-    let mut prev: Option<Complex64> = None;
-    let mut transfer = Complex64::default();
-    let x1 = Complex64::new(0.0, -amplitude_m); // phasor of X sin(wt)
-    for period in 0..MAX_PERIODS {
-        let t0 = period as f64 / freq_hz;
-        for k in 0..n {
-            let tm = t0 + (k as f64 + 0.5) * h;
+    let r = harmonic_response(
+        freq_hz,
+        amplitude_m,
+        STEPS_PER_PERIOD,
+        CONVERGENCE,
+        0.0,
+        |h, tm| {
             let inputs = SemiActiveInputs {
                 elongation_m: amplitude_m * (omega * tm).sin(),
                 elongation_velocity_mps: amplitude_m * omega * (omega * tm).cos(),
                 valve_command_v: 0.0,
             };
-            let out = damper.step(h, &inputs)?;
-            let t = (k as f64 + 1.0) * h;
-            time[k] = t;
-            xs[k] = amplitude_m * (omega * t).sin();
-            vs[k] = amplitude_m * omega * (omega * t).cos();
-            fs[k] = out.force_n;
-        }
-        transfer = first_harmonic(&fs, &time, omega) / x1;
-        if let Some(p) = prev {
-            if period + 1 >= MIN_PERIODS && (transfer - p).norm() <= CONVERGENCE * transfer.norm() {
-                break;
-            }
-        }
-        prev = Some(transfer);
-    }
+            Ok(damper.step(h, &inputs)?.force_n)
+        },
+    )?;
+    let (time, fs, transfer) = (r.time_s, r.response, r.transfer);
+    let xs = time
+        .iter()
+        .map(|t| amplitude_m * (omega * t).sin())
+        .collect();
+    let vs = time
+        .iter()
+        .map(|t| amplitude_m * omega * (omega * t).cos())
+        .collect();
     let peak = fs.iter().fold(0.0f64, |m, f| m.max(f.abs()));
     Ok(HysteresisLoop {
         opening,
@@ -235,33 +281,15 @@ pub fn actuator_frf(
         let omega = 2.0 * PI * f;
         // Keep the communication step inside 1e-4..5e-3 s.
         let n = ((1.0 / (f * 5e-3)).ceil() as usize).clamp(64, 400);
-        let h = 1.0 / (f * n as f64);
-        let mut time = vec![0.0; n];
-        let mut vel = vec![0.0; n];
-        let mut prev: Option<Complex64> = None;
-        let mut g = Complex64::default();
-        let u1 = Complex64::new(0.0, -amplitude_m);
-        for period in 0..MAX_PERIODS {
-            let t0 = period as f64 / f;
-            for k in 0..n {
-                let tm = t0 + (k as f64 + 0.5) * h;
-                let inputs = ActuatorInputs {
-                    spool_command_m: amplitude_m * (omega * tm).sin(),
-                    ..ActuatorInputs::default()
-                };
-                let o = act.step(h, &inputs)?;
-                time[k] = (k as f64 + 1.0) * h;
-                vel[k] = o.rod_velocity_mps;
-            }
-            g = first_harmonic(&vel, &time, omega) / u1;
-            if let Some(pv) = prev {
-                // Absolute floor: inside the dead zone the response is ~0.
-                if period + 1 >= MIN_PERIODS && (g - pv).norm() <= 1e-4 * g.norm() + 1e-9 {
-                    break;
-                }
-            }
-            prev = Some(g);
-        }
+        // Absolute floor: inside the dead zone the response is ~0.
+        let g = harmonic_response(f, amplitude_m, n, 1e-4, 1e-9, |h, tm| {
+            let inputs = ActuatorInputs {
+                spool_command_m: amplitude_m * (omega * tm).sin(),
+                ..ActuatorInputs::default()
+            };
+            Ok(act.step(h, &inputs)?.rod_velocity_mps)
+        })?
+        .transfer;
         out.push(ActuatorFrfPoint {
             freq_hz: f,
             omega_radps: omega,
