@@ -63,7 +63,7 @@
 //!   without flange contact); 300 km/h: 5.8 mm; 320 km/h: 6.5 mm limit cycle on the flange
 //!   root (tan gamma ~ 0.6; seed +-6 mm with flange contact).
 
-use crate::eigen::{critical_speed, CriticalSpeed, DamperRepresentation, EigenError};
+use crate::eigen::{critical_speed, CriticalSpeed, DamperRepresentation, EigenError, LinearDamper};
 use crate::params::Params;
 // The calibrated values are the defaults of [`Params`] and live there; they are named here too,
 // beside the procedure and the reasoning that produced them.
@@ -148,10 +148,10 @@ pub fn maxwell_equivalent(k: f64, c: f64, freq_hz: f64) -> (f64, f64) {
 
 /// The passive reference damper as used by the eigen-analysis.
 pub fn passive_damper() -> DamperRepresentation {
-    DamperRepresentation::Maxwell {
+    DamperRepresentation::Linear(LinearDamper::Maxwell {
         k: PASSIVE_MAXWELL_K_N_PER_M,
         c: PASSIVE_MAXWELL_C_NS_PER_M,
-    }
+    })
 }
 
 /// Finds k_ssx in [0, 20 MN/m] (bisection; V_cr grows with k_ssx) such that the linear

@@ -17,6 +17,7 @@ use nalgebra::{Complex, DMatrix};
 use serde::{Deserialize, Serialize};
 
 use crate::params::{ParamError, Params};
+pub use vehicle_elements::LinearDamper;
 
 /// One point of a frequency-dependent equivalent damper (per damper).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -32,27 +33,10 @@ pub struct DamperPoint {
 /// How the two (identical) yaw dampers enter the linear model; values per damper.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum DamperRepresentation {
-    /// No yaw dampers.
-    None,
-    /// Pure viscous damper c0 [N s/m], the seed's (5.17).
-    Viscous {
-        /// Damping [N s/m].
-        c0: f64,
-    },
-    /// Spring k [N/m] parallel to dashpot c [N s/m] (equivalent values at one frequency).
-    KelvinVoigt {
-        /// Stiffness [N/m].
-        k: f64,
-        /// Damping [N s/m].
-        c: f64,
-    },
-    /// Spring k [N/m] in series with dashpot c [N s/m] (one extra state).
-    Maxwell {
-        /// Series stiffness [N/m].
-        k: f64,
-        /// Damping [N s/m].
-        c: f64,
-    },
+    /// A linear law with constant values (the coach's too): `None`, `Viscous` (the seed's
+    /// (5.17)), `KelvinVoigt` (equivalent values at one frequency) or `Maxwell` (one extra
+    /// state).
+    Linear(LinearDamper),
     /// Kelvin-Voigt with k_eq(f), c_eq(f) interpolated linearly in a table (sorted by
     /// frequency, clamped at the ends), taken at the hunting mode's own frequency (iterated).
     FrequencyDependent(Vec<DamperPoint>),
@@ -138,12 +122,15 @@ pub struct CriticalSpeed {
 fn check_damper(rep: &DamperRepresentation) -> Result<(), EigenError> {
     let ok = |v: f64| v.is_finite() && v >= 0.0;
     match rep {
-        DamperRepresentation::None => Ok(()),
-        DamperRepresentation::Viscous { c0 } if ok(*c0) => Ok(()),
-        DamperRepresentation::KelvinVoigt { k, c } if ok(*k) && ok(*c) => Ok(()),
-        DamperRepresentation::Maxwell { k, c } if ok(*k) && *k > 0.0 && ok(*c) && *c > 0.0 => {
-            Ok(())
-        }
+        DamperRepresentation::Linear(d) => match *d {
+            LinearDamper::None => Ok(()),
+            LinearDamper::Viscous { c } if ok(c) => Ok(()),
+            LinearDamper::KelvinVoigt { k, c } if ok(k) && ok(c) => Ok(()),
+            LinearDamper::Maxwell { k, c } if ok(k) && k > 0.0 && ok(c) && c > 0.0 => Ok(()),
+            _ => Err(EigenError::Damper(format!(
+                "negative, zero or NaN value in {d:?}"
+            ))),
+        },
         DamperRepresentation::FrequencyDependent(t) => {
             if t.is_empty() {
                 return Err(EigenError::Damper("empty frequency table".into()));
@@ -158,9 +145,6 @@ fn check_damper(rep: &DamperRepresentation) -> Result<(), EigenError> {
             }
             Ok(())
         }
-        _ => Err(EigenError::Damper(format!(
-            "negative, zero or NaN value in {rep:?}"
-        ))),
     }
 }
 
@@ -241,10 +225,12 @@ pub fn state_matrix(
 
 fn resolve(rep: &DamperRepresentation, freq_hz: f64) -> Resolved {
     match rep {
-        DamperRepresentation::None => Resolved::Kv { k: 0.0, c: 0.0 },
-        DamperRepresentation::Viscous { c0 } => Resolved::Kv { k: 0.0, c: *c0 },
-        DamperRepresentation::KelvinVoigt { k, c } => Resolved::Kv { k: *k, c: *c },
-        DamperRepresentation::Maxwell { k, c } => Resolved::Maxwell { k: *k, c: *c },
+        DamperRepresentation::Linear(d) => match *d {
+            LinearDamper::None => Resolved::Kv { k: 0.0, c: 0.0 },
+            LinearDamper::Viscous { c } => Resolved::Kv { k: 0.0, c },
+            LinearDamper::KelvinVoigt { k, c } => Resolved::Kv { k, c },
+            LinearDamper::Maxwell { k, c } => Resolved::Maxwell { k, c },
+        },
         DamperRepresentation::FrequencyDependent(t) => {
             let (k, c) = interpolate_table(t, freq_hz);
             Resolved::Kv { k, c }
@@ -400,11 +386,16 @@ mod tests {
     #[test]
     fn viscous_equals_kelvin_voigt_with_zero_k() {
         let p = Params::default();
-        let a = analyse(&p, 70.0, &DamperRepresentation::Viscous { c0: 1e5 }).unwrap();
+        let a = analyse(
+            &p,
+            70.0,
+            &DamperRepresentation::Linear(LinearDamper::Viscous { c: 1e5 }),
+        )
+        .unwrap();
         let b = analyse(
             &p,
             70.0,
-            &DamperRepresentation::KelvinVoigt { k: 0.0, c: 1e5 },
+            &DamperRepresentation::Linear(LinearDamper::KelvinVoigt { k: 0.0, c: 1e5 }),
         )
         .unwrap();
         assert_eq!(a.eigenvalues, b.eigenvalues);
@@ -429,7 +420,7 @@ mod tests {
         let b = analyse(
             &p,
             70.0,
-            &DamperRepresentation::KelvinVoigt { k: 2e6, c: 1.2e5 },
+            &DamperRepresentation::Linear(LinearDamper::KelvinVoigt { k: 2e6, c: 1.2e5 }),
         )
         .unwrap();
         assert!((a.max_re - b.max_re).abs() < 1e-9);
@@ -449,11 +440,16 @@ mod tests {
     #[test]
     fn stiff_maxwell_tends_to_viscous() {
         let p = Params::default();
-        let v = analyse(&p, 70.0, &DamperRepresentation::Viscous { c0: 1.2e5 }).unwrap();
+        let v = analyse(
+            &p,
+            70.0,
+            &DamperRepresentation::Linear(LinearDamper::Viscous { c: 1.2e5 }),
+        )
+        .unwrap();
         let m = analyse(
             &p,
             70.0,
-            &DamperRepresentation::Maxwell { k: 1e11, c: 1.2e5 },
+            &DamperRepresentation::Linear(LinearDamper::Maxwell { k: 1e11, c: 1.2e5 }),
         )
         .unwrap();
         let (hv, hm) = (v.hunting.unwrap(), m.hunting.unwrap());
@@ -463,8 +459,18 @@ mod tests {
     #[test]
     fn bad_damper_rejected() {
         let p = Params::default();
-        assert!(analyse(&p, 70.0, &DamperRepresentation::Viscous { c0: -1.0 }).is_err());
-        assert!(analyse(&p, 70.0, &DamperRepresentation::Maxwell { k: 0.0, c: 1.0 }).is_err());
-        assert!(analyse(&p, 0.0, &DamperRepresentation::None).is_err());
+        assert!(analyse(
+            &p,
+            70.0,
+            &DamperRepresentation::Linear(LinearDamper::Viscous { c: -1.0 })
+        )
+        .is_err());
+        assert!(analyse(
+            &p,
+            70.0,
+            &DamperRepresentation::Linear(LinearDamper::Maxwell { k: 0.0, c: 1.0 })
+        )
+        .is_err());
+        assert!(analyse(&p, 0.0, &DamperRepresentation::Linear(LinearDamper::None)).is_err());
     }
 }

@@ -185,7 +185,7 @@ pub fn rhs_with_hints(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::eigen::{state_matrix, DamperRepresentation};
+    use crate::eigen::{state_matrix, DamperRepresentation, LinearDamper};
 
     /// Finite-difference Jacobian of the linear RHS equals the state matrix (5.30).
     #[test]
@@ -201,7 +201,7 @@ mod tests {
         let a = state_matrix(
             &p,
             p.speed_mps,
-            &DamperRepresentation::KelvinVoigt { k: kd, c: cd },
+            &DamperRepresentation::Linear(LinearDamper::KelvinVoigt { k: kd, c: cd }),
             0.0,
         )
         .unwrap();

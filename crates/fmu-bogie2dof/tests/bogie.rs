@@ -221,7 +221,13 @@ fn stiffness_not_damping_sets_critical_speed() {
         ..Params::default()
     };
     for c0 in [60e3, 120e3, 300e3] {
-        let c = critical_speed(&p, &DamperRepresentation::Viscous { c0 }, 5.0, 200.0).unwrap();
+        let c = critical_speed(
+            &p,
+            &DamperRepresentation::Linear(LinearDamper::Viscous { c: c0 }),
+            5.0,
+            200.0,
+        )
+        .unwrap();
         assert!(c.speed_kmh < 230.0, "c0 {c0}: {c:?}");
         assert!(c.hunting.freq_hz < 2.5, "c0 {c0}: {c:?}");
     }
@@ -233,7 +239,7 @@ fn maxwell_and_frequency_dependent_representations_work() {
     // A stiff Maxwell damper (series stiffness ~10 MN/m, MPE 2019) gives a critical speed.
     let m = critical_speed(
         &p,
-        &DamperRepresentation::Maxwell { k: 10e6, c: 300e3 },
+        &DamperRepresentation::Linear(LinearDamper::Maxwell { k: 10e6, c: 300e3 }),
         5.0,
         200.0,
     )

@@ -13,6 +13,7 @@ use fmu_bogie2dof::calibration::{
 };
 use fmu_bogie2dof::eigen::{
     analyse, critical_speed, CriticalSpeed, DamperRepresentation, EigenError, EigenResult,
+    LinearDamper,
 };
 use fmu_bogie2dof::Params;
 
@@ -83,10 +84,16 @@ impl DamperSpec {
     pub fn representation(&self) -> DamperRepresentation {
         match *self {
             DamperSpec::Passive => passive_damper(),
-            DamperSpec::Viscous(c0) => DamperRepresentation::Viscous { c0 },
-            DamperSpec::Maxwell(k, c) => DamperRepresentation::Maxwell { k, c },
-            DamperSpec::KelvinVoigt(k, c) => DamperRepresentation::KelvinVoigt { k, c },
-            DamperSpec::None => DamperRepresentation::None,
+            DamperSpec::Viscous(c0) => {
+                DamperRepresentation::Linear(LinearDamper::Viscous { c: c0 })
+            }
+            DamperSpec::Maxwell(k, c) => {
+                DamperRepresentation::Linear(LinearDamper::Maxwell { k, c })
+            }
+            DamperSpec::KelvinVoigt(k, c) => {
+                DamperRepresentation::Linear(LinearDamper::KelvinVoigt { k, c })
+            }
+            DamperSpec::None => DamperRepresentation::Linear(LinearDamper::None),
         }
     }
 
