@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 import threading
+from sys import getswitchinterval, setswitchinterval
 import zipfile
 from pathlib import Path
 
@@ -81,22 +82,29 @@ def test_progress_and_the_gil_released_during_a_run(passive_file):
     assert len(seen) >= 50
     # The GIL is released while the FMUs run: this thread's Python loop goes on between the
     # progress calls of a run on another thread (which would all see the same count if the
-    # run held the GIL).
+    # run held the GIL). The run is long (30 s simulated, some 60 ms of wall time) and the
+    # interpreter's switch interval short, so the loop gets the GIL many times during the run
+    # however fast the FMUs are.
     ticks = [0]
     at = []
     done = threading.Event()
 
     def run():
         try:
-            sys.run(stop_time=3.0, progress=lambda k, n: at.append(ticks[0]))
+            sys.run(stop_time=30.0, progress=lambda k, n: at.append(ticks[0]))
         finally:
             done.set()
 
-    t = threading.Thread(target=run)
-    t.start()
-    while not done.is_set():
-        ticks[0] += 1
-    t.join()
+    interval = getswitchinterval()
+    setswitchinterval(1e-4)
+    try:
+        t = threading.Thread(target=run)
+        t.start()
+        while not done.is_set():
+            ticks[0] += 1
+        t.join()
+    finally:
+        setswitchinterval(interval)
     assert len(at) >= 100 and at[-1] > at[0]
 
 
