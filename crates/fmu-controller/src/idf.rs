@@ -32,8 +32,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::{
-    check_finite_nonneg, check_finite_pos, check_outputs, check_sign, finish_step, screen_step,
-    BoardOutputs, NanPolicy, ParamError, SampleClock, StepError,
+    board_outputs, check_finite_nonneg, check_finite_pos, check_sign, finish_step, screen_step,
+    NanPolicy, ParamError, SampleClock, StepError,
 };
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -175,20 +175,7 @@ impl Idf {
     }
 }
 
-impl BoardOutputs for IdfOutputs {
-    fn set_input_status(&mut self, input_fault: bool, dropped_samples: u64) {
-        self.input_fault = input_fault;
-        self.dropped_samples = dropped_samples;
-    }
-
-    fn check_finite(&self) -> Result<(), StepError> {
-        check_outputs(&[
-            ("spool_command_m", self.spool_command_m),
-            ("force_ref_n", self.force_ref_n),
-            ("force_error_n", self.force_error_n),
-        ])
-    }
-}
+board_outputs!(IdfOutputs: spool_command_m, force_ref_n, force_error_n);
 
 #[cfg(test)]
 mod tests {

@@ -159,6 +159,24 @@ pub(crate) trait BoardOutputs: Copy {
     fn check_finite(&self) -> Result<(), StepError>;
 }
 
+/// Implements [`BoardOutputs`] for an outputs struct with the fields `input_fault` and
+/// `dropped_samples`, checking the listed real outputs (named by their field) for finiteness.
+macro_rules! board_outputs {
+    ($outputs:ty: $($real:ident),+ $(,)?) => {
+        impl $crate::BoardOutputs for $outputs {
+            fn set_input_status(&mut self, input_fault: bool, dropped_samples: u64) {
+                self.input_fault = input_fault;
+                self.dropped_samples = dropped_samples;
+            }
+
+            fn check_finite(&self) -> Result<(), $crate::StepError> {
+                $crate::check_outputs(&[$((stringify!($real), self.$real)),+])
+            }
+        }
+    };
+}
+pub(crate) use board_outputs;
+
 /// The common end of every board step: the command of the previous sample is applied if its
 /// instant is now, the input screening is recorded, and the outputs are checked.
 pub(crate) fn finish_step<O: BoardOutputs>(

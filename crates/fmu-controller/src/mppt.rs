@@ -38,8 +38,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::signal::{band_pass, BandPass, RmsWindow};
 use crate::{
-    check_finite_nonneg, check_finite_pos, check_outputs, check_sign, finish_step, screen_step,
-    BoardOutputs, NanPolicy, ParamError, SampleClock, StepError,
+    board_outputs, check_finite_nonneg, check_finite_pos, check_sign, finish_step, screen_step,
+    NanPolicy, ParamError, SampleClock, StepError,
 };
 
 /// EN 14363 lateral acceleration limit of the seed's bogie, a_lim = (12 - m/5)/2 (section 4.2).
@@ -416,22 +416,7 @@ impl Mppt {
     }
 }
 
-impl BoardOutputs for MpptOutputs {
-    fn set_input_status(&mut self, input_fault: bool, dropped_samples: u64) {
-        self.input_fault = input_fault;
-        self.dropped_samples = dropped_samples;
-    }
-
-    fn check_finite(&self) -> Result<(), StepError> {
-        check_outputs(&[
-            ("command_v", self.command_v),
-            ("cost", self.cost),
-            ("rms_accel_mps2", self.rms_accel_mps2),
-            ("rms_force_n", self.rms_force_n),
-            ("filtered_accel_mps2", self.filtered_accel_mps2),
-        ])
-    }
-}
+board_outputs!(MpptOutputs: command_v, cost, rms_accel_mps2, rms_force_n, filtered_accel_mps2);
 
 #[cfg(test)]
 mod tests {

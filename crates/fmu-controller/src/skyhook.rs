@@ -42,8 +42,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::signal::VelocityEstimator;
 use crate::{
-    check_finite_nonneg, check_finite_pos, check_outputs, check_sign, finish_step, screen_step,
-    BoardOutputs, NanPolicy, ParamError, SampleClock, StepError,
+    board_outputs, check_finite_nonneg, check_finite_pos, check_sign, finish_step, screen_step,
+    NanPolicy, ParamError, SampleClock, StepError,
 };
 
 /// Equivalent damping (N s/m) vs valve opening (0..1) of the project's semi-active damper at
@@ -396,20 +396,7 @@ impl SkyHook {
     }
 }
 
-impl BoardOutputs for SkyHookOutputs {
-    fn set_input_status(&mut self, input_fault: bool, dropped_samples: u64) {
-        self.input_fault = input_fault;
-        self.dropped_samples = dropped_samples;
-    }
-
-    fn check_finite(&self) -> Result<(), StepError> {
-        check_outputs(&[
-            ("command_v", self.command_v),
-            ("abs_velocity_mps", self.abs_velocity_mps),
-            ("condition", self.condition),
-        ])
-    }
-}
+board_outputs!(SkyHookOutputs: command_v, abs_velocity_mps, condition);
 
 #[cfg(test)]
 mod tests {
