@@ -494,13 +494,11 @@ fn parse_jobs(jobs_json: &[String]) -> PyResult<Vec<Job>> {
 }
 
 fn parse_format(format: &str) -> PyResult<ResultsFormat> {
-    match format {
-        "csv" => Ok(ResultsFormat::Csv),
-        "parquet" => Ok(ResultsFormat::Parquet),
-        other => Err(PyValueError::new_err(format!(
-            "results format '{other}': expected 'csv' or 'parquet'"
-        ))),
-    }
+    ResultsFormat::from_name(format).ok_or_else(|| {
+        PyValueError::new_err(format!(
+            "results format '{format}': expected 'csv' or 'parquet'"
+        ))
+    })
 }
 
 /// The results format ("csv" or "parquet") a local run set of the base system (resolved JSON)
@@ -514,7 +512,7 @@ fn results_format_by_size(
     let base =
         LoadedSystem::from_json_str(base_json, Path::new(""), label).map_err(|e| system_err(&e))?;
     let jobs = parse_jobs(&jobs_json)?;
-    let format = runs::format_by_size(&base, &jobs).map_err(|e| system_err(&e))?;
+    let format = runs::format_by_description(&base, &jobs).map_err(|e| system_err(&e))?;
     Ok(format.extension().to_string())
 }
 

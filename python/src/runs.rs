@@ -1,7 +1,7 @@
 //! Run-set bookkeeping of the Python package: `sweep.json` over all runs of a resumed set, and
 //! the folders of runs computed in another process ([`RunSetWriter`]). Which runs are complete
 //! in a format, and which format a run set chooses by size, are the master's rules
-//! ([`completed`], [`format_by_size`], re-exported).
+//! ([`completed`], [`format_by_description`], re-exported).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use master::coupling::{ColumnInfo, SimOutput};
 use master::output::{write_json_atomic, OutputError};
 use master::results::{constant_kinds, ConstantKind, ResultsFormat};
-pub use master::runset::{completed, format_by_description as format_by_size};
+pub use master::runset::{completed, format_by_description};
 use master::runset::{run_one_with, Job, ResultsOptions, RunReport};
 
 /// Writes `<outdir>/sweep.json`, the reports in job order (the master's format).

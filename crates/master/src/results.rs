@@ -46,6 +46,21 @@ impl ResultsFormat {
         }
     }
 
+    /// The format named `name` ("csv" or "parquet", its [`Self::extension`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        [ResultsFormat::Csv, ResultsFormat::Parquet]
+            .into_iter()
+            .find(|f| f.extension() == name)
+    }
+
+    /// The other format.
+    pub fn other(self) -> Self {
+        match self {
+            ResultsFormat::Csv => ResultsFormat::Parquet,
+            ResultsFormat::Parquet => ResultsFormat::Csv,
+        }
+    }
+
     /// The format of a file name by its extension, if it is one of ours.
     pub fn of_path(path: &Path) -> Option<Self> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();
@@ -237,5 +252,21 @@ pub fn read_metadata(path: &Path) -> Result<Option<ResultsMetadata>, ReadError> 
                     reason: e.to_string(),
                 })
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ResultsFormat;
+
+    #[test]
+    fn a_format_is_named_by_its_extension_and_has_one_other() {
+        for f in [ResultsFormat::Csv, ResultsFormat::Parquet] {
+            assert_eq!(ResultsFormat::from_name(f.extension()), Some(f));
+            assert_ne!(f.other(), f);
+            assert_eq!(f.other().other(), f);
+        }
+        assert_eq!(ResultsFormat::from_name("CSV"), None);
+        assert_eq!(ResultsFormat::from_name("pq"), None);
     }
 }

@@ -694,11 +694,7 @@ pub fn completed(outdir: &Path, job: &Job, format: ResultsFormat) -> Option<RunR
     let system: SystemDescription =
         serde_json::from_str(&std::fs::read_to_string(dir.join("system.json")).ok()?).ok()?;
     let results = results_path(outdir, &job.name, format);
-    let other = match format {
-        ResultsFormat::Csv => ResultsFormat::Parquet,
-        ResultsFormat::Parquet => ResultsFormat::Csv,
-    };
-    let other = results_path(outdir, &job.name, other);
+    let other = results_path(outdir, &job.name, format.other());
     let complete = report.ok
         && report.name == job.name
         && report.parameters == job.parameters
