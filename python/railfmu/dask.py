@@ -84,18 +84,10 @@ def _prepared(base_json: str, label: str) -> "_railfmu.PreparedSystem":
         return system
 
 
-def _localised_base(base_json: str, fmus: Optional[Dict[str, Tuple[str, str, bytes]]]) -> Tuple[str, Dict[str, str]]:
-    if not fmus:
-        return base_json, {}
-    paths = {p: _local_copy(digest, name, data) for p, (digest, name, data) in fmus.items()}
-    return json.dumps(_localise(json.loads(base_json), paths)), paths
-
-
-def format_task(base_json: str, label: str, jobs_json: List[str], fmus: Optional[Dict[str, Tuple[str, str, bytes]]] = None) -> str:
-    """The results format chosen by size, from a worker's copies of the FMUs (when the client
-    cannot read them). FMUs no one can read make every run fail on its own: no results file,
-    so the format does not matter then."""
-    base_json, _ = _localised_base(base_json, fmus)
+def format_task(base_json: str, label: str, jobs_json: List[str]) -> str:
+    """The results format chosen by size, from the FMUs as a worker reads them from their paths
+    (a shared file system the client does not see). FMUs no one can read make every run fail
+    on its own: no results file, so the format does not matter then."""
     try:
         return _railfmu.results_format_by_size(base_json, label, jobs_json)
     except _railfmu.Error:
@@ -107,8 +99,9 @@ def run_task(base_json: str, label: str, job_json: str, fmus: Optional[Dict[str,
     description to (SHA-256, file name, bytes) when the FMUs are shipped. Returns the run's
     ``header``, ``data`` (float64 bytes), ``summary_json`` and ``columns_json`` (the columns'
     units and FMU variables), or its ``error``."""
-    base_json, paths = _localised_base(base_json, fmus)
-    if paths:
+    if fmus:
+        paths = {p: _local_copy(digest, name, data) for p, (digest, name, data) in fmus.items()}
+        base_json = json.dumps(_localise(json.loads(base_json), paths))
         job = json.loads(job_json)
         job["system"] = _localise(job["system"], paths)
         job_json = json.dumps(job)
@@ -141,21 +134,19 @@ def _scatter_fmus(client: Any, base_json: str) -> Dict[str, Tuple[str, str, Any]
     return {p: (fmus[p][0], fmus[p][1], f) for p, f in zip(paths, scattered)}
 
 
-def results_format(
-    client: Any, base_json: str, label: str, jobs_json: List[str], *, fmus_arg: Any = None, ship_fmus: bool = False, retries: int = 3
-) -> str:
+def results_format(client: Any, base_json: str, label: str, jobs_json: List[str], *, ship_fmus: bool, retries: int = 3) -> str:
     """The results format ("csv" or "parquet") a run set of ``jobs_json`` chooses by size, as a
-    local run set does: from the FMUs' model descriptions read on this client, else on a worker
-    (``fmus_arg``: FMUs already scattered; ``ship_fmus``: scatter them for this). A resumed run
+    local run set does: from the FMUs' model descriptions read on this client. Only when the
+    workers read the FMUs from their own paths (``ship_fmus=False``) can a worker see what the
+    client cannot, and one worker decides; shipped FMUs are the bytes this client could not
+    read, so every run fails on its own and the format does not matter ("csv"). A resumed run
     set decides it over every job before it keeps any run."""
     try:
         return _railfmu.results_format_by_size(base_json, label, jobs_json)
     except _railfmu.Error:
-        pass
-    # the FMUs are not readable here (e.g. on the workers' file system only)
-    if fmus_arg is None and ship_fmus:
-        fmus_arg = _scatter_fmus(client, base_json)
-    return client.submit(format_task, base_json, label, jobs_json, fmus_arg, retries=retries, pure=False).result()
+        if ship_fmus:
+            return "csv"
+    return client.submit(format_task, base_json, label, jobs_json, retries=retries, pure=False).result()
 
 
 def run_jobs_on_cluster(
@@ -178,9 +169,9 @@ def run_jobs_on_cluster(
     from distributed import as_completed
 
 
-    fmus_arg = _scatter_fmus(client, base_json) if ship_fmus else None
     if format is None:
-        format = results_format(client, base_json, label, jobs_json, fmus_arg=fmus_arg, retries=retries)
+        format = results_format(client, base_json, label, jobs_json, ship_fmus=ship_fmus, retries=retries)
+    fmus_arg = _scatter_fmus(client, base_json) if ship_fmus else None
     writer = _railfmu.RunWriter(os.fspath(outdir), jobs_json, format)
     # keys unique per submission: a key resubmitted while the scheduler still releases it from
     # an earlier set would be cancelled
