@@ -354,9 +354,13 @@ fn cargo_build(root: &Path, build: &Build, crates: &[String]) -> Result<(), Stri
     };
     // zig reports its own include folders relative to the working directory when they lie
     // below it (a project-local .venv does), and cargo-zigbuild hands them to bindgen, whose
-    // build scripts run elsewhere: build from outside the workspace so every path is absolute.
+    // build scripts run elsewhere. Build from the filesystem root: zig strips only a working
+    // directory that is a proper prefix ("/" + separator never is), so every path stays
+    // absolute wherever the workspace lies (the temporary folder is no answer: a clone under
+    // /tmp lies below it).
     let manifest = root.join("Cargo.toml");
-    cmd.current_dir(std::env::temp_dir())
+    let filesystem_root = root.ancestors().last().unwrap_or(root);
+    cmd.current_dir(filesystem_root)
         .arg("--manifest-path")
         .arg(&manifest)
         .args(["--release", "--lib", "--features", "fmi-export"]);
