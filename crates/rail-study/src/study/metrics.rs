@@ -66,6 +66,11 @@ pub struct RunMetrics {
     pub max_displacement_m: f64,
     /// Max |damper force| after the skip, both sides [N].
     pub peak_force_n: f64,
+    /// rms of the damper force after the skip, mean over the dampers [N], if recorded.
+    pub rms_force_n: Option<f64>,
+    /// Max |reference force| of the full-active controllers after the skip [N], if recorded:
+    /// above the actuator's force bound the peak force is the bound, not `c_v v`.
+    pub peak_reference_force_n: Option<f64>,
     /// rms of the mechanical power F v per actuator (mean of both sides; the seed's
     /// "dissipated power" of Table 4-3) [W], if recorded.
     pub rms_power_w: Option<f64>,
@@ -187,8 +192,19 @@ pub fn run_metrics(
         .iter()
         .filter_map(|name| out.column(name))
         .fold(0.0f64, |m, f| m.max(max_abs(&f[skip..])));
+    let references: Vec<Vec<f64>> = signals
+        .reference_forces
+        .iter()
+        .filter_map(|name| out.column(name))
+        .collect();
+    let peak_reference_force_n = (!references.is_empty()).then(|| {
+        references
+            .iter()
+            .fold(0.0f64, |m, f| m.max(max_abs(&f[skip..])))
+    });
     // per actuator (the seed's Table 4-3 is per damper): mean of the dampers' rms
     let rms_after_skip = |x: &[f64]| crate::signal::rms(&x[skip..]);
+    let rms_force_n = mean_over(out, &signals.forces, rms_after_skip);
     let rms_power_w = mean_over(out, &signals.powers, rms_after_skip);
     let rms_hydraulic_power_w = mean_over(out, &signals.hydraulic_powers, rms_after_skip);
     let tail_command_v = mean_over(out, &signals.commands, |x| mean(&x[tail..]));
@@ -216,6 +232,8 @@ pub fn run_metrics(
         tail_amplitude_m,
         max_displacement_m,
         peak_force_n,
+        rms_force_n,
+        peak_reference_force_n,
         rms_power_w,
         rms_hydraulic_power_w,
         tail_command_v,
@@ -311,9 +329,43 @@ mod tests {
         assert!((m.tail_amplitude_m - y).abs() < 0.02 * y, "{m:?}");
         assert!((m.max_displacement_m - y).abs() < 0.02 * y);
         assert!((m.peak_force_n - 8e3).abs() < 10.0);
+        // one damper recorded: its rms, 8 kN / sqrt(2); no full-active reference recorded
+        let rms_force = m.rms_force_n.unwrap();
+        assert!((rms_force - 8e3 / 2f64.sqrt()).abs() < 20.0, "{rms_force}");
+        assert_eq!(m.peak_reference_force_n, None);
         assert_eq!(m.rms_power_w, None);
         assert_eq!(m.rms_hydraulic_power_w, None);
         assert!((m.tail_command_v.unwrap() - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn peak_reference_force_is_the_largest_after_the_skip() {
+        let b = bogie();
+        let mut out = synthetic(6.0, 4.0, 20.0, false);
+        let width = out.header.len();
+        out.header.push(format!("{} [N]", b.reference_forces[0]));
+        let rows = out.data.len() / width;
+        let mut data = Vec::with_capacity(out.data.len() + rows);
+        for (k, row) in out.data.chunks(width).enumerate() {
+            data.extend_from_slice(row);
+            // 30 kN before the skip (start-up), then a 21 kN peak
+            let t = row[0];
+            data.push(if t < 5.0 {
+                30e3
+            } else if k == rows - 1 {
+                -21e3
+            } else {
+                1e3
+            });
+        }
+        out.data = data;
+        let spec = MetricSpec {
+            skip_s: 5.0,
+            tail_s: 4.0,
+            speed_kmh: 300.0,
+        };
+        let m = run_metrics(&out, &spec, &b).unwrap();
+        assert_eq!(m.peak_reference_force_n, Some(21e3));
     }
 
     #[test]

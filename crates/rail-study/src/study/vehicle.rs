@@ -228,6 +228,8 @@ pub struct Signals {
     pub commands: Vec<String>,
     pub powers: Vec<String>,
     pub hydraulic_powers: Vec<String>,
+    /// The full-active controllers' reference forces `c_v v` (what the actuator is asked for).
+    pub reference_forces: Vec<String>,
 }
 
 impl Signals {
@@ -240,6 +242,7 @@ impl Signals {
             commands: v.per_position("controller", "valve.command"),
             powers: v.per_position("actuator", "damper.power"),
             hydraulic_powers: v.per_position("actuator", "damper.hydraulic_power"),
+            reference_forces: v.per_position("idf", "reference.force"),
         }
     }
 }
@@ -390,7 +393,8 @@ pub fn coach_system(c: &Configuration) -> Value {
         }
     }
     if c.family == Family::FullActive {
-        record.push(v.first("idf", "reference.force"));
+        // every actuator's reference: the c_v table compares the largest with the delivered force
+        record.extend(v.per_position("idf", "reference.force"));
         record.push(v.first("idf", "spool.command"));
     }
     instances.extend(controllers);

@@ -482,6 +482,8 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         "c_v [kNs/m]",
         "rms acc [m/s2]",
         "F_max [kN]",
+        "rms force [kN]",
+        "peak reference c_v v [kN]",
         "rms power F v [kW]",
         "rms hydraulic power [kW]",
         "seed rms acc [m/s2]",
@@ -505,6 +507,9 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
                     cv,
                     m.map_or(f64::NAN, |m| m.rms()),
                     m.map_or(f64::NAN, |m| m.peak_force_n / 1e3),
+                    m.and_then(|m| m.rms_force_n).map_or(f64::NAN, |f| f / 1e3),
+                    m.and_then(|m| m.peak_reference_force_n)
+                        .map_or(f64::NAN, |f| f / 1e3),
                     m.and_then(|m| m.rms_power_w).map_or(f64::NAN, |p| p / 1e3),
                     m.and_then(|m| m.rms_hydraulic_power_w)
                         .map_or(f64::NAN, |p| p / 1e3),
@@ -535,6 +540,6 @@ mod markdown;
 mod tests;
 
 pub use markdown::{
-    comfort_speeds, gain_over_passive, report_markdown, within_limit_above, DIFFERENCES,
-    DIFFERENCES_COACH,
+    comfort_speeds, force_bound_note, gain_over_passive, report_markdown, within_limit_above,
+    ActuatorBound, DIFFERENCES, DIFFERENCES_COACH,
 };

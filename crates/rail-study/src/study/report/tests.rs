@@ -13,6 +13,8 @@ fn metrics(rms: f64, amp: f64, cmd: Option<f64>) -> RunMetrics {
         tail_amplitude_m: amp,
         max_displacement_m: amp * 1.2,
         peak_force_n: 20e3,
+        rms_force_n: Some(5e3),
+        peak_reference_force_n: None,
         rms_power_w: Some(250.0),
         rms_hydraulic_power_w: Some(8000.0),
         tail_command_v: cmd,
@@ -124,8 +126,8 @@ fn report_has_the_tables_the_timing_and_the_failures() {
         "| passive (30 %) | 290.0 (stable at 280.0) | - | - | 280-300 km/h | R8 |",
         "| MPPT2, ideal valve | > 400 | - | >= +110 |",
         "**10.0 simulated seconds per wall-clock second**",
-        "| 210 | 7.00 | 20.0 | 0.250 | 8.00 | 7.08 | 20.4 | 0.357 |",
-        "| 270 | failed | failed | failed | failed | 5.98 |",
+        "| 210 | 7.00 | 20.0 | 5.00 | - | 0.250 | 8.00 | 7.08 | 20.4 | 0.357 |",
+        "| 270 | failed | failed | failed | failed | failed | failed | 5.98 |",
         "| hil-mppt2_slow (MPPT2, slow valve) | 260 | 3.50 | 1.00 |",
         "`cv-270`: boom",
         "`rms_vs_speed.svg`",
@@ -246,4 +248,49 @@ fn the_coach_report_has_the_car_body_beside_the_en14363_verdict() {
         csv.contains("passive,sweep,280,3.0000,3.0000,2.0000,0.2500,1.5000"),
         "{csv}"
     );
+}
+
+#[test]
+fn force_bound_note_names_the_saturated_gains_from_the_runs() {
+    let bound = ActuatorBound::of_default_actuator();
+    // 100 bar on the 25.16 cm^2 annulus of Table 3-2
+    assert!((bound.force_n - 25_160.0).abs() < 1.0, "{bound:?}");
+    let mut r = results_on(VehicleModel::Coach);
+    assert_eq!(force_bound_note(&r.cv), None, "no reference recorded");
+    let with_reference = |cv: f64, peak: f64, reference: f64| NamedRun {
+        name: format!("cv-{cv:.0}"),
+        config: "full_active",
+        speed_kmh: 380.0,
+        c_v_nspm: Some(cv * 1e3),
+        error: None,
+        metrics: Some(RunMetrics {
+            peak_force_n: peak,
+            peak_reference_force_n: Some(reference),
+            ..metrics(2.0, 1e-3, None)
+        }),
+    };
+    r.cv = vec![
+        with_reference(210.0, 22.3e3, 32.3e3),
+        with_reference(390.0, 19.0e3, 21.4e3),
+    ];
+    let note = force_bound_note(&r.cv).unwrap();
+    for s in [
+        "at most 25.2 kN",
+        "At c_v 210 / 390 kNs/m",
+        "up to 32.3 / 21.4 kN",
+        "delivered up to 22.3 / 19.0 kN",
+        "exceeded the bound at c_v 210 kNs/m",
+        "81 / 93 / 92 / 98 %",
+    ] {
+        assert!(note.contains(s), "missing {s:?} in {note}");
+    }
+    let md = report_markdown(
+        &r,
+        &Timing {
+            wall_s: 1.0,
+            threads: 1,
+        },
+        &[],
+    );
+    assert!(md.contains(&note), "the report carries the note");
 }
