@@ -21,6 +21,9 @@
 //!   fmi2GetBooleanStatus(fmi2Terminated) is true ends the run normally (FMI 2.0 section
 //!   4.2.3), never retried: every slave is terminated, the results stop at the last
 //!   communication point all completed, and the summary names the slave and that time.
+//! * Recording reads every recorded variable at each point, except a connected output whose
+//!   slave has had no call that can change a value (set, step, FMU state restore, mode change)
+//!   since it was read for the exchange: the row takes that value (what a second read returns).
 //! * Every exit path (success, error, cancellation) calls fmi2Terminate on each slave that
 //!   reached step mode (exitInitializationMode) and did not report fmi2Fatal; freeing
 //!   (fmi2FreeInstance, allowed in every state) is the slaves' `Drop`.

@@ -18,6 +18,12 @@ pub(super) struct Engine<'p, 's, 'd, 'o> {
     fatal: Vec<bool>,
     /// Latest connected outputs of each instance (in its `Source::outputs` order).
     outputs: Vec<Vec<f64>>,
+    /// Per instance: how many calls that may change its values (set, step, state restore,
+    /// mode change) it has had, and that count when `outputs` was last read (`u64::MAX`:
+    /// not read yet). Equal counts: a read now returns `outputs` again (FMI 2.0: values
+    /// change only through such calls).
+    changes: Vec<u64>,
+    read_at: Vec<u64>,
     /// Scratch: the inputs of one destination, and their previous values.
     inputs: Vec<f64>,
     previous: Vec<f64>,
@@ -87,6 +93,8 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             initialised: vec![false; n],
             fatal: vec![false; n],
             outputs: vec![Vec::new(); n],
+            changes: vec![0; n],
+            read_at: vec![u64::MAX; n],
             inputs: Vec::new(),
             previous: Vec::new(),
             recorded: Vec::new(),
@@ -131,8 +139,14 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         Ok(())
     }
 
+    /// Counts a call on slave `i` that may change its values.
+    fn touch(&mut self, i: usize) {
+        self.changes[i] = self.changes[i].wrapping_add(1);
+    }
+
     /// Writes a batch to slave `i` (numbers, then the Strings by their texts).
     fn set_batch(&mut self, i: usize, batch: &VarBatch, values: &[f64]) -> Result<(), SlaveError> {
+        self.touch(i);
         self.slaves[i].set(batch, values)?;
         let g = batch.group(ScalarType::String);
         if !g.vrs.is_empty() {
@@ -176,6 +190,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         values.resize(src.outputs.len(), 0.0);
         let r = self.get_batch(i, &src.outputs, &mut values);
         self.outputs[i] = values;
+        self.read_at[i] = if r.is_ok() { self.changes[i] } else { u64::MAX };
         r.map_err(|e| self.slave_err(time, i, e))
     }
 
@@ -319,6 +334,14 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let exchange = self.exchange;
         let mut values = std::mem::take(&mut self.recorded);
         for g in &exchange.record {
+            let i = g.instance;
+            if let (Some(at), true) = (&g.from_outputs, self.read_at[i] == self.changes[i]) {
+                // connected outputs read since the instance's last change: the same values
+                for (&c, &k) in g.columns.iter().zip(at) {
+                    out[row + 1 + c] = self.outputs[i][k];
+                }
+                continue;
+            }
             let read = match g.first_column {
                 // consecutive columns: read straight into the row
                 Some(c) => {
@@ -354,6 +377,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let plan = self.plan;
         let t0 = plan.start_time;
         for i in 0..self.slaves.len() {
+            self.touch(i);
             self.slaves[i]
                 .setup_experiment(t0, plan.stop_time)
                 .map_err(|e| self.slave_err(t0, i, e))?;
@@ -379,6 +403,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                         source,
                     })?;
             }
+            self.touch(i);
             self.slaves[i]
                 .enter_initialization_mode()
                 .map_err(|e| self.slave_err(t0, i, e))?;
@@ -394,6 +419,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             }
         }
         for i in 0..self.slaves.len() {
+            self.touch(i);
             self.slaves[i]
                 .exit_initialization_mode()
                 .map_err(|e| self.slave_err(t0, i, e))?;
@@ -407,6 +433,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
     /// Steps slave `i` over `[ts, ts + h]`; a discard asks the slave whether it ends the
     /// simulation, and how far it got (fmi2LastSuccessfulTime).
     fn step_slave(&mut self, i: usize, ts: f64, h: f64) -> Result<SlaveStep, SimError> {
+        self.touch(i);
         match self.slaves[i].do_step(ts, h) {
             Ok(StepStatus::Ok) => Ok(SlaveStep::Ok),
             Ok(StepStatus::Discard) => {
@@ -578,6 +605,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                 });
             }
             for j in 0..self.slaves.len() {
+                self.touch(j);
                 self.slaves[j]
                     .restore_state()
                     .map_err(|e| self.slave_err(t, j, e))?;

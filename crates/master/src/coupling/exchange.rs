@@ -38,6 +38,10 @@ pub(super) struct RecordGroup {
     /// The first column when `columns` are consecutive (then the slave writes into the row
     /// itself).
     pub first_column: Option<usize>,
+    /// When every variable is also a connected output of the instance: its position in the
+    /// instance's `Source::outputs` (the value read for the exchange is the value a second
+    /// read gives while no call changed the instance since).
+    pub from_outputs: Option<Vec<usize>>,
 }
 
 /// The whole exchange of a plan.
@@ -108,7 +112,7 @@ impl Exchange {
             })
             .collect();
         let links = || plan.connections.iter().zip(connection_at.iter().copied());
-        let sources = (0..n)
+        let sources: Vec<Source> = (0..n)
             .map(|i| {
                 let mine = || {
                     links()
@@ -142,6 +146,14 @@ impl Exchange {
         .into_iter()
         .map(|g| RecordGroup {
             instance: g.instance,
+            from_outputs: {
+                let outputs = sources[g.instance].outputs.vars();
+                g.vars
+                    .vars()
+                    .iter()
+                    .map(|v| outputs.iter().position(|o| o == v))
+                    .collect()
+            },
             vars: g.vars,
             first_column: g
                 .payload

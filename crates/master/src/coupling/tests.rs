@@ -807,3 +807,41 @@ fn gauss_seidel_reads_direct_feedthrough_outputs_again_after_setting_inputs() {
         }
     }
 }
+
+#[test]
+fn a_recorded_connected_output_is_not_read_again_while_its_slave_is_unchanged() {
+    // sdm.coupling_force is connected and recorded. Gauss-Seidel (ms, sdm): after sdm's step
+    // and read nothing is called on sdm before the record, so the record takes the value read
+    // for the exchange (one get per step); ms has its force set after its read, so it is read
+    // again. Jacobi sets sdm's inputs after reading it: read again.
+    let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 0.01, 0.1);
+    plan.record[1] = Recorded {
+        instance: 1,
+        var: r(5),
+        label: "sdm.coupling_force [N]".into(),
+        info: Default::default(),
+    };
+    for (alg, sdm_gets) in [(Algorithm::GaussSeidel, 10), (Algorithm::Jacobi, 20)] {
+        plan.algorithm = alg;
+        let calls = |stop: f64| {
+            let mut p = plan.clone();
+            p.stop_time = stop;
+            let (out, a, b) = run(&p);
+            (out, [a.hooks.gets, b.hooks.gets])
+        };
+        let ((_, short), (out, long)) = (calls(0.1), calls(0.2));
+        assert_eq!(
+            [long[0] - short[0], long[1] - short[1]],
+            [20, sdm_gets],
+            "{alg:?}"
+        );
+        if alg == Algorithm::GaussSeidel {
+            // the force recorded on ms is the one sdm gave at every point
+            let f_sdm = out.column("sdm.coupling_force [N]").unwrap();
+            let f_ms = out.column("ms.force [N]").unwrap();
+            assert_eq!(f_sdm.len(), 21);
+            assert_eq!(f_sdm, f_ms);
+            assert!(f_sdm.iter().any(|f| *f != 0.0));
+        }
+    }
+}
