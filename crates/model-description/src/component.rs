@@ -135,6 +135,9 @@ pub struct Component {
     index: VrIndex,
     /// By declaration index.
     rules: Vec<SetRule>,
+    /// The rules of the Reals by value reference (Real value references are 0, 1, ... in
+    /// declaration order, see [`VrIndex`]): fmi2SetReal's common case without the lookup.
+    real_rules: Vec<SetRule>,
     ctx: InstanceContext,
     sink: Box<dyn LogSink>,
     logging_on: bool,
@@ -170,11 +173,19 @@ impl Component {
         logging_on: bool,
     ) -> Self {
         let index = VrIndex::new(model.metas());
-        let rules = model.metas().iter().map(SetRule::of).collect();
+        let rules: Vec<SetRule> = model.metas().iter().map(SetRule::of).collect();
+        let real_rules = model
+            .metas()
+            .iter()
+            .zip(&rules)
+            .filter(|(m, _)| m.var_type == VarType::Real)
+            .map(|(_, r)| *r)
+            .collect();
         Component {
             model,
             index,
             rules,
+            real_rules,
             ctx,
             sink,
             logging_on,
@@ -222,6 +233,7 @@ impl Component {
     }
 
     #[cold]
+    #[inline(never)]
     fn trace_call(&mut self, call: &str) {
         let msg = format!(
             "{call} (state {}, t = {})",
@@ -231,6 +243,8 @@ impl Component {
         self.sink.log(Status::Ok, "logCalls", &msg);
     }
 
+    #[cold]
+    #[inline(never)]
     fn wrong_state(&mut self, call: &str) -> Status {
         let msg = format!(
             "{call} is not allowed in state {} (FMI 2.0 co-simulation state machine)",
@@ -397,6 +411,7 @@ impl Component {
     }
 
     #[cold]
+    #[inline(never)]
     fn unknown(&mut self, call: &str, var_type: VarType, vr: u32) -> Status {
         let msg = format!(
             "{call}: unknown value reference {vr} for type {}",
@@ -405,15 +420,26 @@ impl Component {
         self.error(&msg)
     }
 
+    #[inline]
     fn check_get(&mut self, call: &str, nvr: usize, nvalue: usize) -> Status {
         if !self.can_get() {
             return self.wrong_state(call);
         }
         if nvr != nvalue {
-            let msg = format!("{call}: {nvr} value references but {nvalue} values");
-            return self.error(&msg);
+            return self.count_mismatch(call, nvr, nvalue);
         }
-        self.refresh_outputs(call)
+        if self.outputs_dirty {
+            self.refresh_outputs(call)
+        } else {
+            Status::Ok
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn count_mismatch(&mut self, call: &str, nvr: usize, nvalue: usize) -> Status {
+        let msg = format!("{call}: {nvr} value references but {nvalue} values");
+        self.error(&msg)
     }
 
     pub fn get_real(&mut self, vrs: &[u32], values: &mut [f64]) -> Status {
@@ -537,6 +563,7 @@ impl Component {
         Ok(())
     }
 
+    #[inline]
     fn check_set_common(&mut self, call: &str, nvr: usize, nvalue: usize) -> Result<(), Status> {
         if !matches!(
             self.state,
@@ -545,8 +572,7 @@ impl Component {
             return Err(self.wrong_state(call));
         }
         if nvr != nvalue {
-            let msg = format!("{call}: {nvr} value references but {nvalue} values");
-            return Err(self.error(&msg));
+            return Err(self.count_mismatch(call, nvr, nvalue));
         }
         Ok(())
     }
@@ -557,6 +583,28 @@ impl Component {
         if let Err(s) = self.check_set_common(CALL, vrs.len(), values.len()) {
             return s;
         }
+        // the common case: every value reference is a Real whose rule accepts the value now
+        let state = self.state;
+        let accepted = vrs.iter().zip(values).all(|(&vr, &v)| {
+            self.real_rules
+                .get(vr as usize)
+                .is_some_and(|r| r.settable(state) && r.accepts(v))
+        });
+        if !accepted {
+            return self.set_real_checked(vrs, values);
+        }
+        self.outputs_dirty = true;
+        match self.model.set_reals(vrs, values) {
+            Ok(()) => Status::Ok,
+            Err(vr) => self.error(&format!("{CALL}: internal: no setter for Real {vr}")),
+        }
+    }
+
+    /// [`Self::set_real`] with the full checks, which name the first refused value.
+    #[cold]
+    #[inline(never)]
+    fn set_real_checked(&mut self, vrs: &[u32], values: &[f64]) -> Status {
+        const CALL: &str = "fmi2SetReal";
         for (vr, v) in vrs.iter().zip(values) {
             let i = match self.resolve(CALL, VarType::Real, *vr) {
                 Ok(i) => i,
