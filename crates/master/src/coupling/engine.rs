@@ -47,6 +47,8 @@ pub(super) struct Engine<'p, 's, 'd, 'o> {
     /// canHandleVariableCommunicationStepSize (capabilities do not change during a run).
     lacking_state: Option<usize>,
     fixed_step: Option<usize>,
+    /// Every instance steps at every point (step multiple 1).
+    every_point: bool,
 }
 
 /// How a macro step ended.
@@ -107,6 +109,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             windows: Vec::with_capacity(n),
             lacking_state,
             fixed_step,
+            every_point: plan.instances.iter().all(|i| i.step_multiple <= 1),
         }
     }
 
@@ -458,12 +461,17 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         // (start, end) of each active slave's window (a scratch vector: no allocation per step)
         let mut windows = std::mem::take(&mut self.windows);
         windows.clear();
-        for inst in &plan.instances {
-            let m = u64::from(inst.step_multiple.max(1));
-            windows.push(
-                k.is_multiple_of(m)
-                    .then(|| (t, self.t((k + m).min(self.n_steps)))),
-            );
+        if self.every_point {
+            let w = Some((t, self.t(k + 1)));
+            windows.extend(plan.instances.iter().map(|_| w));
+        } else {
+            for inst in &plan.instances {
+                let m = u64::from(inst.step_multiple.max(1));
+                windows.push(
+                    k.is_multiple_of(m)
+                        .then(|| (t, self.t((k + m).min(self.n_steps)))),
+                );
+            }
         }
         let result = self.step_windows(k, parts, &windows);
         self.windows = windows;
@@ -481,6 +489,9 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let n = self.slaves.len();
         let t = self.t(k);
         let sub = |(a, b): (f64, f64), j: u64| -> (f64, f64) {
+            if parts == 1 {
+                return (a, b - a);
+            }
             let s = a + (b - a) * (j as f64) / (parts as f64);
             let e = if j + 1 == parts {
                 b
