@@ -334,6 +334,7 @@ impl PySystem {
                 let opts = RunOptions {
                     cancel: Some(cancel_ref),
                     progress: Some(&report),
+                    general_engine: false,
                 };
                 prepared.run(&changes, &opts)
             },

@@ -53,6 +53,10 @@ pub struct RunOptions<'a> {
     pub cancel: Option<&'a AtomicBool>,
     /// Called after every macro step with (steps done, total steps).
     pub progress: Option<&'a dyn Fn(u64, u64)>,
+    /// Run every macro step through the general engine, never the precompiled one of the
+    /// common case (Gauss-Seidel, every instance stepping at every point, no step retry, no
+    /// String exchanged): the same results bit for bit, for comparing the two.
+    pub general_engine: bool,
 }
 
 /// FMI 2.0 (4.3.1): a slave without canHandleVariableCommunicationStepSize must always be
@@ -84,11 +88,20 @@ pub fn simulate(
     slaves: &mut [&mut dyn Slave],
     opts: &RunOptions,
 ) -> Result<SimOutput, SimError> {
+    simulate_with(plan, slaves, opts, !opts.general_engine)
+}
+
+fn simulate_with(
+    plan: &CouplingPlan,
+    slaves: &mut [&mut dyn Slave],
+    opts: &RunOptions,
+    fast: bool,
+) -> Result<SimOutput, SimError> {
     let n_steps = check_plan(plan, slaves.len())?;
     check_step_sizes(plan, slaves, n_steps)?;
     let started = Instant::now();
     let exchange = Exchange::new(plan);
-    let mut eng = Engine::new(plan, &exchange, slaves, opts, n_steps);
+    let mut eng = Engine::new(plan, &exchange, slaves, opts, n_steps, fast);
     let res = eng.run();
     let term = eng.terminate_all();
     let data = res?;

@@ -339,6 +339,7 @@ pub fn run_job(
     let opts = RunOptions {
         cancel: Some(cancel),
         progress: None,
+        general_engine: false,
     };
     system.run(&changes, &opts).map_err(|e| e.to_string())
 }

@@ -136,6 +136,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     let opts = RunOptions {
         cancel: Some(ctx.cancel),
         progress: Some(&progress),
+        general_engine: false,
     };
     let out = sys.run(&opts);
     bar.finish_and_clear();

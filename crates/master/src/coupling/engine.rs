@@ -49,6 +49,11 @@ pub(super) struct Engine<'p, 's, 'd, 'o> {
     fixed_step: Option<usize>,
     /// Every instance steps at every point (step multiple 1).
     every_point: bool,
+    /// The common case runs [`Self::fast_step`]: Gauss-Seidel, every instance stepping at
+    /// every point, no step retry (so no split steps) and no String among the exchanged
+    /// variables. Same calls in the same order as [`Self::step_windows`], so the same results
+    /// bit for bit.
+    fast: bool,
 }
 
 /// How a macro step ended.
@@ -81,6 +86,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         slaves: &'s mut [&'d mut dyn Slave],
         opts: &'o RunOptions<'o>,
         n_steps: u64,
+        fast: bool,
     ) -> Self {
         let n = slaves.len();
         let lacking_state = slaves.iter().position(|s| !s.can_save_state());
@@ -110,7 +116,20 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             lacking_state,
             fixed_step,
             every_point: plan.instances.iter().all(|i| i.step_multiple <= 1),
+            fast: fast && Self::fast_applies(plan, exchange),
         }
+    }
+
+    /// Whether [`Self::fast_step`] does what [`Self::step_windows`] does for this plan.
+    fn fast_applies(plan: &CouplingPlan, exchange: &Exchange) -> bool {
+        let no_strings = |b: &VarBatch| b.group(ScalarType::String).vrs.is_empty();
+        plan.algorithm == Algorithm::GaussSeidel
+            && plan.max_step_halvings == 0
+            && plan.instances.iter().all(|i| i.step_multiple <= 1)
+            && exchange
+                .sources
+                .iter()
+                .all(|s| no_strings(&s.outputs) && s.dests.iter().all(|d| no_strings(&d.inputs)))
     }
 
     /// The instance that ended the run and the time of the last result row, if one did.
@@ -456,6 +475,9 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
     /// Tries macro step `k` split into `parts` sub-steps. A slave that ends the simulation
     /// after completing the last sub-step lets the others complete it too.
     fn try_macro_step(&mut self, k: u64, parts: u64) -> Result<StepEnd, SimError> {
+        if self.fast && parts == 1 {
+            return self.fast_step(k);
+        }
         let plan = self.plan;
         let t = self.t(k);
         // (start, end) of each active slave's window (a scratch vector: no allocation per step)
@@ -476,6 +498,68 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let result = self.step_windows(k, parts, &windows);
         self.windows = windows;
         result
+    }
+
+    /// Macro step `k` in the common case (see `fast`): each instance in order steps over
+    /// `[t_k, t_k+1]`, then its connected outputs are read in one call and written to their
+    /// inputs (one call per destination), with no windows, no sub-step arithmetic and no
+    /// String handling.
+    fn fast_step(&mut self, k: u64) -> Result<StepEnd, SimError> {
+        let plan = self.plan;
+        let exchange = self.exchange;
+        let t = self.t(k);
+        let h = self.t(k + 1) - t;
+        let te = t + h;
+        self.current.iter_mut().for_each(|c| *c = false);
+        let mut ending: Option<usize> = None;
+        for &i in &plan.order {
+            match self.step_slave(i, t, h)? {
+                SlaveStep::Ok => {}
+                SlaveStep::Discarded => return Ok(StepEnd::Discarded(i)),
+                SlaveStep::Terminating { completed: true } => {
+                    ending.get_or_insert(i);
+                }
+                SlaveStep::Terminating { completed: false } => {
+                    return Ok(StepEnd::Terminated {
+                        instance: i,
+                        completed: false,
+                    })
+                }
+            }
+            self.current[i] = true;
+            let src = &exchange.sources[i];
+            if !src.outputs.is_empty() {
+                let out = &mut self.outputs[i];
+                if out.len() != src.outputs.len() {
+                    out.resize(src.outputs.len(), 0.0);
+                }
+                let r = self.slaves[i].get(&src.outputs, out);
+                self.read_at[i] = if r.is_ok() { self.changes[i] } else { u64::MAX };
+                r.map_err(|e| self.slave_err(te, i, e))?;
+                self.check_outputs(te, i)?;
+            }
+            for dest in &src.dests {
+                let j = dest.instance;
+                self.inputs.clear();
+                let outputs = &self.outputs;
+                self.inputs
+                    .extend(dest.from.iter().map(|&(s, k)| outputs[s][k]));
+                self.touch(j);
+                self.slaves[j]
+                    .set(&dest.inputs, &self.inputs)
+                    .map_err(|e| self.slave_err(te, j, e))?;
+            }
+            if !src.feeds_through.is_empty() {
+                self.refresh_feedthrough(te, i)?;
+            }
+        }
+        Ok(match ending {
+            Some(instance) => StepEnd::Terminated {
+                instance,
+                completed: true,
+            },
+            None => StepEnd::Done,
+        })
     }
 
     /// [`Self::try_macro_step`] over the given windows.

@@ -520,6 +520,7 @@ fn cancel_flag_stops_and_terminates_everything() {
     let opts = RunOptions {
         cancel: Some(&flag),
         progress: None,
+        general_engine: false,
     };
     let e = simulate(&plan, &mut [&mut a, &mut b], &opts).unwrap_err();
     assert!(
