@@ -218,6 +218,9 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
 
     /// The connected outputs of instance `i` must be finite (first offender in plan order).
     fn check_outputs(&self, time: f64, i: usize) -> Result<(), SimError> {
+        if self.outputs[i].iter().all(|x| x.is_finite()) {
+            return Ok(());
+        }
         let src = &self.exchange.sources[i];
         for (&x, &ci) in self.outputs[i].iter().zip(&src.connections) {
             if !x.is_finite() {
@@ -540,14 +543,21 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             }
             for dest in &src.dests {
                 let j = dest.instance;
-                self.inputs.clear();
-                let outputs = &self.outputs;
-                self.inputs
-                    .extend(dest.from.iter().map(|&(s, k)| outputs[s][k]));
                 self.touch(j);
-                self.slaves[j]
-                    .set(&dest.inputs, &self.inputs)
-                    .map_err(|e| self.slave_err(te, j, e))?;
+                let r = match dest.run {
+                    // the inputs are consecutive outputs of this source: written from there
+                    Some(k) => {
+                        self.slaves[j].set(&dest.inputs, &self.outputs[i][k..k + dest.from.len()])
+                    }
+                    None => {
+                        self.inputs.clear();
+                        let outputs = &self.outputs;
+                        self.inputs
+                            .extend(dest.from.iter().map(|&(s, k)| outputs[s][k]));
+                        self.slaves[j].set(&dest.inputs, &self.inputs)
+                    }
+                };
+                r.map_err(|e| self.slave_err(te, j, e))?;
             }
             if !src.feeds_through.is_empty() {
                 self.refresh_feedthrough(te, i)?;

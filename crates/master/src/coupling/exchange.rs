@@ -26,6 +26,9 @@ pub(super) struct Dest {
     pub inputs: VarBatch,
     /// For each input: (source instance, position in that source's outputs).
     pub from: Vec<(usize, usize)>,
+    /// When every input comes from one source's consecutive outputs: the first position
+    /// (the inputs are that slice of the source's outputs, written without a copy).
+    pub run: Option<usize>,
 }
 
 /// Recorded variables of one instance.
@@ -91,6 +94,12 @@ fn dests(groups: Vec<Grouped<(usize, usize)>>) -> Vec<Dest> {
         .map(|g| Dest {
             instance: g.instance,
             inputs: g.vars,
+            run: g
+                .payload
+                .windows(2)
+                .all(|w| w[1].0 == w[0].0 && w[1].1 == w[0].1 + 1)
+                .then(|| g.payload.first().map(|&(_, k)| k))
+                .flatten(),
             from: g.payload,
         })
         .collect()

@@ -230,14 +230,18 @@ impl Slave for FmuSlave {
         }
         let (c, lib) = (self.component, self.fmu.library());
         let g = batch.group(ScalarType::Real);
+        if batch.all_real() {
+            // the common case: one fmi2SetReal with the values as they are
+            if !g.vrs.is_empty() {
+                let s = unsafe { (lib.set_real)(c, g.vrs.as_ptr(), g.vrs.len(), values.as_ptr()) };
+                self.check("fmi2SetReal", s)?;
+            }
+            return Ok(());
+        }
         if !g.vrs.is_empty() {
-            let s = if batch.all_real() {
-                unsafe { (lib.set_real)(c, g.vrs.as_ptr(), g.vrs.len(), values.as_ptr()) }
-            } else {
-                self.reals.clear();
-                self.reals.extend(g.positions.iter().map(|&k| values[k]));
-                unsafe { (lib.set_real)(c, g.vrs.as_ptr(), g.vrs.len(), self.reals.as_ptr()) }
-            };
+            self.reals.clear();
+            self.reals.extend(g.positions.iter().map(|&k| values[k]));
+            let s = unsafe { (lib.set_real)(c, g.vrs.as_ptr(), g.vrs.len(), self.reals.as_ptr()) };
             self.check("fmi2SetReal", s)?;
         }
         for (ty, call) in [
