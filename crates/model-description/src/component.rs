@@ -705,6 +705,37 @@ impl Component {
     }
 
     pub fn do_step(&mut self, current: f64, step: f64) -> Status {
+        // the common case in one test: step mode, a finite step from our own time (to the
+        // tolerance), not beyond the stop time; anything else is named by `step_refused`
+        let tol = self.time_tolerance(step);
+        let target = current + step;
+        let valid = self.state == FmiState::StepComplete
+            && current.is_finite()
+            && step.is_finite()
+            && step >= 0.0
+            && (current - self.time).abs() <= tol
+            && self.stop_time.is_none_or(|stop| target <= stop + tol);
+        if !valid {
+            return self.step_refused(current, step);
+        }
+        // Step from our own time to the host's target, so drift never accumulates.
+        let effective = target - self.time;
+        if effective > 0.0 {
+            if let Err(e) = self.model.do_step(self.time, effective, &mut self.diag) {
+                return self.step_failed(e, effective);
+            }
+        }
+        self.time = target;
+        self.last_successful_time = target;
+        // a model whose step computed its outputs needs no second computation before a read
+        self.outputs_dirty = !(effective > 0.0 && self.model.step_computes_outputs());
+        self.flush_diagnostics()
+    }
+
+    /// fmi2DoStep refused before stepping: the first failed check, named.
+    #[cold]
+    #[inline(never)]
+    fn step_refused(&mut self, current: f64, step: f64) -> Status {
         const CALL: &str = "fmi2DoStep";
         if self.state != FmiState::StepComplete {
             return self.wrong_state(CALL);
@@ -729,34 +760,32 @@ impl Component {
                 return self.error(&msg);
             }
         }
-        // Step from our own time to the host's target, so drift never accumulates.
-        let effective = target - self.time;
-        if effective > 0.0 {
-            match self.model.do_step(self.time, effective, &mut self.diag) {
-                Ok(()) => {}
-                Err(StepError::Discard(reason)) => {
-                    let _ = self.flush_diagnostics();
-                    self.state = FmiState::StepFailed;
-                    let msg = format!(
-                        "{CALL}: step from {} over {effective} s discarded: {reason}",
-                        self.time
-                    );
-                    self.sink.log(Status::Discard, "logStatusDiscard", &msg);
-                    return Status::Discard;
-                }
-                Err(StepError::Error(e)) => {
-                    let _ = self.flush_diagnostics();
-                    self.state = FmiState::Error;
-                    let msg = format!("{CALL}: step from {} failed: {e}", self.time);
-                    return self.error(&msg);
-                }
+        let msg = format!("{CALL}: internal: step from {current} over {step} refused");
+        self.error(&msg)
+    }
+
+    /// The model's step failed: discarded (the instance may be restored) or an error.
+    #[cold]
+    #[inline(never)]
+    fn step_failed(&mut self, e: StepError, effective: f64) -> Status {
+        const CALL: &str = "fmi2DoStep";
+        let _ = self.flush_diagnostics();
+        match e {
+            StepError::Discard(reason) => {
+                self.state = FmiState::StepFailed;
+                let msg = format!(
+                    "{CALL}: step from {} over {effective} s discarded: {reason}",
+                    self.time
+                );
+                self.sink.log(Status::Discard, "logStatusDiscard", &msg);
+                Status::Discard
+            }
+            StepError::Error(e) => {
+                self.state = FmiState::Error;
+                let msg = format!("{CALL}: step from {} failed: {e}", self.time);
+                self.error(&msg)
             }
         }
-        self.time = target;
-        self.last_successful_time = target;
-        // a model whose step computed its outputs needs no second computation before a read
-        self.outputs_dirty = !(effective > 0.0 && self.model.step_computes_outputs());
-        self.flush_diagnostics()
     }
 
     pub fn last_successful_time(&self) -> f64 {
