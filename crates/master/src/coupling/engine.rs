@@ -50,8 +50,8 @@ pub(super) struct Engine<'p, 's, 'd, 'o> {
     /// Every instance steps at every point (step multiple 1).
     every_point: bool,
     /// The common case runs [`Self::fast_step`]: Gauss-Seidel, every instance stepping at
-    /// every point, no step retry (so no split steps) and no String among the exchanged
-    /// variables. Same calls in the same order as [`Self::step_windows`], so the same results
+    /// every point, no step retry (so no split steps) and no String among the exchanged or
+    /// recorded variables. Same calls in the same order as [`Self::step_windows`], so the same results
     /// bit for bit.
     fast: bool,
 }
@@ -130,6 +130,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                 .sources
                 .iter()
                 .all(|s| no_strings(&s.outputs) && s.dests.iter().all(|d| no_strings(&d.inputs)))
+            && exchange.record.iter().all(|g| no_strings(&g.vars))
     }
 
     /// The instance that ended the run and the time of the last result row, if one did.
@@ -368,6 +369,11 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                 continue;
             }
             let read = match g.first_column {
+                // the common case (no String recorded): consecutive columns in one call
+                Some(c) if self.fast => {
+                    let at = row + 1 + c;
+                    self.slaves[i].get(&g.vars, &mut out[at..at + g.vars.len()])
+                }
                 // consecutive columns: read straight into the row
                 Some(c) => {
                     let at = row + 1 + c;
@@ -388,6 +394,9 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             }
         }
         self.recorded = values;
+        if out[row + 1..].iter().all(|x| x.is_finite()) {
+            return Ok(());
+        }
         if let Some(k) = out[row + 1..].iter().position(|x| !x.is_finite()) {
             return Err(SimError::NonFinite {
                 time,
