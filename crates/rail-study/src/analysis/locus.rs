@@ -16,6 +16,8 @@ use fmu_bogie2dof::eigen::{
     LinearDamper,
 };
 use fmu_bogie2dof::Params;
+use fmu_damper::characterise::equivalent_stiffness_damping;
+use fmu_damper::semi_active::SemiActiveParams;
 
 use super::locus_figures::{speeds_line, LocusFigures, LocusSpeed};
 use super::{AnalysisError, Artefacts, Table};
@@ -40,12 +42,81 @@ pub enum DamperSpec {
     Maxwell(f64, f64),
     /// Spring k [N/m] parallel to dashpot c [N s/m].
     KelvinVoigt(f64, f64),
+    /// The hydraulic semi-active damper at a fixed opening, linearised at one stroke and
+    /// frequency: a Kelvin-Voigt element with its first-harmonic stiffness and damping.
+    Linearised(LinearisedDamper),
     /// No yaw dampers.
     None,
 }
 
+/// The semi-active damper model (fmu-damper's default parameters, the R1-R2 calibration) with
+/// its valve fixed at `opening`, driven by `x = X sin(2 pi f t)` to a periodic steady state:
+/// `k = Re(F1/X1)`, `c = Im(F1/X1) / w` (equivalent linearisation by the first harmonic, valid
+/// at that stroke and frequency only: the hydraulic damper is strongly non-linear).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinearisedDamper {
+    /// Valve opening, 0 (closed) to 1.
+    pub opening: f64,
+    /// Stroke amplitude X [m].
+    pub stroke_m: f64,
+    /// Stroke frequency f [Hz].
+    pub freq_hz: f64,
+    /// Equivalent stiffness [N/m].
+    pub k_n_per_m: f64,
+    /// Equivalent damping [N s/m].
+    pub c_ns_per_m: f64,
+}
+
+/// Largest stroke amplitude a linearisation is asked for [m]: a yaw damper's stroke is a few
+/// centimetres at most.
+pub const MAX_LINEARISATION_STROKE_M: f64 = 0.05;
+/// Frequency of a linearisation when none is given [Hz]: the hunting frequency of the seed's
+/// bogie (R6: 3-4 Hz) and of the coach at its critical speed (4.0 Hz).
+pub const DEFAULT_LINEARISATION_FREQ_HZ: f64 = 4.0;
+
+impl LinearisedDamper {
+    /// Measures the damper at `opening` (0..1), stroke amplitude `stroke_m` (0 < X <= 5 cm) and
+    /// `freq_hz` (0 < f <= 50 Hz).
+    pub fn measure(opening: f64, stroke_m: f64, freq_hz: f64) -> Result<Self, String> {
+        if !(opening.is_finite() && (0.0..=1.0).contains(&opening)) {
+            return Err(format!(
+                "opening {opening}: must be within 0 (closed) and 1"
+            ));
+        }
+        if !(stroke_m.is_finite() && stroke_m > 0.0 && stroke_m <= MAX_LINEARISATION_STROKE_M) {
+            return Err(format!(
+                "stroke {stroke_m} m: must be > 0 and at most {MAX_LINEARISATION_STROKE_M} m \
+                 (an amplitude in metres, e.g. 3e-3)"
+            ));
+        }
+        if !(freq_hz.is_finite() && freq_hz > 0.0 && freq_hz <= 50.0) {
+            return Err(format!(
+                "frequency {freq_hz} Hz: must be > 0 and at most 50 Hz"
+            ));
+        }
+        let (k, c) =
+            equivalent_stiffness_damping(&SemiActiveParams::default(), opening, freq_hz, stroke_m)
+                .map_err(|e| format!("the damper model cannot be linearised there: {e}"))?;
+        if !(k.is_finite() && c.is_finite() && k >= 0.0 && c >= 0.0) {
+            return Err(format!(
+                "the damper's first harmonic gives k = {k} N/m, c = {c} N s/m: not a \
+                 Kelvin-Voigt element"
+            ));
+        }
+        Ok(Self {
+            opening,
+            stroke_m,
+            freq_hz,
+            k_n_per_m: k,
+            c_ns_per_m: c,
+        })
+    }
+}
+
 /// Parses `passive`, `none`, `viscous:C`, `maxwell:K:C`, `kelvin:K:C` (SI: N/m, N s/m;
-/// `120e3` or `120k` are both accepted).
+/// `120e3` or `120k` are both accepted) and `semi-active:OPENING:STROKE[:FREQ]` (valve opening
+/// 0..1, stroke amplitude in m, frequency in Hz, default 4), which measures the damper model
+/// there ([`LinearisedDamper::measure`]).
 pub fn parse_damper(s: &str) -> Result<DamperSpec, String> {
     let num = |t: &str| -> Result<f64, String> {
         let t = t.trim();
@@ -62,7 +133,13 @@ pub fn parse_damper(s: &str) -> Result<DamperSpec, String> {
         }
     };
     let parts: Vec<&str> = s.trim().split(':').collect();
-    let usage = "use passive, none, viscous:C, maxwell:K:C or kelvin:K:C (N/m, N s/m)";
+    let usage = "use passive, none, viscous:C, maxwell:K:C, kelvin:K:C (N/m, N s/m) or \
+                 semi-active:OPENING:STROKE[:FREQ] (0..1, m, Hz)";
+    let plain = |t: &str| -> Result<f64, String> {
+        t.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("'{}' is not a number", t.trim()))
+    };
     match parts.as_slice() {
         ["passive"] => Ok(DamperSpec::Passive),
         ["none"] => Ok(DamperSpec::None),
@@ -76,6 +153,14 @@ pub fn parse_damper(s: &str) -> Result<DamperSpec, String> {
             }
         }
         ["kelvin", k, c] => Ok(DamperSpec::KelvinVoigt(num(k)?, num(c)?)),
+        ["semi-active", opening, stroke] => Ok(DamperSpec::Linearised(LinearisedDamper::measure(
+            plain(opening)?,
+            plain(stroke)?,
+            DEFAULT_LINEARISATION_FREQ_HZ,
+        )?)),
+        ["semi-active", opening, stroke, freq] => Ok(DamperSpec::Linearised(
+            LinearisedDamper::measure(plain(opening)?, plain(stroke)?, plain(freq)?)?,
+        )),
         _ => Err(format!("'{s}': {usage}")),
     }
 }
@@ -93,6 +178,10 @@ impl DamperSpec {
             DamperSpec::KelvinVoigt(k, c) => {
                 DamperRepresentation::Linear(LinearDamper::KelvinVoigt { k, c })
             }
+            DamperSpec::Linearised(l) => DamperRepresentation::Linear(LinearDamper::KelvinVoigt {
+                k: l.k_n_per_m,
+                c: l.c_ns_per_m,
+            }),
             DamperSpec::None => DamperRepresentation::Linear(LinearDamper::None),
         }
     }
@@ -114,6 +203,16 @@ impl DamperSpec {
                 "Kelvin-Voigt {:.2} MN/m parallel to {:.1} kN s/m per damper",
                 k * 1e-6,
                 c * 1e-3
+            ),
+            DamperSpec::Linearised(l) => format!(
+                "semi-active damper at {:.0} % opening linearised at +-{:.2} mm, {:.2} Hz \
+                 (first harmonic of the fmu-damper model): Kelvin-Voigt {:.2} MN/m parallel \
+                 to {:.1} kN s/m per damper",
+                l.opening * 100.0,
+                l.stroke_m * 1e3,
+                l.freq_hz,
+                l.k_n_per_m * 1e-6,
+                l.c_ns_per_m * 1e-3
             ),
             DamperSpec::None => "no yaw dampers".into(),
         }
@@ -306,6 +405,57 @@ mod tests {
         assert!(parse_damper("viscous:-1").is_err());
         assert!(parse_damper("maxwell:0:1").is_err());
         assert!(parse_damper("hydraulic").is_err());
+    }
+
+    /// The semi-active damper linearised by its first harmonic: the frequency defaults to 4 Hz,
+    /// a closed valve is stiffer and damps more than the 30 % opening at the same stroke, and
+    /// the 30 % damper at +-1 mm, 4 Hz gives the values its Maxwell representation was fitted
+    /// to.
+    #[test]
+    fn semi_active_spec_is_the_damper_model_linearised() {
+        let Ok(DamperSpec::Linearised(open)) = parse_damper("semi-active:0.3:1e-3") else {
+            panic!("semi-active:0.3:1e-3 not parsed");
+        };
+        assert_eq!(
+            (open.opening, open.stroke_m, open.freq_hz),
+            (0.3, 1e-3, DEFAULT_LINEARISATION_FREQ_HZ)
+        );
+        let Ok(DamperSpec::Linearised(closed)) = parse_damper("semi-active:0:1e-3:4") else {
+            panic!("semi-active:0:1e-3:4 not parsed");
+        };
+        assert!(
+            closed.k_n_per_m > 5.0 * open.k_n_per_m,
+            "{closed:?} {open:?}"
+        );
+        assert!(
+            closed.c_ns_per_m > 2.0 * open.c_ns_per_m,
+            "{closed:?} {open:?}"
+        );
+        // the passive damper's characterisation in fmu-bogie2dof's calibration (1 mm, 4 Hz:
+        // 386 kN/m, 95.6 kNs/m), which its Maxwell representation was fitted to
+        assert!((open.k_n_per_m / 386e3 - 1.0).abs() < 0.01, "{open:?}");
+        assert!((open.c_ns_per_m / 95.6e3 - 1.0).abs() < 0.01, "{open:?}");
+        match DamperSpec::Linearised(closed).representation() {
+            DamperRepresentation::Linear(LinearDamper::KelvinVoigt { k, c }) => {
+                assert_eq!((k, c), (closed.k_n_per_m, closed.c_ns_per_m))
+            }
+            other => panic!("{other:?}"),
+        }
+        for bad in [
+            "semi-active:1.5:1e-3",
+            "semi-active:-0.1:1e-3",
+            "semi-active:0:0",
+            "semi-active:0:0.2",
+            "semi-active:0:nan",
+            "semi-active:0:1e-3:0",
+            "semi-active:0:1e-3:inf",
+            "semi-active:0:1e-3:1e9",
+            "semi-active:x:1e-3",
+            "semi-active:0",
+            "semi-active:0:1e-3:4:5",
+        ] {
+            assert!(parse_damper(bad).is_err(), "{bad} accepted");
+        }
     }
 
     #[test]

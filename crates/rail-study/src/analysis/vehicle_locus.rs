@@ -30,6 +30,10 @@ pub fn damper_model(spec: DamperSpec, mounting_n_per_m: Option<f64>) -> YawDampe
         DamperSpec::Viscous(c) => DamperRepresentation::Viscous { c },
         DamperSpec::Maxwell(k, c) => DamperRepresentation::Maxwell { k, c },
         DamperSpec::KelvinVoigt(k, c) => DamperRepresentation::KelvinVoigt { k, c },
+        DamperSpec::Linearised(l) => DamperRepresentation::KelvinVoigt {
+            k: l.k_n_per_m,
+            c: l.c_ns_per_m,
+        },
         DamperSpec::None => DamperRepresentation::None,
     };
     YawDamperModel {

@@ -33,7 +33,10 @@ pub struct Args {
     pub step: f64,
     /// Yaw damper (each of them): `passive` (the calibrated Maxwell representation of the
     /// coupled 30 % passive damper), `viscous:C`, `maxwell:K:C`, `kelvin:K:C` (N/m, N s/m;
-    /// 120k = 120e3) or `none`.
+    /// 120k = 120e3), `none`, or `semi-active:OPENING:STROKE[:FREQ]`: the hydraulic
+    /// semi-active damper model with its valve fixed at OPENING (0 closed .. 1), linearised by
+    /// its first harmonic at stroke amplitude STROKE [m] and FREQ [Hz, default 4], e.g.
+    /// `semi-active:0:3e-3:5.5` (a closed valve at +-3 mm, 5.5 Hz).
     #[arg(long, default_value = "passive", value_parser = parse_damper)]
     pub damper: DamperSpec,
     /// Mounting (series) stiffness of each yaw damper's installation [N/m], coach only
