@@ -451,7 +451,10 @@ gains less.\n\
 steeply with yaw damping than the seed's: in the c_v table the ideal damper of 210 kNs/m keeps \
 our coach within the limit at 380 km/h (seed: 7.08 m/s^2, over it), and a nearly closed valve \
 gives about 330 kNs/m. A damper mounting stiffness of 10 MN/m (MPE 2019) does not change this \
-(VALIDATION.md).\n\
+(VALIDATION.md). The hydraulic damper linearised by its first harmonic in the eigen-analysis \
+(`master root-locus --damper semi-active:OPENING:STROKE:FREQ`) shows why: with the valve closed \
+the linear coach has no stability boundary below 716 km/h at damper strokes up to +-2 mm and \
+crosses at 422 km/h at +-5 mm, while MPPT keeps the strokes near 1 mm (VALIDATION.md, R9).\n\
 * Slow valve (R12). The seed's result is a HIL test with the real valve; ours is the model valve \
 (first-order lag 0.15 s, full travel in 50 ms) in the coach: the accelerometer sky-hook's command \
 switches at about twice the hunting frequency, which such a valve cannot follow; the textbook \
