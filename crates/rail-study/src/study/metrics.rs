@@ -10,6 +10,10 @@
 //! * Car body (coach): rms of the floor lateral acceleration and the EN 12299 lateral comfort
 //!   N_y ([`crate::en12299`]), the largest over front, mid-length and rear.
 //! * Damper force peak, rms hydraulic power (full-active), mean valve command over the tail.
+//! * Yaw-damper stroke (coach): the amplitude of the sinusoid with the elongation's rms about
+//!   its mean after the skip, sqrt(2) x std, the largest over the dampers: what a damper must
+//!   take, and the amplitude at which its linearisation holds (`master root-locus --damper
+//!   semi-active:OPENING:STROKE:FREQ`).
 
 use crate::en12299::{lateral_comfort, ComfortError};
 use crate::en14363::{assess_lateral_acceleration, AssessError, StabilitySettings};
@@ -84,6 +88,10 @@ pub struct RunMetrics {
     /// EN 12299 lateral comfort N_y = 6 a_YP95 (W_d), largest over the measuring points;
     /// `None` without a car body or when less than one 5 s window follows the skip.
     pub comfort_ny: Option<f64>,
+    /// Stroke amplitude of the yaw dampers after the skip, sqrt(2) x the standard deviation of
+    /// the elongation, largest over the dampers [m]; `None` if no elongation is recorded.
+    #[serde(default)]
+    pub damper_stroke_m: Option<f64>,
 }
 
 impl RunMetrics {
@@ -208,6 +216,12 @@ pub fn run_metrics(
     let rms_power_w = mean_over(out, &signals.powers, rms_after_skip);
     let rms_hydraulic_power_w = mean_over(out, &signals.hydraulic_powers, rms_after_skip);
     let tail_command_v = mean_over(out, &signals.commands, |x| mean(&x[tail..]));
+    let damper_stroke_m = signals
+        .elongations
+        .iter()
+        .filter_map(|name| out.column(name))
+        .map(|e| std::f64::consts::SQRT_2 * standard_deviation(&e[skip..]))
+        .reduce(f64::max);
     let mut carbody_rms_mps2: Option<f64> = None;
     let mut comfort_ny: Option<f64> = None;
     for column in &signals.carbody {
@@ -239,7 +253,17 @@ pub fn run_metrics(
         tail_command_v,
         carbody_rms_mps2,
         comfort_ny,
+        damper_stroke_m,
     })
+}
+
+/// Standard deviation (population) of `x`.
+fn standard_deviation(x: &[f64]) -> f64 {
+    if x.is_empty() {
+        return 0.0;
+    }
+    let m = mean(x);
+    (x.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / x.len() as f64).sqrt()
 }
 
 #[cfg(test)]
@@ -336,6 +360,36 @@ mod tests {
         assert_eq!(m.rms_power_w, None);
         assert_eq!(m.rms_hydraulic_power_w, None);
         assert!((m.tail_command_v.unwrap() - 2.0).abs() < 1e-12);
+        // no elongation recorded: no stroke
+        assert_eq!(m.damper_stroke_m, None);
+    }
+
+    /// The stroke is the amplitude of the elongation about its mean after the skip, the larger
+    /// of the dampers: 2 mm on an offset of 5 mm, whatever a large start-up swing before it.
+    #[test]
+    fn damper_stroke_is_the_elongation_amplitude_after_the_skip() {
+        let mut out = synthetic(6.0, 4.0, 20.0, false);
+        let b = bogie();
+        let width = out.header.len();
+        out.header.push(format!("{} [m]", b.elongations[0]));
+        out.header.push(format!("{} [m]", b.elongations[1]));
+        let rows: Vec<Vec<f64>> = out.data.chunks(width).map(<[f64]>::to_vec).collect();
+        out.data.clear();
+        for mut row in rows {
+            let t = row[0];
+            let swing = if t < 5.0 { 0.03 } else { 0.0 };
+            let s = (2.0 * PI * 4.0 * t).sin();
+            row.extend([5e-3 + (2e-3 + swing) * s, 1e-3 * s]);
+            out.data.extend(row);
+        }
+        let spec = MetricSpec {
+            skip_s: 5.0,
+            tail_s: 4.0,
+            speed_kmh: 300.0,
+        };
+        let m = run_metrics(&out, &spec, &b).unwrap();
+        let stroke = m.damper_stroke_m.unwrap();
+        assert!((stroke - 2e-3).abs() < 0.01 * 2e-3, "{stroke}");
     }
 
     #[test]

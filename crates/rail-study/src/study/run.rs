@@ -72,6 +72,8 @@ pub struct SpeedPoint {
     pub carbody_per_seed: Vec<Option<f64>>,
     /// EN 12299 lateral comfort N_y per seed (coach).
     pub comfort_per_seed: Vec<Option<f64>>,
+    /// Yaw-damper stroke amplitude per seed, where the elongations are recorded (coach) [m].
+    pub stroke_per_seed: Vec<Option<f64>>,
 }
 
 /// Max over seeds; `None` if any is missing (or there are none).
@@ -98,6 +100,11 @@ impl SpeedPoint {
     /// N_y, max over seeds.
     pub fn comfort(&self) -> Option<f64> {
         max_all(&self.comfort_per_seed)
+    }
+
+    /// Yaw-damper stroke amplitude, max over seeds [m].
+    pub fn damper_stroke(&self) -> Option<f64> {
+        max_all(&self.stroke_per_seed)
     }
 }
 
@@ -372,6 +379,10 @@ impl Executor<'_> {
                 .map(|m| m.and_then(|m| m.carbody_rms_mps2))
                 .collect(),
             comfort_per_seed: runs.iter().map(|m| m.and_then(|m| m.comfort_ny)).collect(),
+            stroke_per_seed: runs
+                .iter()
+                .map(|m| m.and_then(|m| m.damper_stroke_m))
+                .collect(),
         }
     }
 }

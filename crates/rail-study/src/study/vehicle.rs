@@ -186,6 +186,15 @@ impl VehicleModel {
         }
     }
 
+    /// Yaw-damper elongations, one per damper position (both models name them
+    /// `damper_<position>.elongation`) [m].
+    pub fn damper_elongations(self) -> Vec<String> {
+        self.positions()
+            .iter()
+            .map(|p| self.var(&format!("damper_{}.elongation", p.name)))
+            .collect()
+    }
+
     /// Car-body lateral accelerations at floor height (ride comfort), none on the bogie.
     pub fn carbody_accelerations(self) -> Vec<String> {
         match self {
@@ -230,6 +239,8 @@ pub struct Signals {
     pub hydraulic_powers: Vec<String>,
     /// The full-active controllers' reference forces `c_v v` (what the actuator is asked for).
     pub reference_forces: Vec<String>,
+    /// Yaw-damper elongations (the vehicle's outputs) [m].
+    pub elongations: Vec<String>,
 }
 
 impl Signals {
@@ -243,6 +254,7 @@ impl Signals {
             powers: v.per_position("actuator", "damper.power"),
             hydraulic_powers: v.per_position("actuator", "damper.hydraulic_power"),
             reference_forces: v.per_position("idf", "reference.force"),
+            elongations: v.damper_elongations(),
         }
     }
 }
@@ -273,6 +285,7 @@ pub fn coach_system(c: &Configuration) -> Value {
     let mut record: Vec<String> = v.wheelset_displacements();
     record.extend(v.stability_accelerations());
     record.extend(v.carbody_accelerations());
+    record.extend(v.damper_elongations());
     record.push(v.var("wheelset_1.guiding_force"));
     record.push(v.var("wheelset_1.y_over_q"));
     let valve_model = c.valve.model().unwrap_or(0);

@@ -62,14 +62,17 @@ fn car_body_section(m: &mut String, r: &StudyResults) {
          the rear bogie centre; 1.2 m above the rail), the first {:.0} s skipped: plain rms, and the \
          EN 12299 lateral comfort N_y = 6 a_YP95 (W_d weighting, 95th percentile of 5 s rms values in \
          1 s steps; EN 12299 takes 5 minutes of running, our runs are {:.0} s). Largest over the three \
-         points and all seeds. N_y: < 1 very comfortable, 1-2 comfortable, 2-4 medium.\n",
+         points and all seeds. N_y: < 1 very comfortable, 1-2 comfortable, 2-4 medium. Damper \
+         stroke: the amplitude sqrt(2) x std of the yaw dampers' elongation after the skip, the \
+         largest over the four (the stroke a damper takes, and where its first-harmonic \
+         linearisation in `master root-locus --damper semi-active:OPENING:STROKE:FREQ` holds).\n",
         r.settings.skip_s, r.settings.sweep_stop_s
     );
     let _ = writeln!(
         m,
-        "| configuration | speed [km/h] | EN 14363 rms [m/s^2] | EN 14363 | car-body rms [m/s^2] | N_y |"
+        "| configuration | speed [km/h] | EN 14363 rms [m/s^2] | EN 14363 | car-body rms [m/s^2] | N_y | damper stroke [mm] |"
     );
-    let _ = writeln!(m, "|---|---|---|---|---|---|");
+    let _ = writeln!(m, "|---|---|---|---|---|---|---|");
     for c in &r.configs {
         for &v in &speeds {
             let Some(p) = c.sweep.iter().find(|p| (p.speed_kmh - v).abs() < 1e-6) else {
@@ -82,11 +85,14 @@ fn car_body_section(m: &mut String, r: &StudyResults) {
             };
             let _ = writeln!(
                 m,
-                "| {} | {v:.0} | {} | {verdict} | {} | {} |",
+                "| {} | {v:.0} | {} | {verdict} | {} | {} | {} |",
                 c.label,
                 fmt_opt(p.rms(), 1.0, 2),
                 fmt_opt(p.carbody_rms(), 1.0, 3),
                 fmt_opt(p.comfort(), 1.0, 2),
+                // "-": a failed run, or a system that does not record the elongations
+                p.damper_stroke()
+                    .map_or("-".to_string(), |x| format!("{:.2}", x * 1e3)),
             );
         }
     }

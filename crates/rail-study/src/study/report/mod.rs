@@ -201,6 +201,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
                 if coach {
                     row.push(num(p.carbody_rms()));
                     row.push(num(p.comfort()));
+                    row.push(num(p.damper_stroke().map(|x| x * 1e3)));
                 }
                 rows.push(row);
             }
@@ -219,6 +220,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     if coach {
         header.push("car-body rms max [m/s2]".into());
         header.push("comfort N_y max [-]".into());
+        header.push("damper stroke max [mm]".into());
     }
     write_text_csv(&out.join("rms_vs_speed.csv"), &header, &rows)?;
     if !r.configs.is_empty() {
