@@ -6,8 +6,7 @@
 //! `cargo run --release -p rail-study --example linearised_damper_scan`
 use fmu_vehicle::eigen::critical_speed;
 use fmu_vehicle::VehicleParams;
-use rail_study::analysis::locus::DamperSpec;
-use rail_study::analysis::locus::{LinearisedDamper, DEFAULT_LINEARISATION_FREQ_HZ};
+use rail_study::analysis::locus::{DamperSpec, LinearisedDamper, DEFAULT_LINEARISATION_FREQ_HZ};
 use rail_study::analysis::vehicle_locus::{damper_model, CRITICAL_SEARCH_MPS};
 
 fn main() {
