@@ -153,37 +153,41 @@ pub fn parse_damper(s: &str) -> Result<DamperSpec, String> {
             }
         }
         ["kelvin", k, c] => Ok(DamperSpec::KelvinVoigt(num(k)?, num(c)?)),
-        ["semi-active", opening, stroke] => Ok(DamperSpec::Linearised(LinearisedDamper::measure(
-            plain(opening)?,
-            plain(stroke)?,
-            DEFAULT_LINEARISATION_FREQ_HZ,
-        )?)),
-        ["semi-active", opening, stroke, freq] => Ok(DamperSpec::Linearised(
-            LinearisedDamper::measure(plain(opening)?, plain(stroke)?, plain(freq)?)?,
-        )),
+        ["semi-active", opening, stroke, freq @ ..] if freq.len() <= 1 => {
+            let freq = match freq.first() {
+                Some(f) => plain(f)?,
+                None => DEFAULT_LINEARISATION_FREQ_HZ,
+            };
+            Ok(DamperSpec::Linearised(LinearisedDamper::measure(
+                plain(opening)?,
+                plain(stroke)?,
+                freq,
+            )?))
+        }
         _ => Err(format!("'{s}': {usage}")),
     }
 }
 
 impl DamperSpec {
     pub fn representation(&self) -> DamperRepresentation {
-        match *self {
-            DamperSpec::Passive => passive_damper(),
-            DamperSpec::Viscous(c0) => {
-                DamperRepresentation::Linear(LinearDamper::Viscous { c: c0 })
-            }
-            DamperSpec::Maxwell(k, c) => {
-                DamperRepresentation::Linear(LinearDamper::Maxwell { k, c })
-            }
-            DamperSpec::KelvinVoigt(k, c) => {
-                DamperRepresentation::Linear(LinearDamper::KelvinVoigt { k, c })
-            }
-            DamperSpec::Linearised(l) => DamperRepresentation::Linear(LinearDamper::KelvinVoigt {
+        self.linear()
+            .map_or_else(passive_damper, DamperRepresentation::Linear)
+    }
+
+    /// The linear law of the spec, the one both models' eigen-analyses take; `None` for
+    /// [`DamperSpec::Passive`], whose representation each model keeps for itself.
+    pub fn linear(&self) -> Option<LinearDamper> {
+        Some(match *self {
+            DamperSpec::Passive => return None,
+            DamperSpec::Viscous(c) => LinearDamper::Viscous { c },
+            DamperSpec::Maxwell(k, c) => LinearDamper::Maxwell { k, c },
+            DamperSpec::KelvinVoigt(k, c) => LinearDamper::KelvinVoigt { k, c },
+            DamperSpec::Linearised(l) => LinearDamper::KelvinVoigt {
                 k: l.k_n_per_m,
                 c: l.c_ns_per_m,
-            }),
-            DamperSpec::None => DamperRepresentation::Linear(LinearDamper::None),
-        }
+            },
+            DamperSpec::None => LinearDamper::None,
+        })
     }
 
     pub fn describe(&self) -> String {

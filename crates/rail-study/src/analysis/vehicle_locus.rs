@@ -9,8 +9,7 @@
 
 use fmu_vehicle::calibration::passive_damper;
 use fmu_vehicle::eigen::{
-    analyse, critical_speed, CriticalSpeed, DamperRepresentation, EigenError, EigenResult, Mode,
-    YawDamperModel,
+    analyse, critical_speed, CriticalSpeed, EigenError, EigenResult, Mode, YawDamperModel,
 };
 use fmu_vehicle::VehicleParams;
 
@@ -25,17 +24,9 @@ pub const CRITICAL_SEARCH_MPS: (f64, f64) = (5.0, 199.0);
 
 /// The damper of the coach's linear model for a spec: the spec behind `mounting_n_per_m`.
 pub fn damper_model(spec: DamperSpec, mounting_n_per_m: Option<f64>) -> YawDamperModel {
-    let representation = match spec {
-        DamperSpec::Passive => passive_damper().representation,
-        DamperSpec::Viscous(c) => DamperRepresentation::Viscous { c },
-        DamperSpec::Maxwell(k, c) => DamperRepresentation::Maxwell { k, c },
-        DamperSpec::KelvinVoigt(k, c) => DamperRepresentation::KelvinVoigt { k, c },
-        DamperSpec::Linearised(l) => DamperRepresentation::KelvinVoigt {
-            k: l.k_n_per_m,
-            c: l.c_ns_per_m,
-        },
-        DamperSpec::None => DamperRepresentation::None,
-    };
+    let representation = spec
+        .linear()
+        .unwrap_or_else(|| passive_damper().representation);
     YawDamperModel {
         representation,
         mounting_stiffness_n_per_m: mounting_n_per_m.or(if spec == DamperSpec::Passive {
