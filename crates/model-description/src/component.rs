@@ -442,6 +442,7 @@ impl Component {
         self.error(&msg)
     }
 
+    #[inline]
     pub fn get_real(&mut self, vrs: &[u32], values: &mut [f64]) -> Status {
         const CALL: &str = "fmi2GetReal";
         let status = self.check_get(CALL, vrs.len(), values.len());
@@ -578,6 +579,7 @@ impl Component {
     }
 
     /// Set Reals. All values are checked before any is applied: a rejected call changes nothing.
+    #[inline]
     pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Status {
         const CALL: &str = "fmi2SetReal";
         if let Err(s) = self.check_set_common(CALL, vrs.len(), values.len()) {
@@ -704,6 +706,7 @@ impl Component {
         1.0e-9 * self.time.abs().max(1.0) + 1.0e-6 * step.abs()
     }
 
+    #[inline]
     pub fn do_step(&mut self, current: f64, step: f64) -> Status {
         // the common case in one test: step mode, a finite step from our own time (to the
         // tolerance), not beyond the stop time; anything else is named by `step_refused`
