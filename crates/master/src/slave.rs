@@ -201,6 +201,13 @@ pub trait Slave {
     /// Writes a batch, one call per numeric type; `values.len() == batch.len()`. The String
     /// positions are ignored (the master writes them with [`Slave::set_strings`]).
     fn set(&mut self, batch: &VarBatch, values: &[f64]) -> Result<(), SlaveError>;
+    /// Writes Reals by value reference in one call (`values.len() == vrs.len()`): the inputs
+    /// of one instance gathered from several sources. The default goes through
+    /// [`Slave::set`].
+    fn set_reals(&mut self, vrs: &[u32], values: &[f64]) -> Result<(), SlaveError> {
+        let batch = VarBatch::new(vrs.iter().map(|&vr| VarRef::real(vr)).collect());
+        self.set(&batch, values)
+    }
     /// fmi2GetString of `vrs` into `out` (cleared first, one text per reference).
     fn get_strings(&mut self, vrs: &[u32], out: &mut Vec<String>) -> Result<(), SlaveError> {
         let _ = (vrs, out);

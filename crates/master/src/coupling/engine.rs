@@ -3,7 +3,7 @@
 
 use std::sync::atomic::Ordering;
 
-use super::exchange::{Dest, Exchange};
+use super::exchange::{Dest, Exchange, MergedWrite};
 use super::{Algorithm, CouplingPlan, RunOptions, SimError};
 use crate::slave::{FailStatus, ScalarType, Slave, SlaveError, StepStatus, StringTable, VarBatch};
 
@@ -51,8 +51,10 @@ pub(super) struct Engine<'p, 's, 'd, 'o> {
     every_point: bool,
     /// The common case runs [`Self::fast_step`]: Gauss-Seidel, every instance stepping at
     /// every point, no step retry (so no split steps) and no String among the exchanged or
-    /// recorded variables. Same calls in the same order as [`Self::step_windows`], so the same results
-    /// bit for bit.
+    /// recorded variables. The calls of [`Self::step_windows`] in the same order, except that
+    /// the Real inputs an instance gets from several sources are written in one call before
+    /// its next call: each instance sees the same values at each of its calls, so the results
+    /// are the same bit for bit.
     fast: bool,
 }
 
@@ -513,9 +515,9 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
     }
 
     /// Macro step `k` in the common case (see `fast`): each instance in order steps over
-    /// `[t_k, t_k+1]`, then its connected outputs are read in one call and written to their
-    /// inputs (one call per destination), with no windows, no sub-step arithmetic and no
-    /// String handling.
+    /// `[t_k, t_k+1]`, then its connected outputs are read in one call and passed on to their
+    /// inputs (the Real inputs of each destination written in one call before its next call),
+    /// with no windows, no sub-step arithmetic and no String handling.
     fn fast_step(&mut self, k: u64) -> Result<StepEnd, SimError> {
         let plan = self.plan;
         let exchange = self.exchange;
@@ -524,7 +526,11 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let te = t + h;
         self.current.iter_mut().for_each(|c| *c = false);
         let mut ending: Option<usize> = None;
-        for &i in &plan.order {
+        let writes = &exchange.gauss_seidel;
+        for (p, &i) in plan.order.iter().enumerate() {
+            if let Some(w) = &writes.before_step[p] {
+                self.write_merged(te, w)?;
+            }
             match self.step_slave(i, t, h)? {
                 SlaveStep::Ok => {}
                 SlaveStep::Discarded => return Ok(StepEnd::Discarded(i)),
@@ -550,7 +556,12 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                 r.map_err(|e| self.slave_err(te, i, e))?;
                 self.check_outputs(te, i)?;
             }
-            for dest in &src.dests {
+            for (dest, _) in src
+                .dests
+                .iter()
+                .zip(&writes.immediate[i])
+                .filter(|(_, &now)| now)
+            {
                 let j = dest.instance;
                 self.touch(j);
                 let r = match dest.run {
@@ -572,6 +583,9 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                 self.refresh_feedthrough(te, i)?;
             }
         }
+        for w in &writes.at_end {
+            self.write_merged(te, w)?;
+        }
         Ok(match ending {
             Some(instance) => StepEnd::Terminated {
                 instance,
@@ -579,6 +593,24 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             },
             None => StepEnd::Done,
         })
+    }
+
+    /// One merged write of [`Self::fast_step`] from the latest outputs.
+    #[inline(always)]
+    fn write_merged(&mut self, time: f64, w: &MergedWrite) -> Result<(), SimError> {
+        let j = w.instance;
+        self.touch(j);
+        let r = match w.run {
+            Some((s, k)) => self.slaves[j].set_reals(&w.vrs, &self.outputs[s][k..k + w.vrs.len()]),
+            None => {
+                self.inputs.clear();
+                let outputs = &self.outputs;
+                self.inputs
+                    .extend(w.from.iter().map(|&(s, k)| outputs[s][k]));
+                self.slaves[j].set_reals(&w.vrs, &self.inputs)
+            }
+        };
+        r.map_err(|e| self.slave_err(time, j, e))
     }
 
     /// [`Self::try_macro_step`] over the given windows.

@@ -47,11 +47,109 @@ pub(super) struct RecordGroup {
     pub from_outputs: Option<Vec<usize>>,
 }
 
+/// Real inputs of one instance gathered from one or more sources, written in one call.
+#[derive(Debug)]
+pub(super) struct MergedWrite {
+    pub instance: usize,
+    pub vrs: Vec<u32>,
+    /// For each value: (source instance, position in that source's outputs).
+    pub from: Vec<(usize, usize)>,
+    /// When every value comes from one source's consecutive outputs: (source, first
+    /// position), written from there without a copy.
+    pub run: Option<(usize, usize)>,
+}
+
+/// The writes of a Gauss-Seidel macro step in the common case, arranged once. A write of
+/// Reals to an instance whose outputs are never read again within a step (no input of it
+/// feeds through) is deferred to that instance's next call: its step when the source comes
+/// earlier in the order, else the end of the macro step. Writes deferred to the same point
+/// are merged, so an instance fed by several sources gets one fmi2SetReal, and it sees the
+/// same values at each of its calls as with one write per source.
+#[derive(Debug, Default)]
+pub(super) struct GaussSeidelWrites {
+    /// Per position in the order: the write just before that instance steps.
+    pub before_step: Vec<Option<MergedWrite>>,
+    /// Per instance, per entry of its `Source::dests`: written at once after its outputs are
+    /// read (a batch with other types than Real, or an instance read again within the step).
+    pub immediate: Vec<Vec<bool>>,
+    /// After the last instance stepped: the inputs from instances later in the order.
+    pub at_end: Vec<MergedWrite>,
+}
+
+impl GaussSeidelWrites {
+    fn new(sources: &[Source], order: &[usize]) -> Self {
+        let n = sources.len();
+        let mut position = vec![usize::MAX; n];
+        for (p, &i) in order.iter().enumerate() {
+            if i < n {
+                position[i] = p;
+            }
+        }
+        let read_again: Vec<bool> = (0..n)
+            .map(|j| sources.iter().any(|s| s.feeds_through.contains(&j)))
+            .collect();
+        let mut before_step: Vec<Option<MergedWrite>> = order.iter().map(|_| None).collect();
+        let mut at_end: Vec<MergedWrite> = Vec::new();
+        let mut immediate: Vec<Vec<bool>> = vec![Vec::new(); n];
+        for &i in order {
+            let Some(src) = sources.get(i) else { continue };
+            for d in &src.dests {
+                let j = d.instance;
+                let deferred = d.inputs.all_real() && !read_again[j] && position[j] != usize::MAX;
+                immediate[i].push(!deferred);
+                if !deferred {
+                    continue;
+                }
+                let w = if position[i] < position[j] {
+                    before_step[position[j]].get_or_insert_with(|| MergedWrite::empty(j))
+                } else {
+                    let k = at_end
+                        .iter()
+                        .position(|w| w.instance == j)
+                        .unwrap_or_else(|| {
+                            at_end.push(MergedWrite::empty(j));
+                            at_end.len() - 1
+                        });
+                    &mut at_end[k]
+                };
+                w.vrs.extend(d.inputs.vars().iter().map(|v| v.vr));
+                w.from.extend_from_slice(&d.from);
+            }
+        }
+        for w in before_step.iter_mut().flatten().chain(at_end.iter_mut()) {
+            w.run = w
+                .from
+                .windows(2)
+                .all(|p| p[1].0 == p[0].0 && p[1].1 == p[0].1 + 1)
+                .then(|| w.from.first().copied())
+                .flatten();
+        }
+        GaussSeidelWrites {
+            before_step,
+            immediate,
+            at_end,
+        }
+    }
+}
+
+impl MergedWrite {
+    fn empty(instance: usize) -> Self {
+        MergedWrite {
+            instance,
+            vrs: Vec::new(),
+            from: Vec::new(),
+            run: None,
+        }
+    }
+}
+
 /// The whole exchange of a plan.
 #[derive(Debug, Default)]
 pub(super) struct Exchange {
     /// Indexed by instance.
     pub sources: Vec<Source>,
+    /// Gauss-Seidel's writes in the common case.
+    pub gauss_seidel: GaussSeidelWrites,
     /// Per plan connection: (source instance, position in its outputs).
     pub connection_at: Vec<(usize, usize)>,
     /// All connected inputs per destination instance (Jacobi writes them after all reads).
@@ -174,6 +272,7 @@ impl Exchange {
         })
         .collect();
         Exchange {
+            gauss_seidel: GaussSeidelWrites::new(&sources, &plan.order),
             sources,
             connection_at,
             jacobi,

@@ -342,6 +342,18 @@ impl Slave for FmuSlave {
         };
         (status(s).is_ok() && t.is_finite()).then_some(t)
     }
+    fn set_reals(&mut self, vrs: &[u32], values: &[f64]) -> Result<(), SlaveError> {
+        if values.len() != vrs.len() {
+            return Err(self.internal("fmi2SetReal", "value references and values differ"));
+        }
+        if vrs.is_empty() {
+            return Ok(());
+        }
+        let (c, lib) = (self.component, self.fmu.library());
+        // SAFETY: both slices hold vrs.len() elements and outlive the call
+        let s = unsafe { (lib.set_real)(c, vrs.as_ptr(), vrs.len(), values.as_ptr()) };
+        self.check("fmi2SetReal", s)
+    }
     fn do_step(&mut self, t: f64, h: f64) -> Result<StepStatus, SlaveError> {
         let s = unsafe { (self.lib().do_step)(self.component, t, h, 1) };
         match status(s) {
