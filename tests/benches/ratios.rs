@@ -8,6 +8,8 @@
 //!    FMUs from dist/, Gauss-Seidel, 1 ms) in our master, against the same physics stepped in
 //!    the same order in plain Rust (no FMI); both must end in the same state to rounding
 //!    (checked).
+//!    The instructions per step of both loops, counted by callgrind (load-independent; needs
+//!    valgrind): the benchmark runs itself under it.
 //! 3. fmpy driving the same three FMUs in a Python loop, same order and step.
 //! 4. A run set of 4 runs of that system on 2 worker threads against 1.
 //! 5. The studies' wall time (`master study` on 2 cores), when `BENCH_STUDY` names the study
@@ -18,8 +20,8 @@
 //!
 //! `bash scripts/bench.sh` builds what it needs and runs this; it writes docs/BENCHMARKS.md.
 //! By hand: `cargo bench -p tests --bench ratios` (needs dist/). `BENCH_ONLY=coupled,fmpy`
-//! measures only the named sections (`models`, `coupled`, `fmpy`, `runset`, `studies`,
-//! `results`) and
+//! measures only the named sections (`models`, `coupled`, `instructions`, `fmpy`, `runset`,
+//! `studies`, `results`) and
 //! writes to target/BENCHMARKS.md unless `BENCH_OUT` is set.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // benchmark code
@@ -292,6 +294,60 @@ fn runset_wall(threads: usize) -> (f64, f64) {
     (wall, cpu_seconds() - cpu0)
 }
 
+/// Instructions per communication step of the coupled section's two loops, (master, plain
+/// Rust): this benchmark runs itself under callgrind with `BENCH_COUPLED_ONCE_S` = 2 and 4 s,
+/// and the difference of each loop's inclusive count between the two runs, over 2000 steps,
+/// is one step's cost without the preparation (unpacking, loading, track synthesis).
+fn instructions_per_step() -> Result<(f64, f64), String> {
+    let found = Command::new("valgrind").arg("--version").output();
+    if !found.is_ok_and(|o| o.status.success()) {
+        return Err("valgrind not found (Debian: apt install valgrind)".into());
+    }
+    let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let mut counts = Vec::new();
+    for stop_s in [2, 4] {
+        let file = dir.path().join(format!("callgrind.{stop_s}"));
+        let run = Command::new("valgrind")
+            .arg("--tool=callgrind")
+            .arg(format!("--callgrind-out-file={}", file.display()))
+            .arg(&exe)
+            .arg("--bench")
+            .env("BENCH_COUPLED_ONCE_S", stop_s.to_string())
+            .output()
+            .map_err(|e| e.to_string())?;
+        if !run.status.success() {
+            return Err(format!(
+                "callgrind run of {stop_s} s failed: {}",
+                String::from_utf8_lossy(&run.stderr)
+                    .lines()
+                    .last()
+                    .unwrap_or("")
+            ));
+        }
+        let annotated = Command::new("callgrind_annotate")
+            .arg("--inclusive=yes")
+            .arg(&file)
+            .output()
+            .map_err(|e| e.to_string())?;
+        let text = String::from_utf8_lossy(&annotated.stdout);
+        // "117,175,203 (76.23%)  ???:ratios::master_passive [/path/ratios-...]"
+        let inclusive = |function: &str| -> Result<f64, String> {
+            text.lines()
+                .find(|l| l.contains(&format!(":ratios::{function} ")))
+                .and_then(|l| l.split_whitespace().next())
+                .and_then(|n| n.replace(',', "").parse::<f64>().ok())
+                .ok_or_else(|| format!("no inclusive count of ratios::{function} in the profile"))
+        };
+        counts.push((inclusive("master_passive")?, inclusive("direct_passive")?));
+    }
+    let steps = 2.0 / STEP_S;
+    Ok((
+        (counts[1].0 - counts[0].0) / steps,
+        (counts[1].1 - counts[0].1) / steps,
+    ))
+}
+
 /// `master study OPTIONS` into a temporary folder: (wall [s], its last line).
 fn study_wall(options: &str) -> Result<(f64, String), String> {
     let master = repo().join("target/release/master");
@@ -455,6 +511,25 @@ fn main() {
         ));
     }
 
+    if wanted("instructions") {
+        r.line(String::new());
+        r.line(
+            "## Instructions per step of the coupled passive system (callgrind, load-independent)"
+                .into(),
+        );
+        r.line(String::new());
+        match instructions_per_step() {
+            Ok((master, direct)) => r.line(format!(
+                "- our master: {:.2} k instructions per 1 ms step; the same physics in plain \
+                 Rust: {:.2} k; ratio {:.3} (target <= 1.1)",
+                master / 1e3,
+                direct / 1e3,
+                master / direct
+            )),
+            Err(why) => r.line(format!("- skipped: {why}")),
+        }
+    }
+
     if let (true, Ok(studies)) = (wanted("studies"), std::env::var("BENCH_STUDY")) {
         r.line(String::new());
         r.line("## Studies (the `master` binary, all cores)".into());
@@ -481,11 +556,12 @@ fn main() {
     let mut md = String::from(
         "# Benchmarks\n\nWritten by `bash scripts/bench.sh` (tests/benches/ratios.rs); every figure \
          below comes from one run on one machine, with the load average beside it.\n\n\
-         Instructions per communication step of the coupled passive system (load-independent): \
-         `BENCH_COUPLED_ONCE_S=2` and `=4` run each of the coupled section's two loops once; \
-         under `valgrind --tool=callgrind`, the difference of the inclusive counts of \
-         `ratios::master_passive` and `ratios::direct_passive` between the two runs, divided by \
-         2000 steps, is the cost of one step without preparation.\n\n",
+         Instructions per communication step of the coupled passive system (load-independent, \
+         section `instructions`): the benchmark runs itself under `valgrind --tool=callgrind` \
+         with `BENCH_COUPLED_ONCE_S=2` and `=4`, which run each of the coupled section's two \
+         loops once; the difference of the inclusive counts of `ratios::master_passive` and \
+         `ratios::direct_passive` between the two runs, divided by 2000 steps, is the cost of \
+         one step without preparation.\n\n",
     );
     for l in &r.lines {
         let _ = writeln!(md, "{l}");
