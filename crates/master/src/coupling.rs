@@ -5,8 +5,12 @@
 //!   every `m`-th point over `[t_k, t_min(k+m, N)]`. The master always passes its own `t_k`
 //!   to fmi2DoStep, so an FMU whose internal clock drifts by round-off is not rejected here.
 //! * Jacobi: all slaves step from the same inputs, then all outputs are exchanged.
-//!   Gauss-Seidel: slaves step in `order`; after each step its outputs go to the connected
-//!   inputs at once, so later slaves see them (sample and hold between points).
+//!   Gauss-Seidel: slaves step in `order`; the outputs of each step reach the connected
+//!   inputs before their instance's next call, so later slaves see them (sample and hold
+//!   between points). Inputs that feed through to a connected output are written at once and
+//!   that output read again; the Real inputs of other instances may be written later, just
+//!   before the instance's next call, merged into one call per instance (same values at
+//!   every call, so the same results).
 //! * Initialisation (FMI 2.0 section 4.2.4): setupExperiment, parameters, enterInitializationMode,
 //!   `init_sweeps` fixed-point sweeps that copy connected outputs to inputs (stops early when
 //!   nothing changes), exitInitializationMode, one more exchange, first record at `t0`.

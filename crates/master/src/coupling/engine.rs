@@ -52,9 +52,13 @@ pub(super) struct Engine<'p, 's, 'd, 'o> {
     /// The common case runs [`Self::fast_step`]: Gauss-Seidel, every instance stepping at
     /// every point, no step retry (so no split steps) and no String among the exchanged or
     /// recorded variables. The calls of [`Self::step_windows`] in the same order, except that
-    /// the Real inputs an instance gets from several sources are written in one call before
-    /// its next call: each instance sees the same values at each of its calls, so the results
-    /// are the same bit for bit.
+    /// the Real inputs of an instance whose outputs are not read again within the step are
+    /// written just before its next call (its step, or the end of the macro step), those from
+    /// several sources in one call: each instance holds the same values at each of its calls,
+    /// so a run gives the same results bit for bit. When a step is discarded or ends the
+    /// simulation early, the pending writes to the other instances are made at once. When a
+    /// call fails, the error may name a later call than with one write per source: both end
+    /// the run without results.
     fast: bool,
 }
 
@@ -516,8 +520,10 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
 
     /// Macro step `k` in the common case (see `fast`): each instance in order steps over
     /// `[t_k, t_k+1]`, then its connected outputs are read in one call and passed on to their
-    /// inputs (the Real inputs of each destination written in one call before its next call),
-    /// with no windows, no sub-step arithmetic and no String handling.
+    /// inputs: at once when the destination is read again within the step or the batch holds
+    /// other types than Real, else merged per destination and written before the
+    /// destination's next call (see [`GaussSeidelWrites`](super::exchange::GaussSeidelWrites));
+    /// no windows, no sub-step arithmetic and no String handling.
     fn fast_step(&mut self, k: u64) -> Result<StepEnd, SimError> {
         let plan = self.plan;
         let exchange = self.exchange;
@@ -531,18 +537,29 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             if let Some(w) = &writes.before_step[p] {
                 self.write_merged(te, w)?;
             }
-            match self.step_slave(i, t, h)? {
-                SlaveStep::Ok => {}
-                SlaveStep::Discarded => return Ok(StepEnd::Discarded(i)),
+            let end = match self.step_slave(i, t, h)? {
+                SlaveStep::Ok => None,
+                SlaveStep::Discarded => Some(StepEnd::Discarded(i)),
                 SlaveStep::Terminating { completed: true } => {
                     ending.get_or_insert(i);
+                    None
                 }
-                SlaveStep::Terminating { completed: false } => {
-                    return Ok(StepEnd::Terminated {
-                        instance: i,
-                        completed: false,
-                    })
+                SlaveStep::Terminating { completed: false } => Some(StepEnd::Terminated {
+                    instance: i,
+                    completed: false,
+                }),
+            };
+            if let Some(end) = end {
+                // the steps stop here: the others get the writes still pending, so that each
+                // holds the inputs it would hold with one write per source (what it gets
+                // before fmi2Terminate); not slave `i`, whose step failed
+                for w in writes.before_step[p + 1..].iter().flatten() {
+                    self.write_merged(te, w)?;
                 }
+                for w in writes.at_end.iter().filter(|w| w.instance != i) {
+                    self.write_merged(te, w)?;
+                }
+                return Ok(end);
             }
             self.current[i] = true;
             let src = &exchange.sources[i];

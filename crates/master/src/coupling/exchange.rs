@@ -64,7 +64,10 @@ pub(super) struct MergedWrite {
 /// feeds through) is deferred to that instance's next call: its step when the source comes
 /// earlier in the order, else the end of the macro step. Writes deferred to the same point
 /// are merged, so an instance fed by several sources gets one fmi2SetReal, and it sees the
-/// same values at each of its calls as with one write per source.
+/// same values at each of its calls as with one write per source. This holds for a single
+/// source too, and an instance gets at most two merged writes per step (before its step, at
+/// the end). Each input has one connection (`check_plan`), so merging cannot reorder two
+/// writes of the same input.
 #[derive(Debug, Default)]
 pub(super) struct GaussSeidelWrites {
     /// Per position in the order: the write just before that instance steps.

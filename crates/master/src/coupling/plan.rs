@@ -398,6 +398,30 @@ pub fn check_plan(plan: &CouplingPlan, n_slaves: usize) -> Result<u64, SimError>
     if plan.instances.iter().any(|i| i.step_multiple == 0) {
         return bad("step_multiple must be >= 1".into());
     }
+    // an input takes one value per point: with two connections the last write would win,
+    // and which write comes last depends on the algorithm and on how writes are batched
+    // an Enumeration is written with fmi2SetInteger: same value reference, same variable
+    let base = |ty: ScalarType| match ty {
+        ScalarType::Enumeration => ScalarType::Integer,
+        t => t,
+    } as u8;
+    let mut inputs: Vec<(usize, u8, u32, usize)> = plan
+        .connections
+        .iter()
+        .enumerate()
+        .map(|(k, c)| (c.to_instance, base(c.to.ty), c.to.vr, k))
+        .collect();
+    inputs.sort_unstable();
+    if let Some(w) = inputs
+        .windows(2)
+        .find(|w| (w[0].0, w[0].1, w[0].2) == (w[1].0, w[1].1, w[1].2))
+    {
+        let (a, b) = (&plan.connections[w[0].3], &plan.connections[w[1].3]);
+        return bad(format!(
+            "input {:?} {} of instance '{}' is driven by two connections (from {} and from {})",
+            b.to.ty, b.to.vr, plan.instances[b.to_instance].name, a.label, b.label
+        ));
+    }
     limits
         .recorded(n as u64, plan.record.len() + 1)
         .map_err(SimError::Plan)?;

@@ -723,6 +723,62 @@ fn inputs_from_several_sources_are_written_in_one_call_with_the_same_results() {
     assert!(x2.iter().any(|x| *x != 0.0), "ms2 moved");
 }
 
+#[test]
+fn a_step_that_stops_the_run_leaves_every_instance_with_the_inputs_of_one_write_per_source() {
+    // ms (second in the order) stops the run at its step: sdm has stepped and its new force
+    // is pending for ms2. Both engines must leave every instance with the same inputs for
+    // fmi2Terminate, with a discard (an error) and with a termination request.
+    let finals = |general_engine: bool, terminate: bool| {
+        let plan = two_sources_plan(0.1);
+        let (mut a, mut b) = slaves();
+        let mut c = Mock::new("ms2", MassSpring::new(1.0, 1.0, 1.0, 0.0));
+        if terminate {
+            a.hooks.terminate_from = Some(0.05);
+        } else {
+            a.hooks.discard_above = Some(1e-3);
+        }
+        let opts = RunOptions {
+            general_engine,
+            ..RunOptions::default()
+        };
+        let r = simulate(&plan, &mut [&mut a, &mut b, &mut c], &opts);
+        assert_eq!(r.is_ok(), terminate, "{:?}", r.err());
+        [a.m.vals.clone(), b.m.vals.clone(), c.m.vals.clone()]
+    };
+    for terminate in [false, true] {
+        let fast = finals(false, terminate);
+        assert_eq!(fast, finals(true, terminate), "terminate: {terminate}");
+        // what is checked is a new force on ms2
+        assert!(fast[2][3] != 0.0, "terminate: {terminate}");
+    }
+}
+
+#[test]
+fn an_input_driven_by_two_connections_is_refused() {
+    let mut plan = two_sources_plan(0.1);
+    plan.connections.push(PlanConnection {
+        from_instance: 2,
+        from: r(4),
+        to_instance: 1,
+        to: r(3),
+        label: "ms2.position".into(),
+        feedthrough: false,
+    });
+    let e = check_plan(&plan, 3).unwrap_err().to_string();
+    assert!(
+        e.contains("instance 'sdm' is driven by two connections")
+            && e.contains("ms.position")
+            && e.contains("ms2.position"),
+        "{e}"
+    );
+    // the same value reference as an input of another type is another variable
+    plan.connections.last_mut().unwrap().to = VarRef {
+        vr: 3,
+        ty: ScalarType::Integer,
+    };
+    assert!(check_plan(&plan, 3).is_ok());
+}
+
 /// A slave of a direct-feedthrough chain: `Clock` outputs (vr 0) its time, `Gain` outputs
 /// y = 2 u (vr 1) from its input u (vr 0) at once (direct feedthrough), `Sink` only has an
 /// input (vr 0).
