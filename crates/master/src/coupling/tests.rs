@@ -779,6 +779,83 @@ fn an_input_driven_by_two_connections_is_refused() {
     assert!(check_plan(&plan, 3).is_ok());
 }
 
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig {
+        cases: 256,
+        ..proptest::prelude::ProptestConfig::default()
+    })]
+
+    /// The common-case step against the general engine on random Gauss-Seidel plans over
+    /// three instances: any order, each input driven or not from any output (self-connections
+    /// and direct feedthrough included), optionally an Integer connection beside the Reals
+    /// (written at once), optionally a step that stops the run. Same results bit for bit, same
+    /// inputs held at the end.
+    #[test]
+    fn the_common_case_step_equals_the_general_engine_on_random_plans(
+        order in proptest::sample::select(vec![
+            vec![0, 1, 2], vec![0, 2, 1], vec![1, 0, 2],
+            vec![1, 2, 0], vec![2, 0, 1], vec![2, 1, 0],
+        ]),
+        sources in proptest::collection::vec(proptest::option::of(0usize..7), 4),
+        integer in proptest::bool::ANY,
+        stop_by in proptest::option::of((0usize..3, proptest::bool::ANY)),
+    ) {
+        // outputs: (instance, vr); inputs: (instance, vr)
+        const OUTPUTS: [(usize, u32); 7] = [(0, 4), (0, 5), (1, 5), (1, 6), (1, 7), (2, 4), (2, 5)];
+        const INPUTS: [(usize, u32); 4] = [(0, 3), (1, 3), (1, 4), (2, 3)];
+        let mut plan = two_sources_plan(0.05);
+        plan.order = order;
+        let force_read = sources.iter().flatten().any(|&k| OUTPUTS[k] == (1, 5));
+        plan.connections = INPUTS
+            .iter()
+            .zip(&sources)
+            .filter_map(|(&(ti, tv), s)| {
+                let (fi, fv) = OUTPUTS[(*s)?];
+                Some(PlanConnection {
+                    from_instance: fi,
+                    from: r(fv),
+                    to_instance: ti,
+                    to: r(tv),
+                    label: format!("{fi}.{fv}"),
+                    // sdm's inputs feed through to its coupling force
+                    feedthrough: ti == 1 && force_read,
+                })
+            })
+            .collect();
+        if integer {
+            // ms's mass (1.0) as an Integer to sdm's mass
+            plan.connections.push(PlanConnection {
+                from_instance: 0,
+                from: VarRef { vr: 0, ty: ScalarType::Integer },
+                to_instance: 1,
+                to: VarRef { vr: 0, ty: ScalarType::Integer },
+                label: "ms.m".into(),
+                feedthrough: false,
+            });
+        }
+        let run = |general_engine: bool| {
+            let (mut a, mut b) = slaves();
+            let mut c = Mock::new("ms2", MassSpring::new(1.0, 1.0, 1.0, 0.0));
+            if let Some((who, terminate)) = stop_by {
+                let h = &mut [&mut a.hooks, &mut b.hooks, &mut c.hooks][who];
+                if terminate {
+                    h.terminate_from = Some(0.02);
+                } else {
+                    h.discard_above = Some(1e-3);
+                }
+            }
+            let opts = RunOptions { general_engine, ..RunOptions::default() };
+            let out = simulate(&plan, &mut [&mut a, &mut b, &mut c], &opts)
+                .map(|o| o.data.iter().map(|x| x.to_bits()).collect::<Vec<_>>())
+                .map_err(|e| e.to_string());
+            (out, [a.m.vals.clone(), b.m.vals.clone(), c.m.vals.clone()])
+        };
+        let (fast, general) = (run(false), run(true));
+        proptest::prop_assert_eq!(&fast.0, &general.0);
+        proptest::prop_assert_eq!(&fast.1, &general.1);
+    }
+}
+
 /// A slave of a direct-feedthrough chain: `Clock` outputs (vr 0) its time, `Gain` outputs
 /// y = 2 u (vr 1) from its input u (vr 0) at once (direct feedthrough), `Sink` only has an
 /// input (vr 0).
