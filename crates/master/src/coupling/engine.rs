@@ -537,29 +537,19 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             if let Some(w) = &writes.before_step[p] {
                 self.write_merged(te, w)?;
             }
-            let end = match self.step_slave(i, t, h)? {
-                SlaveStep::Ok => None,
-                SlaveStep::Discarded => Some(StepEnd::Discarded(i)),
+            match self.step_slave(i, t, h)? {
+                SlaveStep::Ok => {}
+                SlaveStep::Discarded => return self.stopped(te, p, StepEnd::Discarded(i)),
                 SlaveStep::Terminating { completed: true } => {
                     ending.get_or_insert(i);
-                    None
                 }
-                SlaveStep::Terminating { completed: false } => Some(StepEnd::Terminated {
-                    instance: i,
-                    completed: false,
-                }),
-            };
-            if let Some(end) = end {
-                // the steps stop here: the others get the writes still pending, so that each
-                // holds the inputs it would hold with one write per source (what it gets
-                // before fmi2Terminate); not slave `i`, whose step failed
-                for w in writes.before_step[p + 1..].iter().flatten() {
-                    self.write_merged(te, w)?;
+                SlaveStep::Terminating { completed: false } => {
+                    let end = StepEnd::Terminated {
+                        instance: i,
+                        completed: false,
+                    };
+                    return self.stopped(te, p, end);
                 }
-                for w in writes.at_end.iter().filter(|w| w.instance != i) {
-                    self.write_merged(te, w)?;
-                }
-                return Ok(end);
             }
             self.current[i] = true;
             let src = &exchange.sources[i];
@@ -610,6 +600,22 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             },
             None => StepEnd::Done,
         })
+    }
+
+    /// [`Self::fast_step`] stops at position `p` of the order: the others get the writes still
+    /// pending, so that each holds the inputs it would hold with one write per source (what it
+    /// gets before fmi2Terminate); not the instance at `p`, whose step failed.
+    #[cold]
+    fn stopped(&mut self, time: f64, p: usize, end: StepEnd) -> Result<StepEnd, SimError> {
+        let writes = &self.exchange.gauss_seidel;
+        let i = self.plan.order[p];
+        for w in writes.before_step[p + 1..].iter().flatten() {
+            self.write_merged(time, w)?;
+        }
+        for w in writes.at_end.iter().filter(|w| w.instance != i) {
+            self.write_merged(time, w)?;
+        }
+        Ok(end)
     }
 
     /// One merged write of [`Self::fast_step`] from the latest outputs.
