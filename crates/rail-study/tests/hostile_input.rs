@@ -526,3 +526,27 @@ fn fifos_and_devices_are_refused_without_reading() {
     let e = c.fails(&["run", "fifo-fmu.json"], &[]);
     assert!(e.contains("not a regular file"), "{e}");
 }
+
+#[test]
+fn a_study_option_out_of_range_is_refused_before_anything_is_touched() {
+    let case = Case::new();
+    std::fs::create_dir_all(case.path("out")).unwrap();
+    let old = case.write("out/REPORT.md", "the previous report");
+    for bad in [
+        "--cv-speed=nan",
+        "--cv-speed=-5",
+        "--cv-speed=1e9",
+        "--cv-speed=inf",
+    ] {
+        let err = case.fails(&["study", "--quick", "--out", "out", bad], &[]);
+        assert!(
+            err.contains("the speed of the c_v runs must lie between 10 and 700 km/h"),
+            "{bad}: {err}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(&old).unwrap(),
+            "the previous report",
+            "{bad}"
+        );
+    }
+}

@@ -469,7 +469,7 @@ sky-hook hardly switches, so the lag does not matter to it.\n\
 set by the actuator's force bound wherever the reference c_v v exceeds it (the paragraph under the \
 c_v table gives the measured peaks beside the bound); the seed's F_max lie just under the same bound \
 at every c_v, ours only where our coach, which its yaw damping steadies more than the seed's \
-vehicle (R9), still moves enough to ask for more. The seed does not give the table's speed: run at 420 or 440 km/h, our actuator reaches the bound at every c_v and the peaks stay at 90-98 % of it (VALIDATION.md, R14).";
+vehicle (R9), still moves enough to ask for more. The seed does not give the table's speed: run at 420 or 440 km/h, our actuator reaches the bound at every c_v and the peaks stay at 90-98 % of it (`master study --cv-speed 420`; VALIDATION.md, R14).";
 
 /// A quantity a run may not have recorded: "failed" without the run's metrics, "-" when the
 /// run did not record it.
