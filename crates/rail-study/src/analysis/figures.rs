@@ -7,7 +7,10 @@ use std::ops::Range;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 
-use crate::plot::{draw_err, draw_limit, draw_lines, render_svg, Chart, PlotError};
+use crate::plot::{
+    draw_err, draw_limit, draw_lines, legend_width, longest, render_svg, Chart, LegendEntry,
+    PlotError, Swatch,
+};
 
 /// Axis scale.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -110,14 +113,16 @@ where
     let t = chart.title.as_str();
     let labels = (chart.x_label.as_str(), chart.y_label.as_str());
     let size = (chart.width, chart.height);
-    render_svg(t, size, labels, (xr, yr), None, |ctx| {
-        draw_lines(ctx, t, &chart.series, |p| usable(p, xs, ys))?;
+    let series: Vec<_> = chart.series.iter().collect();
+    render_svg(t, size, labels, (xr, yr), chart.legend_px(), |ctx| {
+        let mut entries = draw_lines(ctx, t, &series, |p| usable(p, xs, ys))?;
         match &chart.limit {
             Some((v, label)) if ys == Scale::Linear || *v > 0.0 => {
-                draw_limit(ctx, t, x_span, *v, label)
+                entries.push(draw_limit(ctx, t, x_span, *v, label)?);
             }
-            _ => Ok(()),
+            _ => {}
         }
+        Ok(entries)
     })
 }
 
@@ -208,7 +213,15 @@ impl ColourScatter {
         let cu = |c: f64| if c1 > c0 { (c - c0) / (c1 - c0) } else { 0.5 };
         let labels = (self.x_label.as_str(), self.y_label.as_str());
         let size = (self.width, self.height);
-        let legend = Some(SeriesLabelPosition::UpperLeft);
+        let n = self.legend_stops.max(2);
+        let stop = |k: usize| c0 + k as f64 / (n - 1) as f64 * (c1 - c0);
+        let stop_labels: Vec<String> = (0..n)
+            .map(|k| format!("{:.0} {}", stop(k), self.c_unit))
+            .collect();
+        let highlight = self.highlight.iter().map(|(l, _)| l.as_str());
+        let legend = legend_width(longest(
+            highlight.chain(stop_labels.iter().map(String::as_str)),
+        ));
         render_svg(t, size, labels, (xr.clone(), yr.clone()), legend, |ctx| {
             if self.zero_line_x {
                 let style = BLACK.mix(0.6).stroke_width(1);
@@ -225,6 +238,7 @@ impl ColourScatter {
                     .map(|&(x, y, c)| Circle::new((x, y), 3, ramp(cu(c)).filled())),
             )
             .map_err(|e| draw_err(t, &e))?;
+            let mut entries = Vec::new();
             if let Some((label, hp)) = &self.highlight {
                 let hp: Vec<(f64, f64)> = hp
                     .iter()
@@ -235,21 +249,14 @@ impl ColourScatter {
                     hp.into_iter()
                         .map(|p| Circle::new(p, 6, RED.stroke_width(2))),
                 )
-                .map_err(|e| draw_err(t, &e))?
-                .label(label)
-                .legend(|(x, y)| Circle::new((x + 10, y), 6, RED.stroke_width(2)));
+                .map_err(|e| draw_err(t, &e))?;
+                entries.push(LegendEntry::new(label, Swatch::Ring(RED.to_rgba(), 6)));
             }
-            let n = self.legend_stops.max(2);
-            for k in 0..n {
-                let u = k as f64 / (n - 1) as f64;
-                let c = c0 + u * (c1 - c0);
-                let color = ramp(u);
-                ctx.draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
-                    .map_err(|e| draw_err(t, &e))?
-                    .label(format!("{c:.0} {}", self.c_unit))
-                    .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled()));
+            for (k, label) in stop_labels.iter().enumerate() {
+                let color = ramp(k as f64 / (n - 1) as f64).to_rgba();
+                entries.push(LegendEntry::new(label, Swatch::Dot(color, 4)));
             }
-            Ok(())
+            Ok(entries)
         })
     }
 }

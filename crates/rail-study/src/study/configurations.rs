@@ -25,6 +25,20 @@ pub enum Family {
     FullActive,
 }
 
+impl Family {
+    /// The panel of the study's figures over speed that draws this family, beside the passive
+    /// damper drawn in grey in each (`None`: the passive damper itself).
+    pub fn panel(self) -> Option<&'static str> {
+        match self {
+            Family::Passive => None,
+            Family::Mppt1 | Family::Mppt2 => Some("MPPT"),
+            Family::SkyHookOnOff | Family::SkyHookContinuous => Some("sky-hook"),
+            Family::SkyHookAccelerometerOnOff => Some("sky-hook on the frame accelerometer"),
+            Family::FullActive => Some("full-active"),
+        }
+    }
+}
+
 /// Valve dynamics of the semi-active damper.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub enum Valve {

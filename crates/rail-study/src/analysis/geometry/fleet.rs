@@ -16,7 +16,7 @@ use wheel_rail::{compute_table, DeltaR};
 
 use super::{check_options, conicity_at, setup_of, ConicityPoint, GeometryInputs, ProfileSource};
 use crate::analysis::{AnalysisError, Artefacts};
-use crate::plot::PlotError;
+use crate::plot::{colour, draw_legend, legend_width, longest, LegendEntry, PlotError, Swatch};
 use master::output::csv_field;
 
 /// File name endings read from a `--wheel-dir` folder (case-insensitive).
@@ -324,13 +324,14 @@ fn category_svg(
     let pad = ((hi - lo) * 0.08).max(0.01);
     let n = labels.len();
     let rotate = n > 6 || labels.iter().any(|l| l.len() > 14);
-    let longest = labels.iter().map(|l| l.chars().count()).max().unwrap_or(1);
+    let longest_label = longest(labels.iter().map(String::as_str)).max(1);
     let x_area = if rotate {
-        (40 + 7 * longest.min(40)) as u32
+        (40 + 7 * longest_label.min(40)) as u32
     } else {
         45
     };
-    let width = (900_usize).max(60 + 28 * n).min(4000) as u32;
+    let legend_px = legend_width(longest(series.iter().map(|(name, _)| *name)));
+    let width = (900_usize).max(60 + 28 * n).min(4000) as u32 + legend_px;
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (width, 560 + x_area)).into_drawing_area();
@@ -338,6 +339,7 @@ fn category_svg(
         let mut chart = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 20))
             .margin(12)
+            .margin_right(12 + legend_px)
             .x_label_area_size(x_area)
             .y_label_area_size(70)
             .build_cartesian_2d(-0.5..(n as f64 - 0.5), (lo - pad)..(hi + pad))
@@ -374,8 +376,9 @@ fn category_svg(
                     .map_err(|e| draw(&e))?;
             }
         }
+        let mut entries = Vec::with_capacity(series.len());
         for (i, (name, vals)) in series.iter().enumerate() {
-            let color = Palette99::pick(i).to_rgba();
+            let color = colour(i);
             let marker = 4 - i.min(2) as i32;
             chart
                 .draw_series(
@@ -384,16 +387,12 @@ fn category_svg(
                         .filter(|(_, v)| v.is_finite())
                         .map(|(k, &v)| Circle::new((k as f64, v), marker, color.filled())),
                 )
-                .map_err(|e| draw(&e))?
-                .label(*name)
-                .legend(move |(x, y)| Circle::new((x + 10, y), marker, color.filled()));
+                .map_err(|e| draw(&e))?;
+            entries.push(LegendEntry::new(*name, Swatch::Dot(color, marker)));
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| draw(&e))?;
+        // right of the plotting area, never over the data
+        let (xs, ys) = chart.plotting_area().get_pixel_range();
+        draw_legend(&root, title, &entries, (xs.end + 10, ys.start))?;
         root.present().map_err(|e| draw(&e))?;
     }
     Ok(svg)

@@ -68,7 +68,17 @@ fn write_series_csv(path: &Path, columns: &[(String, Vec<(f64, f64)>)]) -> Resul
     Ok(())
 }
 
-/// A time-history chart + CSV of one column across several runs.
+/// A configuration's curve in a figure over speed: in its control family's panel, the passive
+/// damper in grey in every panel, so that twelve curves never share one frame.
+fn speed_curve(chart: Chart, id: &str, label: &str, points: Vec<(f64, f64)>) -> Chart {
+    match configuration(id).map(|c| c.family.panel()) {
+        Some(None) => chart.with_reference(label, points),
+        Some(Some(panel)) => chart.with_series_in(panel, label, points),
+        None => chart.with_series_in("other", label, points),
+    }
+}
+
+/// A time-history chart + CSV of one column across several runs, one panel per run.
 #[allow(clippy::too_many_arguments)]
 fn history_chart(
     r: &StudyResults,
@@ -92,7 +102,9 @@ fn history_chart(
         return Ok(None);
     }
     write_series_csv(&dir.join(format!("{stem}.csv")), &cols)?;
-    chart.write_lines(&dir.join(format!("{stem}.svg")))?;
+    chart
+        .one_panel_per_series()
+        .write_lines(&dir.join(format!("{stem}.svg")))?;
     Ok(Some(stem.to_string()))
 }
 
@@ -163,7 +175,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             .filter_map(|p| p.rms.map(|v| (p.speed_kmh, v)))
             .collect();
         if !pts.is_empty() {
-            chart = chart.with_series(c.label, pts);
+            chart = speed_curve(chart, c.id, c.label, pts);
         }
         let by_speed = |f: fn(&SpeedPoint) -> Option<f64>| -> Vec<(f64, f64)> {
             let mut v: Vec<(f64, f64)> = c
@@ -184,10 +196,10 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             comfort_rows.push(vec![c.id.to_string(), format!("{v}"), format!("{x:.4}")]);
         }
         if !cb.is_empty() {
-            carbody_chart = carbody_chart.with_series(c.label, cb);
+            carbody_chart = speed_curve(carbody_chart, c.id, c.label, cb);
         }
         if !ny.is_empty() {
-            comfort_chart = comfort_chart.with_series(c.label, ny);
+            comfort_chart = speed_curve(comfort_chart, c.id, c.label, ny);
         }
         for (kind, pts) in [("sweep", &c.sweep), ("bisection", &c.bisection)] {
             for p in pts.iter() {
@@ -227,7 +239,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         chart.write_lines(&out.join("rms_vs_speed.svg"))?;
         figures.push((
             "rms_vs_speed".into(),
-            "rms vs speed, all configurations, a_lim dashed (Figs. 4.13, 4.23, 4.24)",
+            "rms vs speed, a panel per control family with the passive damper in grey, a_lim dashed (Figs. 4.13, 4.23, 4.24)",
         ));
     }
     if coach && !r.configs.is_empty() {
@@ -285,11 +297,18 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     let command = vehicle.first("controller", "valve.command");
     let opening = vehicle.first("damper", "valve.opening");
     let carbody_mid = signals.carbody.get(1).cloned().unwrap_or_default();
+    // the stored record is low-passed before decimation: a switching command shows as pulses
+    // rounded by that filter, not as its 0 / 10 V steps (skyhook_valve_zoom has the switching)
+    let command_what = format!(
+        "first damper's valve command ({:.0} Hz low-pass of the {:.0} Hz record)",
+        master::decimation::ANTI_ALIAS_CUTOFF * r.settings.stored_rate_hz,
+        r.settings.stored_rate_hz
+    );
     let mut histories = vec![
         ("history_displacement", "leading wheelset lateral displacement relative to the track", "displacement [mm]", ws_y, 1e3, &hist_runs, "wheelset displacement, passive / MPPT2 / sky-hook / full-active (Figs. 4.18, 4.21, 4.25)"),
         ("history_acceleration", acc_what, "acceleration [m/s^2]", acc, 1.0, &hist_runs, "EN 14363 acceleration (Figs. 4.18, 4.21, 4.26)"),
         ("history_force", damper_what, "force [kN]", force.as_str(), 1e-3, &semi_runs, "damper force (Figs. 4.18, 4.21)"),
-        ("history_command", "first damper's valve command", "command [V]", command.as_str(), 1.0, &semi_runs, "valve command MPPT2 vs sky-hook (Figs. 4.18, 4.21)"),
+        ("history_command", command_what.as_str(), "command [V]", command.as_str(), 1.0, &semi_runs, "valve command MPPT2 vs sky-hook (Figs. 4.18, 4.21)"),
     ];
     if coach {
         histories.push((
@@ -354,7 +373,9 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     }
     if !pert_cols.is_empty() {
         write_series_csv(&out.join("perturbation.csv"), &pert_cols)?;
-        chart.write_lines(&out.join("perturbation.svg"))?;
+        chart
+            .one_panel_per_series()
+            .write_lines(&out.join("perturbation.svg"))?;
         figures.push((
             "perturbation".into(),
             if coach {
@@ -470,7 +491,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             "time [s]",
             "opening [-]",
         )
-        .with_series("slow valve: command", zoom(&cmd))
+        .with_series("slow valve: command / 10 V", zoom(&cmd))
         .with_series("slow valve: actual opening", zoom(&open))
         .write_lines(&out.join("skyhook_valve_zoom.svg"))?;
         figures.push((

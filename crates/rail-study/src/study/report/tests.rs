@@ -247,6 +247,25 @@ fn the_coach_report_has_the_car_body_beside_the_en14363_verdict() {
     for f in ["carbody_vs_speed.svg", "comfort_vs_speed.svg"] {
         assert!(d.path().join(f).exists(), "{f}");
     }
+    // figures over speed: a panel per control family present, the passive damper in each
+    for f in [
+        "rms_vs_speed.svg",
+        "carbody_vs_speed.svg",
+        "comfort_vs_speed.svg",
+    ] {
+        let svg = std::fs::read_to_string(d.path().join(f)).unwrap();
+        for s in [
+            ">\nMPPT\n<",
+            ">\npassive (30 %)\n<",
+            ">\nMPPT2, ideal valve\n<",
+        ] {
+            assert!(svg.contains(s), "{f}: missing {s:?}");
+        }
+        assert!(
+            !svg.contains(">\nfull-active\n<"),
+            "{f}: a panel without a curve"
+        );
+    }
     let csv = std::fs::read_to_string(d.path().join("rms_vs_speed.csv")).unwrap();
     assert!(
         csv.contains("passive,sweep,280,3.0000,3.0000,2.0000,0.2500,1.5000,1.5000"),

@@ -1,0 +1,273 @@
+//! SVG figures with plotters: line charts (several series, axis labels with units, legend,
+//! optional horizontal limit line), stacked panels sharing their axes, and scatter plots (root
+//! locus). Rendered into a string and written atomically.
+//!
+//! Every legend sits in a column right of the plotting area, never over the data; a chart
+//! whose series would crowd one frame is split into panels (one per run of a time history,
+//! one per controller family of a speed sweep), each with the grey reference series and the
+//! limit line drawn again for comparison.
+
+mod frame;
+#[cfg(test)]
+mod tests;
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+use master::output::{write_bytes_atomic, OutputError};
+
+pub(crate) use frame::{
+    colour, draw_err, draw_legend, draw_limit, draw_lines, legend_width, longest, render_svg,
+    LegendEntry, Swatch,
+};
+use frame::{draw_frame, titled, Frame, FrameSpec, PANEL_FONT_PX};
+
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    #[error("plot '{title}': {reason}")]
+    Data { title: String, reason: String },
+    #[error("plot '{title}': drawing failed: {reason}")]
+    Draw { title: String, reason: String },
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
+
+/// (min, max) of an axis.
+type Range = (f64, f64);
+
+/// One named series of (x, y) points.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+    /// Index into [`Chart::panels`] (0 without panels).
+    pub panel: usize,
+    /// Drawn in grey in every panel, under the others (e.g. the passive damper).
+    pub reference: bool,
+}
+
+/// A chart description.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Chart {
+    pub title: String,
+    /// e.g. "time [s]"
+    pub x_label: String,
+    /// e.g. "lateral acceleration rms [m/s^2]"
+    pub y_label: String,
+    pub series: Vec<Series>,
+    /// Horizontal line (value, label), e.g. the EN 14363 limit; in every panel.
+    pub limit: Option<(f64, String)>,
+    /// Captions of the stacked panels, top to bottom; empty: one frame.
+    pub panels: Vec<String>,
+    /// Width of the plot without the legend column [px].
+    pub width: u32,
+    /// Height of a one-frame chart [px].
+    pub height: u32,
+    /// Height of each panel [px].
+    pub panel_height: u32,
+}
+
+/// Height of the figure's title above its panels [px].
+const TITLE_PX: u32 = 40;
+
+impl Chart {
+    pub fn new(title: &str, x_label: &str, y_label: &str) -> Self {
+        Chart {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            series: Vec::new(),
+            limit: None,
+            panels: Vec::new(),
+            width: 900,
+            height: 560,
+            panel_height: 230,
+        }
+    }
+    /// Adds a series (to the first panel, if there are panels).
+    pub fn with_series(mut self, name: &str, points: Vec<(f64, f64)>) -> Self {
+        self.series.push(Series {
+            name: name.into(),
+            points,
+            panel: 0,
+            reference: false,
+        });
+        self
+    }
+    /// Adds a series drawn in grey in every panel.
+    pub fn with_reference(mut self, name: &str, points: Vec<(f64, f64)>) -> Self {
+        self.series.push(Series {
+            name: name.into(),
+            points,
+            panel: 0,
+            reference: true,
+        });
+        self
+    }
+    /// Adds a series to the panel with this caption, begun below the others if new.
+    pub fn with_series_in(mut self, panel: &str, name: &str, points: Vec<(f64, f64)>) -> Self {
+        let p = match self.panels.iter().position(|c| c == panel) {
+            Some(p) => p,
+            None => {
+                self.panels.push(panel.into());
+                self.panels.len() - 1
+            }
+        };
+        self.series.push(Series {
+            name: name.into(),
+            points,
+            panel: p,
+            reference: false,
+        });
+        self
+    }
+    /// Puts each series in a panel of its own, captioned with its name (time histories of
+    /// several runs, which overlap into one band in a single frame).
+    pub fn one_panel_per_series(mut self) -> Self {
+        self.panels.clear();
+        for s in self.series.iter_mut().filter(|s| !s.reference) {
+            s.panel = self.panels.len();
+            self.panels.push(s.name.clone());
+        }
+        self
+    }
+    pub fn with_limit(mut self, value: f64, label: &str) -> Self {
+        self.limit = Some((value, label.into()));
+        self
+    }
+
+    /// The series of panel `p`: the references first (drawn under the others).
+    fn panel_series(&self, p: usize) -> Vec<&Series> {
+        let refs = self.series.iter().filter(|s| s.reference);
+        let own = self
+            .series
+            .iter()
+            .filter(|s| !s.reference && (self.panels.is_empty() || s.panel == p));
+        refs.chain(own).collect()
+    }
+
+    /// Whether panel `p` needs a legend: not when its caption names its only line.
+    fn needs_legend(&self, p: usize) -> bool {
+        let entries = self.panel_series(p).len() + usize::from(self.limit.is_some());
+        entries > 1 || self.panels.is_empty()
+    }
+
+    /// The legend column's width, the same for every panel so that their plotting areas
+    /// align: enough for the longest entry; none when no panel needs a legend.
+    pub(crate) fn legend_px(&self) -> u32 {
+        if !(0..self.panels.len().max(1)).any(|p| self.needs_legend(p)) {
+            return 0;
+        }
+        let names = self.series.iter().map(|s| s.name.as_str());
+        legend_width(longest(
+            names.chain(self.limit.iter().map(|(_, l)| l.as_str())),
+        ))
+    }
+
+    fn ranges(&self) -> Result<(Range, Range), PlotError> {
+        let pts = self.series.iter().flat_map(|s| s.points.iter());
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        let mut any = false;
+        for &(x, y) in pts {
+            if x.is_finite() && y.is_finite() {
+                any = true;
+                x0 = x0.min(x);
+                x1 = x1.max(x);
+                y0 = y0.min(y);
+                y1 = y1.max(y);
+            }
+        }
+        if !any {
+            return Err(PlotError::Data {
+                title: self.title.clone(),
+                reason: "no finite points".into(),
+            });
+        }
+        if let Some((v, _)) = &self.limit {
+            y0 = y0.min(*v);
+            y1 = y1.max(*v);
+        }
+        let pad = |a: f64, b: f64| {
+            let d = if b > a {
+                (b - a) * 0.05
+            } else {
+                a.abs().max(1.0) * 0.05
+            };
+            (a - d, b + d)
+        };
+        let xr = if x1 > x0 { (x0, x1) } else { pad(x0, x1) };
+        Ok((xr, pad(y0, y1)))
+    }
+
+    /// Renders to an SVG string; `scatter` draws points instead of lines. With panels, they
+    /// are stacked under the title and share both axes' ranges, so that they compare.
+    pub fn to_svg(&self, scatter: bool) -> Result<String, PlotError> {
+        let ((x0, x1), (y0, y1)) = self.ranges()?;
+        let t = self.title.as_str();
+        let legend_px = self.legend_px();
+        let finite = |(x, y): (f64, f64)| x.is_finite() && y.is_finite();
+        let body = |p: usize, chart: &mut Frame<'_, '_, _, _>| {
+            let series = self.panel_series(p);
+            let mut entries = if scatter {
+                let mut entries = Vec::with_capacity(series.len());
+                for (i, s) in series.iter().enumerate() {
+                    let color = colour(i);
+                    let pts = s.points.iter().copied().filter(|&p| finite(p));
+                    chart
+                        .draw_series(pts.map(|p| Circle::new(p, 3, color.filled())))
+                        .map_err(|e| draw_err(t, &e))?;
+                    entries.push(LegendEntry::new(&s.name, Swatch::Dot(color, 3)));
+                }
+                entries
+            } else {
+                draw_lines(chart, t, &series, finite)?
+            };
+            if let Some((v, label)) = &self.limit {
+                entries.push(draw_limit(chart, t, (x0, x1), *v, label)?);
+            }
+            Ok(entries)
+        };
+        if self.panels.is_empty() {
+            let labels = (self.x_label.as_str(), self.y_label.as_str());
+            let size = (self.width, self.height);
+            return render_svg(t, size, labels, (x0..x1, y0..y1), legend_px, |c| body(0, c));
+        }
+        let n = self.panels.len();
+        let height = TITLE_PX + self.panel_height * n as u32;
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, (self.width + legend_px, height))
+                .into_drawing_area();
+            root.fill(&WHITE).map_err(|e| draw_err(t, &e))?;
+            let panels = titled(&root, t)?;
+            for (p, area) in panels.split_evenly((n, 1)).iter().enumerate() {
+                let last = p + 1 == n;
+                let spec = FrameSpec {
+                    caption: Some((self.panels[p].as_str(), PANEL_FONT_PX)),
+                    labels: (
+                        if last { self.x_label.as_str() } else { "" },
+                        self.y_label.as_str(),
+                    ),
+                    legend_px,
+                    legend: self.needs_legend(p),
+                };
+                draw_frame(area, t, &spec, (x0..x1, y0..y1), |c| body(p, c))?;
+            }
+            root.present().map_err(|e| draw_err(t, &e))?;
+        }
+        Ok(svg)
+    }
+
+    /// Line chart to an SVG file (atomic).
+    pub fn write_lines(&self, path: &Path) -> Result<(), PlotError> {
+        let svg = self.to_svg(false)?;
+        Ok(write_bytes_atomic(path, svg.as_bytes())?)
+    }
+
+    /// Scatter chart to an SVG file (atomic), e.g. a root locus (x = real part, y = imaginary).
+    pub fn write_scatter(&self, path: &Path) -> Result<(), PlotError> {
+        let svg = self.to_svg(true)?;
+        Ok(write_bytes_atomic(path, svg.as_bytes())?)
+    }
+}
