@@ -19,6 +19,8 @@ const LEGEND_ROW_PX: i32 = 18;
 /// Font size of a figure's title and of a panel's caption [px].
 const TITLE_FONT_PX: u32 = 20;
 pub(super) const PANEL_FONT_PX: u32 = 15;
+/// Lines of a wrapped title at most; the rest is cut.
+const MAX_TITLE_LINES: usize = 3;
 /// Line colours in order (Tableau 10 without its grey, which marks references): distinct on
 /// white and for the common colour-vision deficiencies, no pale yellow.
 const PALETTE: [RGBColor; 9] = [
@@ -56,8 +58,22 @@ pub(crate) fn legend_width(chars: usize) -> u32 {
         return 0;
     }
     let em = f64::from(LEGEND_FONT_PX) / 1.24;
-    let text = (chars as f64 * 0.56 * em).ceil() as u32;
+    let text = (chars.min(MAX_LEGEND_CHARS) as f64 * 0.56 * em).ceil() as u32;
     36 + text + 12
+}
+
+/// Characters of a legend entry at most; a longer one is cut (the CSV beside the figure
+/// keeps the full name).
+const MAX_LEGEND_CHARS: usize = 60;
+
+/// `label` cut to [`MAX_LEGEND_CHARS`].
+fn legend_label(label: &str) -> String {
+    if label.chars().count() <= MAX_LEGEND_CHARS {
+        return label.to_string();
+    }
+    let mut cut: String = label.chars().take(MAX_LEGEND_CHARS - 4).collect();
+    cut.push_str(" ...");
+    cut
 }
 
 /// The longest of `labels`, in characters.
@@ -121,8 +137,12 @@ pub(crate) fn draw_legend(
             Swatch::Ring(c, r) => area.draw(&Circle::new((x + 12, yk), r, c.stroke_width(2))),
         };
         drawn.map_err(|err| draw_err(title, &err))?;
-        area.draw(&Text::new(e.label.clone(), (x + 32, yk), font.clone()))
-            .map_err(|err| draw_err(title, &err))?;
+        area.draw(&Text::new(
+            legend_label(&e.label),
+            (x + 32, yk),
+            font.clone(),
+        ))
+        .map_err(|err| draw_err(title, &err))?;
     }
     Ok(())
 }
@@ -153,7 +173,12 @@ pub(crate) fn titled<'a>(
     // plotters writes 1/1.24 of the size into the SVG; a sans-serif character is ~0.56 em
     let char_px = 0.56 * f64::from(TITLE_FONT_PX) / 1.24;
     let max_chars = ((f64::from(w) - 24.0) / char_px).max(10.0) as usize;
-    let lines = wrap(title, max_chars);
+    let mut lines = wrap(title, max_chars);
+    if lines.len() > MAX_TITLE_LINES {
+        // a title that long (a user's label in it) must not crowd out the plot
+        lines.truncate(MAX_TITLE_LINES);
+        lines[MAX_TITLE_LINES - 1].push_str(" ...");
+    }
     let line_px = 24;
     let (top, rest) = root.split_vertically(12 + line_px * lines.len().max(1) as i32);
     let style = ("sans-serif", TITLE_FONT_PX)

@@ -176,3 +176,38 @@ fn long_titles_wrap_between_words() {
         title.split_whitespace().collect::<Vec<_>>().join(" ")
     );
 }
+
+#[test]
+fn a_huge_title_is_cut_to_three_lines_and_the_plot_still_drawn() {
+    let title = "word ".repeat(2000);
+    for panels in [false, true] {
+        let mut c = Chart::new(&title, "x [s]", "y [m]")
+            .with_series("a", vec![(0.0, 0.0), (1.0, 1.0), (2.0, 0.5)])
+            .with_series("b", vec![(0.0, 1.0), (1.0, 0.0), (2.0, 0.2)]);
+        if panels {
+            c = c.one_panel_per_series();
+        }
+        let svg = c.to_svg(false).unwrap();
+        let all = texts(&svg);
+        let lines: Vec<_> = all.iter().filter(|t| t.2.starts_with("word")).collect();
+        assert_eq!(lines.len(), 3, "{panels}");
+        assert!(lines[2].2.ends_with(" ..."));
+        assert!(data_right_edge(&svg) > 0.0, "the data are drawn");
+    }
+}
+
+#[test]
+fn a_huge_legend_label_is_cut_and_the_column_bounded() {
+    let long = "x".repeat(5000);
+    let c = Chart::new("t", "x [s]", "y [m]")
+        .with_series(&long, vec![(0.0, 0.0), (1.0, 1.0), (2.0, 0.5)])
+        .with_series("b", vec![(0.0, 1.0), (1.0, 0.0), (2.0, 0.2)]);
+    assert_eq!(c.legend_px(), legend_width(60));
+    assert!(c.legend_px() < 500);
+    let svg = c.to_svg(false).unwrap();
+    let all = texts(&svg);
+    let cut: Vec<_> = all.iter().filter(|t| t.2.starts_with("xxx")).collect();
+    assert_eq!(cut.len(), 1);
+    assert_eq!(cut[0].2.chars().count(), 60);
+    assert!(cut[0].2.ends_with(" ..."));
+}
