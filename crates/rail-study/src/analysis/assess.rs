@@ -347,6 +347,10 @@ impl AssessReport {
             chart = chart.with_series(name, a.rms.clone());
         }
         chart = chart.with_limit(self.limit(), "limit");
+        if self.signals.len() > 2 {
+            // several signals' rms along the track overlap into one band: a panel each
+            chart = chart.one_panel_per_series();
+        }
         files.add_table("assess.csv", &t)?;
         files.add_lines("assess.svg", &chart)?;
         let mut legend =
