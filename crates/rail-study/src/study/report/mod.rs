@@ -547,6 +547,79 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         &cv_header,
         cv_rows.iter().map(Vec::as_slice),
     )?;
+    // Table 4-3 as figures: ours beside the seed's, the trend R14 compares
+    let ours = |col: usize| -> Vec<(f64, f64)> {
+        cv_rows
+            .iter()
+            .filter(|row| row[0].is_finite() && row[col].is_finite())
+            .map(|row| (row[0], row[col]))
+            .collect()
+    };
+    let v_cv = r.settings.cv_speed_kmh;
+    let ours_label = format!("ours, {v_cv:.0} km/h");
+    // the data behind each figure: columns of the c_v table
+    let columns_csv = |stem: &str, cols: &[usize]| {
+        let header: Vec<String> = cols.iter().map(|&c| cv_header[c].clone()).collect();
+        let rows: Vec<Vec<f64>> = cv_rows
+            .iter()
+            .map(|row| cols.iter().map(|&c| row[c]).collect())
+            .collect();
+        write_csv_atomic(
+            &out.join(format!("{stem}.csv")),
+            &header,
+            rows.iter().map(Vec::as_slice),
+        )
+    };
+    if ours(1).len() >= 2 {
+        columns_csv("cv_acceleration", &[0, 1, 7])?;
+        Chart::new(
+            "full-active c_v sensitivity: EN 14363 rms acceleration (Table 4-3)",
+            "c_v [kNs/m]",
+            "rms acceleration [m/s^2]",
+        )
+        .with_series(&ours_label, ours(1))
+        .with_series(
+            "seed (Table 4-3)",
+            SEED_TABLE_4_3.iter().map(|s| (s.0, s.1)).collect(),
+        )
+        .write_lines(&out.join("cv_acceleration.svg"))?;
+        figures.push((
+            "cv_acceleration".into(),
+            "full-active: rms acceleration vs c_v, ours and the seed's (Table 4-3, R14)",
+        ));
+    }
+    if ours(2).len() >= 2 {
+        columns_csv("cv_force", &[0, 2, 4, 8])?;
+        let bound = ActuatorBound::of_default_actuator();
+        let mut chart = Chart::new(
+            "full-active c_v sensitivity: peak actuator force (Table 4-3)",
+            "c_v [kNs/m]",
+            "force [kN]",
+        )
+        .with_series(&format!("{ours_label}: F_max"), ours(2));
+        if ours(4).len() >= 2 {
+            chart = chart.with_series(&format!("{ours_label}: peak reference c_v v"), ours(4));
+        }
+        chart
+            .with_series(
+                "seed (Table 4-3): F_max",
+                SEED_TABLE_4_3.iter().map(|s| (s.0, s.2)).collect(),
+            )
+            .with_limit(
+                bound.force_n / 1e3,
+                &format!(
+                    "force bound {:.1} kN ({:.0} bar on {:.2} cm^2)",
+                    bound.force_n / 1e3,
+                    bound.pressure_bar,
+                    bound.area_cm2
+                ),
+            )
+            .write_lines(&out.join("cv_force.svg"))?;
+        figures.push((
+            "cv_force".into(),
+            "full-active: peak force vs c_v against the actuator's force bound, ours and the seed's (Table 4-3, R14)",
+        ));
+    }
 
     let text = report_markdown(r, timing, &figures);
     write_bytes_atomic(&out.join("REPORT.md"), text.as_bytes())?;

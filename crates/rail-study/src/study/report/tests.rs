@@ -316,4 +316,37 @@ fn force_bound_note_names_the_saturated_gains_from_the_runs() {
         &[],
     );
     assert!(md.contains(&note), "the report carries the note");
+    // Table 4-3 as figures, with the table's columns behind them
+    let d = tempfile::tempdir().unwrap();
+    let text = write_outputs(
+        &r,
+        d.path(),
+        &Timing {
+            wall_s: 1.0,
+            threads: 1,
+        },
+    )
+    .unwrap();
+    let svg = std::fs::read_to_string(d.path().join("cv_force.svg")).unwrap();
+    for s in [
+        "force bound 25.2 kN (100 bar on 25.16 cm^2)",
+        "seed (Table 4-3): F_max",
+        "ours, 380 km/h: peak reference c_v v",
+    ] {
+        assert!(svg.contains(s), "cv_force.svg: missing {s:?}");
+    }
+    let csv = std::fs::read_to_string(d.path().join("cv_force.csv")).unwrap();
+    assert_eq!(
+        csv.lines().collect::<Vec<_>>(),
+        [
+            "c_v [kNs/m],F_max [kN],peak reference c_v v [kN],seed F_max [kN]",
+            "210,22.3,32.3,20.369",
+            "390,19,21.4,24.57"
+        ]
+    );
+    assert!(d.path().join("cv_acceleration.svg").exists());
+    assert!(
+        text.contains("`cv_force.svg` (data `cv_force.csv`)"),
+        "{text}"
+    );
 }
