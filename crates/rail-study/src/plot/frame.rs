@@ -19,6 +19,8 @@ const LEGEND_ROW_PX: i32 = 18;
 /// Font size of a figure's title and of a panel's caption [px].
 const TITLE_FONT_PX: u32 = 20;
 pub(super) const PANEL_FONT_PX: u32 = 15;
+/// Characters of a panel's caption at most (a signal's name may be a user's).
+pub(super) const MAX_PANEL_CHARS: usize = 90;
 /// Lines of a wrapped title at most; the rest is cut.
 const MAX_TITLE_LINES: usize = 3;
 /// Line colours in order (Tableau 10 without its grey, which marks references): distinct on
@@ -66,12 +68,12 @@ pub(crate) fn legend_width(chars: usize) -> u32 {
 /// keeps the full name).
 const MAX_LEGEND_CHARS: usize = 60;
 
-/// `label` cut to [`MAX_LEGEND_CHARS`].
-fn legend_label(label: &str) -> String {
-    if label.chars().count() <= MAX_LEGEND_CHARS {
-        return label.to_string();
+/// `text` cut to `max_chars` characters, the cut marked by " ...".
+pub(super) fn cut(text: &str, max_chars: usize) -> String {
+    if text.chars().count() <= max_chars {
+        return text.to_string();
     }
-    let mut cut: String = label.chars().take(MAX_LEGEND_CHARS - 4).collect();
+    let mut cut: String = text.chars().take(max_chars.saturating_sub(4)).collect();
     cut.push_str(" ...");
     cut
 }
@@ -138,7 +140,7 @@ pub(crate) fn draw_legend(
         };
         drawn.map_err(|err| draw_err(title, &err))?;
         area.draw(&Text::new(
-            legend_label(&e.label),
+            cut(&e.label, MAX_LEGEND_CHARS),
             (x + 32, yk),
             font.clone(),
         ))

@@ -21,7 +21,7 @@ pub(crate) use frame::{
     colour, draw_err, draw_legend, draw_limit, draw_lines, legend_width, longest, render_svg,
     LegendEntry, Swatch,
 };
-use frame::{draw_frame, titled, Frame, FrameSpec, PANEL_FONT_PX};
+use frame::{cut, draw_frame, titled, Frame, FrameSpec, MAX_PANEL_CHARS, PANEL_FONT_PX};
 
 #[derive(Debug, thiserror::Error)]
 pub enum PlotError {
@@ -243,8 +243,9 @@ impl Chart {
             let panels = titled(&root, t)?;
             for (p, area) in panels.split_evenly((n, 1)).iter().enumerate() {
                 let last = p + 1 == n;
+                let caption = cut(&self.panels[p], MAX_PANEL_CHARS);
                 let spec = FrameSpec {
-                    caption: Some((self.panels[p].as_str(), PANEL_FONT_PX)),
+                    caption: Some((caption.as_str(), PANEL_FONT_PX)),
                     labels: (
                         if last { self.x_label.as_str() } else { "" },
                         self.y_label.as_str(),

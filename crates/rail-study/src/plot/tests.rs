@@ -210,4 +210,10 @@ fn a_huge_legend_label_is_cut_and_the_column_bounded() {
     assert_eq!(cut.len(), 1);
     assert_eq!(cut[0].2.chars().count(), 60);
     assert!(cut[0].2.ends_with(" ..."));
+    // as a panel's caption: cut to 90
+    let svg = c.one_panel_per_series().to_svg(false).unwrap();
+    let all = texts(&svg);
+    let caption: Vec<_> = all.iter().filter(|t| t.2.starts_with("xxx")).collect();
+    assert_eq!(caption.len(), 1);
+    assert_eq!(caption[0].2.chars().count(), 90);
 }
