@@ -66,6 +66,8 @@ pub struct Chart {
     pub height: u32,
     /// Height of each panel [px].
     pub panel_height: u32,
+    /// Dots on the lines' points (a few measured points, e.g. the c_v table).
+    pub markers: bool,
 }
 
 /// Height of the figure's title above its panels [px].
@@ -83,6 +85,7 @@ impl Chart {
             width: 900,
             height: 560,
             panel_height: 230,
+            markers: false,
         }
     }
     /// Adds a series (to the first panel, if there are panels).
@@ -130,6 +133,11 @@ impl Chart {
             s.panel = self.panels.len();
             self.panels.push(s.name.clone());
         }
+        self
+    }
+    /// Marks each point of the lines with a dot.
+    pub fn with_markers(mut self) -> Self {
+        self.markers = true;
         self
     }
     pub fn with_limit(mut self, value: f64, label: &str) -> Self {
@@ -196,7 +204,12 @@ impl Chart {
             };
             (a - d, b + d)
         };
-        let xr = if x1 > x0 { (x0, x1) } else { pad(x0, x1) };
+        // a dot on an end point needs room beside it
+        let xr = if x1 > x0 && !self.markers {
+            (x0, x1)
+        } else {
+            pad(x0, x1)
+        };
         Ok((xr, pad(y0, y1)))
     }
 
@@ -221,7 +234,19 @@ impl Chart {
                 }
                 entries
             } else {
-                draw_lines(chart, t, &series, finite)?
+                let entries = draw_lines(chart, t, &series, finite)?;
+                if self.markers {
+                    for (s, e) in series.iter().zip(&entries) {
+                        let Swatch::Line(color, _) = e.swatch else {
+                            continue;
+                        };
+                        let pts = s.points.iter().copied().filter(|&p| finite(p));
+                        chart
+                            .draw_series(pts.map(|p| Circle::new(p, 4, color.filled())))
+                            .map_err(|e| draw_err(t, &e))?;
+                    }
+                }
+                entries
             };
             if let Some((v, label)) = &self.limit {
                 entries.push(draw_limit(chart, t, (x0, x1), *v, label)?);

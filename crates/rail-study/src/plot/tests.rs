@@ -217,3 +217,13 @@ fn a_huge_legend_label_is_cut_and_the_column_bounded() {
     assert_eq!(caption.len(), 1);
     assert_eq!(caption[0].2.chars().count(), 90);
 }
+
+#[test]
+fn markers_put_a_dot_on_every_point() {
+    let c = Chart::new("c_v", "c_v [kNs/m]", "force [kN]")
+        .with_series("ours", vec![(210.0, 22.3), (270.0, 24.4), (330.0, 22.4)])
+        .with_series("seed", vec![(210.0, 20.4), (270.0, 23.5)]);
+    let dots = |svg: &str| svg.matches("<circle").count();
+    assert_eq!(dots(&c.to_svg(false).unwrap()), 0);
+    assert_eq!(dots(&c.with_markers().to_svg(false).unwrap()), 5);
+}

@@ -577,6 +577,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             "c_v [kNs/m]",
             "rms acceleration [m/s^2]",
         )
+        .with_markers()
         .with_series(&ours_label, ours(1))
         .with_series(
             "seed (Table 4-3)",
@@ -596,6 +597,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             "c_v [kNs/m]",
             "force [kN]",
         )
+        .with_markers()
         .with_series(&format!("{ours_label}: F_max"), ours(2));
         if ours(4).len() >= 2 {
             chart = chart.with_series(&format!("{ours_label}: peak reference c_v v"), ours(4));
