@@ -115,7 +115,7 @@ where
     let size = (chart.width, chart.height);
     let series: Vec<_> = chart.series.iter().collect();
     render_svg(t, size, labels, (xr, yr), chart.legend_px(), |ctx| {
-        let mut entries = draw_lines(ctx, t, &series, |p| usable(p, xs, ys))?;
+        let mut entries = draw_lines(ctx, t, &series, chart.markers, |p| usable(p, xs, ys))?;
         match &chart.limit {
             Some((v, label)) if ys == Scale::Linear || *v > 0.0 => {
                 entries.push(draw_limit(ctx, t, x_span, *v, label)?);

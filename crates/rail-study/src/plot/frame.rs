@@ -165,37 +165,66 @@ pub(crate) fn wrap(text: &str, max_chars: usize) -> Vec<String> {
     lines
 }
 
+/// Height of a title line [px].
+const TITLE_LINE_PX: i32 = 24;
+
+/// The lines of `title` on a figure `width_px` wide: wrapped between words, at most
+/// [`MAX_TITLE_LINES`] (a title that long, a user's label in it, must not crowd out the plot).
+fn title_lines(title: &str, width_px: u32) -> Vec<String> {
+    // plotters writes 1/1.24 of the size into the SVG; a sans-serif character is ~0.56 em
+    let char_px = 0.56 * f64::from(TITLE_FONT_PX) / 1.24;
+    let max_chars = ((f64::from(width_px) - 24.0) / char_px).max(10.0) as usize;
+    let mut lines = wrap(title, max_chars);
+    if lines.len() > MAX_TITLE_LINES {
+        lines.truncate(MAX_TITLE_LINES);
+        lines[MAX_TITLE_LINES - 1].push_str(" ...");
+    }
+    lines
+}
+
+/// Height the title of a figure `width_px` wide takes above its frames [px].
+pub(super) fn title_height_px(title: &str, width_px: u32) -> u32 {
+    (12 + TITLE_LINE_PX * title_lines(title, width_px).len().max(1) as i32) as u32
+}
+
 /// Writes the figure's title across the top of `root`, wrapped to its width, and returns the
 /// area below it.
-pub(crate) fn titled<'a>(
+fn titled<'a>(
     root: &DrawingArea<SVGBackend<'a>, Shift>,
     title: &str,
 ) -> Result<DrawingArea<SVGBackend<'a>, Shift>, PlotError> {
     let (w, _) = root.dim_in_pixel();
-    // plotters writes 1/1.24 of the size into the SVG; a sans-serif character is ~0.56 em
-    let char_px = 0.56 * f64::from(TITLE_FONT_PX) / 1.24;
-    let max_chars = ((f64::from(w) - 24.0) / char_px).max(10.0) as usize;
-    let mut lines = wrap(title, max_chars);
-    if lines.len() > MAX_TITLE_LINES {
-        // a title that long (a user's label in it) must not crowd out the plot
-        lines.truncate(MAX_TITLE_LINES);
-        lines[MAX_TITLE_LINES - 1].push_str(" ...");
-    }
-    let line_px = 24;
-    let (top, rest) = root.split_vertically(12 + line_px * lines.len().max(1) as i32);
+    let (top, rest) = root.split_vertically(title_height_px(title, w));
     let style = ("sans-serif", TITLE_FONT_PX)
         .into_font()
         .into_text_style(root)
         .pos(Pos::new(HPos::Center, VPos::Top));
-    for (k, line) in lines.into_iter().enumerate() {
+    for (k, line) in title_lines(title, w).into_iter().enumerate() {
         top.draw(&Text::new(
             line,
-            (w as i32 / 2, 8 + k as i32 * line_px),
+            (w as i32 / 2, 8 + k as i32 * TITLE_LINE_PX),
             style.clone(),
         ))
         .map_err(|e| draw_err(title, &e))?;
     }
     Ok(rest)
+}
+
+/// A figure of `size` as an SVG string: white background, the title, then `draw` on the area
+/// below the title.
+pub(super) fn svg_figure(
+    title: &str,
+    size: (u32, u32),
+    draw: impl FnOnce(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), PlotError>,
+) -> Result<String, PlotError> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| draw_err(title, &e))?;
+        draw(&titled(&root, title)?)?;
+        root.present().map_err(|e| draw_err(title, &e))?;
+    }
+    Ok(svg)
 }
 
 /// What one frame of a figure shows besides its data.
@@ -277,29 +306,25 @@ where
         &mut Frame<'_, '_, XR::CoordDescType, YR::CoordDescType>,
     ) -> Result<Vec<LegendEntry>, PlotError>,
 {
-    let mut svg = String::new();
-    {
-        let root =
-            SVGBackend::with_string(&mut svg, (size.0 + legend_px, size.1)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| draw_err(title, &e))?;
-        let spec = FrameSpec {
-            caption: None,
-            labels,
-            legend_px,
-            legend: true,
-        };
-        draw_frame(&titled(&root, title)?, title, &spec, ranges, body)?;
-        root.present().map_err(|e| draw_err(title, &e))?;
-    }
-    Ok(svg)
+    let spec = FrameSpec {
+        caption: None,
+        labels,
+        legend_px,
+        legend: true,
+    };
+    svg_figure(title, (size.0 + legend_px, size.1), |area| {
+        draw_frame(area, title, &spec, ranges, body)
+    })
 }
 
 /// Each series as a line in the palette colour of its place among `series` (a reference
-/// series in grey); points failing `keep` are left out. Returns their legend entries.
+/// series in grey), with a dot on each point if `markers`; points failing `keep` are left
+/// out. Returns their legend entries.
 pub(crate) fn draw_lines<X, Y>(
     chart: &mut Frame<'_, '_, X, Y>,
     title: &str,
     series: &[&Series],
+    markers: bool,
     keep: impl Fn((f64, f64)) -> bool,
 ) -> Result<Vec<LegendEntry>, PlotError>
 where
@@ -316,6 +341,11 @@ where
             colour(colour_index - 1)
         };
         let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(|&p| keep(p)).collect();
+        if markers {
+            chart
+                .draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))
+                .map_err(|e| draw_err(title, &e))?;
+        }
         chart
             .draw_series(LineSeries::new(pts, color.stroke_width(2)))
             .map_err(|e| draw_err(title, &e))?;

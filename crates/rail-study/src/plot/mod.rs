@@ -21,7 +21,9 @@ pub(crate) use frame::{
     colour, draw_err, draw_legend, draw_limit, draw_lines, legend_width, longest, render_svg,
     LegendEntry, Swatch,
 };
-use frame::{cut, draw_frame, titled, Frame, FrameSpec, MAX_PANEL_CHARS, PANEL_FONT_PX};
+use frame::{
+    cut, draw_frame, svg_figure, title_height_px, Frame, FrameSpec, MAX_PANEL_CHARS, PANEL_FONT_PX,
+};
 
 #[derive(Debug, thiserror::Error)]
 pub enum PlotError {
@@ -69,9 +71,6 @@ pub struct Chart {
     /// Dots on the lines' points (a few measured points, e.g. the c_v table).
     pub markers: bool,
 }
-
-/// Height of the figure's title above its panels [px].
-const TITLE_PX: u32 = 40;
 
 impl Chart {
     pub fn new(title: &str, x_label: &str, y_label: &str) -> Self {
@@ -234,19 +233,7 @@ impl Chart {
                 }
                 entries
             } else {
-                let entries = draw_lines(chart, t, &series, finite)?;
-                if self.markers {
-                    for (s, e) in series.iter().zip(&entries) {
-                        let Swatch::Line(color, _) = e.swatch else {
-                            continue;
-                        };
-                        let pts = s.points.iter().copied().filter(|&p| finite(p));
-                        chart
-                            .draw_series(pts.map(|p| Circle::new(p, 4, color.filled())))
-                            .map_err(|e| draw_err(t, &e))?;
-                    }
-                }
-                entries
+                draw_lines(chart, t, &series, self.markers, finite)?
             };
             if let Some((v, label)) = &self.limit {
                 entries.push(draw_limit(chart, t, (x0, x1), *v, label)?);
@@ -259,13 +246,9 @@ impl Chart {
             return render_svg(t, size, labels, (x0..x1, y0..y1), legend_px, |c| body(0, c));
         }
         let n = self.panels.len();
-        let height = TITLE_PX + self.panel_height * n as u32;
-        let mut svg = String::new();
-        {
-            let root = SVGBackend::with_string(&mut svg, (self.width + legend_px, height))
-                .into_drawing_area();
-            root.fill(&WHITE).map_err(|e| draw_err(t, &e))?;
-            let panels = titled(&root, t)?;
+        let width = self.width + legend_px;
+        let height = title_height_px(t, width) + self.panel_height * n as u32;
+        svg_figure(t, (width, height), |panels| {
             for (p, area) in panels.split_evenly((n, 1)).iter().enumerate() {
                 let last = p + 1 == n;
                 let caption = cut(&self.panels[p], MAX_PANEL_CHARS);
@@ -280,9 +263,8 @@ impl Chart {
                 };
                 draw_frame(area, t, &spec, (x0..x1, y0..y1), |c| body(p, c))?;
             }
-            root.present().map_err(|e| draw_err(t, &e))?;
-        }
-        Ok(svg)
+            Ok(())
+        })
     }
 
     /// Line chart to an SVG file (atomic).

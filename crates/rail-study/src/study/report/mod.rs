@@ -570,7 +570,8 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             rows.iter().map(Vec::as_slice),
         )
     };
-    if ours(1).len() >= 2 {
+    let (acceleration, peak, reference) = (ours(1), ours(2), ours(4));
+    if acceleration.len() >= 2 {
         columns_csv("cv_acceleration", &[0, 1, 7])?;
         Chart::new(
             "full-active c_v sensitivity: EN 14363 rms acceleration (Table 4-3)",
@@ -578,7 +579,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             "rms acceleration [m/s^2]",
         )
         .with_markers()
-        .with_series(&ours_label, ours(1))
+        .with_series(&ours_label, acceleration)
         .with_series(
             "seed (Table 4-3)",
             SEED_TABLE_4_3.iter().map(|s| (s.0, s.1)).collect(),
@@ -589,7 +590,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             "full-active: rms acceleration vs c_v, ours and the seed's (Table 4-3, R14)",
         ));
     }
-    if ours(2).len() >= 2 {
+    if peak.len() >= 2 {
         columns_csv("cv_force", &[0, 2, 4, 8])?;
         let bound = ActuatorBound::of_default_actuator();
         let mut chart = Chart::new(
@@ -598,9 +599,9 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             "force [kN]",
         )
         .with_markers()
-        .with_series(&format!("{ours_label}: F_max"), ours(2));
-        if ours(4).len() >= 2 {
-            chart = chart.with_series(&format!("{ours_label}: peak reference c_v v"), ours(4));
+        .with_series(&format!("{ours_label}: F_max"), peak);
+        if reference.len() >= 2 {
+            chart = chart.with_series(&format!("{ours_label}: peak reference c_v v"), reference);
         }
         chart
             .with_series(

@@ -172,19 +172,21 @@ fn speeds_within_the_limit_above_a_burst_are_listed_as_ranges() {
     assert_eq!(within_limit_above(&c, 5.39), "-");
 }
 
+/// Every output file of `r` written into a new temporary folder, and the report's text.
+fn outputs_of(r: &StudyResults) -> (tempfile::TempDir, String) {
+    let d = tempfile::tempdir().unwrap();
+    let timing = Timing {
+        wall_s: 1.0,
+        threads: 1,
+    };
+    let text = write_outputs(r, d.path(), &timing).unwrap();
+    (d, text)
+}
+
 #[test]
 fn outputs_are_written_even_without_time_histories() {
     let r = results();
-    let d = tempfile::tempdir().unwrap();
-    let text = write_outputs(
-        &r,
-        d.path(),
-        &Timing {
-            wall_s: 1.0,
-            threads: 1,
-        },
-    )
-    .unwrap();
+    let (d, text) = outputs_of(&r);
     assert!(text.contains("Critical speeds"));
     for f in [
         "REPORT.md",
@@ -234,16 +236,7 @@ fn the_coach_report_has_the_car_body_beside_the_en14363_verdict() {
         &[]
     )
     .contains("Car body"));
-    let d = tempfile::tempdir().unwrap();
-    write_outputs(
-        &r,
-        d.path(),
-        &Timing {
-            wall_s: 1.0,
-            threads: 1,
-        },
-    )
-    .unwrap();
+    let (d, _) = outputs_of(&r);
     for f in ["carbody_vs_speed.svg", "comfort_vs_speed.svg"] {
         assert!(d.path().join(f).exists(), "{f}");
     }
@@ -317,16 +310,7 @@ fn force_bound_note_names_the_saturated_gains_from_the_runs() {
     );
     assert!(md.contains(&note), "the report carries the note");
     // Table 4-3 as figures, with the table's columns behind them
-    let d = tempfile::tempdir().unwrap();
-    let text = write_outputs(
-        &r,
-        d.path(),
-        &Timing {
-            wall_s: 1.0,
-            threads: 1,
-        },
-    )
-    .unwrap();
+    let (d, text) = outputs_of(&r);
     let svg = std::fs::read_to_string(d.path().join("cv_force.svg")).unwrap();
     for s in [
         "force bound 25.2 kN (100 bar on 25.16 cm^2)",
