@@ -183,6 +183,51 @@ fn actuator_step_size_study() {
     }
 }
 
+/// The internal error test's tolerances (`solver.rtol`, which scales the absolute ones): on
+/// the benchmark's reference stroke (3 mm at 4 Hz plus a 17 Hz ripple, IDF-like spool command
+/// of 0.6 mm), 5 s of 1 ms steps with the default rtol 1e-6 give the force within 2e-4 of its
+/// amplitude of a run at rtol 1e-8 (measured 8.4e-5; with the spool's tolerances 10 times
+/// tighter, as before they scaled with its travel, 1.7e-5 at 1.7 times the cost); 100 times
+/// looser tolerances do not (measured 1.3e-3 at rtol 1e-4), so the test fails if the defaults
+/// are made too loose.
+#[test]
+fn actuator_tolerances_study() {
+    use fmu_damper::perf::stroke;
+    let forces = |rtol: f64| -> Vec<f64> {
+        let mut p = ActuatorParams::default();
+        p.solver.rtol = rtol;
+        let mut a = Actuator::new(p).unwrap();
+        (0..5000u64)
+            .map(|k| {
+                let (x, v) = stroke(k);
+                let i = ActuatorInputs {
+                    spool_command_m: 0.6e-3 * v / (3e-3 * 2.0 * PI * 4.0),
+                    elongation_m: x,
+                    elongation_velocity_mps: v,
+                    ..Default::default()
+                };
+                a.step(1e-3, &i).unwrap().force_n
+            })
+            .collect()
+    };
+    let reference = forces(1e-8);
+    let amplitude = reference.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+    let error = |f: &[f64]| {
+        f.iter()
+            .zip(&reference)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f64, f64::max)
+            / amplitude
+    };
+    let default = error(&forces(ActuatorParams::default().solver.rtol));
+    let loose = error(&forces(1e-4));
+    eprintln!(
+        "force error of the amplitude {amplitude:.0} N: rtol 1e-6 {default:.2e}, 1e-4 {loose:.2e}"
+    );
+    assert!(default < 2e-4, "{default:e}");
+    assert!(loose > 2e-4, "{loose:e}");
+}
+
 /// Active mode, rod blocked (imposed at rest), u = alpha: chamber A fills until the
 /// valve flow equals the leakage, K z sqrt(P_S - P_A) = C_L (P_A - P_B) with
 /// P_A + P_B = P_S by symmetry; the actuator pushes (force_n < 0).
