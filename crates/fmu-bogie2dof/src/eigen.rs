@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::params::{ParamError, Params};
 pub use vehicle_elements::LinearDamper;
+use vehicle_elements::{first_unstable_speed, Crossing};
 
 /// One point of a frequency-dependent equivalent damper (per damper).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -347,29 +348,12 @@ fn critical_speed_by(
     if !(lo_mps > 0.0 && hi_mps > lo_mps && hi_mps.is_finite()) {
         return Err(no);
     }
-    let mut a = lo_mps;
-    if f(a)?.max_re >= 0.0 {
+    let crossing = first_unstable_speed(lo_mps, hi_mps, 0.5, 1e-6, |v| {
+        Ok::<_, EigenError>(f(v)?.max_re >= 0.0)
+    })?;
+    let Crossing::At(b) = crossing else {
         return Err(no);
-    }
-    let n = ((hi_mps - lo_mps) / 0.5).ceil() as usize;
-    let mut b = None;
-    for i in 1..=n {
-        let v = (lo_mps + i as f64 * 0.5).min(hi_mps);
-        if f(v)?.max_re >= 0.0 {
-            b = Some(v);
-            break;
-        }
-        a = v;
-    }
-    let Some(mut b) = b else { return Err(no) };
-    while b - a > 1e-6 {
-        let mid = 0.5 * (a + b);
-        if f(mid)?.max_re >= 0.0 {
-            b = mid;
-        } else {
-            a = mid;
-        }
-    }
+    };
     let r = f(b)?;
     let hunting = r.hunting.ok_or(no)?;
     Ok(CriticalSpeed {

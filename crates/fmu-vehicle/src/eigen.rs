@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::layout::{damper_rows, mass_diagonal, N_DAMPERS, N_DOF};
 use crate::params::{ParamError, VehicleParams};
+use vehicle_elements::{first_unstable_speed, Crossing};
 
 /// Linear representation of one yaw damper (all four identical), values per damper: the law the
 /// closed loop evaluates too.
@@ -403,29 +404,13 @@ pub fn critical_speed(
         let r = max_re(&q, v, d);
         Ok((q, r))
     };
-    if at(lo_mps)?.1 >= 0.0 {
-        return Err(EigenError::UnstableAtLowerEnd { lo_mps });
-    }
-    let mut a = lo_mps;
-    let n = (hi_mps - lo_mps).ceil() as usize;
-    let mut b = None;
-    for i in 1..=n {
-        let v = (lo_mps + i as f64).min(hi_mps);
-        if at(v)?.1 >= 0.0 {
-            b = Some(v);
-            break;
-        }
-        a = v;
-    }
-    let Some(mut b) = b else { return Err(no) };
-    while b - a > 1e-6 {
-        let mid = 0.5 * (a + b);
-        if at(mid)?.1 >= 0.0 {
-            b = mid;
-        } else {
-            a = mid;
-        }
-    }
+    let b = match first_unstable_speed(lo_mps, hi_mps, 1.0, 1e-6, |v| {
+        Ok::<_, EigenError>(at(v)?.1 >= 0.0)
+    })? {
+        Crossing::At(b) => b,
+        Crossing::UnstableAtStart => return Err(EigenError::UnstableAtLowerEnd { lo_mps }),
+        Crossing::None => return Err(no),
+    };
     let (q, _) = at(b)?;
     let r = analyse_validated(&q, b, d);
     let mode = r.least_stable.ok_or(no)?;

@@ -10,6 +10,8 @@
 //! * [`resources`]: file parameters looked up under the FMU's `resources/` folder first;
 //! * [`shell`]: what both FMU shells do alike (inputs, physics built at initialisation and
 //!   previewed before, outputs, host step, the physics' step errors under FMI names);
+//! * [`stability`]: the search for a linear critical speed (scan, then bisection) that both
+//!   eigen-analyses run;
 //! * [`damper`]: the linear yaw damper law (none, viscous, Kelvin-Voigt, Maxwell) that the
 //!   closed-loop runs evaluate beside a model, co-simulation style, and the coach's
 //!   eigen-analysis takes; the loop itself.
@@ -20,6 +22,7 @@ pub mod damper;
 pub mod params;
 pub mod resources;
 pub mod shell;
+pub mod stability;
 pub mod step;
 pub mod track;
 
@@ -27,5 +30,6 @@ pub use damper::{run_closed_loop, ClosedLoopModel, LinearDamper};
 pub use params::{finite, in_range, non_negative, positive, ParamError};
 pub use resources::resource_or_given;
 pub use shell::{Shell, ShellPhysics};
+pub use stability::{first_unstable_speed, Crossing};
 pub use step::{check_inputs, check_step, host_step, InputError};
 pub use track::{TrackChoiceSource, TrackLevel, TrackSetting};
