@@ -1,0 +1,415 @@
+//! Executing a run set: one job on the prepared system, the jobs in parallel, each run's
+//! results written into a temporary folder and moved into place whole.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+use rayon::prelude::*;
+use serde_json::Value;
+
+use super::{Job, RunReport, SweepError, PARQUET_FOLDER};
+use crate::coupling::{CouplingPlan, RunOptions, SimOutput, Summary};
+use crate::output::write_json_atomic;
+use crate::results::{constant_kinds, write_results, ConstantKind, ResultsFormat, RunContext};
+use crate::system::{LoadedSystem, PreparedSystem, SystemDescription, SystemError};
+
+/// Runs one job of `system`'s run set (a job from [`RunSet::expand`] of that system: the same
+/// instances, FMUs and timing; only start values and the stop time differ) on the prepared
+/// FMUs: validates its start values, simulates, returns the output.
+pub fn run_job(
+    system: &PreparedSystem,
+    job: &Job,
+    cancel: &AtomicBool,
+) -> Result<SimOutput, String> {
+    let run = format!("run '{}'", job.name);
+    let base = &system.system().desc;
+    let same_fmus = job.system.instances.len() == base.instances.len()
+        && job
+            .system
+            .instances
+            .iter()
+            .zip(&base.instances)
+            .zip(system.fmu_paths())
+            .all(|((j, b), p)| {
+                j.name == b.name && j.fmu == *p && j.step_multiple == b.step_multiple
+            });
+    if !same_fmus || job.system.step != base.step || job.system.start_time != base.start_time {
+        return Err(format!(
+            "{run}: not a run of the prepared system '{}' (instances, FMUs or timing differ)",
+            system.system().file
+        ));
+    }
+    let changes = system
+        .changes(&job.parameters, Some(job.system.stop_time), &run)
+        .map_err(|e| e.to_string())?;
+    let opts = RunOptions {
+        cancel: Some(cancel),
+        progress: None,
+        general_engine: false,
+    };
+    system.run(&changes, &opts).map_err(|e| e.to_string())
+}
+
+/// How the runs of a run set write their results.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResultsOptions {
+    pub format: ResultsFormat,
+    /// Constant columns besides the parameters, per run name (e.g. a study's configuration).
+    pub labels: BTreeMap<String, BTreeMap<String, Value>>,
+}
+
+impl Default for ResultsOptions {
+    fn default() -> Self {
+        ResultsOptions {
+            format: ResultsFormat::Csv,
+            labels: BTreeMap::new(),
+        }
+    }
+}
+
+/// Where the results of `job` go in `outdir` in `format`.
+pub fn results_path(outdir: &Path, job_name: &str, format: ResultsFormat) -> PathBuf {
+    match format {
+        ResultsFormat::Csv => outdir.join(job_name).join("results.csv"),
+        ResultsFormat::Parquet => outdir
+            .join(PARQUET_FOLDER)
+            .join(format!("{job_name}.parquet")),
+    }
+}
+
+/// The format chosen by size for the runs of `system` (its longest job): Parquet from
+/// [`crate::results::PARQUET_FROM_VALUES`] values on.
+pub fn format_by_size(system: &PreparedSystem, jobs: &[Job]) -> ResultsFormat {
+    format_by_plan(system.plan(), jobs)
+}
+
+/// [`format_by_size`] from the FMUs' model descriptions alone (no FMU is unpacked or
+/// loaded): the format a fresh sweep of `base` chooses for `jobs`, decided before any run.
+pub fn format_by_description(
+    base: &LoadedSystem,
+    jobs: &[Job],
+) -> Result<ResultsFormat, SystemError> {
+    let archives = base.open_fmus()?;
+    let models: Vec<_> = archives.iter().map(|a| &a.model).collect();
+    Ok(format_by_plan(&base.plan(&models)?, jobs))
+}
+
+/// [`format_by_size`] from the coupling plan alone, which the model descriptions give
+/// ([`LoadedSystem::plan`]): a process that hands the runs to others chooses as a local run
+/// set does without loading the FMUs.
+pub fn format_by_plan(plan: &CouplingPlan, jobs: &[Job]) -> ResultsFormat {
+    let stop = jobs
+        .iter()
+        .map(|j| j.system.stop_time)
+        .fold(plan.stop_time, f64::max);
+    let rows = ((stop - plan.start_time) / plan.step).max(0.0) as u64 + 1;
+    ResultsFormat::by_size(rows, plan.record.len() as u64 + 1)
+}
+
+/// Prefix of a run folder being written (renamed onto the run's folder when complete).
+const PARTIAL_PREFIX: &str = ".partial-";
+/// Prefix of a previous run folder being replaced (removed right after the swap).
+const REPLACED_PREFIX: &str = ".replaced-";
+
+/// Runs all jobs on `threads` workers with `runner`, writing each run's folder and
+/// `<outdir>/sweep.json`. Returns the reports in job order.
+///
+/// Each run is written into a fresh hidden folder in `outdir` and swapped onto
+/// `<outdir>/<run>` only when complete (its description, its results if it succeeded, its
+/// summary), so a rerun never leaves the previous run's results beside the new run's
+/// description, and an interrupted sweep leaves no half-written run folder. The previous
+/// `sweep.json` is removed first, so an interrupted sweep never leaves an old report looking
+/// current; hidden folders left by an interrupted sweep are removed at the start. A runner
+/// that panics fails its run (reported like any failure), never the sweep.
+pub fn execute<F>(
+    jobs: &[Job],
+    outdir: &Path,
+    threads: usize,
+    show_progress: bool,
+    runner: F,
+) -> Result<Vec<RunReport>, SweepError>
+where
+    F: Fn(&Job) -> Result<SimOutput, String> + Sync,
+{
+    execute_with(
+        jobs,
+        outdir,
+        threads,
+        show_progress,
+        &ResultsOptions::default(),
+        runner,
+    )
+}
+
+/// [`execute`] with results written as `results` says.
+pub fn execute_with<F>(
+    jobs: &[Job],
+    outdir: &Path,
+    threads: usize,
+    show_progress: bool,
+    results: &ResultsOptions,
+    runner: F,
+) -> Result<Vec<RunReport>, SweepError>
+where
+    F: Fn(&Job) -> Result<SimOutput, String> + Sync,
+{
+    let kinds = constant_kinds(jobs.iter().flat_map(|j| {
+        j.parameters
+            .iter()
+            .chain(results.labels.get(&j.name).into_iter().flatten())
+    }));
+    let dir_err = |source| SweepError::Dir {
+        path: outdir.to_path_buf(),
+        source,
+    };
+    std::fs::create_dir_all(outdir).map_err(dir_err)?;
+    let report_path = outdir.join("sweep.json");
+    match std::fs::remove_file(&report_path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            return Err(SweepError::Dir {
+                path: report_path,
+                source: e,
+            })
+        }
+        _ => {}
+    }
+    remove_partial_folders(outdir);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.clamp(1, jobs.len().max(1)))
+        .build()
+        .map_err(|e| SweepError::Pool {
+            jobs: threads,
+            reason: e.to_string(),
+        })?;
+    let bar = if show_progress {
+        indicatif::ProgressBar::new(jobs.len() as u64)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} runs, {elapsed} elapsed, eta {eta} {msg}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let reports: Vec<RunReport> = pool.install(|| {
+        jobs.par_iter()
+            .map(|job| {
+                let r = run_one_with(job, outdir, results, &kinds, &runner);
+                bar.inc(1);
+                if !r.ok {
+                    bar.println(format!(
+                        "run '{}' failed: {}",
+                        r.name,
+                        r.error.as_deref().unwrap_or("")
+                    ));
+                }
+                r
+            })
+            .collect()
+    });
+    bar.finish_and_clear();
+    write_json_atomic(&report_path, &reports)?;
+    Ok(reports)
+}
+
+/// Removes the hidden run folders an interrupted sweep left in `outdir`.
+fn remove_partial_folders(outdir: &Path) {
+    let Ok(entries) = std::fs::read_dir(outdir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let name = name.to_string_lossy();
+        if (name.starts_with(PARTIAL_PREFIX) || name.starts_with(REPLACED_PREFIX))
+            && e.file_type().is_ok_and(|t| t.is_dir())
+        {
+            let _ = std::fs::remove_dir_all(e.path());
+        }
+    }
+}
+
+/// Puts the complete folder `new` in place of `dest` (which may exist from an earlier
+/// sweep): the old folder is moved aside, the new one renamed onto `dest`, the old one
+/// removed. On failure the old folder is put back.
+fn swap_into_place(new: tempfile::TempDir, dest: &Path, outdir: &Path) -> Result<(), String> {
+    let fail = |e: std::io::Error| format!("cannot move the run into '{}': {e}", dest.display());
+    let old = if dest.symlink_metadata().is_ok() {
+        let aside = tempfile::Builder::new()
+            .prefix(REPLACED_PREFIX)
+            .tempdir_in(outdir)
+            .map_err(fail)?
+            .keep();
+        let aside = aside.join("old");
+        std::fs::rename(dest, &aside).map_err(fail)?;
+        Some(aside)
+    } else {
+        None
+    };
+    let new = new.keep();
+    if let Err(e) = std::fs::rename(&new, dest) {
+        if let Some(a) = &old {
+            let _ = std::fs::rename(a, dest);
+        }
+        let _ = std::fs::remove_dir_all(&new);
+        return Err(fail(e));
+    }
+    if let Some(a) = old {
+        if let Some(holder) = a.parent() {
+            let _ = std::fs::remove_dir_all(holder);
+        }
+    }
+    Ok(())
+}
+
+/// Runs one job with `runner` and writes its folder `<outdir>/<job>/`: `system.json`, then
+/// `results.csv` (if the run succeeded) and `summary.json` (each atomically) into a fresh
+/// hidden folder, which is swapped onto `<outdir>/<job>` when complete, so a run folder never
+/// mixes files of two runs and a run whose `summary.json` says ok has all its files. A runner
+/// may also hand over results computed elsewhere (another process or machine); a runner that
+/// panics fails the run.
+pub fn run_one<F>(job: &Job, outdir: &Path, runner: &F) -> RunReport
+where
+    F: Fn(&Job) -> Result<SimOutput, String>,
+{
+    run_one_with(
+        job,
+        outdir,
+        &ResultsOptions::default(),
+        &BTreeMap::new(),
+        runner,
+    )
+}
+
+/// [`run_one`] with results written as `results` says; `kinds` are the constant columns of
+/// the whole run set. Parquet results go to `<outdir>/results/<job>.parquet`: an earlier
+/// one is removed before the run, so a failed rerun leaves no stale results in the table.
+pub fn run_one_with<F>(
+    job: &Job,
+    outdir: &Path,
+    results: &ResultsOptions,
+    kinds: &BTreeMap<String, ConstantKind>,
+    runner: &F,
+) -> RunReport
+where
+    F: Fn(&Job) -> Result<SimOutput, String>,
+{
+    let dest = outdir.join(&job.name);
+    let table_file = results_path(outdir, &job.name, ResultsFormat::Parquet);
+    let mut report = RunReport {
+        name: job.name.clone(),
+        parameters: job.parameters.clone(),
+        ok: false,
+        error: None,
+        summary: None,
+        results: None,
+    };
+    let partial = match tempfile::Builder::new()
+        .prefix(&format!("{PARTIAL_PREFIX}{}-", job.name))
+        .tempdir_in(outdir)
+    {
+        Ok(d) => d,
+        Err(e) => {
+            report.error = Some(format!(
+                "cannot create a folder in '{}': {e}",
+                outdir.display()
+            ));
+            return report;
+        }
+    };
+    let dir = partial.path().to_path_buf();
+    match std::fs::remove_file(&table_file) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            report.error = Some(format!(
+                "cannot remove the earlier results '{}': {e}",
+                table_file.display()
+            ));
+            return report;
+        }
+        _ => {}
+    }
+    if results.format == ResultsFormat::Csv {
+        // a CSV run set rerun over a Parquet one leaves no empty table folder behind (only
+        // an empty folder is removed: other runs' files stay)
+        let _ = std::fs::remove_dir(outdir.join(PARQUET_FOLDER));
+    }
+    let final_path = results_path(outdir, &job.name, results.format);
+    let result = (|| -> Result<Summary, String> {
+        write_json_atomic(&dir.join("system.json"), &job.system).map_err(|e| e.to_string())?;
+        let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| runner(job)))
+            .unwrap_or_else(|p| {
+                let what = p
+                    .downcast_ref::<&str>()
+                    .map(|s| s.to_string())
+                    .or_else(|| p.downcast_ref::<String>().cloned())
+                    .unwrap_or_default();
+                Err(format!("the run panicked: {what}"))
+            })?;
+        let ctx = RunContext {
+            run: Some(job.name.clone()),
+            parameters: job.parameters.clone(),
+            labels: results.labels.get(&job.name).cloned().unwrap_or_default(),
+            system: serde_json::to_value(&job.system).ok(),
+            kinds: kinds.clone(),
+        };
+        let path = match results.format {
+            ResultsFormat::Csv => dir.join("results.csv"),
+            ResultsFormat::Parquet => {
+                let folder = outdir.join(PARQUET_FOLDER);
+                std::fs::create_dir_all(&folder)
+                    .map_err(|e| format!("cannot create '{}': {e}", folder.display()))?;
+                final_path.clone()
+            }
+        };
+        write_results(&path, &out, results.format, &ctx).map_err(|e| e.to_string())?;
+        Ok(out.summary)
+    })();
+    match result {
+        Ok(s) => {
+            report.ok = true;
+            report.summary = Some(s);
+            report.results = Some(final_path.clone());
+        }
+        Err(e) => report.error = Some(e),
+    }
+    let finished = write_json_atomic(&dir.join("summary.json"), &report)
+        .map_err(|e| e.to_string())
+        .and_then(|()| swap_into_place(partial, &dest, outdir));
+    if let Err(e) = finished {
+        let _ = std::fs::remove_file(&table_file);
+        report.ok = false;
+        report.results = None;
+        report.error = Some(match report.error.take() {
+            Some(first) => format!("{first}; also: {e}"),
+            None => e,
+        });
+    }
+    report
+}
+
+/// The report of `job` in `outdir` if that run is complete in `format` and is the same run:
+/// its `summary.json` says ok, its results are there in `format` (and not in the other
+/// format) and its `system.json` is the job's resolved system (same FMUs, start values,
+/// timing). A failed, unfinished or changed run, or one whose results are in the other format,
+/// gives `None` and is run again: a resumed run set stays in one format, so the Parquet folder
+/// (or the CSV files) hold every run. The sweep decides `format` before (explicit, else
+/// [`format_by_description`] over all its jobs, as a fresh sweep does).
+pub fn completed(outdir: &Path, job: &Job, format: ResultsFormat) -> Option<RunReport> {
+    let dir = outdir.join(&job.name);
+    let mut report: RunReport =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).ok()?).ok()?;
+    let system: SystemDescription =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("system.json")).ok()?).ok()?;
+    let results = results_path(outdir, &job.name, format);
+    let other = results_path(outdir, &job.name, format.other());
+    let complete = report.ok
+        && report.name == job.name
+        && report.parameters == job.parameters
+        && system == job.system
+        && report.results.as_deref().and_then(Path::file_name) == results.file_name()
+        && results.is_file()
+        && other.symlink_metadata().is_err();
+    report.results = Some(results);
+    complete.then_some(report)
+}

@@ -1,0 +1,312 @@
+//! Run sets: a base system plus parameter variations, run in parallel.
+//!
+//! ```json
+//! {
+//!   "base": "system.json",                       // or "system": { ...inline... }
+//!   "product": {"bogie.speed_mps": [60, 70, 80], "controller.mode": [0, 1]},
+//!   "runs": [{"name": "special", "parameters": {"bogie.speed_mps": 90}}]
+//! }
+//! ```
+//! Every combination of `product` (cartesian, keys in alphabetical order) and every entry of
+//! `runs` is one job; with neither, the base alone is run. Keys are `instance.variable`.
+//! Each job is self-contained (its resolved system description, FMU paths absolute) and is
+//! written to `<outdir>/<run>/system.json`, with `summary.json` beside it and its results:
+//! as CSV `<outdir>/<run>/results.csv` (metadata in `results.meta.json`), as Parquet
+//! `<outdir>/results/<run>.parquet`, a folder of Parquet files alone that reads as one table
+//! (`pandas.read_parquet("<outdir>/results")`: every run with its name and parameters as
+//! columns; see [`crate::results`]).
+//! The base system is prepared once ([`PreparedSystem`]: FMUs unpacked and loaded once, plan
+//! built once); a job is then its start values and stop time ([`run_job`]). Jobs run on a
+//! rayon pool; each job instantiates its own FMU instances (never shared across threads) and
+//! frees them when done. A failed job is reported in its own summary and in
+//! `<outdir>/sweep.json`; the other jobs go on.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use crate::coupling::Summary;
+use crate::output::OutputError;
+use crate::system::{split_ref, LoadedSystem, SystemDescription, SystemError};
+
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunSet {
+    /// Path of the base system JSON (relative to the run-set file).
+    #[serde(default)]
+    pub base: Option<PathBuf>,
+    /// Inline base system (FMU paths relative to the run-set file).
+    #[serde(default)]
+    pub system: Option<SystemDescription>,
+    #[serde(default)]
+    pub product: BTreeMap<String, Vec<Value>>,
+    #[serde(default)]
+    pub runs: Vec<RunSpec>,
+}
+
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunSpec {
+    #[serde(default)]
+    pub name: Option<String>,
+    pub parameters: BTreeMap<String, Value>,
+}
+
+/// One self-contained run (serialisable both ways: a job can be sent to another process).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Job {
+    pub name: String,
+    pub parameters: BTreeMap<String, Value>,
+    pub system: SystemDescription,
+}
+
+/// Outcome of one job (also each run's `summary.json`, which reads back into it).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RunReport {
+    pub name: String,
+    pub parameters: BTreeMap<String, Value>,
+    pub ok: bool,
+    pub error: Option<String>,
+    pub summary: Option<Summary>,
+    pub results: Option<PathBuf>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    #[error(transparent)]
+    System(#[from] SystemError),
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    #[error("cannot create '{path}': {source}")]
+    Dir {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("cannot start {jobs} worker threads: {reason}")]
+    Pool { jobs: usize, reason: String },
+}
+
+fn invalid(file: &str, field: String, reason: String) -> SystemError {
+    SystemError::Invalid {
+        file: file.to_string(),
+        line: None,
+        field,
+        reason,
+    }
+}
+
+/// Most runs a run set may expand to: a product beyond this is refused before any job is
+/// built (a typo such as 1e6 values in one list should not fill the disk).
+pub const MAX_RUNS: usize = 100_000;
+
+/// The folder of a run set's Parquet results (`<outdir>/results/<run>.parquet`), a name no
+/// run may have.
+pub const PARQUET_FOLDER: &str = "results";
+
+/// Longest run name (folder names are limited to 255 bytes on common file systems).
+const MAX_RUN_NAME_LEN: usize = 200;
+
+/// Folder-safe run name: characters other than ASCII letters, digits and `._-=` become `_`.
+pub fn sanitize(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "._-=".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// The folder name of a run: [`sanitize`]d, and refused when it could not be a folder of its
+/// own inside the output folder: empty, `.`/`..` or any name starting with `.` (hidden, and
+/// the prefix of the sweep's temporary folders), `sweep.json` (the sweep's report) or longer
+/// than 200 characters. `Err` is the reason.
+pub fn run_folder_name(name: &str) -> Result<String, String> {
+    let folder = sanitize(name);
+    if folder.is_empty() {
+        return Err("a run name must not be empty".into());
+    }
+    if folder.starts_with('.') {
+        return Err(format!(
+            "run name '{name}' would be the folder '{folder}': a run folder may not start with \
+             '.' ('.' and '..' are not folders of their own)"
+        ));
+    }
+    if folder.eq_ignore_ascii_case("sweep.json") {
+        return Err(format!(
+            "run name '{name}' is the name of the sweep's report file"
+        ));
+    }
+    if folder.eq_ignore_ascii_case(PARQUET_FOLDER) {
+        return Err(format!(
+            "run name '{name}' is the name of the folder of the run set's Parquet results"
+        ));
+    }
+    if folder.len() > MAX_RUN_NAME_LEN {
+        return Err(format!(
+            "run name '{}...' is longer than {MAX_RUN_NAME_LEN} characters",
+            &folder[..40]
+        ));
+    }
+    Ok(folder)
+}
+
+impl RunSet {
+    /// Reads a run-set file and expands it into jobs.
+    pub fn load_jobs(path: &Path) -> Result<Vec<Job>, SystemError> {
+        Ok(Self::load(path)?.1)
+    }
+
+    /// Reads a run-set file: its base system and its jobs.
+    pub fn load(path: &Path) -> Result<(LoadedSystem, Vec<Job>), SystemError> {
+        let text = crate::input::read_text_file(path, crate::input::MAX_TEXT_FILE_BYTES).map_err(
+            |source| SystemError::Read {
+                path: path.to_path_buf(),
+                source,
+            },
+        )?;
+        let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Self::from_str_with_base(&text, &base_dir, &path.display().to_string())
+    }
+
+    pub fn jobs_from_str(text: &str, base_dir: &Path, file: &str) -> Result<Vec<Job>, SystemError> {
+        Ok(Self::from_str_with_base(text, base_dir, file)?.1)
+    }
+
+    /// Parses run-set text: its base system and its jobs.
+    pub fn from_str_with_base(
+        text: &str,
+        base_dir: &Path,
+        file: &str,
+    ) -> Result<(LoadedSystem, Vec<Job>), SystemError> {
+        let rs: RunSet = serde_json::from_str(text).map_err(|e| SystemError::json(file, &e))?;
+        let base = match (&rs.base, &rs.system) {
+            (Some(p), None) => LoadedSystem::load(&base_dir.join(p))?,
+            (None, Some(s)) => LoadedSystem::from_description(s.clone(), base_dir, file),
+            _ => {
+                return Err(invalid(
+                    file,
+                    "base".into(),
+                    "give exactly one of 'base' (a path) or 'system' (inline)".into(),
+                ))
+            }
+        };
+        let jobs = rs.expand(&base, file)?;
+        Ok((base, jobs))
+    }
+
+    /// Expands into jobs with resolved (absolute-path) system descriptions.
+    pub fn expand(&self, base: &LoadedSystem, file: &str) -> Result<Vec<Job>, SystemError> {
+        let resolved = base.resolved();
+        let mut sets: Vec<(Option<String>, BTreeMap<String, Value>, String)> = Vec::new();
+        if !self.product.is_empty() {
+            let keys: Vec<&String> = self.product.keys().collect();
+            for k in &keys {
+                if self.product[*k].is_empty() {
+                    return Err(invalid(
+                        file,
+                        format!("product.{k}"),
+                        "empty list of values".into(),
+                    ));
+                }
+            }
+            let total = self
+                .product
+                .values()
+                .try_fold(1usize, |n, v| n.checked_mul(v.len()))
+                .filter(|&n| n.saturating_add(self.runs.len()) <= MAX_RUNS)
+                .ok_or_else(|| {
+                    let sizes: Vec<String> =
+                        self.product.values().map(|v| v.len().to_string()).collect();
+                    let combinations: f64 = self.product.values().map(|v| v.len() as f64).product();
+                    invalid(
+                        file,
+                        "product".into(),
+                        format!(
+                            "{} = {combinations:e} combinations plus {} listed runs are more than \
+                             the {MAX_RUNS} runs a run set may have; split it into several run sets",
+                            sizes.join(" x "),
+                            self.runs.len()
+                        ),
+                    )
+                })?;
+            for mut idx in 0..total {
+                let mut p = BTreeMap::new();
+                for k in keys.iter().rev() {
+                    let vals = &self.product[*k];
+                    p.insert((*k).clone(), vals[idx % vals.len()].clone());
+                    idx /= vals.len();
+                }
+                sets.push((None, p, "product".into()));
+            }
+        }
+        for (i, r) in self.runs.iter().enumerate() {
+            sets.push((r.name.clone(), r.parameters.clone(), format!("runs[{i}]")));
+        }
+        if sets.is_empty() {
+            sets.push((Some("base".into()), BTreeMap::new(), String::new()));
+        }
+        if self.runs.len() > MAX_RUNS {
+            return Err(invalid(
+                file,
+                "runs".into(),
+                format!(
+                    "{} runs are more than the {MAX_RUNS} a run set may have",
+                    self.runs.len()
+                ),
+            ));
+        }
+        let mut jobs = Vec::new();
+        // folder name (lower case: also distinct on case-insensitive file systems) -> run
+        let mut folders: std::collections::HashMap<String, String> =
+            std::collections::HashMap::new();
+        for (n, (name, params, field)) in sets.into_iter().enumerate() {
+            let mut sys = resolved.clone();
+            for (key, value) in &params {
+                let f = format!("{field}.{key}");
+                let Some((inst, var)) = split_ref(key) else {
+                    return Err(invalid(
+                        file,
+                        f,
+                        format!("'{key}' is not of the form 'instance.variable'"),
+                    ));
+                };
+                let Some(spec) = sys.instances.iter_mut().find(|i| i.name == inst) else {
+                    return Err(invalid(file, f, format!("unknown instance '{inst}'")));
+                };
+                spec.parameters.insert(var.to_string(), value.clone());
+            }
+            let given = name.unwrap_or_else(|| format!("run-{n:03}"));
+            let name = run_folder_name(&given).map_err(|r| invalid(file, field.clone(), r))?;
+            if let Some(other) = folders.insert(name.to_ascii_lowercase(), given.clone()) {
+                let reason = if other == given {
+                    format!("run name '{name}' is used twice")
+                } else {
+                    format!(
+                        "run names '{other}' and '{given}' would both write the folder '{name}' \
+                         (run names are used twice or differ only in characters replaced by '_' \
+                         or in case)"
+                    )
+                };
+                return Err(invalid(file, field, reason));
+            }
+            jobs.push(Job {
+                name,
+                parameters: params,
+                system: sys,
+            });
+        }
+        Ok(jobs)
+    }
+}
+
+mod execute;
+
+pub use execute::*;
+
+#[cfg(test)]
+mod tests;

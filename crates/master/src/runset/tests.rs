@@ -1,0 +1,260 @@
+use super::*;
+use crate::coupling::tests::{two_mass_plan, MassSpring, Mock, SpringDamperMass};
+use crate::coupling::{simulate, Algorithm, RunOptions, SimOutput};
+use crate::results::ResultsFormat;
+
+const BASE: &str = r#"{
+  "instances": [{"name": "ms", "fmu": "MassSpring.fmu"}, {"name": "sdm", "fmu": "SDM.fmu"}],
+  "stop_time": 0.1, "step": 0.001
+}"#;
+
+fn jobs(rs: &str) -> Result<Vec<Job>, SystemError> {
+    let base = LoadedSystem::from_json_str(BASE, Path::new("/d"), "base.json").unwrap();
+    let r: RunSet = serde_json::from_str(rs).unwrap();
+    r.expand(&base, "set.json")
+}
+
+#[test]
+fn product_and_list_expand() {
+    let j = jobs(
+        r#"{"product": {"ms.k": [1, 2, 3], "sdm.m": [true, false]},
+                      "runs": [{"name": "extra run", "parameters": {"ms.k": 9}}]}"#,
+    )
+    .unwrap();
+    assert_eq!(j.len(), 7);
+    assert_eq!(j[0].name, "run-000");
+    assert_eq!(j[6].name, "extra_run");
+    let ks: Vec<String> = j[..6]
+        .iter()
+        .map(|j| format!("{}{}", j.parameters["ms.k"], j.parameters["sdm.m"]))
+        .collect();
+    assert_eq!(
+        ks,
+        ["1true", "1false", "2true", "2false", "3true", "3false"]
+    );
+    assert_eq!(
+        j[3].system.instances[0].parameters["k"],
+        serde_json::json!(2)
+    );
+    assert_eq!(
+        j[3].system.instances[1].parameters["m"],
+        serde_json::json!(false)
+    );
+    assert_eq!(
+        j[0].system.instances[0].fmu,
+        PathBuf::from("/d/MassSpring.fmu")
+    );
+    assert_eq!(jobs("{}").unwrap().len(), 1);
+}
+
+#[test]
+fn expansion_errors() {
+    let e = jobs(r#"{"product": {"xx.k": [1]}}"#)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("product.xx.k: unknown instance 'xx'"), "{e}");
+    let e = jobs(r#"{"runs": [{"name": "a", "parameters": {}}, {"name": "a", "parameters": {}}]}"#)
+        .unwrap_err();
+    assert!(e.to_string().contains("used twice"));
+    let e = jobs(r#"{"product": {"ms.k": []}}"#).unwrap_err();
+    assert!(e.to_string().contains("empty list"));
+    let e = RunSet::jobs_from_str(
+        "{\"base\": \"a.json\", \"system\": null, \"bogus\": 1}",
+        Path::new("/"),
+        "s.json",
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("unknown field `bogus`"), "{e}");
+}
+
+#[test]
+fn parallel_execution_keeps_every_result_and_reports_failures() {
+    let j = jobs(r#"{"product": {"ms.k": [50, 100, -1, 200]}}"#).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    // mock runner: the two-mass plan with ms.k from the job; k < 0 fails
+    let runner = |job: &Job| -> Result<SimOutput, String> {
+        let k = job.parameters["ms.k"].as_f64().unwrap();
+        if k < 0.0 {
+            return Err("negative stiffness".into());
+        }
+        let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.1);
+        plan.instances[0].parameters[1].1 = k;
+        let mut a = Mock::new("ms", MassSpring::new(1.0, 1.0, 1.0, 0.0));
+        let mut b = Mock::new("sdm", SpringDamperMass::new(1.0, 1.0, 1.0));
+        simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).map_err(|e| e.to_string())
+    };
+    let reports = execute(&j, dir.path(), 2, false, runner).unwrap();
+    assert_eq!(reports.len(), 4);
+    assert_eq!(reports.iter().filter(|r| r.ok).count(), 3);
+    assert_eq!(reports[2].error.as_deref(), Some("negative stiffness"));
+    for r in &reports {
+        let d = dir.path().join(&r.name);
+        assert!(d.join("system.json").exists() && d.join("summary.json").exists());
+        assert_eq!(d.join("results.csv").exists(), r.ok);
+    }
+    // different stiffness, different results
+    let a = std::fs::read_to_string(dir.path().join("run-000/results.csv")).unwrap();
+    let b = std::fs::read_to_string(dir.path().join("run-003/results.csv")).unwrap();
+    assert_ne!(a, b);
+    assert_eq!(a.lines().count(), 102);
+    let sweep: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("sweep.json")).unwrap())
+            .unwrap();
+    assert_eq!(sweep.as_array().unwrap().len(), 4);
+    assert_eq!(sweep[2]["ok"], serde_json::json!(false));
+}
+
+#[test]
+fn parquet_results_of_a_set_share_one_folder_and_a_failed_rerun_leaves_none() {
+    let j = jobs(r#"{"product": {"ms.k": [50, 100, 200]}}"#).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let runner = |fail: Option<&'static str>| {
+        move |job: &Job| -> Result<SimOutput, String> {
+            if Some(job.name.as_str()) == fail {
+                return Err("failed this time".into());
+            }
+            let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.05);
+            plan.instances[0].parameters[1].1 = job.parameters["ms.k"].as_f64().unwrap();
+            let mut a = Mock::new("ms", MassSpring::new(1.0, 1.0, 1.0, 0.0));
+            let mut b = Mock::new("sdm", SpringDamperMass::new(1.0, 1.0, 1.0));
+            simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default())
+                .map_err(|e| e.to_string())
+        }
+    };
+    let opts = ResultsOptions {
+        format: ResultsFormat::Parquet,
+        ..ResultsOptions::default()
+    };
+    let reports = execute_with(&j, dir.path(), 2, false, &opts, runner(None)).unwrap();
+    assert!(reports.iter().all(|r| r.ok));
+    let table = dir.path().join(PARQUET_FOLDER);
+    let mut files: Vec<String> = std::fs::read_dir(&table)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    assert_eq!(
+        files,
+        ["run-000.parquet", "run-001.parquet", "run-002.parquet"]
+    );
+    for r in &reports {
+        assert!(!dir.path().join(&r.name).join("results.csv").exists());
+        assert_eq!(
+            r.results.as_deref(),
+            Some(table.join(format!("{}.parquet", r.name)).as_path())
+        );
+        assert!(completed(dir.path(), &j[0], ResultsFormat::Parquet).is_some());
+        assert!(completed(dir.path(), &j[0], ResultsFormat::Csv).is_none());
+    }
+    let (columns, meta) =
+        crate::parquet_file::read_parquet(&table.join("run-001.parquet")).unwrap();
+    assert_eq!(meta.unwrap().parameters["ms.k"], serde_json::json!(100));
+    let k = columns.iter().find(|(n, _)| n == "ms.k").unwrap();
+    assert_eq!(
+        k.1,
+        crate::parquet_file::ColumnData::Numbers(vec![Some(100.0); 51])
+    );
+    // a rerun in which run-001 fails leaves no stale results of it in the table
+    let reports = execute_with(&j, dir.path(), 2, false, &opts, runner(Some("run-001"))).unwrap();
+    assert!(!reports[1].ok && reports[0].ok);
+    assert!(!table.join("run-001.parquet").exists());
+    assert!(table.join("run-002.parquet").exists());
+    assert!(run_folder_name("Results").is_err());
+}
+
+/// Resumes a run set as `master sweep --resume` does: keeps the runs complete in `format`,
+/// runs the others; returns the names run.
+fn resume(j: &[Job], outdir: &Path, format: ResultsFormat) -> Vec<String> {
+    let todo: Vec<Job> = j
+        .iter()
+        .filter(|job| completed(outdir, job, format).is_none())
+        .cloned()
+        .collect();
+    let opts = ResultsOptions {
+        format,
+        ..ResultsOptions::default()
+    };
+    let reports = execute_with(&todo, outdir, 2, false, &opts, |job: &Job| {
+        let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.02);
+        plan.instances[0].parameters[1].1 = job.parameters["ms.k"].as_f64().unwrap();
+        let mut a = Mock::new("ms", MassSpring::new(1.0, 1.0, 1.0, 0.0));
+        let mut b = Mock::new("sdm", SpringDamperMass::new(1.0, 1.0, 1.0));
+        simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).map_err(|e| e.to_string())
+    })
+    .unwrap();
+    assert!(reports.iter().all(|r| r.ok), "{reports:?}");
+    reports.into_iter().map(|r| r.name).collect()
+}
+
+fn files_under(dir: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if e.file_type().unwrap().is_dir() {
+            out.extend(
+                files_under(&e.path())
+                    .into_iter()
+                    .map(|f| format!("{name}/{f}")),
+            );
+        } else {
+            out.push(name);
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn a_run_set_resumed_in_the_other_format_reruns_every_run_into_one_format() {
+    let j = jobs(r#"{"product": {"ms.k": [50, 100, 200]}}"#).unwrap();
+    let names: Vec<String> = j.iter().map(|r| r.name.clone()).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path();
+    assert_eq!(resume(&j, out, ResultsFormat::Csv), names);
+    assert!(out.join("run-001/results.csv").is_file());
+    // the same format keeps every run
+    assert!(resume(&j, out, ResultsFormat::Csv).is_empty());
+    // CSV runs resumed as Parquet: every run again, all in results/, no CSV left
+    assert_eq!(resume(&j, out, ResultsFormat::Parquet), names);
+    let files = files_under(out);
+    let expected: Vec<String> = names
+        .iter()
+        .flat_map(|n| {
+            [
+                format!("results/{n}.parquet"),
+                format!("{n}/summary.json"),
+                format!("{n}/system.json"),
+            ]
+        })
+        .chain(["sweep.json".to_string()])
+        .collect();
+    let mut expected = expected;
+    expected.sort();
+    assert_eq!(files, expected);
+    for job in &j {
+        let r = completed(out, job, ResultsFormat::Parquet).unwrap();
+        assert_eq!(
+            r.results,
+            Some(results_path(out, &job.name, ResultsFormat::Parquet))
+        );
+    }
+    assert!(resume(&j, out, ResultsFormat::Parquet).is_empty());
+    // and back to CSV: every run again, no Parquet file (nor an empty results/) left
+    assert_eq!(resume(&j, out, ResultsFormat::Csv), names);
+    let files = files_under(out);
+    assert!(
+        files.iter().all(|f| !f.ends_with(".parquet")) && !out.join("results").exists(),
+        "{files:?}"
+    );
+    assert_eq!(
+        files.iter().filter(|f| f.ends_with("/results.csv")).count(),
+        3
+    );
+    // a run with results in both formats (e.g. an interrupted rerun) is complete in neither
+    std::fs::create_dir_all(out.join("results")).unwrap();
+    std::fs::write(results_path(out, "run-000", ResultsFormat::Parquet), b"x").unwrap();
+    assert!(completed(out, &j[0], ResultsFormat::Csv).is_none());
+    assert!(completed(out, &j[0], ResultsFormat::Parquet).is_none());
+    assert_eq!(resume(&j, out, ResultsFormat::Csv), ["run-000"]);
+    assert!(!out.join("results").exists());
+}
