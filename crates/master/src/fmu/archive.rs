@@ -268,6 +268,140 @@ mod tests {
         }
     }
 
+    /// A valid FMU archive of a few kB: deflated and stored entries, a folder entry.
+    fn small_fmu() -> Vec<u8> {
+        let (dir, suf) = platform_binary_dir().unwrap();
+        let mut z = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+        let deflated = zip::write::SimpleFileOptions::default();
+        let stored = deflated.compression_method(zip::CompressionMethod::Stored);
+        z.start_file("modelDescription.xml", deflated).unwrap();
+        z.write_all(MD.as_bytes()).unwrap();
+        z.start_file(format!("binaries/{dir}/MassSpring{suf}"), stored)
+            .unwrap();
+        z.write_all(&[0x7f, b'E', b'L', b'F', 2, 1, 1, 0]).unwrap();
+        z.add_directory("resources/", deflated).unwrap();
+        z.start_file("resources/table.csv", deflated).unwrap();
+        z.write_all("y,r\n0,0.46\n0.001,0.4601\n".repeat(20).as_bytes())
+            .unwrap();
+        z.finish().unwrap().into_inner()
+    }
+
+    #[derive(Debug, Clone)]
+    enum ByteMutation {
+        Replace {
+            at: usize,
+            byte: u8,
+        },
+        /// a 32-bit field (sizes, offsets, counts) set to an extreme value
+        Field {
+            at: usize,
+            value: u32,
+        },
+        Delete {
+            at: usize,
+            len: usize,
+        },
+        Duplicate {
+            at: usize,
+            len: usize,
+        },
+    }
+
+    fn byte_mutation() -> impl proptest::strategy::Strategy<Value = ByteMutation> {
+        use proptest::prelude::*;
+        prop_oneof![
+            (any::<usize>(), any::<u8>()).prop_map(|(at, byte)| ByteMutation::Replace { at, byte }),
+            (
+                any::<usize>(),
+                prop_oneof![
+                    Just(0u32),
+                    Just(1),
+                    Just(u32::MAX),
+                    Just(0x7fff_ffff),
+                    any::<u32>()
+                ]
+            )
+                .prop_map(|(at, value)| ByteMutation::Field { at, value }),
+            (any::<usize>(), 1usize..64).prop_map(|(at, len)| ByteMutation::Delete { at, len }),
+            (any::<usize>(), 1usize..256).prop_map(|(at, len)| ByteMutation::Duplicate { at, len }),
+        ]
+    }
+
+    fn mutate_bytes(mut b: Vec<u8>, mutations: &[ByteMutation]) -> Vec<u8> {
+        for m in mutations {
+            let n = b.len().max(1);
+            match *m {
+                ByteMutation::Replace { at, byte } => {
+                    if !b.is_empty() {
+                        let at = at % b.len();
+                        b[at] = byte;
+                    }
+                }
+                ByteMutation::Field { at, value } => {
+                    if b.len() >= 4 {
+                        let at = at % (b.len() - 3);
+                        b[at..at + 4].copy_from_slice(&value.to_le_bytes());
+                    }
+                }
+                ByteMutation::Delete { at, len } => {
+                    let at = at % n;
+                    let end = (at + len).min(b.len());
+                    if at < end {
+                        b.drain(at..end);
+                    }
+                }
+                ByteMutation::Duplicate { at, len } => {
+                    let at = at % n;
+                    let end = (at + len).min(b.len());
+                    let piece = b[at.min(b.len())..end].to_vec();
+                    b.splice(end..end, piece);
+                }
+            }
+        }
+        b
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 1500, ..Default::default() })]
+
+        /// Property: whatever bytes an .fmu holds, opening and unpacking it is a typed error or
+        /// a success, never a panic, and unpacking writes only inside its extraction folder.
+        #[test]
+        fn mutated_archives_are_read_or_refused_never_panic(
+            ms in proptest::collection::vec(byte_mutation(), 1..5)
+        ) {
+            let d = tempfile::tempdir().unwrap();
+            let p = d.path().join("x.fmu");
+            std::fs::write(&p, mutate_bytes(small_fmu(), &ms)).unwrap();
+            let root = d.path().join("extract");
+            std::fs::create_dir(&root).unwrap();
+            if FmuArchive::open(&p).is_ok() {
+                if let Ok(dir) = extract::unpack(&p, &root, &ArchiveLimits::default()) {
+                    let inside: Vec<_> = std::fs::read_dir(&root).unwrap().map(|e| e.unwrap().path()).collect();
+                    proptest::prop_assert_eq!(inside, vec![dir.path().to_path_buf()]);
+                }
+            }
+            // the archive's own folder holds only what the test put there
+            let mut names: Vec<_> = std::fs::read_dir(d.path()).unwrap()
+                .map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+            names.sort();
+            proptest::prop_assert_eq!(names, vec!["extract".to_string(), "x.fmu".to_string()]);
+        }
+    }
+
+    #[test]
+    fn the_unmutated_small_fmu_opens_and_unpacks() {
+        // the property above starts from an archive that passes, so mutations probe real paths
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join("x.fmu");
+        std::fs::write(&p, small_fmu()).unwrap();
+        let a = FmuArchive::open(&p).unwrap();
+        assert_eq!(a.model.model_name, "MassSpring");
+        let dir = extract::unpack(&p, d.path(), &ArchiveLimits::default()).unwrap();
+        let csv = std::fs::read_to_string(dir.path().join("resources/table.csv")).unwrap();
+        assert!(csv.starts_with("y,r\n0,0.46"));
+    }
+
     #[test]
     fn stale_extraction_folders_are_removed_live_ones_kept() {
         let root = tempfile::tempdir().unwrap();
