@@ -32,8 +32,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::{
-    board_outputs, check_finite_nonneg, check_finite_pos, check_sign, finish_step, screen_step,
-    NanPolicy, ParamError, SampleClock, StepError,
+    board_outputs, check_finite_nonneg, check_finite_pos, check_sample_time, check_sign,
+    finish_step, screen_step, NanPolicy, ParamError, SampleClock, StepError,
 };
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -66,7 +66,7 @@ impl Default for IdfParams {
 
 impl IdfParams {
     pub fn validate(&self) -> Result<(), ParamError> {
-        check_finite_pos("sample_time_s", self.sample_time_s)?;
+        check_sample_time(self.sample_time_s)?;
         check_finite_nonneg("c_v_nspm", self.c_v_nspm)?;
         check_finite_nonneg("k_p_m_per_n", self.k_p_m_per_n)?;
         check_sign("command_sign", self.command_sign)?;

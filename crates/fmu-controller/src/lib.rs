@@ -84,6 +84,32 @@ pub enum StepError {
     /// An output became NaN/inf (should not happen; guards the host against garbage).
     #[error("non-finite output `{name}` = {value}")]
     NonFiniteOutput { name: &'static str, value: f64 },
+    /// The step holds more board samples than one step may compute (its cost is bounded).
+    #[error(
+        "the step holds {samples} board samples, more than {MAX_SAMPLES_PER_STEP} \
+         (communication step / board.sample_time): use a shorter communication step"
+    )]
+    TooManySamples { samples: u64 },
+}
+
+/// Shortest board sample time [s] (a 1 MHz board): a shorter one would make every step cost
+/// more samples than any board computes.
+pub const MIN_SAMPLE_TIME_S: f64 = 1e-6;
+
+/// Most board samples one communication step computes: 10 s of a 1 MHz board, about a second
+/// of work; a longer step is refused before anything changes.
+pub const MAX_SAMPLES_PER_STEP: u64 = 10_000_000;
+
+/// The board sample time is finite and at least [`MIN_SAMPLE_TIME_S`].
+pub(crate) fn check_sample_time(v: f64) -> Result<(), ParamError> {
+    check_finite_pos("sample_time_s", v)?;
+    if v < MIN_SAMPLE_TIME_S {
+        return Err(ParamError::new(
+            "sample_time_s",
+            format!("must be at least {MIN_SAMPLE_TIME_S} s, got {v}"),
+        ));
+    }
+    Ok(())
 }
 
 /// What to do with a NaN/inf sensor input.
@@ -223,7 +249,8 @@ impl SampleClock {
         }
     }
 
-    /// Advance the clock by `h`; returns how many sample instants lie in `[t, t+h)`.
+    /// Advance the clock by `h`; returns how many sample instants lie in `[t, t+h)`. More than
+    /// [`MAX_SAMPLES_PER_STEP`] is an error that leaves the clock as it was.
     pub fn advance(&mut self, h: f64) -> Result<u64, StepError> {
         if !h.is_finite() || h < 0.0 {
             return Err(StepError::InvalidStep(h));
@@ -243,6 +270,9 @@ impl SampleClock {
             limit.ceil() as u64
         };
         let n = last_excl.saturating_sub(self.next_sample);
+        if n > MAX_SAMPLES_PER_STEP {
+            return Err(StepError::TooManySamples { samples: n });
+        }
         self.next_sample += n;
         self.time_s = t_end;
         Ok(n)
@@ -259,6 +289,27 @@ impl SampleClock {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A step's cost is bounded: a sample time of a few ulps (accepted once, it made one 1 ms
+    /// step loop for ever) is refused, and a step holding more samples than the bound is an
+    /// error that leaves the clock as it was, so a shorter step can follow.
+    #[test]
+    fn a_step_never_holds_more_samples_than_the_bound() {
+        for bad in [1e-310, 1e-12, 0.99e-6] {
+            let e = check_sample_time(bad).unwrap_err();
+            assert_eq!(e.name, "sample_time_s", "{bad}");
+        }
+        check_sample_time(MIN_SAMPLE_TIME_S).unwrap();
+        let mut c = SampleClock::new(MIN_SAMPLE_TIME_S);
+        let before = c.clone();
+        let e = c.advance(20.0).unwrap_err();
+        assert!(
+            matches!(e, StepError::TooManySamples { samples } if samples > MAX_SAMPLES_PER_STEP)
+        );
+        assert!(e.to_string().contains("shorter communication step"), "{e}");
+        assert_eq!(c, before);
+        assert_eq!(c.advance(1e-3).unwrap(), 1000);
+    }
 
     #[test]
     fn clock_counts_samples_independent_of_step() {

@@ -38,8 +38,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::signal::{band_pass, BandPass, RmsWindow};
 use crate::{
-    board_outputs, check_finite_nonneg, check_finite_pos, check_sign, finish_step, screen_step,
-    NanPolicy, ParamError, SampleClock, StepError,
+    board_outputs, check_finite_nonneg, check_finite_pos, check_sample_time, check_sign,
+    finish_step, screen_step, NanPolicy, ParamError, SampleClock, StepError,
 };
 
 /// EN 14363 lateral acceleration limit of the seed's bogie, a_lim = (12 - m/5)/2 (section 4.2).
@@ -145,7 +145,7 @@ impl MpptParams {
     }
 
     pub fn validate(&self) -> Result<(), ParamError> {
-        check_finite_pos("sample_time_s", self.sample_time_s)?;
+        check_sample_time(self.sample_time_s)?;
         check_finite_pos("update_period_s", self.update_period_s)?;
         let r = self.update_period_s / self.sample_time_s;
         if r < 1.0 - 1e-9 || (r - r.round()).abs() > 1e-6 * r.max(1.0) {

@@ -42,8 +42,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::signal::VelocityEstimator;
 use crate::{
-    board_outputs, check_finite_nonneg, check_finite_pos, check_sign, finish_step, screen_step,
-    NanPolicy, ParamError, SampleClock, StepError,
+    board_outputs, check_finite_nonneg, check_finite_pos, check_sample_time, check_sign,
+    finish_step, screen_step, NanPolicy, ParamError, SampleClock, StepError,
 };
 
 /// Equivalent damping (N s/m) vs valve opening (0..1) of the project's semi-active damper at
@@ -217,7 +217,7 @@ impl Default for SkyHookParams {
 
 impl SkyHookParams {
     pub fn validate(&self) -> Result<(), ParamError> {
-        check_finite_pos("sample_time_s", self.sample_time_s)?;
+        check_sample_time(self.sample_time_s)?;
         check_finite_pos("velocity_filter_corner_hz", self.velocity_filter_corner_hz)?;
         if self.velocity_filter_corner_hz > 0.05 / self.sample_time_s {
             return Err(ParamError::new(

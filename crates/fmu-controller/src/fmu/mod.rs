@@ -224,11 +224,15 @@ impl FieldError for PhysicsStepError {
 }
 
 /// A failed physics step of model `M`. Inputs are finite (the glue checks them at set time) and
-/// the step is finite and positive (the glue checks it too), so the only realistic case is a
-/// non-finite output: the controller state is then garbage and the run cannot go on
+/// the step is finite and positive (the glue checks it too). A step holding too many board
+/// samples changed nothing, and a shorter one will do (fmi2Discard); otherwise an output
+/// became non-finite: the controller state is then garbage and the run cannot go on
 /// (fmi2Error).
 fn step_error<M: FmuModel>(e: &PhysicsStepError) -> StepError {
-    StepError::Error(field_error::<M>(e))
+    match e {
+        PhysicsStepError::TooManySamples { .. } => StepError::Discard(e.to_string()),
+        _ => StepError::Error(field_error::<M>(e)),
+    }
 }
 
 /// Log the start (warning) and the end (event) of the physics' hold path for non-finite
