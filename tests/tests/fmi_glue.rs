@@ -96,6 +96,34 @@ fn bad_values_are_rejected_and_change_nothing() {
     assert_eq!(s, ERROR);
 }
 
+/// Whatever fmi2GetReal returns with fmi2OK is finite: an output that overflows (here a
+/// coupling force of 1e300 N/m times 1e300 m) is an error naming it, and the instance goes on
+/// once the input is sane again.
+#[test]
+fn an_output_that_is_not_finite_is_an_error_naming_it() {
+    let f = TestFmu::open_dist("SpringDamperMass").expect("dist/SpringDamperMass.fmu");
+    let inst = f.instantiate("overflow").unwrap();
+    assert_eq!(inst.set_real("coupling_stiffness", 1e300), OK);
+    assert_eq!(inst.initialize(0.0), OK);
+    assert_eq!(inst.set_real("input_position", 1e300), OK);
+    let (status, value) = inst.get_real("coupling_force");
+    assert_eq!(status, ERROR, "{value}");
+    assert!(
+        inst.messages()
+            .iter()
+            .any(|m| m.contains("'coupling_force' is -inf") && m.contains("cannot compute")),
+        "{:?}",
+        inst.messages()
+    );
+    assert_eq!(inst.set_real("input_position", 1e-3), OK);
+    let (status, value) = inst.get_real("coupling_force");
+    assert_eq!(status, OK);
+    assert!((value.abs() - 1e297).abs() < 1e285, "{value}");
+    assert_eq!(inst.set_real("input_position", 0.0), OK);
+    assert_eq!(inst.get_real("coupling_force"), (OK, 0.0));
+    assert_eq!(inst.do_step(0.0, 1e-3), OK);
+}
+
 #[test]
 fn invalid_parameter_is_reported_at_initialisation() {
     let f = TestFmu::open_dist("SpringDamperMass").unwrap();
