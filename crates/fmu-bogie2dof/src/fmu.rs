@@ -31,6 +31,7 @@ impl FieldError for PhysicsModelError {
             PhysicsModelError::Param(p) => p.field(),
             // The contact table is the shell's field `contact`.
             PhysicsModelError::Contact(_) => Some("contact"),
+            PhysicsModelError::TooStiff(_) => None,
         }
     }
 
@@ -38,6 +39,7 @@ impl FieldError for PhysicsModelError {
         match self {
             PhysicsModelError::Param(p) => p.reason(),
             PhysicsModelError::Contact(c) => c.to_string(),
+            PhysicsModelError::TooStiff(e) => e.to_string(),
         }
     }
 }

@@ -32,7 +32,7 @@
 //! [`Bogie::outputs`] with the current inputs to get them without stepping.
 
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{check_inputs, check_step};
+use vehicle_elements::{check_inputs, check_step, check_substep, TooStiff};
 
 pub use vehicle_elements::InputError;
 
@@ -79,6 +79,9 @@ pub enum ModelError {
     /// Contact table could not be loaded.
     #[error(transparent)]
     Contact(#[from] TableError),
+    /// The parameters need an internal step too short to compute.
+    #[error(transparent)]
+    TooStiff(#[from] TooStiff),
 }
 
 /// Errors of a step or an output evaluation.
@@ -246,6 +249,7 @@ impl Bogie {
             _ => None,
         };
         let h_sub_max = substep_bound(&consts, &table, generator.as_ref());
+        check_substep(h_sub_max)?;
         let mut state = [0.0; N_STATES];
         state[0] = params.initial_lateral_m;
         state[1] = params.initial_yaw_rad;

@@ -119,6 +119,17 @@ fn fmu_equals_plain_physics_bit_for_bit() {
     }
 }
 
+/// A parameter that passes its range but leaves the dynamics faster than any step can follow
+/// (a bogie of 1e-300 kg) is refused at initialisation, saying why.
+#[test]
+fn parameters_too_stiff_to_integrate_are_refused() {
+    let (mut c, log) = initialising::<M>();
+    assert_eq!(set::<M>(&mut c, "inertia.mass", 1e-300), Status::Ok);
+    assert_eq!(c.exit_initialization_mode(), Status::Error);
+    let l = log.take();
+    assert!(logged(&l, Status::Error, "internal steps of"), "{l:?}");
+}
+
 /// Negative values are rejected when set (declared min); zero, speed and friction at
 /// fmi2ExitInitializationMode by the physics' validation; the FMI variable is named.
 #[test]

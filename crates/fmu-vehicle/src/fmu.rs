@@ -32,6 +32,7 @@ impl FieldError for PhysicsModelError {
             PhysicsModelError::Table(_) | PhysicsModelError::FlangeNotCovered { .. } => {
                 Some("contact")
             }
+            PhysicsModelError::TooStiff(_) => None,
         }
     }
 

@@ -17,7 +17,7 @@
 //! acceleration at once. [`Vehicle::outputs`] evaluates them without stepping.
 
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{check_inputs, check_step};
+use vehicle_elements::{check_inputs, check_step, check_substep, TooStiff};
 
 pub use vehicle_elements::InputError;
 use wheel_rail::{GeometryTable, SegmentHint, TableError};
@@ -51,6 +51,9 @@ pub enum ModelError {
     /// The contact table could not be read.
     #[error(transparent)]
     Table(#[from] TableError),
+    /// The parameters need an internal step too short to compute.
+    #[error(transparent)]
+    TooStiff(#[from] TooStiff),
     /// The contact table does not reach flange contact on one side.
     #[error(
         "contact table does not cover the flange: on the {side} wheel tan(gamma) reaches only \
@@ -292,9 +295,9 @@ impl Vehicle {
                 Track::Internal(TrackGenerator::new(level, seed))
             }
         };
-        let substep_s = params
-            .solver_substep_s
-            .min(consts.stable_substep_s(&params, &table));
+        let stable_s = consts.stable_substep_s(&params, &table);
+        check_substep(stable_s)?;
+        let substep_s = params.solver_substep_s.min(stable_s);
         Ok(Self {
             substep_s,
             table_range_m: table.y_range(),

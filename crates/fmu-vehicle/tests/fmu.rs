@@ -174,6 +174,30 @@ fn impossible_parameters_are_named() {
     }
 }
 
+/// A parameter that passes its range but leaves the dynamics faster than any step can follow
+/// (a wheelset of 1e-300 kg) is refused at initialisation, saying why, instead of making every
+/// later step loop for ever.
+#[test]
+fn parameters_too_stiff_to_integrate_are_refused() {
+    for (name, value) in [
+        ("wheelset.mass", 1e-300),
+        ("primary.lateral_stiffness", 1e300),
+    ] {
+        let (mut c, log) = initialising::<M>();
+        assert_eq!(set::<M>(&mut c, name, value), Status::Ok, "{name}");
+        assert_eq!(c.exit_initialization_mode(), Status::Error, "{name}");
+        let l = log.take();
+        assert!(
+            logged(&l, Status::Error, "internal steps of"),
+            "{name}: {l:?}"
+        );
+        assert!(
+            logged(&l, Status::Error, "outside any vehicle's range"),
+            "{name}: {l:?}"
+        );
+    }
+}
+
 #[test]
 fn a_contact_table_without_flange_is_refused() {
     let dir = std::env::temp_dir().join(format!("rail_vehicle_table_{}", std::process::id()));

@@ -31,5 +31,7 @@ pub use params::{finite, in_range, non_negative, positive, ParamError};
 pub use resources::resource_or_given;
 pub use shell::{Shell, ShellPhysics};
 pub use stability::{first_unstable_speed, Crossing};
-pub use step::{check_inputs, check_step, host_step, InputError};
+pub use step::{
+    check_inputs, check_step, check_substep, host_step, InputError, TooStiff, MIN_SUBSTEP_S,
+};
 pub use track::{TrackChoiceSource, TrackLevel, TrackSetting};

@@ -86,6 +86,33 @@ impl FieldError for InputError {
     }
 }
 
+/// Shortest internal sub-step the vehicle models accept [s]. Their sub-step follows their
+/// fastest dynamics (creep decay, contact and suspension frequencies); parameters that need a
+/// shorter one are outside any vehicle's range (a mass of a few ulps, a stiffness of 1e300), and
+/// would make a 1 ms step take longer than any host waits.
+pub const MIN_SUBSTEP_S: f64 = 1e-7;
+
+/// The parameters need a shorter internal step than [`MIN_SUBSTEP_S`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "the parameters need internal steps of {substep_s:e} s to stay stable, shorter than \
+     {MIN_SUBSTEP_S:e} s: a mass, an inertia, a stiffness or a creep coefficient is outside any \
+     vehicle's range"
+)]
+pub struct TooStiff {
+    /// The sub-step the dynamics need [s] (NaN when the parameters give no rate at all).
+    pub substep_s: f64,
+}
+
+/// `substep_s` is at least [`MIN_SUBSTEP_S`] (and a number).
+pub fn check_substep(substep_s: f64) -> Result<(), TooStiff> {
+    if substep_s >= MIN_SUBSTEP_S {
+        Ok(())
+    } else {
+        Err(TooStiff { substep_s })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
