@@ -31,7 +31,7 @@ impl FieldError for PhysicsModelError {
             PhysicsModelError::Param(p) => p.field(),
             // The contact table is the shell's field `contact`.
             PhysicsModelError::Contact(_) => Some("contact"),
-            PhysicsModelError::TooStiff(_) => None,
+            PhysicsModelError::TooStiff(e) => e.parameter.as_deref(),
         }
     }
 
@@ -39,7 +39,7 @@ impl FieldError for PhysicsModelError {
         match self {
             PhysicsModelError::Param(p) => p.reason(),
             PhysicsModelError::Contact(c) => c.to_string(),
-            PhysicsModelError::TooStiff(e) => e.to_string(),
+            PhysicsModelError::TooStiff(e) => e.reason(),
         }
     }
 }

@@ -32,7 +32,7 @@
 //! [`Bogie::outputs`] with the current inputs to get them without stepping.
 
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{check_inputs, check_step, check_substep, TooStiff};
+use vehicle_elements::{blame_substep, check_inputs, check_step, check_substep, TooStiff};
 
 pub use vehicle_elements::InputError;
 
@@ -236,20 +236,18 @@ impl Bogie {
     /// As [`Self::new`] with an explicit contact table (ignores `params.contact`).
     pub fn with_table(params: Params, table: GeometryTable) -> Result<Self, ModelError> {
         params.validate()?;
-        let mut consts = Consts::new(&params);
-        if consts.nonlinear {
-            // Wheel speed from the table's centred rolling radius (the A/A table has
-            // delta r = -0.44 mm at y = 0): no longitudinal creep in the centred position.
-            let c0 = table.lookup(0.0);
-            let r_c = consts.r0 + 0.5 * (c0.delta_r_left_m + c0.delta_r_right_m);
-            consts.omega = consts.v / r_c;
-        }
+        let consts = consts_with_table(&params, &table);
         let generator = match params.track {
             TrackSource::Internal { level, seed } => Some(TrackGenerator::new(level, seed)),
             _ => None,
         };
         let h_sub_max = substep_bound(&consts, &table, generator.as_ref());
-        check_substep(h_sub_max)?;
+        if let Err(mut e) = check_substep(h_sub_max) {
+            e.parameter = blame_substep(&params, &Params::default(), |p| {
+                substep_bound(&consts_with_table(p, &table), &table, generator.as_ref())
+            });
+            return Err(e.into());
+        }
         let mut state = [0.0; N_STATES];
         state[0] = params.initial_lateral_m;
         state[1] = params.initial_yaw_rad;
@@ -495,6 +493,19 @@ impl Bogie {
         self.cache = OutputCache(Some((yt1, e)));
         self.outputs_from(yt1, &e)
     }
+}
+
+/// The constants of `params`, with the wheel speed of the non-linear model from the table's
+/// centred rolling radius (the A/A table has delta r = -0.44 mm at y = 0): no longitudinal
+/// creep in the centred position.
+fn consts_with_table(params: &Params, table: &GeometryTable) -> Consts {
+    let mut consts = Consts::new(params);
+    if consts.nonlinear {
+        let c0 = table.lookup(0.0);
+        let r_c = consts.r0 + 0.5 * (c0.delta_r_left_m + c0.delta_r_right_m);
+        consts.omega = consts.v / r_c;
+    }
+    consts
 }
 
 /// Largest RK4 sub-step for the model's fastest dynamics (see the module docs) [s].

@@ -120,13 +120,14 @@ fn fmu_equals_plain_physics_bit_for_bit() {
 }
 
 /// A parameter that passes its range but leaves the dynamics faster than any step can follow
-/// (a bogie of 1e-300 kg) is refused at initialisation, saying why.
+/// (a bogie of 1e-300 kg) is refused at initialisation, naming it and saying why.
 #[test]
 fn parameters_too_stiff_to_integrate_are_refused() {
     let (mut c, log) = initialising::<M>();
     assert_eq!(set::<M>(&mut c, "inertia.mass", 1e-300), Status::Ok);
     assert_eq!(c.exit_initialization_mode(), Status::Error);
     let l = log.take();
+    assert!(logged(&l, Status::Error, "'inertia.mass'"), "{l:?}");
     assert!(logged(&l, Status::Error, "internal steps of"), "{l:?}");
 }
 

@@ -32,13 +32,14 @@ impl FieldError for PhysicsModelError {
             PhysicsModelError::Table(_) | PhysicsModelError::FlangeNotCovered { .. } => {
                 Some("contact")
             }
-            PhysicsModelError::TooStiff(_) => None,
+            PhysicsModelError::TooStiff(e) => e.parameter.as_deref(),
         }
     }
 
     fn reason(&self) -> String {
         match self {
             PhysicsModelError::Param(p) => p.reason(),
+            PhysicsModelError::TooStiff(e) => e.reason(),
             other => other.to_string(),
         }
     }

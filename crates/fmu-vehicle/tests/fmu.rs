@@ -175,8 +175,8 @@ fn impossible_parameters_are_named() {
 }
 
 /// A parameter that passes its range but leaves the dynamics faster than any step can follow
-/// (a wheelset of 1e-300 kg) is refused at initialisation, saying why, instead of making every
-/// later step loop for ever.
+/// (a wheelset of 1e-300 kg) is refused at initialisation, naming it and saying why, instead of
+/// making every later step loop for ever.
 #[test]
 fn parameters_too_stiff_to_integrate_are_refused() {
     for (name, value) in [
@@ -187,6 +187,10 @@ fn parameters_too_stiff_to_integrate_are_refused() {
         assert_eq!(set::<M>(&mut c, name, value), Status::Ok, "{name}");
         assert_eq!(c.exit_initialization_mode(), Status::Error, "{name}");
         let l = log.take();
+        assert!(
+            logged(&l, Status::Error, &format!("'{name}'")),
+            "{name}: {l:?}"
+        );
         assert!(
             logged(&l, Status::Error, "internal steps of"),
             "{name}: {l:?}"

@@ -32,6 +32,7 @@ pub use resources::resource_or_given;
 pub use shell::{Shell, ShellPhysics};
 pub use stability::{first_unstable_speed, Crossing};
 pub use step::{
-    check_inputs, check_step, check_substep, host_step, InputError, TooStiff, MIN_SUBSTEP_S,
+    blame_substep, check_inputs, check_step, check_substep, host_step, InputError, TooStiff,
+    MIN_SUBSTEP_S,
 };
 pub use track::{TrackChoiceSource, TrackLevel, TrackSetting};
