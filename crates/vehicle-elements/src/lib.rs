@@ -10,6 +10,8 @@
 //! * [`resources`]: file parameters looked up under the FMU's `resources/` folder first;
 //! * [`shell`]: what both FMU shells do alike (inputs, physics built at initialisation and
 //!   previewed before, outputs, host step, the physics' step errors under FMI names);
+//! * [`substep`]: the shortest internal sub-step the models accept, and the parameter to blame
+//!   when a parameter set needs a shorter one;
 //! * [`stability`]: the search for a linear critical speed (scan, then bisection) that both
 //!   eigen-analyses run;
 //! * [`damper`]: the linear yaw damper law (none, viscous, Kelvin-Voigt, Maxwell) that the
@@ -24,6 +26,7 @@ pub mod resources;
 pub mod shell;
 pub mod stability;
 pub mod step;
+pub mod substep;
 pub mod track;
 
 pub use damper::{run_closed_loop, ClosedLoopModel, LinearDamper};
@@ -31,8 +34,6 @@ pub use params::{finite, in_range, non_negative, positive, ParamError};
 pub use resources::resource_or_given;
 pub use shell::{Shell, ShellPhysics};
 pub use stability::{first_unstable_speed, Crossing};
-pub use step::{
-    blame_substep, check_inputs, check_step, check_substep, host_step, InputError, TooStiff,
-    MIN_SUBSTEP_S,
-};
+pub use step::{check_inputs, check_step, host_step, InputError};
+pub use substep::{blame_substep, check_substep, TooStiff, MIN_SUBSTEP_S};
 pub use track::{TrackChoiceSource, TrackLevel, TrackSetting};

@@ -1,8 +1,6 @@
 //! Checks of what a host hands a model's step: the communication step and the inputs, with
 //! the error that names the offending input.
 
-use serde::{de::DeserializeOwned, Serialize};
-
 use model_description::FieldError;
 
 /// The largest communication step a model accepts [s].
@@ -85,114 +83,6 @@ impl FieldError for InputError {
             InputError::NonFiniteInput { value, .. } => format!("not finite ({value})"),
             other => other.to_string(),
         }
-    }
-}
-
-/// Shortest internal sub-step the vehicle models accept [s]. Their sub-step follows their
-/// fastest dynamics (creep decay, contact and suspension frequencies); parameters that need a
-/// shorter one are outside any vehicle's range (a mass of a few ulps, a stiffness of 1e300), and
-/// would make a 1 ms step take longer than any host waits.
-pub const MIN_SUBSTEP_S: f64 = 1e-7;
-
-/// The parameters need a shorter internal step than [`MIN_SUBSTEP_S`].
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{}{}", .parameter.as_ref().map(|p| format!("`{p}`: ")).unwrap_or_default(), self.reason())]
-pub struct TooStiff {
-    /// The sub-step the dynamics need [s] (NaN when the parameters give no rate at all).
-    pub substep_s: f64,
-    /// The parameter to blame (dotted field of the parameter struct, see [`blame_substep`]).
-    pub parameter: Option<String>,
-}
-
-impl TooStiff {
-    /// What is wrong, without the parameter's name.
-    pub fn reason(&self) -> String {
-        format!(
-            "the parameters need internal steps of {:e} s to stay stable, shorter than {:e} s: \
-             a mass, an inertia, a stiffness or a creep coefficient is outside any vehicle's \
-             range",
-            self.substep_s, MIN_SUBSTEP_S
-        )
-    }
-}
-
-/// The parameter that makes the sub-step too short: of the numbers in `params` that differ
-/// from `defaults`, the one whose default value alone gives the longest sub-step (its path in
-/// the parameter struct, `wheelset.mass_kg`). Only on the error path: it rebuilds the sub-step
-/// once per changed number.
-pub fn blame_substep<P: Serialize + DeserializeOwned>(
-    params: &P,
-    defaults: &P,
-    substep_s: impl Fn(&P) -> f64,
-) -> Option<String> {
-    let given = serde_json::to_value(params).ok()?;
-    let default = serde_json::to_value(defaults).ok()?;
-    let mut changed = Vec::new();
-    changed_numbers(&given, &default, &mut Vec::new(), &mut changed);
-    let mut best: Option<(f64, String)> = None;
-    for path in changed {
-        let mut candidate = given.clone();
-        let (Some(slot), Some(value)) =
-            (pointer_mut(&mut candidate, &path), pointer(&default, &path))
-        else {
-            continue;
-        };
-        *slot = value.clone();
-        let Ok(p) = serde_json::from_value::<P>(candidate) else {
-            continue;
-        };
-        let h = substep_s(&p);
-        if h.is_finite() && best.as_ref().is_none_or(|(b, _)| h > *b) {
-            best = Some((h, path.join(".")));
-        }
-    }
-    best.map(|(_, path)| path)
-}
-
-/// Paths of the numbers of `given` that differ from `default` (same shape: both serialise the
-/// same struct).
-fn changed_numbers(
-    given: &serde_json::Value,
-    default: &serde_json::Value,
-    path: &mut Vec<String>,
-    out: &mut Vec<Vec<String>>,
-) {
-    use serde_json::Value;
-    match (given, default) {
-        (Value::Object(g), Value::Object(d)) => {
-            for (k, gv) in g {
-                if let Some(dv) = d.get(k) {
-                    path.push(k.clone());
-                    changed_numbers(gv, dv, path, out);
-                    path.pop();
-                }
-            }
-        }
-        (Value::Number(g), Value::Number(d)) if g != d => out.push(path.clone()),
-        _ => {}
-    }
-}
-
-fn pointer<'a>(v: &'a serde_json::Value, path: &[String]) -> Option<&'a serde_json::Value> {
-    path.iter().try_fold(v, |v, k| v.get(k))
-}
-
-fn pointer_mut<'a>(
-    v: &'a mut serde_json::Value,
-    path: &[String],
-) -> Option<&'a mut serde_json::Value> {
-    path.iter().try_fold(v, |v, k| v.get_mut(k))
-}
-
-/// `substep_s` is at least [`MIN_SUBSTEP_S`] (and a number).
-pub fn check_substep(substep_s: f64) -> Result<(), TooStiff> {
-    if substep_s >= MIN_SUBSTEP_S {
-        Ok(())
-    } else {
-        Err(TooStiff {
-            substep_s,
-            parameter: None,
-        })
     }
 }
 
