@@ -1,6 +1,7 @@
 //! Property: whatever sequence of FMI calls a host makes, in any order and with any values
-//! (unknown value references, NaN, infinities, huge numbers, steps from the wrong time, FMU
-//! states got, set, freed and serialised at any point), every packaged FMU answers each call
+//! (unknown value references, NaN, infinities, huge numbers, several values per call with
+//! repeats, empty calls with NULL arrays, steps from the wrong time, FMU states got, set, freed
+//! and serialised at any point), every packaged FMU answers each call
 //! with a defined status, never aborts or hangs, and whatever fmi2GetReal returns with
 //! fmi2OK or fmi2Warning is finite. Through the real C ABI of dist/*.fmu, as a third-party
 //! host would call it.
@@ -61,21 +62,58 @@ fn variables(model_description: &str) -> Vec<Variable> {
 /// One host call; `var` picks a variable of the call's type or an unknown value reference.
 #[derive(Debug, Clone)]
 enum Call {
-    Setup { start: f64, stop: Option<f64> },
+    Setup {
+        start: f64,
+        stop: Option<f64>,
+    },
     EnterInit,
     ExitInit,
-    SetReal { var: usize, value: f64 },
-    SetInteger { var: usize, value: i32 },
-    SetBoolean { var: usize, value: i32 },
-    SetString { var: usize, value: usize },
+    SetReal {
+        var: usize,
+        value: f64,
+    },
+    SetInteger {
+        var: usize,
+        value: i32,
+    },
+    SetBoolean {
+        var: usize,
+        value: i32,
+    },
+    SetString {
+        var: usize,
+        value: usize,
+    },
+    /// fmi2SetReal of several values at once (repeats and unknown references possible), the
+    /// values drawn from the same set as [`Call::SetReal`]'s
+    SetReals {
+        vars: Vec<usize>,
+        values: Vec<f64>,
+    },
+    /// fmi2GetReal of several values at once, with the same finiteness check as GetAll
+    GetReals {
+        vars: Vec<usize>,
+    },
+    /// every get and set with no values and NULL arrays (legal: nothing to read or write)
+    Empty,
     GetAll,
-    DoStep { from_own_time: bool, t: f64, h: f64 },
+    DoStep {
+        from_own_time: bool,
+        t: f64,
+        h: f64,
+    },
     Reset,
     Terminate,
     GetState,
-    SetState { slot: usize },
-    FreeState { slot: usize },
-    SerialiseRoundTrip { slot: usize },
+    SetState {
+        slot: usize,
+    },
+    FreeState {
+        slot: usize,
+    },
+    SerialiseRoundTrip {
+        slot: usize,
+    },
 }
 
 const STRINGS: [&str; 4] = ["", "x", "../../../../etc/passwd", "%s%n%s%n"];
@@ -114,6 +152,10 @@ fn call() -> impl Strategy<Value = Call> {
             .prop_map(|(var, value)| Call::SetBoolean { var, value }),
         1 => (var, 0..STRINGS.len() + 1).prop_map(|(var, value)| Call::SetString { var, value }),
         3 => Just(Call::GetAll),
+        2 => (proptest::collection::vec(any::<usize>(), 1..8), proptest::collection::vec(real(), 8))
+            .prop_map(|(vars, values)| Call::SetReals { vars, values }),
+        2 => proptest::collection::vec(any::<usize>(), 1..8).prop_map(|vars| Call::GetReals { vars }),
+        1 => Just(Call::Empty),
         2 => (any::<bool>(),
          prop_oneof![Just(0.0), Just(-1.0), Just(f64::NAN), 0.0..1.0f64],
          prop_oneof![Just(1e-3), Just(0.0), Just(-1e-3), Just(f64::NAN), Just(f64::INFINITY), Just(1e-12), Just(0.02)])
@@ -187,6 +229,38 @@ fn run_sequence(fmu: &TestFmu, vars: &[Variable], calls: &[Call]) -> Result<(), 
                     let text = CString::new(STRINGS.get(value).copied().unwrap_or(&long)).unwrap();
                     let p: *const c_char = text.as_ptr();
                     b.fmi2SetString(c, &pick(&strings, var), 1, &p)
+                }
+                Call::SetReals {
+                    ref vars,
+                    ref values,
+                } => {
+                    let vrs: Vec<u32> = vars.iter().map(|&v| pick(&reals, v)).collect();
+                    b.fmi2SetReal(c, vrs.as_ptr(), vrs.len(), values.as_ptr())
+                }
+                Call::GetReals { ref vars } => {
+                    let vrs: Vec<u32> = vars.iter().map(|&v| pick(&reals, v)).collect();
+                    let mut values = vec![f64::NAN; vrs.len()];
+                    let s = b.fmi2GetReal(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr());
+                    if (s == OK || s == WARNING) && values.iter().any(|x| !x.is_finite()) {
+                        return Err(TestCaseError::fail(format!(
+                            "call {k}: fmi2GetReal of {vrs:?} gave {values:?} with status {s}"
+                        )));
+                    }
+                    s
+                }
+                Call::Empty => {
+                    let (vr, null) = (std::ptr::null(), std::ptr::null_mut());
+                    let statuses = [
+                        b.fmi2GetReal(c, vr, 0, null),
+                        b.fmi2GetInteger(c, vr, 0, null.cast()),
+                        b.fmi2GetBoolean(c, vr, 0, null.cast()),
+                        b.fmi2GetString(c, vr, 0, null.cast()),
+                        b.fmi2SetReal(c, vr, 0, null),
+                        b.fmi2SetInteger(c, vr, 0, null.cast()),
+                        b.fmi2SetBoolean(c, vr, 0, null.cast()),
+                        b.fmi2SetString(c, vr, 0, null.cast()),
+                    ];
+                    statuses.into_iter().max().unwrap_or(OK)
                 }
                 Call::GetAll => {
                     let mut values = vec![f64::NAN; reals.len()];
