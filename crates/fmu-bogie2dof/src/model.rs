@@ -32,7 +32,7 @@
 //! [`Bogie::outputs`] with the current inputs to get them without stepping.
 
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{blame_substep, check_inputs, check_step, check_substep, TooStiff};
+use vehicle_elements::{check_inputs, check_step, stable_substep, TooStiff};
 
 pub use vehicle_elements::InputError;
 
@@ -236,18 +236,14 @@ impl Bogie {
     /// As [`Self::new`] with an explicit contact table (ignores `params.contact`).
     pub fn with_table(params: Params, table: GeometryTable) -> Result<Self, ModelError> {
         params.validate()?;
-        let consts = consts_with_table(&params, &table);
         let generator = match params.track {
             TrackSource::Internal { level, seed } => Some(TrackGenerator::new(level, seed)),
             _ => None,
         };
-        let h_sub_max = substep_bound(&consts, &table, generator.as_ref());
-        if let Err(mut e) = check_substep(h_sub_max) {
-            e.parameter = blame_substep(&params, &Params::default(), |p| {
-                substep_bound(&consts_with_table(p, &table), &table, generator.as_ref())
-            });
-            return Err(e.into());
-        }
+        let h_sub_max = stable_substep(&params, |p| {
+            substep_bound(&consts_with_table(p, &table), &table, generator.as_ref())
+        })?;
+        let consts = consts_with_table(&params, &table);
         let mut state = [0.0; N_STATES];
         state[0] = params.initial_lateral_m;
         state[1] = params.initial_yaw_rad;

@@ -17,7 +17,7 @@
 //! acceleration at once. [`Vehicle::outputs`] evaluates them without stepping.
 
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{blame_substep, check_inputs, check_step, check_substep, TooStiff};
+use vehicle_elements::{check_inputs, check_step, stable_substep, TooStiff};
 
 pub use vehicle_elements::InputError;
 use wheel_rail::{GeometryTable, SegmentHint, TableError};
@@ -295,13 +295,9 @@ impl Vehicle {
                 Track::Internal(TrackGenerator::new(level, seed))
             }
         };
-        let stable_s = consts.stable_substep_s(&params, &table);
-        if let Err(mut e) = check_substep(stable_s) {
-            e.parameter = blame_substep(&params, &VehicleParams::default(), |p| {
-                Consts::new(p, &table).stable_substep_s(p, &table)
-            });
-            return Err(e.into());
-        }
+        let stable_s = stable_substep(&params, |p| {
+            Consts::new(p, &table).stable_substep_s(p, &table)
+        })?;
         let substep_s = params.solver_substep_s.min(stable_s);
         Ok(Self {
             substep_s,

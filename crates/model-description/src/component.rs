@@ -453,21 +453,20 @@ impl Component {
             // whatever a host reads with fmi2OK is a number: a model whose parameters give
             // no finite value (before initialisation, where they are not yet checked, or
             // through a physics fault) says so instead
-            Ok(()) if values.iter().all(|v| v.is_finite()) => status,
-            Ok(()) => self.non_finite_reals(vrs, values),
+            Ok(()) => match values.iter().position(|v| !v.is_finite()) {
+                None => status,
+                Some(k) => self.non_finite_real(vrs[k], values[k]),
+            },
             Err(vr) => self.unknown(CALL, VarType::Real, vr),
         }
     }
 
-    /// fmi2GetReal found a value that is not finite: an error naming the first one.
+    /// fmi2GetReal found a value that is not finite: an error naming its variable.
     #[cold]
     #[inline(never)]
-    fn non_finite_reals(&mut self, vrs: &[u32], values: &[f64]) -> Status {
-        let Some(k) = values.iter().position(|v| !v.is_finite()) else {
-            return Status::Ok;
-        };
-        let name = self.index.lookup(VarType::Real, vrs[k]).map_or_else(
-            || vrs[k].to_string(),
+    fn non_finite_real(&mut self, vr: u32, value: f64) -> Status {
+        let name = self.index.lookup(VarType::Real, vr).map_or_else(
+            || vr.to_string(),
             |i| format!("'{}'", self.model.metas()[i].name),
         );
         let hint = if self.state == FmiState::StepComplete {
@@ -476,7 +475,7 @@ impl Component {
             "the parameters give no finite value (they are checked at \
              fmi2ExitInitializationMode, which names the one that is refused)"
         };
-        let msg = format!("fmi2GetReal: {name} is {} ({hint})", values[k]);
+        let msg = format!("fmi2GetReal: {name} is {value} ({hint})");
         self.error(&msg)
     }
 

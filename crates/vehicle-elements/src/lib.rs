@@ -35,5 +35,5 @@ pub use resources::resource_or_given;
 pub use shell::{Shell, ShellPhysics};
 pub use stability::{first_unstable_speed, Crossing};
 pub use step::{check_inputs, check_step, host_step, InputError};
-pub use substep::{blame_substep, check_substep, TooStiff, MIN_SUBSTEP_S};
+pub use substep::{blame_substep, check_substep, stable_substep, TooStiff, MIN_SUBSTEP_S};
 pub use track::{TrackChoiceSource, TrackLevel, TrackSetting};

@@ -99,6 +99,20 @@ fn pointer_mut<'a>(
     path.iter().try_fold(v, |v, k| v.get_mut(k))
 }
 
+/// The sub-step `substep_s` gives `params`, if it is at least [`MIN_SUBSTEP_S`]; otherwise the
+/// error, with the parameter to blame against `P::default()` (see [`blame_substep`]).
+pub fn stable_substep<P: Serialize + DeserializeOwned + Default>(
+    params: &P,
+    substep_s: impl Fn(&P) -> f64,
+) -> Result<f64, TooStiff> {
+    let h = substep_s(params);
+    check_substep(h).map_err(|mut e| {
+        e.parameter = blame_substep(params, &P::default(), &substep_s);
+        e
+    })?;
+    Ok(h)
+}
+
 /// `substep_s` is at least [`MIN_SUBSTEP_S`] (and a number).
 pub fn check_substep(substep_s: f64) -> Result<(), TooStiff> {
     if substep_s >= MIN_SUBSTEP_S {

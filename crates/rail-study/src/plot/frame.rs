@@ -184,7 +184,12 @@ fn title_lines(title: &str, width_px: u32) -> Vec<String> {
 
 /// Height the title of a figure `width_px` wide takes above its frames [px].
 pub(super) fn title_height_px(title: &str, width_px: u32) -> u32 {
-    (12 + TITLE_LINE_PX * title_lines(title, width_px).len().max(1) as i32) as u32
+    height_of_lines(title_lines(title, width_px).len())
+}
+
+/// Height of a title of `n` lines [px].
+fn height_of_lines(n: usize) -> u32 {
+    (12 + TITLE_LINE_PX * n.max(1) as i32) as u32
 }
 
 /// Writes the figure's title across the top of `root`, wrapped to its width, and returns the
@@ -194,12 +199,13 @@ fn titled<'a>(
     title: &str,
 ) -> Result<DrawingArea<SVGBackend<'a>, Shift>, PlotError> {
     let (w, _) = root.dim_in_pixel();
-    let (top, rest) = root.split_vertically(title_height_px(title, w));
+    let lines = title_lines(title, w);
+    let (top, rest) = root.split_vertically(height_of_lines(lines.len()));
     let style = ("sans-serif", TITLE_FONT_PX)
         .into_font()
         .into_text_style(root)
         .pos(Pos::new(HPos::Center, VPos::Top));
-    for (k, line) in title_lines(title, w).into_iter().enumerate() {
+    for (k, line) in lines.into_iter().enumerate() {
         top.draw(&Text::new(
             line,
             (w as i32 / 2, 8 + k as i32 * TITLE_LINE_PX),
