@@ -549,4 +549,16 @@ fn a_study_option_out_of_range_is_refused_before_anything_is_touched() {
             "{bad}"
         );
     }
+    // a value outside the enumeration is a usage error (exit status 2) naming the choices
+    let out = case.master(
+        &["study", "--quick", "--out", "out", "--track-level", "medium"],
+        &[],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("invalid value 'medium'") && err.contains("low, high"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&old).unwrap(), "the previous report");
 }

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use crate::study::{
-    run_study, write_outputs, Sources, StudyError, StudyOptions, StudySettings, Timing,
+    run_study, write_outputs, Sources, StudyError, StudyOptions, StudySettings, Timing, TrackLevel,
     VehicleModel,
 };
 use master::cli::{CommandError, Context};
@@ -47,6 +47,11 @@ pub struct Args {
     /// speed R13 names; the seed does not give the table's speed.
     #[arg(long, value_name = "KM/H")]
     pub cv_speed: Option<f64>,
+    /// ERRI B176 level of the lateral alignment of every irregular-track run (it replaces the
+    /// systems' `track.level`, as the study sets speed and seed): low (the seed's high-speed
+    /// line) or high (2.9 times the low level's spectrum).
+    #[arg(long, value_enum, default_value = "low")]
+    pub track_level: TrackLevel,
 }
 
 /// The range of `--cv-speed` [km/h]: the vehicle FMUs' running speed is 1-200 m/s.
@@ -79,6 +84,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         StudySettings::full(args.vehicle)
     };
     settings.stored_format = args.format;
+    settings.track_level = args.track_level;
     if let Some(v) = args.cv_speed {
         if !CV_SPEED_RANGE_KMH.contains(&v) {
             return Err(CommandError::Failed(format!(

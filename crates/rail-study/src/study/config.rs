@@ -42,6 +42,7 @@ use master::runset::{sanitize, Job, RunSet, RunSpec};
 use master::system::{LoadedSystem, SystemDescription, SystemError};
 
 use crate::study::configurations::Configuration;
+use crate::study::settings::TrackLevel;
 use crate::study::vehicle::{coach_system, VehicleModel};
 
 /// Where the study takes its system descriptions and FMUs from.
@@ -141,6 +142,8 @@ pub struct RunRequest {
     pub speed_kmh: f64,
     /// Track seed; `None` = ideal track (track.source = 0).
     pub seed: Option<u32>,
+    /// Level of the irregular track (with a seed).
+    pub track_level: TrackLevel,
     pub stop_time_s: f64,
     /// Further start values (`instance.variable` -> value).
     pub extra: BTreeMap<String, Value>,
@@ -166,6 +169,7 @@ impl RunRequest {
             config,
             speed_kmh,
             seed,
+            track_level: TrackLevel::Low,
             stop_time_s,
             extra: BTreeMap::new(),
         }
@@ -173,6 +177,12 @@ impl RunRequest {
 
     pub fn with(mut self, key: &str, value: Value) -> Self {
         self.extra.insert(key.to_string(), value);
+        self
+    }
+
+    /// The same run on a track of `level` (irregular-track runs only).
+    pub fn on_track(mut self, level: TrackLevel) -> Self {
+        self.track_level = level;
         self
     }
 
@@ -190,6 +200,7 @@ impl RunRequest {
             Some(s) => {
                 p.insert(v.track_source(), Value::from(2));
                 p.insert(v.track_seed(), Value::from(s));
+                p.insert(v.track_level(), Value::from(self.track_level.fmu_value()));
             }
             None => {
                 p.insert(v.track_source(), Value::from(0));
@@ -331,7 +342,21 @@ mod tests {
         let speed = coach.parameters["running.speed"].as_f64().unwrap();
         assert!((speed - 300.0 / 3.6).abs() < 1e-12);
         assert_eq!(coach.parameters["track.seed"], Value::from(2));
+        assert_eq!(coach.parameters["track.level"], Value::from(0));
         assert_eq!(j.system.instances.len(), 9);
+    }
+
+    #[test]
+    fn the_track_level_reaches_every_irregular_track_run_and_no_ideal_one() {
+        let c = configuration("passive").unwrap();
+        for v in [VehicleModel::Coach, VehicleModel::Bogie2Dof] {
+            let r = RunRequest::new("s-", v, c, 300.0, Some(2), 3.0);
+            assert_eq!(r.parameters()[&v.track_level()], Value::from(0));
+            let high = r.on_track(TrackLevel::High).parameters();
+            assert_eq!(high[&v.track_level()], Value::from(1));
+            let ideal = RunRequest::new("p-", v, c, 220.0, None, 5.0).on_track(TrackLevel::High);
+            assert!(!ideal.parameters().contains_key(&v.track_level()));
+        }
     }
 
     #[test]

@@ -29,5 +29,5 @@ pub use configurations::{Configuration, CONFIGURATIONS};
 pub use critical::Critical;
 pub use report::{write_outputs, Timing};
 pub use run::{run_study, StudyError, StudyOptions, StudyResults};
-pub use settings::StudySettings;
+pub use settings::{StudySettings, TrackLevel};
 pub use vehicle::VehicleModel;

@@ -231,9 +231,12 @@ impl Executor<'_> {
     }
 
     /// Runs one batch in `<out>/runs/<batch>` and collects its numbers.
-    fn run_batch(&mut self, batch: &str, planned: Vec<Planned>) -> Result<(), StudyError> {
+    fn run_batch(&mut self, batch: &str, mut planned: Vec<Planned>) -> Result<(), StudyError> {
         if planned.is_empty() {
             return Ok(());
+        }
+        for p in &mut planned {
+            p.request.track_level = self.settings.track_level;
         }
         for p in &planned {
             self.prepare(p.request.config)?;

@@ -14,7 +14,9 @@ pub struct StudySettings {
     pub configurations: Vec<&'static str>,
     /// Speeds of the rms sweep [km/h].
     pub speeds_kmh: Vec<f64>,
-    /// Track seeds of the internal ERRI B176 low-level generator.
+    /// Level of the ERRI B176 lateral alignment of every run on irregular track.
+    pub track_level: TrackLevel,
+    /// Track seeds of the internal ERRI B176 generator.
     pub seeds: Vec<u32>,
     /// Length of a sweep run [s].
     pub sweep_stop_s: f64,
@@ -53,6 +55,36 @@ pub struct StudySettings {
     pub stored_rate_hz: f64,
 }
 
+/// ERRI B176 (ORE B176) track quality of the irregular-track runs: the study's default is the
+/// low level (high-speed lines); the high level has 2.9 times its spectrum.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum TrackLevel {
+    /// A = 2.119e-7 m rad (the seed's high-speed line).
+    #[default]
+    Low,
+    /// A = 6.125e-7 m rad.
+    High,
+}
+
+impl TrackLevel {
+    /// The value of the vehicle FMUs' `track.level` Enumeration.
+    pub fn fmu_value(self) -> i64 {
+        match self {
+            TrackLevel::Low => 0,
+            TrackLevel::High => 1,
+        }
+    }
+
+    /// As the report writes it: "low-level", "high-level".
+    pub fn name(self) -> &'static str {
+        match self {
+            TrackLevel::Low => "low-level",
+            TrackLevel::High => "high-level",
+        }
+    }
+}
+
 fn range(from: f64, to: f64, step: f64) -> Vec<f64> {
     let n = ((to - from) / step).round() as usize;
     (0..=n).map(|k| from + k as f64 * step).collect()
@@ -75,6 +107,7 @@ impl StudySettings {
                 VehicleModel::Coach => range(200.0, 440.0, 10.0),
                 VehicleModel::Bogie2Dof => range(200.0, 400.0, 10.0),
             },
+            track_level: TrackLevel::Low,
             seeds: vec![1, 2],
             // 5 s start-up + 10 s assessed: 556 m (46 windows of 100 m) at 200 km/h
             sweep_stop_s: 15.0,

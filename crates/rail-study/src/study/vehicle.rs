@@ -150,6 +150,10 @@ impl VehicleModel {
         self.var("track.seed")
     }
 
+    pub fn track_level(self) -> String {
+        self.var("track.level")
+    }
+
     /// Initial lateral displacement (of both bogies on the coach) [m].
     pub fn initial_lateral(self) -> String {
         self.var("initial.lateral_displacement")

@@ -131,7 +131,7 @@ pub fn report_markdown(r: &StudyResults, timing: &Timing, figures: &[(String, &s
     );
     let _ = writeln!(
         m,
-        "Vehicle: {}. ERRI B176 low-level lateral alignment (internal generator, seeds {:?}), \
+        "Vehicle: {}. ERRI B176 {} lateral alignment (internal generator, seeds {:?}), \
          co-simulated by the master with the damper and controller FMUs: Gauss-Seidel, 1 ms \
          communication steps, in the order vehicle, dampers, controllers. Each damper steps on \
          the elongations the vehicle gave at the end of its step and the command its controller \
@@ -144,6 +144,7 @@ pub fn report_markdown(r: &StudyResults, timing: &Timing, figures: &[(String, &s
          100 m windows in 10 m steps, first {:.0} s skipped, maximum over {} and all seeds, \
          limit a_lim = (12 - 6.1/5)/2 = {:.2} m/s^2.\n",
         s.vehicle.description(),
+        s.track_level.name(),
         s.seeds,
         s.skip_s,
         if coach {
