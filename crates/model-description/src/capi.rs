@@ -305,7 +305,9 @@ pub unsafe fn free_instance(c: fmi2Component) {
     }));
 }
 
-/// Run `f` on the component behind `c`, catching panics (the instance then goes to Error).
+/// Run `f` on the component behind `c`, catching panics: the call returns fmi2Error and the
+/// instance goes to the Error state, so a panic is not repeated on every later call (a state
+/// the host handed in may break an invariant the physics relies on).
 pub unsafe fn with(
     c: fmi2Component,
     call: &str,
@@ -321,14 +323,20 @@ pub unsafe fn with(
         Err(_) => {
             let cc = &mut *(c as *mut CComponent);
             let _ = catch_unwind(AssertUnwindSafe(|| {
+                cc.component.enter_error_state();
                 cc.component.error(&format!(
-                    "{call}: internal error (panic caught at the C boundary)"
+                    "{call}: internal error (panic caught at the C boundary); the instance is \
+                     in the Error state until fmi2Reset"
                 ));
             }));
             FMI2_ERROR
         }
     }
 }
+
+#[cfg(test)]
+#[path = "capi_tests.rs"]
+mod tests;
 
 unsafe fn slice<'a, T>(p: *const T, n: usize) -> Option<&'a [T]> {
     if n == 0 {

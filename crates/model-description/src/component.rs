@@ -220,6 +220,12 @@ impl Component {
         Status::Error
     }
 
+    /// The instance can no longer be trusted (a call panicked part-way through): every call
+    /// but fmi2Reset, fmi2FreeInstance and the getters is refused from now on.
+    pub fn enter_error_state(&mut self) {
+        self.state = FmiState::Error;
+    }
+
     fn warning(&mut self, message: &str) {
         self.sink.log(Status::Warning, "logStatusWarning", message);
     }

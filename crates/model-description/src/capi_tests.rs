@@ -1,0 +1,101 @@
+//! The C boundary: a panic inside a call is caught, and the instance is then refused until
+//! fmi2Reset instead of panicking again at every call.
+#![allow(clippy::unwrap_used)]
+
+use super::*;
+use crate::model::{DefaultExperiment, ModelInfo, StepError};
+use crate::{declare, rust_component, value_reference, Diagnostics, Variable};
+
+/// x grows by u per step; a step with u < 0 panics (an invariant broken, as by a bad state).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct Fragile {
+    u: f64,
+    x: f64,
+}
+
+impl FmuModel for Fragile {
+    const INFO: ModelInfo = ModelInfo {
+        name: "Fragile",
+        description: "panics on a negative input",
+        author: "test",
+        version: "0",
+        default_experiment: DefaultExperiment {
+            start_time: 0.0,
+            stop_time: 1.0,
+            step_size: 0.1,
+        },
+        documentation_html: "",
+        resources: &[],
+    };
+
+    fn variables() -> Vec<Variable<Self>> {
+        let mut v: Vec<Variable<Self>> = Vec::new();
+        declare! { v;
+            /// Input
+            input "u" => u;
+            /// State
+            output "x" => x;
+        }
+        v
+    }
+
+    fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
+        Ok(Fragile { u: 0.0, x: 0.0 })
+    }
+
+    fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
+        Ok(())
+    }
+
+    fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
+        Ok(())
+    }
+
+    fn do_step(&mut self, _t: f64, _h: f64, _diag: &mut Diagnostics) -> Result<(), StepError> {
+        let table = std::hint::black_box([1.0, 2.0]);
+        // index out of bounds for u < 0: a panic in the middle of the physics
+        let i = std::hint::black_box(if self.u < 0.0 { 7 } else { 0 });
+        self.x += self.u * table[i];
+        Ok(())
+    }
+}
+
+#[test]
+fn a_panic_is_an_error_and_leaves_the_instance_in_the_error_state_until_reset() {
+    let (component, log) = rust_component::<Fragile>(InstanceContext::default()).unwrap();
+    let c = Box::into_raw(Box::new(CComponent {
+        component,
+        serialized: None,
+        booleans: Vec::new(),
+    })) as fmi2Component;
+    let u = [value_reference::<Fragile>("u").unwrap()];
+    let start = |c| unsafe {
+        assert_eq!(setup_experiment(c, 0, 0.0, 0.0, 0, 0.0), FMI2_OK);
+        assert_eq!(enter_initialization_mode(c), FMI2_OK);
+        assert_eq!(exit_initialization_mode(c), FMI2_OK);
+    };
+    unsafe {
+        start(c);
+        assert_eq!(set_real(c, u.as_ptr(), 1, [1.0].as_ptr()), FMI2_OK);
+        assert_eq!(do_step(c, 0.0, 0.1), FMI2_OK);
+        assert_eq!(set_real(c, u.as_ptr(), 1, [-1.0].as_ptr()), FMI2_OK);
+        assert_eq!(do_step(c, 0.1, 0.1), FMI2_ERROR);
+        let first: Vec<String> = log.take().into_iter().map(|(_, _, m)| m).collect();
+        assert!(
+            first.iter().any(|m| m.contains("panic caught")),
+            "{first:?}"
+        );
+        // refused without running the physics again, even with a sane input
+        assert_eq!(set_real(c, u.as_ptr(), 1, [1.0].as_ptr()), FMI2_ERROR);
+        assert_eq!(do_step(c, 0.1, 0.1), FMI2_ERROR);
+        let later: Vec<String> = log.take().into_iter().map(|(_, _, m)| m).collect();
+        assert!(!later.iter().any(|m| m.contains("panic")), "{later:?}");
+        assert!(later.iter().any(|m| m.contains("Error")), "{later:?}");
+        // fmi2Reset gives a fresh instance that steps again
+        assert_eq!(reset(c), FMI2_OK);
+        start(c);
+        assert_eq!(set_real(c, u.as_ptr(), 1, [1.0].as_ptr()), FMI2_OK);
+        assert_eq!(do_step(c, 0.0, 0.1), FMI2_OK);
+        free_instance(c);
+    }
+}
