@@ -66,12 +66,42 @@ pub fn band_pass(
 
 /// Moving rms over the last `len` samples (ring buffer of squares, allocated once).
 /// Before the window is full, the rms is taken over the samples seen so far.
+/// A deserialised window (a saved FMU state, say) is checked for the ring's invariants.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RmsRing")]
 pub struct RmsWindow {
     squares: Vec<f64>,
     head: usize,
     filled: usize,
     sum: f64,
+}
+
+/// The serialised form of [`RmsWindow`] before its checks.
+#[derive(Deserialize)]
+struct RmsRing {
+    squares: Vec<f64>,
+    head: usize,
+    filled: usize,
+    sum: f64,
+}
+
+impl TryFrom<RmsRing> for RmsWindow {
+    type Error = String;
+    fn try_from(r: RmsRing) -> Result<Self, String> {
+        let len = r.squares.len();
+        if len == 0 || r.head >= len || r.filled > len {
+            return Err(format!(
+                "rms window: {len} samples, head {}, filled {}: not a ring",
+                r.head, r.filled
+            ));
+        }
+        Ok(RmsWindow {
+            squares: r.squares,
+            head: r.head,
+            filled: r.filled,
+            sum: r.sum,
+        })
+    }
 }
 
 impl RmsWindow {
@@ -167,6 +197,27 @@ mod tests {
     use super::*;
     use approx::assert_relative_eq;
     use std::f64::consts::PI;
+
+    #[test]
+    fn a_deserialised_rms_window_must_be_a_ring() {
+        let mut w = RmsWindow::new(4);
+        w.push(1.0);
+        let good = serde_json::to_value(&w).unwrap();
+        assert_eq!(
+            serde_json::from_value::<RmsWindow>(good.clone()).unwrap(),
+            w
+        );
+        for (field, value) in [
+            ("head", serde_json::json!(4)),
+            ("filled", serde_json::json!(5)),
+            ("squares", serde_json::json!([])),
+        ] {
+            let mut bad = good.clone();
+            bad[field] = value;
+            let e = serde_json::from_value::<RmsWindow>(bad).unwrap_err();
+            assert!(e.to_string().contains("rms window"), "{field}: {e}");
+        }
+    }
 
     /// Steady-state rms of the filter output for a unit sinusoid, measured by simulation.
     fn sim_gain(bp: &mut BandPass, f: f64, dt: f64) -> f64 {

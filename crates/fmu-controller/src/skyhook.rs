@@ -65,9 +65,29 @@ pub const DAMPING_TABLE_4HZ: [(f64, f64); 9] = [
 
 /// Equivalent damping vs opening: `(opening 0..1, c_eq N s/m)`, openings strictly increasing,
 /// damping strictly decreasing.
+/// A deserialised table (a saved FMU state, say) must hold a point for the lookups to read;
+/// its order is checked by [`DampingTable::validate`] at initialisation, as for a table the
+/// host sets.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "DampingPoints")]
 pub struct DampingTable {
     pub points: Vec<(f64, f64)>,
+}
+
+/// The serialised form of [`DampingTable`] before its check.
+#[derive(Deserialize)]
+struct DampingPoints {
+    points: Vec<(f64, f64)>,
+}
+
+impl TryFrom<DampingPoints> for DampingTable {
+    type Error = &'static str;
+    fn try_from(d: DampingPoints) -> Result<Self, Self::Error> {
+        if d.points.is_empty() {
+            return Err("damping table without points");
+        }
+        Ok(DampingTable { points: d.points })
+    }
 }
 
 impl Default for DampingTable {
@@ -403,6 +423,16 @@ mod tests {
     use super::*;
     use approx::assert_relative_eq;
     use std::f64::consts::PI;
+
+    #[test]
+    fn a_deserialised_damping_table_has_points() {
+        let t = DampingTable::default();
+        let good = serde_json::to_value(&t).unwrap();
+        assert_eq!(serde_json::from_value::<DampingTable>(good).unwrap(), t);
+        let e =
+            serde_json::from_value::<DampingTable>(serde_json::json!({"points": []})).unwrap_err();
+        assert!(e.to_string().contains("without points"), "{e}");
+    }
 
     fn ideal(mode: SkyHookMode) -> SkyHook {
         SkyHook::new(SkyHookParams {

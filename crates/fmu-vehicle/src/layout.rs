@@ -320,12 +320,36 @@ pub fn damper_rows(p: &VehicleParams) -> [[(usize, f64); 2]; N_DAMPERS] {
 /// accumulated column by column (f -= K[:, j] q_j + C[:, j] q'_j), which vectorises over the rows
 /// without a floating-point reduction (a sparse loop over the 83 non-zeros is four times slower:
 /// every entry waits for the previous update of its row).
+/// A deserialised one (a saved FMU state, say) must hold N_DOF x N_DOF of each.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "SuspensionColumns")]
 pub struct SparseSuspension {
     /// K by column, column j at [j * N_DOF ..].
     k: Vec<f64>,
     /// C by column.
     c: Vec<f64>,
+}
+
+/// The serialised form of [`SparseSuspension`] before its check.
+#[derive(Deserialize)]
+struct SuspensionColumns {
+    k: Vec<f64>,
+    c: Vec<f64>,
+}
+
+impl TryFrom<SuspensionColumns> for SparseSuspension {
+    type Error = String;
+    fn try_from(s: SuspensionColumns) -> Result<Self, String> {
+        if s.k.len() != N_DOF * N_DOF || s.c.len() != N_DOF * N_DOF {
+            return Err(format!(
+                "suspension matrices of {} and {} entries, {} expected",
+                s.k.len(),
+                s.c.len(),
+                N_DOF * N_DOF
+            ));
+        }
+        Ok(SparseSuspension { k: s.k, c: s.c })
+    }
 }
 
 impl SparseSuspension {
@@ -385,6 +409,23 @@ impl SparseSuspension {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn deserialised_suspension_matrices_must_be_n_dof_square() {
+        let s = SparseSuspension::from_dense(&Suspension::new(&VehicleParams::default()));
+        let good = serde_json::to_value(&s).unwrap();
+        assert_eq!(
+            serde_json::from_value::<SparseSuspension>(good.clone()).unwrap(),
+            s
+        );
+        let mut bad = good;
+        bad["k"]
+            .as_array_mut()
+            .unwrap()
+            .push(serde_json::json!(0.0));
+        let e = serde_json::from_value::<SparseSuspension>(bad).unwrap_err();
+        assert!(e.to_string().contains("expected"), "{e}");
+    }
 
     #[test]
     fn suspension_is_symmetric_and_rigid_motion_is_free() {

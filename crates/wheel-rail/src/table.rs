@@ -149,13 +149,33 @@ pub fn write_csv(rows: impl IntoIterator<Item = CsvRow>, numbers: CsvNumbers) ->
 
 /// Contact geometry of one wheelset as functions of its lateral displacement relative to the
 /// track (format and conventions in the module docs). Immutable once built.
+/// A deserialised table (a saved FMU state, say) is checked as [`GeometryTable::from_columns`]
+/// checks a built one, so that no lookup can index out of its rows.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "TableColumns")]
 pub struct GeometryTable {
     y: Vec<f64>,
     dr_l: Vec<f64>,
     dr_r: Vec<f64>,
     tg_l: Vec<f64>,
     tg_r: Vec<f64>,
+}
+
+/// The serialised form of [`GeometryTable`] before its checks.
+#[derive(Deserialize)]
+struct TableColumns {
+    y: Vec<f64>,
+    dr_l: Vec<f64>,
+    dr_r: Vec<f64>,
+    tg_l: Vec<f64>,
+    tg_r: Vec<f64>,
+}
+
+impl TryFrom<TableColumns> for GeometryTable {
+    type Error = TableError;
+    fn try_from(c: TableColumns) -> Result<Self, TableError> {
+        Self::from_columns(c.y, c.dr_l, c.dr_r, c.tg_l, c.tg_r)
+    }
 }
 
 /// Interpolated contact geometry at one lateral displacement.
@@ -520,6 +540,28 @@ impl GeometryTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_deserialised_table_is_checked_as_a_built_one() {
+        let t = synthetic();
+        let good = serde_json::to_value(&t).unwrap();
+        let back: GeometryTable = serde_json::from_value(good.clone()).unwrap();
+        assert_eq!(back, t);
+        let mut short = good.clone();
+        short["dr_l"] = serde_json::json!([0.0]);
+        let e = serde_json::from_value::<GeometryTable>(short).unwrap_err();
+        assert!(e.to_string().contains("unequal length"), "{e}");
+        let mut one_row = good.clone();
+        for c in ["y", "dr_l", "dr_r", "tg_l", "tg_r"] {
+            one_row[c] = serde_json::json!([0.0]);
+        }
+        let e = serde_json::from_value::<GeometryTable>(one_row).unwrap_err();
+        assert!(e.to_string().contains("at least 2 needed"), "{e}");
+        let mut unordered = good;
+        unordered["y"][1] = unordered["y"][0].clone();
+        let e = serde_json::from_value::<GeometryTable>(unordered).unwrap_err();
+        assert!(e.to_string().contains("increas"), "{e}");
+    }
 
     fn synthetic() -> GeometryTable {
         GeometryTable::synthetic(0.15, 7e-3, 0.5e-3, 2.7).unwrap()

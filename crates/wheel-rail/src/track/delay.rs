@@ -17,13 +17,53 @@ pub struct DelayUndo {
 /// travelled distance, so the wheelsets behind it (e.g. the bogie's rear wheelset, 2p behind)
 /// see the same track. Samples are stored every `spacing` metres at most (bounded memory for
 /// any speed/step): 2048 samples over the delay it was made for.
+/// A deserialised line (a saved FMU state, say) is checked for the ring's invariants, so that
+/// no push or read can index out of it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "DelayRing")]
 pub struct DelayLine {
     x: Vec<f64>,
     v: Vec<f64>,
     head: usize,
     len: usize,
     spacing: f64,
+}
+
+/// The serialised form of [`DelayLine`] before its checks.
+#[derive(Deserialize)]
+struct DelayRing {
+    x: Vec<f64>,
+    v: Vec<f64>,
+    head: usize,
+    len: usize,
+    spacing: f64,
+}
+
+impl TryFrom<DelayRing> for DelayLine {
+    type Error = String;
+    fn try_from(r: DelayRing) -> Result<Self, String> {
+        let cap = r.x.len();
+        if cap < 2 || r.v.len() != cap || r.head >= cap || r.len > cap {
+            return Err(format!(
+                "delay line: {} positions, {} values, head {}, length {}: not a ring of at \
+                 least 2 samples",
+                cap,
+                r.v.len(),
+                r.head,
+                r.len
+            ));
+        }
+        if !(r.spacing.is_finite() && r.spacing > 0.0) {
+            return Err(format!("delay line: spacing {} m", r.spacing));
+        }
+        Ok(DelayLine {
+            x: r.x,
+            v: r.v,
+            head: r.head,
+            len: r.len,
+            spacing: r.spacing,
+        })
+    }
 }
 
 impl DelayLine {
@@ -126,6 +166,27 @@ impl DelayLine {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_deserialised_line_must_be_a_ring() {
+        let mut d = DelayLine::new(2.5);
+        d.push(0.0, 1.0);
+        let good = serde_json::to_value(&d).unwrap();
+        let back: DelayLine = serde_json::from_value(good.clone()).unwrap();
+        assert_eq!(back, d);
+        for (field, value) in [
+            ("head", serde_json::json!(4096)),
+            ("len", serde_json::json!(5000)),
+            ("x", serde_json::json!([0.0])),
+            ("v", serde_json::json!([0.0, 1.0])),
+            ("spacing", serde_json::json!(0.0)),
+        ] {
+            let mut bad = good.clone();
+            bad[field] = value;
+            let e = serde_json::from_value::<DelayLine>(bad).unwrap_err();
+            assert!(e.to_string().contains("delay line"), "{field}: {e}");
+        }
+    }
 
     #[test]
     fn delay_line_returns_past_values() {
