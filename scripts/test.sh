@@ -67,6 +67,13 @@ export RAIL_FMPY_RESULTS="$PWD/target/fmpy"
 export RAIL_FOREIGN_FMUS="$PWD/target/foreign"
 # the venv's python with fmpy: tests/tests/master_vs_fmpy.rs replays master runs in fmpy
 export RAIL_PYTHON="$VENV/bin/python"
+# a test that finds one of these missing fails instead of skipping
+export RAIL_REQUIRE_EXTERNAL=1
+if [ -f ../shared/reference-fmus/Stair.fmu ]; then
+    export RAIL_REFERENCE_FMUS="$(cd ../shared/reference-fmus && pwd)"
+else
+    echo "SKIPPED: the Reference FMU tests (../shared/reference-fmus not found)"
+fi
 cargo test --release --workspace
 # The glue's no-allocation test calls the exported C functions in-process (feature fmi-export).
 cargo test --release -p fmu-examples --features fmi-export

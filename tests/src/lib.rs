@@ -197,9 +197,20 @@ pub fn workspace_root() -> PathBuf {
 pub fn rail_python() -> Option<PathBuf> {
     let p = std::env::var_os("RAIL_PYTHON").map(PathBuf::from);
     if p.is_none() {
-        eprintln!("RAIL_PYTHON not set: run scripts/test.sh (it points it to the venv with fmpy, libcosimpy and ecospy)");
+        missing_external("RAIL_PYTHON not set: run scripts/test.sh (it points it to the venv with fmpy, libcosimpy and ecospy)");
     }
     p
+}
+
+/// A test that needs something outside the crate (a Python with fmpy, files the test command
+/// prepares) skips, saying why, under a plain `cargo test`. Under scripts/test.sh, which sets
+/// RAIL_REQUIRE_EXTERNAL, it fails instead: the test command cannot pass without running it.
+#[allow(clippy::panic)]
+pub fn missing_external(what: &str) {
+    if std::env::var_os("RAIL_REQUIRE_EXTERNAL").is_some() {
+        panic!("{what} (RAIL_REQUIRE_EXTERNAL is set: the test must run)");
+    }
+    eprintln!("skipped: {what}");
 }
 
 /// One instance; freed on drop.

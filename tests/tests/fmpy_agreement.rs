@@ -10,7 +10,9 @@ fn results_dir() -> Option<std::path::PathBuf> {
     match std::env::var_os("RAIL_FMPY_RESULTS") {
         Some(d) => Some(d.into()),
         None => {
-            eprintln!("RAIL_FMPY_RESULTS not set: run scripts/test.sh (it runs fmpy first)");
+            tests::missing_external(
+                "RAIL_FMPY_RESULTS not set: run scripts/test.sh (it runs fmpy first)",
+            );
             None
         }
     }

@@ -27,8 +27,8 @@ fn foreign_dir() -> Option<PathBuf> {
     match std::env::var_os("RAIL_FOREIGN_FMUS") {
         Some(d) => Some(d.into()),
         None => {
-            eprintln!(
-                "RAIL_FOREIGN_FMUS not set: run scripts/test.sh (it builds the foreign FMUs first)"
+            tests::missing_external(
+                "RAIL_FOREIGN_FMUS not set: run scripts/test.sh (it builds the foreign FMUs first)",
             );
             None
         }
