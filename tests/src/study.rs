@@ -83,6 +83,16 @@ impl SharedStudy {
         self.critical(id).at_least_kmh()
     }
 
+    /// The first speed over the limit, infinite when stable throughout: for orderings, where
+    /// a configuration stable to the end of the range must rank above one that exceeds the
+    /// limit at that end ([`Self::vcr`] gives both the last speed).
+    pub fn exceedance_kmh(&self, id: &str) -> f64 {
+        match self.critical(id) {
+            Critical::Above { .. } => f64::INFINITY,
+            c => c.at_least_kmh(),
+        }
+    }
+
     /// The metrics of a scenario run.
     #[allow(clippy::panic)]
     pub fn scenario_metrics(&self, name: &str) -> &RunMetrics {

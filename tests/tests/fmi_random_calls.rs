@@ -172,6 +172,15 @@ fn call() -> impl Strategy<Value = Call> {
 
 const STATUSES: [ffi::fmi2Status; 5] = [OK, WARNING, DISCARD, ERROR, ffi::fmi2Status_fmi2Fatal];
 
+/// The worst of several calls' statuses, or the first that is not a defined fmi2Status (which
+/// the caller then reports).
+fn defined_or_first_undefined(statuses: &[ffi::fmi2Status]) -> ffi::fmi2Status {
+    match statuses.iter().find(|s| !STATUSES.contains(s)) {
+        Some(&undefined) => undefined,
+        None => statuses.iter().copied().max().unwrap_or(OK),
+    }
+}
+
 /// Runs one call sequence on a fresh instance; fails on an undefined status or a non-finite
 /// Real read with fmi2OK or fmi2Warning.
 fn run_sequence(fmu: &TestFmu, vars: &[Variable], calls: &[Call]) -> Result<(), TestCaseError> {
@@ -260,7 +269,7 @@ fn run_sequence(fmu: &TestFmu, vars: &[Variable], calls: &[Call]) -> Result<(), 
                         b.fmi2SetBoolean(c, vr, 0, null.cast()),
                         b.fmi2SetString(c, vr, 0, null.cast()),
                     ];
-                    statuses.into_iter().max().unwrap_or(OK)
+                    defined_or_first_undefined(&statuses)
                 }
                 Call::GetAll => {
                     let mut values = vec![f64::NAN; reals.len()];
@@ -274,10 +283,10 @@ fn run_sequence(fmu: &TestFmu, vars: &[Variable], calls: &[Call]) -> Result<(), 
                         }
                     }
                     let mut ints = vec![0; integers.len()];
-                    let _ =
+                    let si =
                         b.fmi2GetInteger(c, integers.as_ptr(), integers.len(), ints.as_mut_ptr());
                     let mut bools = vec![0; booleans.len()];
-                    let _ =
+                    let sb =
                         b.fmi2GetBoolean(c, booleans.as_ptr(), booleans.len(), bools.as_mut_ptr());
                     let mut texts: Vec<ffi::fmi2String> = vec![std::ptr::null(); strings.len()];
                     let s2 =
@@ -287,7 +296,7 @@ fn run_sequence(fmu: &TestFmu, vars: &[Variable], calls: &[Call]) -> Result<(), 
                             "call {k}: fmi2GetString gave NULL with fmi2OK"
                         )));
                     }
-                    s
+                    defined_or_first_undefined(&[s, si, sb, s2])
                 }
                 Call::DoStep {
                     from_own_time,

@@ -91,6 +91,7 @@ fn exported_systems_are_valid_and_import_back_bit_for_bit() {
         assert_eq!(back.step, sys.desc.step);
         assert_eq!(back.stop_time, STOP_TIME_S);
         assert_eq!(back.algorithm, Algorithm::Jacobi);
+        assert_eq!(sys.desc.instances.len(), back.instances.len());
         for (a, b) in sys.desc.instances.iter().zip(&back.instances) {
             assert_eq!(a.name, b.name);
             assert_eq!(a.parameters, b.parameters, "{name}: {}", a.name);

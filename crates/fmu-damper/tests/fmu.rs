@@ -624,7 +624,10 @@ fn no_direct_feedthrough_where_none_is_declared() {
     // feedthrough is checked with the reduced-order model below.
     let (mut c, _) = init::<FullActiveActuator>(&[]);
     let before = get::<FullActiveActuator>(&mut c, "spool.position");
-    set::<FullActiveActuator>(&mut c, "spool.command", -0.7e-3);
+    assert_eq!(
+        set::<FullActiveActuator>(&mut c, "spool.command", -0.7e-3),
+        Status::Ok
+    );
     assert_eq!(get::<FullActiveActuator>(&mut c, "spool.position"), before);
     let (mut c, _) = new::<FullActiveActuator>();
     assert_eq!(
@@ -633,7 +636,10 @@ fn no_direct_feedthrough_where_none_is_declared() {
     );
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
     let f = get::<FullActiveActuator>(&mut c, "damper.force");
-    set::<FullActiveActuator>(&mut c, "spool.command", -0.7e-3);
+    assert_eq!(
+        set::<FullActiveActuator>(&mut c, "spool.command", -0.7e-3),
+        Status::Ok
+    );
     assert_eq!(get::<FullActiveActuator>(&mut c, "spool.position"), -0.7e-3);
     assert_eq!(get::<FullActiveActuator>(&mut c, "damper.force"), f);
 
@@ -642,7 +648,10 @@ fn no_direct_feedthrough_where_none_is_declared() {
     assert_eq!(c.do_step(0.0, 0.01), Status::Ok);
     let f = get::<SemiActiveDamper>(&mut c, "damper.force");
     assert!(f > 1e3);
-    set::<SemiActiveDamper>(&mut c, "damper.elongation_velocity", -0.5);
+    assert_eq!(
+        set::<SemiActiveDamper>(&mut c, "damper.elongation_velocity", -0.5),
+        Status::Ok
+    );
     assert_eq!(get::<SemiActiveDamper>(&mut c, "damper.force"), f);
     assert_eq!(c.do_step(0.01, 1e-3), Status::Ok);
     assert!(get::<SemiActiveDamper>(&mut c, "damper.force") < f);

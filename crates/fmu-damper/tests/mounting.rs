@@ -206,7 +206,10 @@ fn through_the_fmu_zero_is_rigid_and_a_stiffness_changes_the_force() {
             assert!(c.do_step(k as f64 * de.step_size, de.step_size) <= Status::Warning);
         }
         let mut f = [0.0];
-        c.get_real(&[value_reference::<M>("damper.force").unwrap()], &mut f);
+        assert_eq!(
+            c.get_real(&[value_reference::<M>("damper.force").unwrap()], &mut f),
+            Status::Ok
+        );
         f[0]
     };
     let (rigid, zero, soft) = (run_default(), run(0.0), run(1e5));
@@ -230,7 +233,10 @@ fn through_the_fmu_zero_is_rigid_and_a_stiffness_changes_the_force() {
             assert!(c.do_step(k as f64 * de.step_size, de.step_size) <= Status::Warning);
         }
         let mut f = [0.0];
-        c.get_real(&[value_reference::<M>("damper.force").unwrap()], &mut f);
+        assert_eq!(
+            c.get_real(&[value_reference::<M>("damper.force").unwrap()], &mut f),
+            Status::Ok
+        );
         f[0]
     }
 }

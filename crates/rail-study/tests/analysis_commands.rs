@@ -105,6 +105,7 @@ fn characterise_damper_writes_loops_frfs_and_r1_table() {
     let closed = table_row(&r.stdout, "0 %");
     let open = table_row(&r.stdout, "100 %");
     assert_eq!(closed.len(), 2, "{}", r.stdout);
+    assert_eq!(open.len(), 2, "{}", r.stdout);
     for f in &closed {
         assert!((12.0..=20.0).contains(f), "R1 0 %: {f} kN\n{}", r.stdout);
     }

@@ -343,15 +343,37 @@ fn archive_limits_and_unsafe_entries_are_refused_before_extraction() {
         e.contains("it has 3 entries, more than the limit of 2"),
         "{e}"
     );
-    // zip-slip, absolute paths, links: refused, nothing written
+    // zip-slip, absolute paths, links: refused, nothing written. The archive is unpacked in
+    // <case>/tmp/master-fmu-*/, so "../../escaped.txt" would land in <case>/escaped.txt.
+    let absolute = std::env::temp_dir().join(format!(
+        "absolute-{}-{}.txt",
+        std::process::id(),
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap()
+            .as_nanos()
+    ));
+    let absolute_entry = absolute.to_string_lossy().to_string();
     for (entry, reason) in [
         ("../../escaped.txt", "leaves the archive"),
-        ("/tmp/absolute.txt", "leaves the archive"),
+        ("../escaped.txt", "leaves the archive"),
+        (absolute_entry.as_str(), "leaves the archive"),
     ] {
         zip_into(&c.path("Hostile.fmu"), &[md, bin, (entry, b"x")]);
         let e = c.fails(&["run", "system.json"], &[]);
         assert!(e.contains(reason), "{entry}: {e}");
-        assert!(!c.root.path().join("escaped.txt").exists());
+        for landed in [
+            c.path("escaped.txt"),
+            c.path("tmp/escaped.txt"),
+            c.root.path().join("escaped.txt"),
+            absolute.clone(),
+        ] {
+            assert!(
+                !landed.exists(),
+                "{entry} was written to {}",
+                landed.display()
+            );
+        }
     }
     let mut z = zip::ZipWriter::new(std::fs::File::create(c.path("Hostile.fmu")).unwrap());
     let o = zip::write::SimpleFileOptions::default();
@@ -551,7 +573,14 @@ fn a_study_option_out_of_range_is_refused_before_anything_is_touched() {
     }
     // a value outside the enumeration is a usage error (exit status 2) naming the choices
     let out = case.master(
-        &["study", "--quick", "--out", "out", "--track-level", "medium"],
+        &[
+            "study",
+            "--quick",
+            "--out",
+            "out",
+            "--track-level",
+            "medium",
+        ],
         &[],
     );
     let err = String::from_utf8_lossy(&out.stderr);
@@ -560,5 +589,8 @@ fn a_study_option_out_of_range_is_refused_before_anything_is_touched() {
         err.contains("invalid value 'medium'") && err.contains("low, high"),
         "{err}"
     );
-    assert_eq!(std::fs::read_to_string(&old).unwrap(), "the previous report");
+    assert_eq!(
+        std::fs::read_to_string(&old).unwrap(),
+        "the previous report"
+    );
 }

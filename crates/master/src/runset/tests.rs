@@ -137,14 +137,16 @@ fn parquet_results_of_a_set_share_one_folder_and_a_failed_rerun_leaves_none() {
         files,
         ["run-000.parquet", "run-001.parquet", "run-002.parquet"]
     );
-    for r in &reports {
+    assert_eq!(reports.len(), j.len());
+    for (r, job) in reports.iter().zip(&j) {
+        assert_eq!(r.name, job.name);
         assert!(!dir.path().join(&r.name).join("results.csv").exists());
         assert_eq!(
             r.results.as_deref(),
             Some(table.join(format!("{}.parquet", r.name)).as_path())
         );
-        assert!(completed(dir.path(), &j[0], ResultsFormat::Parquet).is_some());
-        assert!(completed(dir.path(), &j[0], ResultsFormat::Csv).is_none());
+        assert!(completed(dir.path(), job, ResultsFormat::Parquet).is_some());
+        assert!(completed(dir.path(), job, ResultsFormat::Csv).is_none());
     }
     let (columns, meta) =
         crate::parquet_file::read_parquet(&table.join("run-001.parquet")).unwrap();
