@@ -571,24 +571,23 @@ fn a_study_option_out_of_range_is_refused_before_anything_is_touched() {
             "{bad}"
         );
     }
-    // a value outside the enumeration is a usage error (exit status 2) naming the choices
-    let out = case.master(
-        &[
-            "study",
-            "--quick",
-            "--out",
-            "out",
-            "--track-level",
-            "medium",
-        ],
-        &[],
-    );
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("invalid value 'medium'") && err.contains("low, high"),
-        "{err}"
-    );
+    // a value outside the enumeration or a bad list is a usage error (exit status 2) saying
+    // what is wrong
+    for (option, value, reason) in [
+        ("--track-level", "medium", "low, high"),
+        ("--speeds", "300:200:10", "FROM <= TO"),
+        ("--speeds", "10:700:0.001", "more than 200 speeds"),
+        ("--speeds", "250,1e9", "between 10 and 700 km/h"),
+        ("--seeds", "1,-2", "not a track seed"),
+    ] {
+        let out = case.master(&["study", "--quick", "--out", "out", option, value], &[]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{option} {value}: {err}");
+        assert!(
+            err.contains(&format!("invalid value '{value}'")) && err.contains(reason),
+            "{option} {value}: {err}"
+        );
+    }
     assert_eq!(
         std::fs::read_to_string(&old).unwrap(),
         "the previous report"

@@ -1,5 +1,5 @@
 //! `master study [--vehicle vehicle|bogie2dof] [--fmus DIR] [--out DIR] [--quick] [--jobs N]
-//! [--cv-speed KM/H]`:
+//! [--speeds FROM:TO:STEP|V,V,...] [--seeds N,N,...] [--track-level low|high] [--cv-speed KM/H]`:
 //! the stability study (see [`crate::study`]): speed sweep per configuration, critical speeds,
 //! car-body acceleration and ride comfort (coach), perturbation runs, c_v sensitivity, time
 //! histories; REPORT.md, SVG plots and CSVs under `--out`.
@@ -52,10 +52,102 @@ pub struct Args {
     /// line) or high (2.9 times the low level's spectrum).
     #[arg(long, value_enum, default_value = "low")]
     pub track_level: TrackLevel,
+    /// Speeds of the sweep [km/h], instead of the study's (full: 200-440 km/h on the coach,
+    /// 200-400 on the bogie, in 10 km/h steps): `FROM:TO:STEP` (e.g. 250:350:5) or a list
+    /// (e.g. 280,290,300). Critical speeds are refined by bisection between them as usual.
+    #[arg(long, value_name = "FROM:TO:STEP|V,V,...", value_parser = parse_speeds)]
+    pub speeds: Option<SpeedList>,
+    /// Track seeds of the irregular-track runs, e.g. 1,2,3 (default: 1,2; --quick: 1); each
+    /// sweep point is the worst over them. The c_v and time-history runs use the first.
+    #[arg(long, value_name = "N,N,...", value_parser = parse_seeds)]
+    pub seeds: Option<SeedList>,
 }
 
-/// The range of `--cv-speed` [km/h]: the vehicle FMUs' running speed is 1-200 m/s.
+/// The range of `--cv-speed` and `--speeds` [km/h]: the vehicle FMUs' running speed is
+/// 1-200 m/s.
 const CV_SPEED_RANGE_KMH: std::ops::RangeInclusive<f64> = 10.0..=700.0;
+/// At most this many sweep speeds (the full study has 25) and track seeds.
+const MAX_SPEEDS: usize = 200;
+const MAX_SEEDS: usize = 20;
+/// The vehicle FMUs' `track.seed` range.
+const MAX_SEED: u32 = 2_147_483_647;
+
+/// The sweep speeds of `--speeds` [km/h], ascending and distinct.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpeedList(pub Vec<f64>);
+
+/// The track seeds of `--seeds`, in the order given, distinct.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeedList(pub Vec<u32>);
+
+fn parse_speed(text: &str) -> Result<f64, String> {
+    let v: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a speed in km/h"))?;
+    if !CV_SPEED_RANGE_KMH.contains(&v) {
+        return Err(format!(
+            "{v} km/h: speeds must lie between {} and {} km/h",
+            CV_SPEED_RANGE_KMH.start(),
+            CV_SPEED_RANGE_KMH.end()
+        ));
+    }
+    Ok(v)
+}
+
+/// `FROM:TO:STEP` or `V,V,...`.
+fn parse_speeds(text: &str) -> Result<SpeedList, String> {
+    let mut speeds = match text.split(':').collect::<Vec<_>>()[..] {
+        [from, to, step] => {
+            let (from, to) = (parse_speed(from)?, parse_speed(to)?);
+            let step: f64 = step
+                .trim()
+                .parse()
+                .map_err(|_| format!("'{step}' is not a speed step in km/h"))?;
+            if !(step.is_finite() && step > 0.0) || to < from {
+                return Err(format!(
+                    "{text}: FROM:TO:STEP needs FROM <= TO and a step > 0"
+                ));
+            }
+            // a tenth of a step of slack so that TO itself is in when the step divides the range
+            let n = ((to - from) / step + 0.1).floor();
+            if n >= MAX_SPEEDS as f64 {
+                return Err(format!("{text}: more than {MAX_SPEEDS} speeds"));
+            }
+            (0..=n as usize).map(|k| from + k as f64 * step).collect()
+        }
+        [_] => text
+            .split(',')
+            .map(parse_speed)
+            .collect::<Result<Vec<_>, _>>()?,
+        _ => return Err(format!("'{text}': FROM:TO:STEP or a list V,V,...")),
+    };
+    speeds.sort_by(f64::total_cmp);
+    speeds.dedup();
+    if speeds.len() > MAX_SPEEDS {
+        return Err(format!("{} speeds, at most {MAX_SPEEDS}", speeds.len()));
+    }
+    Ok(SpeedList(speeds))
+}
+
+fn parse_seeds(text: &str) -> Result<SeedList, String> {
+    let mut seeds: Vec<u32> = Vec::new();
+    for part in text.split(',') {
+        let seed: u32 = part
+            .trim()
+            .parse()
+            .ok()
+            .filter(|&s| s <= MAX_SEED)
+            .ok_or_else(|| format!("'{part}' is not a track seed (0 to {MAX_SEED})"))?;
+        if !seeds.contains(&seed) {
+            seeds.push(seed);
+        }
+    }
+    if seeds.len() > MAX_SEEDS {
+        return Err(format!("{} seeds, at most {MAX_SEEDS}", seeds.len()));
+    }
+    Ok(SeedList(seeds))
+}
 
 impl From<StudyError> for CommandError {
     fn from(e: StudyError) -> Self {
@@ -85,6 +177,12 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     };
     settings.stored_format = args.format;
     settings.track_level = args.track_level;
+    if let Some(SpeedList(speeds)) = &args.speeds {
+        settings.speeds_kmh = speeds.clone();
+    }
+    if let Some(SeedList(seeds)) = &args.seeds {
+        settings.seeds = seeds.clone();
+    }
     if let Some(v) = args.cv_speed {
         if !CV_SPEED_RANGE_KMH.contains(&v) {
             return Err(CommandError::Failed(format!(
@@ -158,4 +256,56 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         args.out.join("REPORT.md").display()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn speeds_as_a_range_or_a_list() {
+        assert_eq!(
+            parse_speeds("250:300:10").unwrap().0,
+            [250.0, 260.0, 270.0, 280.0, 290.0, 300.0]
+        );
+        // the end is in when the step divides the range, not past it otherwise
+        assert_eq!(parse_speeds("200:215:10").unwrap().0, [200.0, 210.0]);
+        assert_eq!(parse_speeds("300:300:5").unwrap().0, [300.0]);
+        assert_eq!(
+            parse_speeds("300, 280,290,280").unwrap().0,
+            [280.0, 290.0, 300.0]
+        );
+        for bad in [
+            "",
+            "abc",
+            "300:200:10",
+            "200:300:0",
+            "200:300:-5",
+            "200:300:nan",
+            "5",
+            "800",
+            "nan",
+            "inf",
+            "200:300",
+            "1:2:3:4",
+            "10:700:0.001",
+        ] {
+            assert!(parse_speeds(bad).is_err(), "{bad:?} accepted");
+        }
+        let e = parse_speeds("200,9000").unwrap_err();
+        assert!(e.contains("between 10 and 700 km/h"), "{e}");
+    }
+
+    #[test]
+    fn seeds_as_a_list() {
+        assert_eq!(parse_seeds("3,1,3").unwrap().0, [3, 1]);
+        assert_eq!(parse_seeds("2147483647").unwrap().0, [MAX_SEED]);
+        for bad in ["", "-1", "1.5", "2147483648", "a,b"] {
+            assert!(parse_seeds(bad).is_err(), "{bad:?} accepted");
+        }
+        let many: Vec<String> = (0..21).map(|k| k.to_string()).collect();
+        assert!(parse_seeds(&many.join(","))
+            .unwrap_err()
+            .contains("at most 20"));
+    }
 }
