@@ -95,7 +95,7 @@ impl Default for SemiActiveParams {
     /// Calibrated (examples/search.rs, examples/calibrate.rs) so that at 4 Hz, +-1 mm
     /// and +-3 mm the peak force is 12-20 kN at 0 % and 0.5-1 kN at 100 % opening (R1)
     /// with the equivalent stiffness at 0 % peaking as high in frequency as R1 allows
-    /// (about 4.7 Hz, see the crate docs). Only the products `K Q_ref`, `K C_f`,
+    /// (4.76 Hz, with a margin inside R1; see the crate docs). Only the products `K Q_ref`, `K C_f`,
     /// `K c_d A_v` matter for `dP`; `K` is fixed at 3e8 Pa, a fifth of pure oil
     /// (entrained air and hose compliance, REFERENCE.md) and the rest follows.
     fn default() -> Self {

@@ -13,7 +13,7 @@
 //! Modules: [`params`] (data set, sources, validation), [`layout`] (dofs, suspension assembly),
 //! [`linear`] (linear matrices), [`eigen`] (state matrix, modes, critical speed, root locus),
 //! [`calibration`], [`dynamics`] (right-hand side), [`model`] (time-domain [`Vehicle`]),
-//! [`track`], [`sim`] (closed loop with linear dampers), [`fmu`] (FMU shell `RailVehicle`,
+//! [`sim`] (closed loop with linear dampers), [`fmu`] (FMU shell `RailVehicle`,
 //! exported with feature `fmi-export`).
 pub mod calibration;
 pub mod dynamics;

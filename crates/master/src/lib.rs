@@ -4,7 +4,7 @@
 //! analyses live in `rail-study`, whose `master` binary composes [`cli`] with its own
 //! subcommands.
 //!
-//! * [`fmu`]: open and check a `.fmu`, instantiate it (through the `fmi` crate), drive it.
+//! * [`fmu`]: open and check a `.fmu`, instantiate it (through the `fmi-sys` bindings), drive it.
 //! * [`model_description`]: the parts of modelDescription.xml the master needs.
 //! * [`system`]: JSON system description -> validated [`coupling::CouplingPlan`] -> run.
 //! * [`ssp`]: SSP 1.0/2.0 import (a `.ssp` or `.ssd` becomes a system) and export.
@@ -14,7 +14,7 @@
 //! * [`decimation`]: results decimated without aliasing, and the sampling record of a file.
 //! * [`output`]: atomic CSV/JSON output.
 //! * [`results`]: results files, CSV or Parquet ([`parquet_file`]), and their metadata.
-//! * [`cli`]: the generic subcommands (run, sweep, inspect) and the binary's common main.
+//! * [`cli`]: the generic subcommands (run, sweep, inspect, export-ssp) and the binary's common main.
 //!
 //! A coupled run in a test is three lines:
 //! ```no_run

@@ -1,7 +1,7 @@
 //! The railway study on top of the generic co-simulation master (crate `master`): EN 14363
 //! stability assessment, the yaw-damper study of the seed's chapter 4, the offline analyses of
 //! the physics crates, the figures, and the `master` binary that offers the generic
-//! subcommands (run, sweep, inspect) together with the railway ones.
+//! subcommands (run, sweep, inspect, export-ssp) together with the railway ones.
 //!
 //! * [`signal`], [`en14363`]: spectrum, sliding rms, EN 14363 stability assessment (the
 //!   band-pass is `signal-processing`'s).

@@ -10,7 +10,7 @@
 //! * dampers `damper_left/right` (PassiveYawDamper, SemiActiveDamper) or
 //!   `actuator_left/right` (FullActiveActuator); their `damper.force` is recorded.
 //! * controllers `controller_left/right` (MpptController, SkyHookController; `valve.command`
-//!   recorded) or `idf_left/right` (IdealDamperForceController, parameter `c_v`).
+//!   recorded) or `idf_left/right` (IdealDamperForceController, parameter `reference.damping`, the c_v of (3.14)).
 //!
 //! System-level choices on the bogie (the seed leaves them open):
 //! * each controller takes the signals of its own side: the left MPPT board the frame

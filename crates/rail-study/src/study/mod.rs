@@ -1,5 +1,6 @@
 //! The stability study of the seed's chapter 4: passive, semi-active (MPPT1/2, sky-hook on/off
-//! and continuous, each with an ideal and a slow valve) and full-active (IDF) yaw dampers on
+//! and continuous, each with an ideal and a slow valve; on the coach also the seed's
+//! accelerometer-based on/off sky-hook) and full-active (IDF) yaw dampers on
 //! the coach (default, four dampers) or the non-linear 2-dof bogie (the seed's HIL
 //! configuration, two dampers), assessed by the EN 14363 rms criterion, with the car body's
 //! lateral acceleration and ride comfort (EN 12299) on the coach.

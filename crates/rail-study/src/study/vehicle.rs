@@ -29,7 +29,7 @@
 //!   board (`sensor.velocity_source = estimated`), `sensor.sign` -1 on the left dampers and +1
 //!   on the right ones (the coach's elongations follow the bogie's e_L = +b psi_frame when the
 //!   car body is still).
-//! * IDF: each on its own actuator's elongation velocity and force, `command_sign = -1`.
+//! * IDF: each on its own actuator's elongation velocity and force, `force_loop.command_sign = -1`.
 
 use serde_json::{json, Value};
 
