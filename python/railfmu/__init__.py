@@ -3,7 +3,8 @@
 Load a system of FMI 2.0 co-simulation FMUs (the master's JSON system description), set start
 values, run it, and get the results as NumPy or pandas with their units; run a run set (a base
 system plus parameter variations) on local threads or on a Dask cluster; read result folders
-back. Every run is the master's own (the same Rust code as the ``master`` command, bit for bit);
+back; assess recorded signals by the EN 14363 stability criterion (:func:`assess_stability`).
+Every run is the master's own (the same Rust code as the ``master`` command, bit for bit);
 the GIL is released while FMUs run. Errors are exceptions carrying the master's messages.
 
 >>> import railfmu
@@ -13,21 +14,26 @@ the GIL is released while FMUs run. Errors are exceptions carrying the master's 
 'm'
 """
 
-from ._railfmu import Error, FmuError, OutputError, SimulationError, SystemDescriptionError
+from ._assess import SignalAssessment, StabilityAssessment, assess_stability
+from ._railfmu import AssessmentError, Error, FmuError, OutputError, SimulationError, SystemDescriptionError
 from ._results import Results, RunSetResults, read_results, split_label
 from ._runset import RunSet, run_set
 from ._system import System
 
 __all__ = [
+    "AssessmentError",
     "Error",
     "FmuError",
     "OutputError",
     "Results",
     "RunSet",
     "RunSetResults",
+    "SignalAssessment",
     "SimulationError",
+    "StabilityAssessment",
     "System",
     "SystemDescriptionError",
+    "assess_stability",
     "read_results",
     "run_set",
     "split_label",

@@ -32,7 +32,13 @@ class Results:
     :meth:`to_numpy` (each field's dtype metadata ``{"unit": ...}``).
     """
 
-    def __init__(self, header: List[str], values: np.ndarray, summary: Optional[Dict[str, Any]] = None):
+    def __init__(
+        self,
+        header: List[str],
+        values: np.ndarray,
+        summary: Optional[Dict[str, Any]] = None,
+        full_rate: bool = False,
+    ):
         if values.ndim != 2 or values.shape[1] != len(header):
             raise ValueError(f"{values.shape} values do not match {len(header)} columns")
         self.header: List[str] = list(header)
@@ -41,6 +47,10 @@ class Results:
         """The table, one row per communication point, float64."""
         self.summary: Dict[str, Any] = dict(summary or {})
         """Run statistics: steps, rejected_steps, simulated_time_s, wall_time_s, realtime_ratio."""
+        self.full_rate: bool = full_rate
+        """Every communication point of the run is here (a run's own results): the signals
+        carry their full band. False when unknown (a table read back: its file's metadata
+        say, see :func:`assess_stability`)."""
         split = [split_label(h) for h in self.header]
         self.names: List[str] = [n for n, _ in split]
         """Column names without units; the first is ``time``."""
@@ -48,9 +58,11 @@ class Results:
         """Unit of each column (None where the FMU declares none)."""
 
     @classmethod
-    def _from_bytes(cls, header: List[str], data: bytes, summary: Optional[Dict[str, Any]] = None) -> "Results":
+    def _from_bytes(
+        cls, header: List[str], data: bytes, summary: Optional[Dict[str, Any]] = None, full_rate: bool = False
+    ) -> "Results":
         values = np.frombuffer(data, dtype=np.float64).reshape(-1, max(len(header), 1))
-        return cls(header, values, summary)
+        return cls(header, values, summary, full_rate)
 
     @classmethod
     def read_csv(cls, path: PathLike) -> "Results":

@@ -144,7 +144,7 @@ class System:
 
         with bar(progress, "steps") as cb:
             header, data, summary = self._prepared.run(merged, stop, cb)
-        return Results._from_bytes(header, data, json.loads(summary))
+        return Results._from_bytes(header, data, json.loads(summary), full_rate=True)
 
     def __repr__(self) -> str:
         return f"<System {self.file}: {', '.join(self.instances)}>"

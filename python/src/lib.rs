@@ -5,10 +5,12 @@
 //! Only [`py`] needs pyo3 (feature `python`, set by maturin); the helpers below are plain Rust,
 //! so `cargo test --workspace` checks them without a Python installation.
 //!
+//! * [`assess`]: the EN 14363 stability assessment of results, as `master assess` makes it.
 //! * [`results`]: reading a `results.csv` back, exactly (shortest round-trip numbers).
 //! * [`runs`]: which runs of a run set are complete in an output folder (resuming a set) and
 //!   a job's wire format.
 
+pub mod assess;
 pub mod results;
 pub mod runs;
 

@@ -25,6 +25,7 @@ use master::runset::{
 };
 use master::system::{LoadedSystem, PreparedSystem, RunError, SystemError};
 
+use crate::assess::{self, AssessOptions};
 use crate::{error_message, f64_bytes, f64_from_bytes, results, runs};
 
 pyo3::create_exception!(
@@ -56,6 +57,13 @@ pyo3::create_exception!(
     OutputError,
     Error,
     "A result file or folder cannot be written or read."
+);
+
+pyo3::create_exception!(
+    _railfmu,
+    AssessmentError,
+    Error,
+    "Signals cannot be assessed: an unknown column, too short a record, a recorded band narrower than the assessed one, a bad option."
 );
 
 fn system_err(e: &SystemError) -> PyErr {
@@ -602,6 +610,50 @@ fn write_csv(path: PathBuf, header: Vec<String>, data: &[u8]) -> PyResult<()> {
         .map_err(|e| OutputError::new_err(error_message(&e)))
 }
 
+/// EN 14363 assessment of a results file (CSV or Parquet), as `master assess`: options and
+/// answer as JSON ([`crate::assess`]).
+#[pyfunction]
+fn assess_file(py: Python<'_>, path: PathBuf, options_json: &str) -> PyResult<String> {
+    let options: AssessOptions = serde_json::from_str(options_json)
+        .map_err(|e| AssessmentError::new_err(format!("options: {e}")))?;
+    let answer = py
+        .detach(|| assess::table_from_file(&path).and_then(|t| assess::assess(&t, &options)))
+        .map_err(AssessmentError::new_err)?;
+    serde_json::to_string(&answer).map_err(|e| Error::new_err(format!("internal: {e}")))
+}
+
+/// EN 14363 assessment of columns held by the caller: `names` (the first is the time) and the
+/// row-major float64 `data`; `full_rate`: every communication point of a run (no decimation).
+#[pyfunction]
+fn assess_columns(
+    py: Python<'_>,
+    names: Vec<String>,
+    data: &[u8],
+    full_rate: bool,
+    options_json: &str,
+) -> PyResult<String> {
+    let options: AssessOptions = serde_json::from_str(options_json)
+        .map_err(|e| AssessmentError::new_err(format!("options: {e}")))?;
+    let data = f64_from_bytes(data).map_err(AssessmentError::new_err)?;
+    let n = names.len().max(1);
+    if !data.len().is_multiple_of(n) {
+        return Err(AssessmentError::new_err(format!(
+            "{} values do not fill rows of {n} columns",
+            data.len()
+        )));
+    }
+    let columns: Vec<Vec<f64>> = (0..n)
+        .map(|j| data.iter().skip(j).step_by(n).copied().collect())
+        .collect();
+    let answer = py
+        .detach(|| {
+            assess::table_from_columns(names, columns, full_rate)
+                .and_then(|t| assess::assess(&t, &options))
+        })
+        .map_err(AssessmentError::new_err)?;
+    serde_json::to_string(&answer).map_err(|e| Error::new_err(format!("internal: {e}")))
+}
+
 #[pymodule]
 fn _railfmu(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // FMU logger messages and the master's warnings go to stderr, as in the command line.
@@ -615,6 +667,9 @@ fn _railfmu(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("FmuError", py.get_type::<FmuError>())?;
     m.add("SimulationError", py.get_type::<SimulationError>())?;
     m.add("OutputError", py.get_type::<OutputError>())?;
+    m.add("AssessmentError", py.get_type::<AssessmentError>())?;
+    m.add_function(wrap_pyfunction!(assess_file, m)?)?;
+    m.add_function(wrap_pyfunction!(assess_columns, m)?)?;
     m.add_class::<PySystem>()?;
     m.add_function(wrap_pyfunction!(load_run_set, m)?)?;
     m.add_function(wrap_pyfunction!(run_set_from_json, m)?)?;

@@ -1,0 +1,83 @@
+"""EN 14363 assessment from Python: the same numbers as `master assess`, on a run's results in
+memory and on its file; bad input raises AssessmentError with the command's message."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import railfmu
+from conftest import passive, run_master
+
+SIGNALS = ["bogie.wheelset_front.lateral_acceleration", "bogie.wheelset_rear.lateral_acceleration"]
+
+
+@pytest.fixture(scope="module")
+def hunting(dist: Path) -> railfmu.Results:
+    """The passive bogie at 320 km/h (above its critical speed) for 12 s."""
+    sys = railfmu.System.from_dict(passive(dist, 12.0), label="passive-320")
+    return sys.run({"bogie.vehicle.speed": 320.0 / 3.6})
+
+
+def test_a_runs_results_are_assessed_as_the_command_line_assesses_their_file(hunting, master_cmd, tmp_path):
+    a = railfmu.assess_stability(hunting, SIGNALS, 320.0, skip_s=5.0)
+    assert a.quantity == "acceleration" and a.unit == "m/s2"
+    assert a.limit == pytest.approx(5.39, abs=1e-9)
+    assert set(a.signals) == set(SIGNALS)
+    assert a.max_rms == max(s.max_rms for s in a.signals.values())
+    assert a.stable == (a.max_rms <= a.limit)
+    assert a.notes == [], "a run's own results carry their full band"
+    for s in a.signals.values():
+        assert 2.0 < s.dominant_frequency_hz < 8.0
+        assert len(s.window_centre_m) == len(s.rms) > 10
+        assert np.all(np.diff(s.window_centre_m) == pytest.approx(10.0))
+    # the command line on the same values written to a file
+    path = tmp_path / "hunting.csv"
+    hunting.to_csv(path)
+    out = tmp_path / "assess"
+    args = ["assess", path, "--speed", "320", "--skip", "5", "--out", out]
+    for s in SIGNALS:
+        args += ["--signal", s]
+    r = run_master(master_cmd, *args)
+    assert r.returncode == 0, r.stderr
+    with open(out / "assess_summary.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == len(SIGNALS)
+    for row in rows:
+        s = a.signals[row["signal"]]
+        assert s.max_rms == pytest.approx(float(row["max rms"]), rel=1e-12)
+        assert s.dominant_frequency_hz == pytest.approx(float(row["dominant frequency [Hz]"]), rel=1e-12)
+        assert (row["stable"] == "true") == s.stable
+    # and from Python on the file: the same numbers, with the note that a CSV without
+    # metadata cannot say how it was sampled
+    f = railfmu.assess_stability(path, SIGNALS, 320.0, skip_s=5.0)
+    assert f.max_rms == pytest.approx(a.max_rms, rel=1e-12)
+    assert len(f.notes) == 1
+    df = a.to_pandas()
+    assert list(df.columns) == ["signal", "window_centre_m", "rms"]
+    assert df.attrs["limit"] == a.limit and len(df) == sum(len(s.rms) for s in a.signals.values())
+
+
+def test_the_hunting_bogie_exceeds_the_limit_and_the_slow_one_does_not(hunting, dist):
+    assert not railfmu.assess_stability(hunting, SIGNALS, 320.0, skip_s=5.0).stable
+    sys = railfmu.System.from_dict(passive(dist, 12.0), label="passive-220")
+    slow = sys.run({"bogie.vehicle.speed": 220.0 / 3.6})
+    assert railfmu.assess_stability(slow, SIGNALS, 220.0, skip_s=5.0).stable
+
+
+def test_what_cannot_be_assessed_raises_with_the_reason(hunting, tmp_path):
+    with pytest.raises(railfmu.AssessmentError, match="no_such_signal"):
+        railfmu.assess_stability(hunting, "no_such_signal", 320.0)
+    with pytest.raises(railfmu.AssessmentError, match="window"):
+        railfmu.assess_stability(hunting, SIGNALS, 320.0, skip_s=11.5)
+    with pytest.raises(railfmu.AssessmentError, match="speed"):
+        railfmu.assess_stability(hunting, SIGNALS, -1.0)
+    with pytest.raises(railfmu.AssessmentError, match="quantity 'jerk'"):
+        railfmu.assess_stability(hunting, SIGNALS, 320.0, quantity="jerk")
+    with pytest.raises(railfmu.AssessmentError):
+        railfmu.assess_stability(tmp_path / "missing.csv", SIGNALS, 320.0)
+    assert issubclass(railfmu.AssessmentError, railfmu.Error)
