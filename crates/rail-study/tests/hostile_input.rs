@@ -588,6 +588,29 @@ fn a_study_option_out_of_range_is_refused_before_anything_is_touched() {
             "{option} {value}: {err}"
         );
     }
+    // an unknown configuration (or the coach's accelerometer sky-hook on the bogie)
+    for (vehicle, ids) in [
+        ("vehicle", "passive,mppt9"),
+        ("bogie2dof", "skyhook_accel_onoff"),
+    ] {
+        let err = case.fails(
+            &[
+                "study",
+                "--quick",
+                "--vehicle",
+                vehicle,
+                "--out",
+                "out",
+                "--configurations",
+                ids,
+            ],
+            &[],
+        );
+        assert!(
+            err.contains("is not a configuration of this vehicle (one of passive, "),
+            "{ids}: {err}"
+        );
+    }
     assert_eq!(
         std::fs::read_to_string(&old).unwrap(),
         "the previous report"

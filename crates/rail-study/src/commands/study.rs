@@ -1,5 +1,6 @@
 //! `master study [--vehicle vehicle|bogie2dof] [--fmus DIR] [--out DIR] [--quick] [--jobs N]
-//! [--speeds FROM:TO:STEP|V,V,...] [--seeds N,N,...] [--track-level low|high] [--cv-speed KM/H]`:
+//! [--speeds FROM:TO:STEP|V,V,...] [--seeds N,N,...] [--configurations ID,ID,...]
+//! [--track-level low|high] [--cv-speed KM/H]`:
 //! the stability study (see [`crate::study`]): speed sweep per configuration, critical speeds,
 //! car-body acceleration and ride comfort (coach), perturbation runs, c_v sensitivity, time
 //! histories; REPORT.md, SVG plots and CSVs under `--out`.
@@ -61,6 +62,12 @@ pub struct Args {
     /// sweep point is the worst over them. The c_v and time-history runs use the first.
     #[arg(long, value_name = "N,N,...", value_parser = parse_seeds)]
     pub seeds: Option<SeedList>,
+    /// Configurations of the sweep, e.g. passive,mppt1 (default: all of the vehicle's; ids as
+    /// in systems/*.json: passive, mppt1, mppt2, skyhook_onoff, skyhook_continuous, their
+    /// *_slow variants, skyhook_accel_onoff[_slow] on the coach, full_active). The c_v and
+    /// time-history runs are made as usual.
+    #[arg(long, value_name = "ID,ID,...", value_delimiter = ',')]
+    pub configurations: Option<Vec<String>>,
 }
 
 /// The range of `--cv-speed` and `--speeds` [km/h]: the vehicle FMUs' running speed is
@@ -130,6 +137,24 @@ fn parse_speeds(text: &str) -> Result<SpeedList, String> {
     Ok(SpeedList(speeds))
 }
 
+/// `ids` in the study's order, each one of `available` (the vehicle's configurations).
+fn chosen_configurations(
+    ids: &[String],
+    available: &[&'static str],
+) -> Result<Vec<&'static str>, CommandError> {
+    if let Some(bad) = ids.iter().find(|id| !available.contains(&id.trim())) {
+        return Err(CommandError::Failed(format!(
+            "--configurations: '{bad}' is not a configuration of this vehicle (one of {})",
+            available.join(", ")
+        )));
+    }
+    Ok(available
+        .iter()
+        .copied()
+        .filter(|a| ids.iter().any(|id| id.trim() == *a))
+        .collect())
+}
+
 fn parse_seeds(text: &str) -> Result<SeedList, String> {
     let mut seeds: Vec<u32> = Vec::new();
     for part in text.split(',') {
@@ -182,6 +207,9 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     }
     if let Some(SeedList(seeds)) = &args.seeds {
         settings.seeds = seeds.clone();
+    }
+    if let Some(ids) = &args.configurations {
+        settings.configurations = chosen_configurations(ids, &settings.configurations)?;
     }
     if let Some(v) = args.cv_speed {
         if !CV_SPEED_RANGE_KMH.contains(&v) {
@@ -294,6 +322,25 @@ mod tests {
         }
         let e = parse_speeds("200,9000").unwrap_err();
         assert!(e.contains("between 10 and 700 km/h"), "{e}");
+    }
+
+    #[test]
+    fn configurations_keep_the_study_order_and_unknown_ones_are_refused() {
+        let all = StudySettings::full(VehicleModel::Bogie2Dof).configurations;
+        let ids = ["mppt1".to_string(), " passive".to_string()];
+        assert_eq!(
+            chosen_configurations(&ids, &all).unwrap(),
+            ["passive", "mppt1"]
+        );
+        // the accelerometer sky-hook is the coach's
+        let e = chosen_configurations(&["skyhook_accel_onoff".to_string()], &all).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("not a configuration of this vehicle"),
+            "{e}"
+        );
+        let coach = StudySettings::full(VehicleModel::Coach).configurations;
+        assert!(chosen_configurations(&["skyhook_accel_onoff".to_string()], &coach).is_ok());
     }
 
     #[test]
