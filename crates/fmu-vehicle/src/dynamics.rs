@@ -46,7 +46,9 @@ pub struct Consts {
     pub minv: [f64; N_DOF],
     /// Suspension.
     pub suspension: SparseSuspension,
-    /// Damper elongation rows.
+    /// Damper elongation rows (dof index, coefficient); a restored state's indices are
+    /// checked against the dofs.
+    #[serde(deserialize_with = "damper_rows_within_the_dofs")]
     pub dampers: [[(usize, f64); 2]; N_DAMPERS],
     /// Linear contact (linear model).
     pub linear: LinearContactConsts,
@@ -68,6 +70,20 @@ pub struct Consts {
     pub load: f64,
     /// mu P [N].
     pub mu_p: f64,
+}
+
+/// The damper rows of a deserialised [`Consts`] (a saved FMU state): every index names a dof,
+/// so that the force assembly cannot index past the force vector.
+fn damper_rows_within_the_dofs<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<[[(usize, f64); 2]; N_DAMPERS], D::Error> {
+    let rows = <[[(usize, f64); 2]; N_DAMPERS]>::deserialize(d)?;
+    if let Some(&(i, _)) = rows.iter().flatten().find(|(i, _)| *i >= N_DOF) {
+        return Err(serde::de::Error::custom(format!(
+            "damper row index {i} beyond the {N_DOF} degrees of freedom"
+        )));
+    }
+    Ok(rows)
 }
 
 /// Serialisable copy of [`LinearContact`].

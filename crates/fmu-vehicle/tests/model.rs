@@ -318,3 +318,17 @@ fn step_size_independence_of_the_model_alone() {
     }
     assert!(diff < 5e-3 * 3e-3, "{diff}");
 }
+
+/// A saved state whose damper rows index past the dofs (a tampered one) is refused when read,
+/// instead of panicking in the next step's force assembly.
+#[test]
+fn restored_damper_rows_must_index_the_dofs() {
+    let table = worn_surrogate_table().unwrap();
+    let c = Consts::new(&VehicleParams::default(), &table);
+    let good = serde_json::to_value(&c).unwrap();
+    assert_eq!(serde_json::from_value::<Consts>(good.clone()).unwrap(), c);
+    let mut bad = good;
+    bad["dampers"][2][1][0] = serde_json::json!(N_DOF);
+    let e = serde_json::from_value::<Consts>(bad).unwrap_err();
+    assert!(e.to_string().contains("beyond the"), "{e}");
+}
