@@ -576,7 +576,8 @@ fn a_study_option_out_of_range_is_refused_before_anything_is_touched() {
     for (option, value, reason) in [
         ("--track-level", "medium", "low, high"),
         ("--speeds", "300:200:10", "FROM <= TO"),
-        ("--speeds", "10:700:0.001", "more than 200 speeds"),
+        ("--speeds", "10:700:1", "more than 200 speeds"),
+        ("--speeds", "200:300:0.05", "at least 0.1 km/h"),
         ("--speeds", "250,1e9", "between 10 and 700 km/h"),
         ("--seeds", "1,-2", "not a track seed"),
     ] {
@@ -588,6 +589,12 @@ fn a_study_option_out_of_range_is_refused_before_anything_is_touched() {
             "{option} {value}: {err}"
         );
     }
+    // a speed too low for one EN 14363 window in a sweep run
+    let err = case.fails(
+        &["study", "--quick", "--out", "out", "--speeds", "20,300"],
+        &[],
+    );
+    assert!(err.contains("less than one 100 m EN 14363 window"), "{err}");
     // an unknown configuration (or the coach's accelerometer sky-hook on the bogie)
     for (vehicle, ids) in [
         ("vehicle", "passive,mppt9"),

@@ -49,8 +49,8 @@ pub struct Args {
     #[arg(long, value_name = "KM/H")]
     pub cv_speed: Option<f64>,
     /// ERRI B176 level of the lateral alignment of every irregular-track run (it replaces the
-    /// systems' `track.level`, as the study sets speed and seed): low (the seed's high-speed
-    /// line) or high (2.9 times the low level's spectrum).
+    /// systems' `track.level`, as the study sets speed and seed): low (high-speed lines, the
+    /// study's default) or high (2.9 times the low level's spectrum).
     #[arg(long, value_enum, default_value = "low")]
     pub track_level: TrackLevel,
     /// Speeds of the sweep [km/h], instead of the study's (full: 200-440 km/h on the coach,
@@ -102,7 +102,12 @@ fn parse_speed(text: &str) -> Result<f64, String> {
     Ok(v)
 }
 
-/// `FROM:TO:STEP` or `V,V,...`.
+/// Speeds are kept to 0.1 km/h, the resolution of the runs' names (`sweep-passive_v287.5_s1`).
+fn to_tenth(v: f64) -> f64 {
+    (v * 10.0).round() / 10.0
+}
+
+/// `FROM:TO:STEP` or `V,V,...`, each to 0.1 km/h.
 fn parse_speeds(text: &str) -> Result<SpeedList, String> {
     let mut speeds = match text.split(':').collect::<Vec<_>>()[..] {
         [from, to, step] => {
@@ -111,21 +116,24 @@ fn parse_speeds(text: &str) -> Result<SpeedList, String> {
                 .trim()
                 .parse()
                 .map_err(|_| format!("'{step}' is not a speed step in km/h"))?;
-            if !(step.is_finite() && step > 0.0) || to < from {
+            if !(step.is_finite() && step >= 0.1) || to < from {
                 return Err(format!(
-                    "{text}: FROM:TO:STEP needs FROM <= TO and a step > 0"
+                    "{text}: FROM:TO:STEP needs FROM <= TO and a step of at least 0.1 km/h"
                 ));
             }
-            // a tenth of a step of slack so that TO itself is in when the step divides the range
-            let n = ((to - from) / step + 0.1).floor();
+            // slack for rounding only: TO is in when the step divides the range, never past it
+            let n = ((to - from) / step + 1e-9).floor();
             if n >= MAX_SPEEDS as f64 {
                 return Err(format!("{text}: more than {MAX_SPEEDS} speeds"));
             }
-            (0..=n as usize).map(|k| from + k as f64 * step).collect()
+            (0..=n as usize)
+                .map(|k| to_tenth(from + k as f64 * step))
+                .filter(|&v| v <= to_tenth(to))
+                .collect()
         }
         [_] => text
             .split(',')
-            .map(parse_speed)
+            .map(|v| parse_speed(v).map(to_tenth))
             .collect::<Result<Vec<_>, _>>()?,
         _ => return Err(format!("'{text}': FROM:TO:STEP or a list V,V,...")),
     };
@@ -135,6 +143,29 @@ fn parse_speeds(text: &str) -> Result<SpeedList, String> {
         return Err(format!("{} speeds, at most {MAX_SPEEDS}", speeds.len()));
     }
     Ok(SpeedList(speeds))
+}
+
+/// Every sweep run must cover one EN 14363 window of track after its start-up, or its speed
+/// would count as unstable without being assessed.
+fn check_assessable(settings: &StudySettings) -> Result<(), CommandError> {
+    let window_m = crate::en14363::StabilitySettings::default().window_m;
+    let assessed_s = settings.sweep_stop_s - settings.skip_s;
+    match settings
+        .speeds_kmh
+        .iter()
+        .find(|&&v| assessed_s * v / 3.6 < window_m)
+    {
+        Some(v) => Err(CommandError::Failed(format!(
+            "--speeds: at {v} km/h a sweep run ({} s, the first {} s skipped) covers {:.0} m of \
+             track, less than one {window_m:.0} m EN 14363 window; the lowest speed this study \
+             can assess is {:.1} km/h",
+            settings.sweep_stop_s,
+            settings.skip_s,
+            assessed_s * v / 3.6,
+            (window_m * 3.6 / assessed_s * 10.0).ceil() / 10.0
+        ))),
+        None => Ok(()),
+    }
 }
 
 /// `ids` in the study's order, each one of `available` (the vehicle's configurations).
@@ -211,6 +242,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     if let Some(ids) = &args.configurations {
         settings.configurations = chosen_configurations(ids, &settings.configurations)?;
     }
+    check_assessable(&settings)?;
     if let Some(v) = args.cv_speed {
         if !CV_SPEED_RANGE_KMH.contains(&v) {
             return Err(CommandError::Failed(format!(
@@ -298,6 +330,14 @@ mod tests {
         );
         // the end is in when the step divides the range, not past it otherwise
         assert_eq!(parse_speeds("200:215:10").unwrap().0, [200.0, 210.0]);
+        assert_eq!(parse_speeds("250:349:10").unwrap().0.last(), Some(&340.0));
+        assert_eq!(parse_speeds("10:700:766").unwrap().0, [10.0]);
+        assert_eq!(
+            parse_speeds("280:280.3:0.1").unwrap().0,
+            [280.0, 280.1, 280.2, 280.3]
+        );
+        // to 0.1 km/h, the runs' names: 300 and 300.04 are one speed
+        assert_eq!(parse_speeds("300,300.04,287.46").unwrap().0, [287.5, 300.0]);
         assert_eq!(parse_speeds("300:300:5").unwrap().0, [300.0]);
         assert_eq!(
             parse_speeds("300, 280,290,280").unwrap().0,
@@ -310,6 +350,7 @@ mod tests {
             "200:300:0",
             "200:300:-5",
             "200:300:nan",
+            "200:300:0.05",
             "5",
             "800",
             "nan",
@@ -341,6 +382,21 @@ mod tests {
         );
         let coach = StudySettings::full(VehicleModel::Coach).configurations;
         assert!(chosen_configurations(&["skyhook_accel_onoff".to_string()], &coach).is_ok());
+    }
+
+    #[test]
+    fn every_sweep_speed_covers_one_window() {
+        let mut s = StudySettings::quick(VehicleModel::Bogie2Dof);
+        assert!(check_assessable(&s).is_ok());
+        // 12 s runs, 5 s skipped: 7 s cover 100 m from 51.5 km/h on
+        s.speeds_kmh = vec![51.5, 300.0];
+        assert!(check_assessable(&s).is_ok());
+        s.speeds_kmh = vec![51.4, 300.0];
+        let e = check_assessable(&s).unwrap_err().to_string();
+        assert!(
+            e.contains("at 51.4 km/h") && e.contains("is 51.5 km/h"),
+            "{e}"
+        );
     }
 
     #[test]

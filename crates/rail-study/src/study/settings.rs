@@ -60,7 +60,7 @@ pub struct StudySettings {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum TrackLevel {
-    /// A = 2.119e-7 m rad (the seed's high-speed line).
+    /// A = 2.119e-7 m rad (high-speed lines; the study's default).
     #[default]
     Low,
     /// A = 6.125e-7 m rad.
