@@ -97,11 +97,21 @@ def assess_stability(
     a narrower band than the one assessed (decimated too far) is refused unless
     ``accept_narrow_band``.
 
+    The band check needs the record of how the signals were sampled: a file of ours carries it
+    (assess the file itself), a run's own :class:`Results` are full rate; a table read back
+    into :class:`Results` has lost it, so it is assessed with a note instead of the check.
+
     Raises :class:`AssessmentError` when the signals cannot be assessed (unknown column, record
     shorter than one window, bad option, narrow band) and :class:`OutputError` when the file
     cannot be read.
     """
     names = [signals] if isinstance(signals, str) else list(signals)
+    numbers = {"speed_kmh": speed_kmh, "bogie_mass_t": bogie_mass_t, "wheel_load_kn": wheel_load_kn, "skip_s": skip_s}
+    if f0_hz is not None:
+        numbers["f0_hz"] = f0_hz
+    for key, value in numbers.items():
+        if not np.isfinite(float(value)):
+            raise _railfmu.AssessmentError(f"{key} = {value}: not a finite number")
     options = json.dumps(
         {
             "signals": names,
@@ -112,7 +122,8 @@ def assess_stability(
             "skip_s": float(skip_s),
             "f0_hz": None if f0_hz is None else float(f0_hz),
             "accept_narrow_band": bool(accept_narrow_band),
-        }
+        },
+        allow_nan=False,
     )
     if isinstance(source, Results):
         data = np.ascontiguousarray(source.values, dtype=np.float64).tobytes()

@@ -616,9 +616,10 @@ fn write_csv(path: PathBuf, header: Vec<String>, data: &[u8]) -> PyResult<()> {
 fn assess_file(py: Python<'_>, path: PathBuf, options_json: &str) -> PyResult<String> {
     let options: AssessOptions = serde_json::from_str(options_json)
         .map_err(|e| AssessmentError::new_err(format!("options: {e}")))?;
-    let answer = py
-        .detach(|| assess::table_from_file(&path).and_then(|t| assess::assess(&t, &options)))
-        .map_err(AssessmentError::new_err)?;
+    let answer = py.detach(|| -> PyResult<_> {
+        let table = assess::table_from_file(&path).map_err(OutputError::new_err)?;
+        assess::assess(&table, &options).map_err(AssessmentError::new_err)
+    })?;
     serde_json::to_string(&answer).map_err(|e| Error::new_err(format!("internal: {e}")))
 }
 
@@ -634,19 +635,19 @@ fn assess_columns(
 ) -> PyResult<String> {
     let options: AssessOptions = serde_json::from_str(options_json)
         .map_err(|e| AssessmentError::new_err(format!("options: {e}")))?;
-    let data = f64_from_bytes(data).map_err(AssessmentError::new_err)?;
-    let n = names.len().max(1);
-    if !data.len().is_multiple_of(n) {
-        return Err(AssessmentError::new_err(format!(
-            "{} values do not fill rows of {n} columns",
-            data.len()
-        )));
-    }
-    let columns: Vec<Vec<f64>> = (0..n)
-        .map(|j| data.iter().skip(j).step_by(n).copied().collect())
-        .collect();
     let answer = py
         .detach(|| {
+            let data = f64_from_bytes(data)?;
+            let n = names.len().max(1);
+            if !data.len().is_multiple_of(n) {
+                return Err(format!(
+                    "{} values do not fill rows of {n} columns",
+                    data.len()
+                ));
+            }
+            let columns: Vec<Vec<f64>> = (0..n)
+                .map(|j| data.iter().skip(j).step_by(n).copied().collect())
+                .collect();
             assess::table_from_columns(names, columns, full_rate)
                 .and_then(|t| assess::assess(&t, &options))
         })
