@@ -84,6 +84,9 @@ fn serialised_state(f: &TestFmu) -> (Instance<'_>, Vec<c_char>) {
     (inst, bytes)
 }
 
+/// Deserialises `size` bytes into a state and, as a host restoring a checkpoint would, sets the
+/// instance to any state it gets: a refused state must come back NULL, so a tampered one that
+/// were accepted would change the instance (compared with a twin below).
 fn deserialise(inst: &Instance, bytes: &[c_char], size: usize) -> ffi::fmi2Status {
     let mut state: ffi::fmi2FMUstate = std::ptr::null_mut();
     // SAFETY: `bytes` holds at least `size` bytes in every call below.
@@ -91,8 +94,12 @@ fn deserialise(inst: &Instance, bytes: &[c_char], size: usize) -> ffi::fmi2Statu
         inst.b()
             .fmi2DeSerializeFMUstate(inst.component, bytes.as_ptr(), size, &mut state)
     };
+    if s != OK {
+        assert!(state.is_null(), "a refused state came back non-NULL");
+    }
     if !state.is_null() {
         unsafe {
+            assert_eq!(inst.b().fmi2SetFMUstate(inst.component, state), OK);
             inst.b().fmi2FreeFMUstate(inst.component, &mut state);
         }
     }

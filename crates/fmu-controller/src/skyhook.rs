@@ -65,9 +65,10 @@ pub const DAMPING_TABLE_4HZ: [(f64, f64); 9] = [
 
 /// Equivalent damping vs opening: `(opening 0..1, c_eq N s/m)`, openings strictly increasing,
 /// damping strictly decreasing.
-/// A deserialised table (a saved FMU state, say) must hold a point for the lookups to read;
-/// its order is checked by [`DampingTable::validate`] at initialisation, as for a table the
-/// host sets.
+/// A deserialised table (a saved FMU state, say) must hold a point for the lookups to read.
+/// Its order is checked by [`DampingTable::validate`] when the host sets it and initialises;
+/// a restored state is not checked again (a disordered table gives wrong or NaN commands,
+/// and fmi2GetReal refuses to return a NaN, but no lookup reads out of bounds).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "DampingPoints")]
 pub struct DampingTable {

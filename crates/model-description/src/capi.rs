@@ -326,7 +326,7 @@ pub unsafe fn with(
                 cc.component.enter_error_state();
                 cc.component.error(&format!(
                     "{call}: internal error (panic caught at the C boundary); the instance is \
-                     in the Error state until fmi2Reset"
+                     in the Error state (fmi2Reset, or fmi2SetFMUstate of a saved state)"
                 ));
             }));
             FMI2_ERROR

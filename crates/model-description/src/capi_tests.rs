@@ -88,6 +88,11 @@ fn a_panic_is_an_error_and_leaves_the_instance_in_the_error_state_until_reset() 
         // refused without running the physics again, even with a sane input
         assert_eq!(set_real(c, u.as_ptr(), 1, [1.0].as_ptr()), FMI2_ERROR);
         assert_eq!(do_step(c, 0.1, 0.1), FMI2_ERROR);
+        // the getters still answer in the Error state (for the host's diagnosis)
+        let x = [value_reference::<Fragile>("x").unwrap()];
+        let mut value = [f64::NAN];
+        assert_eq!(get_real(c, x.as_ptr(), 1, value.as_mut_ptr()), FMI2_OK);
+        assert_eq!(value, [1.0]);
         let later: Vec<String> = log.take().into_iter().map(|(_, _, m)| m).collect();
         assert!(!later.iter().any(|m| m.contains("panic")), "{later:?}");
         assert!(later.iter().any(|m| m.contains("Error")), "{later:?}");

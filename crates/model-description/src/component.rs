@@ -220,8 +220,9 @@ impl Component {
         Status::Error
     }
 
-    /// The instance can no longer be trusted (a call panicked part-way through): every call
-    /// but fmi2Reset, fmi2FreeInstance and the getters is refused from now on.
+    /// The instance can no longer be trusted (a call panicked part-way through): the calls the
+    /// Error state refuses (steps, sets, initialisation, termination) are refused from now on
+    /// until fmi2Reset, or until fmi2SetFMUstate restores a state saved before.
     pub fn enter_error_state(&mut self) {
         self.state = FmiState::Error;
     }
