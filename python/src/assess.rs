@@ -6,7 +6,8 @@
 use std::path::{Path, PathBuf};
 
 use master::decimation::Sampling;
-use rail_study::analysis::assess::{assess_table, check_bandwidth, Criterion, ResultsTable};
+use rail_study::analysis::assess::{assess_checked, BandRemark, ResultsTable};
+use rail_study::commands::assess::Quantity;
 use rail_study::en14363::StabilitySettings;
 use serde::{Deserialize, Serialize};
 
@@ -85,14 +86,30 @@ pub fn table_from_columns(
         described: full_rate,
     };
     if full_rate {
-        let rate_hz = table.sampling_rate_hz().map_err(|e| e.to_string())?;
-        table.sampling = Some(Sampling {
-            rate_hz,
-            passband_hz: rate_hz / 2.0,
-            decimation: None,
-        });
+        table.sampling = Some(Sampling::full_rate(
+            table.sampling_rate_hz().map_err(|e| e.to_string())?,
+        ));
     }
     Ok(table)
+}
+
+/// As [`table_from_columns`] from the row-major values of `names.len()` columns.
+pub fn table_from_rows(
+    names: Vec<String>,
+    data: &[f64],
+    full_rate: bool,
+) -> Result<ResultsTable, String> {
+    let n = names.len().max(1);
+    if !data.len().is_multiple_of(n) {
+        return Err(format!(
+            "{} values do not fill rows of {n} columns",
+            data.len()
+        ));
+    }
+    let columns = (0..n)
+        .map(|j| data.iter().skip(j).step_by(n).copied().collect())
+        .collect();
+    table_from_columns(names, columns, full_rate)
 }
 
 /// The table of a results file (CSV, whitespace separated, or Parquet).
@@ -102,13 +119,9 @@ pub fn table_from_file(path: &Path) -> Result<ResultsTable, String> {
 
 /// Assesses `table` as `master assess` would; `Err` is the message the command would print.
 pub fn assess(table: &ResultsTable, options: &AssessOptions) -> Result<AssessAnswer, String> {
-    let criterion = match options.quantity.as_str() {
-        "acceleration" => Criterion::LateralAcceleration {
-            bogie_mass_t: options.bogie_mass_t,
-        },
-        "guiding_force" => Criterion::GuidingForces {
-            static_wheel_load_n: options.wheel_load_kn * 1e3,
-        },
+    let quantity = match options.quantity.as_str() {
+        "acceleration" => Quantity::Acceleration,
+        "guiding_force" => Quantity::GuidingForce,
         other => {
             return Err(format!(
                 "quantity '{other}': expected 'acceleration' or 'guiding_force'"
@@ -120,30 +133,25 @@ pub fn assess(table: &ResultsTable, options: &AssessOptions) -> Result<AssessAns
         dominant_frequency_hz: options.f0_hz,
         ..StabilitySettings::default()
     };
-    let report = assess_table(
+    let (report, remark) = assess_checked(
         table,
         &options.signals,
         options.speed_kmh,
-        criterion,
+        quantity.criterion(options.bogie_mass_t, options.wheel_load_kn),
         &settings,
+        options.accept_narrow_band,
     )
     .map_err(|e| e.to_string())?;
-    let mut notes = Vec::new();
-    match check_bandwidth(table, &report) {
-        Ok(None) => {}
-        Ok(Some(note)) => notes.push(note),
-        Err(e) if options.accept_narrow_band => notes.push(format!(
+    let notes = match remark {
+        None => Vec::new(),
+        Some(BandRemark::Unrecorded(note)) => vec![note],
+        Some(BandRemark::Narrow(e)) => vec![format!(
             "{e} (assessed anyway: accept_narrow_band; the rms may be wrong)"
-        )),
-        Err(e) => return Err(e.to_string()),
-    }
-    let unit = match criterion {
-        Criterion::LateralAcceleration { .. } => "m/s2",
-        Criterion::GuidingForces { .. } => "kN",
+        )],
     };
     Ok(AssessAnswer {
         quantity: options.quantity.clone(),
-        unit,
+        unit: report.unit(),
         speed_kmh: report.speed_kmh,
         limit: report.limit(),
         max_rms: report.max_rms(),

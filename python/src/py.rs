@@ -614,13 +614,12 @@ fn write_csv(path: PathBuf, header: Vec<String>, data: &[u8]) -> PyResult<()> {
 /// answer as JSON ([`crate::assess`]).
 #[pyfunction]
 fn assess_file(py: Python<'_>, path: PathBuf, options_json: &str) -> PyResult<String> {
-    let options: AssessOptions = serde_json::from_str(options_json)
-        .map_err(|e| AssessmentError::new_err(format!("options: {e}")))?;
+    let options = assess_options(options_json)?;
     let answer = py.detach(|| -> PyResult<_> {
         let table = assess::table_from_file(&path).map_err(OutputError::new_err)?;
         assess::assess(&table, &options).map_err(AssessmentError::new_err)
     })?;
-    serde_json::to_string(&answer).map_err(|e| Error::new_err(format!("internal: {e}")))
+    assess_answer_json(&answer)
 }
 
 /// EN 14363 assessment of columns held by the caller: `names` (the first is the time) and the
@@ -633,26 +632,22 @@ fn assess_columns(
     full_rate: bool,
     options_json: &str,
 ) -> PyResult<String> {
-    let options: AssessOptions = serde_json::from_str(options_json)
-        .map_err(|e| AssessmentError::new_err(format!("options: {e}")))?;
+    let options = assess_options(options_json)?;
     let answer = py
         .detach(|| {
-            let data = f64_from_bytes(data)?;
-            let n = names.len().max(1);
-            if !data.len().is_multiple_of(n) {
-                return Err(format!(
-                    "{} values do not fill rows of {n} columns",
-                    data.len()
-                ));
-            }
-            let columns: Vec<Vec<f64>> = (0..n)
-                .map(|j| data.iter().skip(j).step_by(n).copied().collect())
-                .collect();
-            assess::table_from_columns(names, columns, full_rate)
+            assess::table_from_rows(names, &f64_from_bytes(data)?, full_rate)
                 .and_then(|t| assess::assess(&t, &options))
         })
         .map_err(AssessmentError::new_err)?;
-    serde_json::to_string(&answer).map_err(|e| Error::new_err(format!("internal: {e}")))
+    assess_answer_json(&answer)
+}
+
+fn assess_options(json: &str) -> PyResult<AssessOptions> {
+    serde_json::from_str(json).map_err(|e| AssessmentError::new_err(format!("options: {e}")))
+}
+
+fn assess_answer_json(answer: &assess::AssessAnswer) -> PyResult<String> {
+    serde_json::to_string(answer).map_err(|e| Error::new_err(format!("internal: {e}")))
 }
 
 #[pymodule]

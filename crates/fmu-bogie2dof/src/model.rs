@@ -240,10 +240,12 @@ impl Bogie {
             TrackSource::Internal { level, seed } => Some(TrackGenerator::new(level, seed)),
             _ => None,
         };
-        let h_sub_max = stable_substep(&params, |p| {
-            substep_bound(&consts_with_table(p, &table), &table, generator.as_ref())
-        })?;
         let consts = consts_with_table(&params, &table);
+        let h_sub_max = stable_substep(
+            &params,
+            substep_bound(&consts, &table, generator.as_ref()),
+            |p| substep_bound(&consts_with_table(p, &table), &table, generator.as_ref()),
+        )?;
         let mut state = [0.0; N_STATES];
         state[0] = params.initial_lateral_m;
         state[1] = params.initial_yaw_rad;

@@ -295,7 +295,7 @@ impl Vehicle {
                 Track::Internal(TrackGenerator::new(level, seed))
             }
         };
-        let stable_s = stable_substep(&params, |p| {
+        let stable_s = stable_substep(&params, consts.stable_substep_s(&params, &table), |p| {
             Consts::new(p, &table).stable_substep_s(p, &table)
         })?;
         let substep_s = params.solver_substep_s.min(stable_s);

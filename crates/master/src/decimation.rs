@@ -83,18 +83,29 @@ fn filter_passband_hz(order: usize, cutoff_hz: f64) -> f64 {
     q * cutoff_hz
 }
 
+impl Sampling {
+    /// Every communication point stored: the signals carry everything up to the Nyquist
+    /// frequency.
+    pub fn full_rate(rate_hz: f64) -> Self {
+        Sampling {
+            rate_hz,
+            passband_hz: 0.5 * rate_hz,
+            decimation: None,
+        }
+    }
+}
+
 impl SimOutput {
     /// The sampling of the rows as stored; `None` with fewer than two rows.
     pub fn sampling(&self) -> Option<Sampling> {
         let rate_hz = sample_rate_hz(self)?;
-        let passband_hz = match &self.decimation {
-            Some(d) => filter_passband_hz(d.filter_order, d.cutoff_hz).min(0.5 * rate_hz),
-            None => 0.5 * rate_hz,
-        };
-        Some(Sampling {
-            rate_hz,
-            passband_hz,
-            decimation: self.decimation.clone(),
+        Some(match &self.decimation {
+            Some(d) => Sampling {
+                rate_hz,
+                passband_hz: filter_passband_hz(d.filter_order, d.cutoff_hz).min(0.5 * rate_hz),
+                decimation: Some(d.clone()),
+            },
+            None => Sampling::full_rate(rate_hz),
         })
     }
 }

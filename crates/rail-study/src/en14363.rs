@@ -63,6 +63,14 @@ impl Default for StabilitySettings {
     }
 }
 
+impl StabilitySettings {
+    /// Track a record of `duration_s` at `speed_kmh` covers once `skip_s` is dropped [m]: the
+    /// assessment needs at least one window of `window_m`.
+    pub fn assessed_m(&self, duration_s: f64, speed_kmh: f64) -> f64 {
+        (duration_s - self.skip_s) * speed_kmh / 3.6
+    }
+}
+
 /// Why an assessment could not be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum AssessError {

@@ -99,18 +99,20 @@ fn pointer_mut<'a>(
     path.iter().try_fold(v, |v, k| v.get_mut(k))
 }
 
-/// The sub-step `substep_s` gives `params`, if it is at least [`MIN_SUBSTEP_S`]; otherwise the
-/// error, with the parameter to blame against `P::default()` (see [`blame_substep`]).
+/// `substep_s`, the sub-step the caller computed for `params`, if it is at least
+/// [`MIN_SUBSTEP_S`]; otherwise the error, with the parameter to blame against `P::default()`
+/// (see [`blame_substep`]; `substep_of` computes the sub-step of a parameter set, and runs only
+/// on that error path).
 pub fn stable_substep<P: Serialize + DeserializeOwned + Default>(
     params: &P,
-    substep_s: impl Fn(&P) -> f64,
+    substep_s: f64,
+    substep_of: impl Fn(&P) -> f64,
 ) -> Result<f64, TooStiff> {
-    let h = substep_s(params);
-    check_substep(h).map_err(|mut e| {
-        e.parameter = blame_substep(params, &P::default(), &substep_s);
+    check_substep(substep_s).map_err(|mut e| {
+        e.parameter = blame_substep(params, &P::default(), &substep_of);
         e
     })?;
-    Ok(h)
+    Ok(substep_s)
 }
 
 /// `substep_s` is at least [`MIN_SUBSTEP_S`] (and a number).

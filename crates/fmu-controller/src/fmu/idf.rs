@@ -86,7 +86,7 @@ impl FmuModel for IdealDamperForceController {
             /// Must make a positive command increase the measured tension (see documentation)
             parameter "force_loop.command_sign" [range = -1.0..=1.0] => params.command_sign as Sign;
             /// Board sample time (1 kHz board)
-            parameter "board.sample_time" [unit = "s", display_unit = "ms", min = 1e-6] => params.sample_time_s;
+            parameter "board.sample_time" [unit = "s", display_unit = "ms", min = crate::MIN_SAMPLE_TIME_S] => params.sample_time_s;
 
             /// Damper (actuator rod) elongation velocity, positive = extension
             input "damper.elongation_velocity" [unit = "m/s"] => board.inputs.elongation_velocity_mps;

@@ -144,7 +144,7 @@ impl FmuModel for MpptController {
             /// Upper command saturation (seed 4.4.1: 10 V)
             parameter "valve.command_max" [unit = "V", range = 0.0..=10.0] => params.command_max_v;
             /// Board sample time (1 kHz board)
-            parameter "board.sample_time" [unit = "s", display_unit = "ms", min = 1e-6] => params.sample_time_s;
+            parameter "board.sample_time" [unit = "s", display_unit = "ms", min = crate::MIN_SAMPLE_TIME_S] => params.sample_time_s;
             /// Order of the Butterworth band-pass on the acceleration: 2 or 4
             parameter "band_pass.order" [range = 2.0..=4.0] => params.filter_order;
             /// Band-pass lower -3 dB edge, f0 - 2 Hz (EN 14363 via seed 4.2)

@@ -186,7 +186,7 @@ impl FmuModel for SkyHookController {
             /// Corner of the high-pass and of the leaky integrator of the velocity estimate
             parameter "sensor.filter_corner" [unit = "Hz", min = 0.0] => params.velocity_filter_corner_hz;
             /// Board sample time (1 kHz board)
-            parameter "board.sample_time" [unit = "s", display_unit = "ms", min = 1e-6] => params.sample_time_s;
+            parameter "board.sample_time" [unit = "s", display_unit = "ms", min = crate::MIN_SAMPLE_TIME_S] => params.sample_time_s;
             /// Valve command before the first sample (0 V = closed)
             parameter "valve.initial_command" [unit = "V", range = 0.0..=10.0] => params.initial_command_v;
             /// Damper valve opening of table point (strictly increasing)

@@ -296,7 +296,8 @@ impl AssessReport {
         self.signals.iter().all(|(_, a)| a.stable)
     }
 
-    fn unit(&self) -> &'static str {
+    /// Unit of the rms and the limit: `m/s2` or `kN`.
+    pub fn unit(&self) -> &'static str {
         match self.criterion {
             Criterion::LateralAcceleration { .. } => "m/s2",
             Criterion::GuidingForces { .. } => "kN",
@@ -450,6 +451,36 @@ pub fn check_bandwidth(
     )))
 }
 
+/// What the recorded band left to say about an assessment of [`assess_checked`].
+#[derive(Debug)]
+pub enum BandRemark {
+    /// The table records no sampling, so its band could not be checked (the note of
+    /// [`check_bandwidth`]).
+    Unrecorded(String),
+    /// The band is narrower than the one assessed, and the caller accepted it (the refusal
+    /// [`check_bandwidth`] would have given).
+    Narrow(AnalysisError),
+}
+
+/// What `master assess` does with a table: [`assess_table`], then [`check_bandwidth`]; a band
+/// narrower than the one assessed is refused unless `accept_narrow_band`.
+pub fn assess_checked(
+    table: &ResultsTable,
+    signals: &[String],
+    speed_kmh: f64,
+    criterion: Criterion,
+    settings: &StabilitySettings,
+    accept_narrow_band: bool,
+) -> Result<(AssessReport, Option<BandRemark>), AnalysisError> {
+    let report = assess_table(table, signals, speed_kmh, criterion, settings)?;
+    let remark = match check_bandwidth(table, &report) {
+        Ok(note) => note.map(BandRemark::Unrecorded),
+        Err(e) if accept_narrow_band => Some(BandRemark::Narrow(e)),
+        Err(e) => return Err(e),
+    };
+    Ok((report, remark))
+}
+
 /// Assesses each named signal of `table` at a constant `speed_kmh`.
 pub fn assess_table(
     table: &ResultsTable,
@@ -470,7 +501,7 @@ pub fn assess_table(
     }
     let fs = table.sampling_rate_hz()?;
     let duration = table.columns[0].len() as f64 / fs;
-    let assessed_m = (duration - settings.skip_s) * speed_kmh / 3.6;
+    let assessed_m = settings.assessed_m(duration, speed_kmh);
     if assessed_m < settings.window_m {
         return Err(AnalysisError::Input(format!(
             "{}: {duration:.2} s at {speed_kmh} km/h minus {} s skipped covers {assessed_m:.0} m, \

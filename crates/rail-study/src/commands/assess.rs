@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use super::{failed, write_analysis};
-use crate::analysis::assess::{assess_table, check_bandwidth, Criterion, ResultsTable};
+use crate::analysis::assess::{assess_checked, BandRemark, Criterion, ResultsTable};
 use crate::en14363::StabilitySettings;
 use master::cli::{CommandError, Context};
 
@@ -56,30 +56,42 @@ pub struct Args {
     pub out: PathBuf,
 }
 
+impl Quantity {
+    /// The criterion of this quantity: the limit from the bogie mass [t] or the static wheel
+    /// load [kN].
+    pub fn criterion(self, bogie_mass_t: f64, wheel_load_kn: f64) -> Criterion {
+        match self {
+            Quantity::Acceleration => Criterion::LateralAcceleration { bogie_mass_t },
+            Quantity::GuidingForce => Criterion::GuidingForces {
+                static_wheel_load_n: wheel_load_kn * 1e3,
+            },
+        }
+    }
+}
+
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
-    let criterion = match args.quantity {
-        Quantity::Acceleration => Criterion::LateralAcceleration {
-            bogie_mass_t: args.bogie_mass,
-        },
-        Quantity::GuidingForce => Criterion::GuidingForces {
-            static_wheel_load_n: args.wheel_load * 1e3,
-        },
-    };
+    let criterion = args.quantity.criterion(args.bogie_mass, args.wheel_load);
     let settings = StabilitySettings {
         skip_s: args.skip,
         dominant_frequency_hz: args.f0,
         ..StabilitySettings::default()
     };
     let table = ResultsTable::load(&args.table).map_err(failed)?;
-    let report =
-        assess_table(&table, &args.signals, args.speed, criterion, &settings).map_err(failed)?;
-    match check_bandwidth(&table, &report) {
-        Ok(None) => {}
-        Ok(Some(note)) => eprintln!("note: {note}"),
-        Err(e) if args.accept_narrow_band => {
+    let (report, remark) = assess_checked(
+        &table,
+        &args.signals,
+        args.speed,
+        criterion,
+        &settings,
+        args.accept_narrow_band,
+    )
+    .map_err(failed)?;
+    match remark {
+        None => {}
+        Some(BandRemark::Unrecorded(note)) => eprintln!("note: {note}"),
+        Some(BandRemark::Narrow(e)) => {
             eprintln!("WARNING: {e}\nWARNING: assessed anyway (--accept-narrow-band): the rms below may be wrong");
         }
-        Err(e) => return Err(failed(e)),
     }
     write_analysis(&args.out, ctx.cancel, &report.summary(), |f| {
         report.add_artefacts(f)

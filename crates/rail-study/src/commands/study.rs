@@ -72,12 +72,12 @@ pub struct Args {
 
 /// The range of `--cv-speed` and `--speeds` [km/h]: the vehicle FMUs' running speed is
 /// 1-200 m/s.
-const CV_SPEED_RANGE_KMH: std::ops::RangeInclusive<f64> = 10.0..=700.0;
+const SPEED_RANGE_KMH: std::ops::RangeInclusive<f64> = 10.0..=700.0;
 /// At most this many sweep speeds (the full study has 25) and track seeds.
 const MAX_SPEEDS: usize = 200;
 const MAX_SEEDS: usize = 20;
-/// The vehicle FMUs' `track.seed` range.
-const MAX_SEED: u32 = 2_147_483_647;
+/// The vehicle FMUs' `track.seed` is an FMI Integer (32-bit), from 0.
+const MAX_SEED: u32 = i32::MAX as u32;
 
 /// The sweep speeds of `--speeds` [km/h], ascending and distinct.
 #[derive(Debug, Clone, PartialEq)]
@@ -92,11 +92,11 @@ fn parse_speed(text: &str) -> Result<f64, String> {
         .trim()
         .parse()
         .map_err(|_| format!("'{text}' is not a speed in km/h"))?;
-    if !CV_SPEED_RANGE_KMH.contains(&v) {
+    if !SPEED_RANGE_KMH.contains(&v) {
         return Err(format!(
             "{v} km/h: speeds must lie between {} and {} km/h",
-            CV_SPEED_RANGE_KMH.start(),
-            CV_SPEED_RANGE_KMH.end()
+            SPEED_RANGE_KMH.start(),
+            SPEED_RANGE_KMH.end()
         ));
     }
     Ok(v)
@@ -148,21 +148,23 @@ fn parse_speeds(text: &str) -> Result<SpeedList, String> {
 /// Every sweep run must cover one EN 14363 window of track after its start-up, or its speed
 /// would count as unstable without being assessed.
 fn check_assessable(settings: &StudySettings) -> Result<(), CommandError> {
-    let window_m = crate::en14363::StabilitySettings::default().window_m;
-    let assessed_s = settings.sweep_stop_s - settings.skip_s;
+    let en14363 = crate::en14363::StabilitySettings {
+        skip_s: settings.skip_s,
+        ..Default::default()
+    };
+    let (window_m, stop_s) = (en14363.window_m, settings.sweep_stop_s);
     match settings
         .speeds_kmh
         .iter()
-        .find(|&&v| assessed_s * v / 3.6 < window_m)
+        .find(|&&v| en14363.assessed_m(stop_s, v) < window_m)
     {
-        Some(v) => Err(CommandError::Failed(format!(
-            "--speeds: at {v} km/h a sweep run ({} s, the first {} s skipped) covers {:.0} m of \
-             track, less than one {window_m:.0} m EN 14363 window; the lowest speed this study \
+        Some(&v) => Err(CommandError::Failed(format!(
+            "--speeds: at {v} km/h a sweep run ({stop_s} s, the first {} s skipped) covers {:.0} m \
+             of track, less than one {window_m:.0} m EN 14363 window; the lowest speed this study \
              can assess is {:.1} km/h",
-            settings.sweep_stop_s,
             settings.skip_s,
-            assessed_s * v / 3.6,
-            (window_m * 3.6 / assessed_s * 10.0).ceil() / 10.0
+            en14363.assessed_m(stop_s, v),
+            (window_m / en14363.assessed_m(stop_s, 1.0) * 10.0).ceil() / 10.0
         ))),
         None => Ok(()),
     }
@@ -244,11 +246,11 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     }
     check_assessable(&settings)?;
     if let Some(v) = args.cv_speed {
-        if !CV_SPEED_RANGE_KMH.contains(&v) {
+        if !SPEED_RANGE_KMH.contains(&v) {
             return Err(CommandError::Failed(format!(
                 "--cv-speed {v}: the speed of the c_v runs must lie between {} and {} km/h",
-                CV_SPEED_RANGE_KMH.start(),
-                CV_SPEED_RANGE_KMH.end()
+                SPEED_RANGE_KMH.start(),
+                SPEED_RANGE_KMH.end()
             )));
         }
         settings.cv_speed_kmh = v;
