@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The benchmark command: builds and packages the FMUs and the master, then measures every speed
-# figure in one run (tests/benches/ratios.rs): each model alone, the coupled passive system in
+# figure in one run (tests/benches/ratios/): each model alone, the coupled passive system in
 # our master vs the same physics in plain Rust (wall clock and instructions) and vs fmpy, the
 # run-set speed-up on 2 workers and the studies' wall time. Writes docs/BENCHMARKS.md (linked from the README).
 # Speed is never asserted by the tests; this is where it is measured.

@@ -1,7 +1,7 @@
 """fmpy driving the FMUs of one of our JSON system descriptions in a Python loop
 (fmpy.fmi2.FMU2Slave), coupled as the master's Gauss-Seidel does: instances stepped in the
 system's "order", each instance's connected inputs set from the latest outputs just before it
-steps. Used by the benchmark tests/benches/ratios.rs.
+steps. Used by the benchmark tests/benches/ratios/.
 
 Usage: python bench_fmpy_system.py SYSTEM.json STOP_TIME REPEATS
 Prints `fmpy_wall_per_sim_s <seconds>`: wall time of the stepping loop (after initialisation,
