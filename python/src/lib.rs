@@ -2,7 +2,7 @@
 //! the generic master (`master` crate). The Python side (`python/railfmu/`) builds the user
 //! API on it: results as NumPy/pandas, run sets on threads or on a Dask cluster.
 //!
-//! Only [`py`] needs pyo3 (feature `python`, set by maturin); the helpers below are plain Rust,
+//! Only the `py` module needs pyo3 (feature `python`, set by maturin); the helpers below are plain Rust,
 //! so `cargo test --workspace` checks them without a Python installation.
 //!
 //! * [`assess`]: the EN 14363 stability assessment of results, as `master assess` makes it.

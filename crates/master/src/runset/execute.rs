@@ -14,7 +14,7 @@ use crate::output::write_json_atomic;
 use crate::results::{constant_kinds, write_results, ConstantKind, ResultsFormat, RunContext};
 use crate::system::{LoadedSystem, PreparedSystem, SystemDescription, SystemError};
 
-/// Runs one job of `system`'s run set (a job from [`RunSet::expand`] of that system: the same
+/// Runs one job of `system`'s run set (a job from [`RunSet::expand`](super::RunSet::expand) of that system: the same
 /// instances, FMUs and timing; only start values and the stop time differ) on the prepared
 /// FMUs: validates its start values, simulates, returns the output.
 pub fn run_job(

@@ -15,7 +15,7 @@
 //! `<outdir>/results/<run>.parquet`, a folder of Parquet files alone that reads as one table
 //! (`pandas.read_parquet("<outdir>/results")`: every run with its name and parameters as
 //! columns; see [`crate::results`]).
-//! The base system is prepared once ([`PreparedSystem`]: FMUs unpacked and loaded once, plan
+//! The base system is prepared once ([`PreparedSystem`](crate::system::PreparedSystem): FMUs unpacked and loaded once, plan
 //! built once); a job is then its start values and stop time ([`run_job`]). Jobs run on a
 //! rayon pool; each job instantiates its own FMU instances (never shared across threads) and
 //! frees them when done. A failed job is reported in its own summary and in

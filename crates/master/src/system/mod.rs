@@ -1,5 +1,5 @@
 //! System description (JSON): FMU instances, parameters, connections, timing, coupling,
-//! recording; validated against the FMUs' model descriptions into a [`CouplingPlan`].
+//! recording; validated against the FMUs' model descriptions into a [`CouplingPlan`](crate::coupling::CouplingPlan).
 //!
 //! ```json
 //! {
