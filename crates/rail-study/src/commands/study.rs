@@ -59,7 +59,8 @@ pub struct Args {
     #[arg(long, value_name = "FROM:TO:STEP|V,V,...", value_parser = parse_speeds)]
     pub speeds: Option<SpeedList>,
     /// Track seeds of the irregular-track runs, e.g. 1,2,3 (default: 1,2; --quick: 1); each
-    /// sweep point is the worst over them. The c_v and time-history runs use the first.
+    /// sweep point, and each row of the c_v table, is the worst over them. The time-history runs
+    /// use the first.
     #[arg(long, value_name = "N,N,...", value_parser = parse_seeds)]
     pub seeds: Option<SeedList>,
     /// Configurations of the sweep, e.g. passive,mppt1 (default: all of the vehicle's; ids as

@@ -99,6 +99,42 @@ impl RunMetrics {
     pub fn rms(&self) -> f64 {
         self.rms_by_signal.iter().fold(0.0, |m: f64, &r| m.max(r))
     }
+
+    /// The same runs over several track seeds as one: each quantity the largest over them (the
+    /// worst case, as a sweep point is the worst over its seeds), the dominant frequency that
+    /// of the run with the largest EN 14363 rms. `None` for no runs.
+    pub fn largest_over(runs: &[RunMetrics]) -> Option<RunMetrics> {
+        let worst = runs.iter().max_by(|a, b| a.rms().total_cmp(&b.rms()))?;
+        let max = |f: fn(&RunMetrics) -> f64| runs.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
+        let max_opt =
+            |f: fn(&RunMetrics) -> Option<f64>| runs.iter().filter_map(f).reduce(f64::max);
+        let signals = runs
+            .iter()
+            .map(|r| r.rms_by_signal.len())
+            .max()
+            .unwrap_or(0);
+        Some(RunMetrics {
+            rms_by_signal: (0..signals)
+                .map(|k| {
+                    runs.iter()
+                        .filter_map(|r| r.rms_by_signal.get(k).copied())
+                        .fold(f64::NEG_INFINITY, f64::max)
+                })
+                .collect(),
+            frequency_hz: worst.frequency_hz,
+            tail_amplitude_m: max(|r| r.tail_amplitude_m),
+            max_displacement_m: max(|r| r.max_displacement_m),
+            peak_force_n: max(|r| r.peak_force_n),
+            rms_force_n: max_opt(|r| r.rms_force_n),
+            peak_reference_force_n: max_opt(|r| r.peak_reference_force_n),
+            rms_power_w: max_opt(|r| r.rms_power_w),
+            rms_hydraulic_power_w: max_opt(|r| r.rms_hydraulic_power_w),
+            tail_command_v: max_opt(|r| r.tail_command_v),
+            carbody_rms_mps2: max_opt(|r| r.carbody_rms_mps2),
+            comfort_ny: max_opt(|r| r.comfort_ny),
+            damper_stroke_m: max_opt(|r| r.damper_stroke_m),
+        })
+    }
 }
 
 fn col(out: &SimOutput, name: &str) -> Result<Vec<f64>, MetricsError> {
@@ -491,5 +527,53 @@ mod tests {
             .push("vehicle.carbody.lateral_acceleration_front".into());
         let e = run_metrics(&out, &spec, &signals).unwrap_err().to_string();
         assert!(e.contains("lateral_acceleration_front"), "{e}");
+    }
+
+    fn metrics(
+        rms: [f64; 2],
+        frequency_hz: f64,
+        peak_force_n: f64,
+        power: Option<f64>,
+    ) -> RunMetrics {
+        RunMetrics {
+            rms_by_signal: rms.to_vec(),
+            frequency_hz,
+            tail_amplitude_m: 1e-3 * rms[0],
+            max_displacement_m: 2e-3 * rms[1],
+            peak_force_n,
+            rms_force_n: Some(0.5 * peak_force_n),
+            peak_reference_force_n: Some(2.0 * peak_force_n),
+            rms_power_w: power,
+            rms_hydraulic_power_w: None,
+            tail_command_v: None,
+            carbody_rms_mps2: Some(0.1 * rms[1]),
+            comfort_ny: Some(rms[0]),
+            damper_stroke_m: Some(1e-3),
+        }
+    }
+
+    #[test]
+    fn largest_over_seeds_takes_each_quantity_from_its_worst_run() {
+        let a = metrics([3.0, 1.0], 4.0, 19e3, Some(140.0));
+        let b = metrics([2.0, 2.5], 4.5, 22.7e3, None);
+        let m = RunMetrics::largest_over(&[a.clone(), b.clone()]).unwrap();
+        // per signal, not the run with the larger maximum
+        assert_eq!(m.rms_by_signal, vec![3.0, 2.5]);
+        assert_eq!(m.rms(), 3.0);
+        // the dominant frequency of the run with the largest EN 14363 rms
+        assert_eq!(m.frequency_hz, 4.0);
+        assert_eq!(m.peak_force_n, 22.7e3);
+        assert_eq!(m.peak_reference_force_n, Some(45.4e3));
+        assert_eq!(m.rms_force_n, Some(11.35e3));
+        assert_eq!(m.max_displacement_m, 5e-3);
+        assert_eq!(m.tail_amplitude_m, 3e-3);
+        assert_eq!(m.carbody_rms_mps2, Some(0.25));
+        assert_eq!(m.comfort_ny, Some(3.0));
+        // a quantity one run did not record comes from the others
+        assert_eq!(m.rms_power_w, Some(140.0));
+        assert_eq!(m.rms_hydraulic_power_w, None);
+        // one run is itself; none is nothing
+        assert_eq!(RunMetrics::largest_over(std::slice::from_ref(&b)), Some(b));
+        assert_eq!(RunMetrics::largest_over(&[]), None);
     }
 }

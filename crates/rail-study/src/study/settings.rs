@@ -159,7 +159,7 @@ impl StudySettings {
     pub fn planned_runs(&self) -> usize {
         self.configurations.len() * self.speeds_kmh.len() * self.seeds.len()
             + self.perturbation_speeds_kmh.len()
-            + self.cv_values_nspm.len()
+            + self.cv_values_nspm.len() * self.seeds.len()
     }
 }
 
