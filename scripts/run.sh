@@ -7,6 +7,15 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
 
+# every run's full-rate results are kept (Parquet): about 2.1 GB for the two studies
+mkdir -p results
+free_kb=$(df -Pk results | awk 'NR == 2 {print $4}')
+if [ "$#" -eq 0 ] && [ -n "$free_kb" ] && [ "$free_kb" -lt 2600000 ]; then
+  echo "warning: the two studies store about 2.1 GB of results under results/ and only" \
+    "$((free_kb / 1024)) MB are free; a run that cannot be written fails the study." \
+    "'bash scripts/run.sh --format csv' stores about a third." >&2
+fi
+
 step "package the FMUs into dist/"
 package_fmus
 
