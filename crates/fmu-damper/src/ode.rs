@@ -112,13 +112,19 @@ pub(crate) fn integrate<S: Rhs<N>, const N: usize>(
     let mut attempts: u32 = 0;
     let mut accepted: u32 = 0;
     let mut h_proposed = h;
+    // ode23s is FSAL: the last stage's derivative at an accepted state is that state's f0 (the
+    // inputs are frozen within the step, so the right-hand side is the same function of y)
+    let mut f_accepted: Option<[f64; N]> = None;
 
     while t < h_total * (1.0 - 1e-12) {
         let last = h >= (h_total - t) * (1.0 - 1e-9);
         if last {
             h = h_total - t;
         }
-        let f0 = sys.rhs(y);
+        let f0 = match f_accepted.take() {
+            Some(f) => f,
+            None => sys.rhs(y),
+        };
         if !all_finite(&f0) {
             return Err(StepError::Integration {
                 at_s: t,
@@ -136,7 +142,7 @@ pub(crate) fn integrate<S: Rhs<N>, const N: usize>(
             }
             let trial = rosenbrock_attempt(sys, y, &f0, &jac, h);
             let err_norm = match &trial {
-                Some((ynew, err)) => {
+                Some((ynew, err, _)) => {
                     let mut m: f64 = 0.0;
                     for i in 0..N {
                         let sc = atol[i] + rtol * y[i].abs().max(ynew[i].abs());
@@ -151,8 +157,9 @@ pub(crate) fn integrate<S: Rhs<N>, const N: usize>(
                 None => f64::INFINITY,
             };
             if err_norm <= 1.0 {
-                if let Some((ynew, _)) = trial {
+                if let Some((ynew, _, f_new)) = trial {
                     *y = ynew;
+                    f_accepted = Some(f_new);
                 }
                 t += h;
                 accepted += 1;
@@ -189,7 +196,8 @@ fn all_finite<const N: usize>(v: &[f64; N]) -> bool {
     v.iter().all(|x| x.is_finite())
 }
 
-/// One ode23s attempt; `None` if the linear system is singular or a stage is non-finite.
+/// One ode23s attempt: the new state, its error estimate and the derivative at the new state
+/// (the last stage's); `None` if the linear system is singular or a stage is non-finite.
 #[allow(clippy::type_complexity)]
 fn rosenbrock_attempt<S: Rhs<N>, const N: usize>(
     sys: &S,
@@ -197,7 +205,7 @@ fn rosenbrock_attempt<S: Rhs<N>, const N: usize>(
     f0: &[f64; N],
     jac: &[[f64; N]; N],
     h: f64,
-) -> Option<([f64; N], [f64; N])> {
+) -> Option<([f64; N], [f64; N], [f64; N])> {
     let mut w = [[0.0; N]; N];
     for i in 0..N {
         for j in 0..N {
@@ -241,7 +249,7 @@ fn rosenbrock_attempt<S: Rhs<N>, const N: usize>(
     for i in 0..N {
         err[i] = h / 6.0 * (k1[i] - 2.0 * k2[i] + k3[i]);
     }
-    Some((ynew, err))
+    Some((ynew, err, f2))
 }
 
 /// Forward-difference Jacobian.
@@ -353,6 +361,38 @@ mod tests {
         let e = (-1.0f64).exp();
         assert!((y[1] - e).abs() < 1e-6 * 10.0, "{}", y[1]);
         assert!((y[0] - 1000.0 / 999.0 * e).abs() < 1e-5, "{}", y[0]);
+    }
+
+    /// [`Stiff`] recording where it is evaluated.
+    struct Recorded(std::cell::RefCell<Vec<[u64; 2]>>);
+    impl Rhs<2> for Recorded {
+        fn rhs(&self, y: &[f64; 2]) -> [f64; 2] {
+            self.0.borrow_mut().push(y.map(f64::to_bits));
+            Stiff.rhs(y)
+        }
+    }
+
+    /// ode23s is FSAL: an accepted internal step's last stage, the derivative at the new state,
+    /// is the next step's f0, so no state is evaluated twice (without it every accepted state
+    /// but the last would be: once as a stage, once as f0); the result is the same.
+    #[test]
+    fn the_last_stage_of_an_accepted_step_is_the_next_f0() {
+        let recorded = Recorded(std::cell::RefCell::new(Vec::new()));
+        let (mut y, mut hi) = ([0.0, 1.0], 1e-5);
+        let s = SolverSettings {
+            rtol: 1e-9,
+            ..SolverSettings::default()
+        };
+        let accepted = integrate(&recorded, &mut y, &[1e-12; 2], 1e-2, &mut hi, &s).unwrap();
+        assert!(accepted > 3, "{accepted} internal steps: too few to tell");
+        let mut points = recorded.0.into_inner();
+        let evaluations = points.len();
+        points.sort_unstable();
+        points.dedup();
+        assert_eq!(points.len(), evaluations, "a state was evaluated twice");
+        let (mut y_plain, mut hi_plain) = ([0.0, 1.0], 1e-5);
+        integrate(&Stiff, &mut y_plain, &[1e-12; 2], 1e-2, &mut hi_plain, &s).unwrap();
+        assert_eq!(y.map(f64::to_bits), y_plain.map(f64::to_bits));
     }
 
     #[test]
