@@ -324,13 +324,19 @@ pub fn report_markdown(r: &StudyResults, timing: &Timing, figures: &[(String, &s
     }
     let _ = writeln!(
         m,
-        "\nEach row is the largest over the track seeds {:?} (one run per seed), as a sweep point is. \
+        "\n{} \
          rms acc is the same EN 14363 quantity as the sweep; F_max the largest |actuator force| after the start-up; \
          rms force the rms of the actuator force, mean over the actuators; peak reference the largest |c_v v| \
          the controllers asked for; \
          rms power F v the rms of the mechanical power taken from the vehicle per actuator \
          (the seed's \"dissipated power\"); rms hydraulic power that drawn from the 10 MPa supply per actuator.\n",
-        s.seeds
+        match s.seeds.as_slice() {
+            [seed] => format!("Track seed {seed}, one run per c_v."),
+            seeds => format!(
+                "Each row is the largest over the track seeds {} (one run per seed), as a sweep point is.",
+                seeds.iter().map(u32::to_string).collect::<Vec<_>>().join(", ")
+            ),
+        }
     );
     if let Some(note) = force_bound_note(&r.cv) {
         let _ = writeln!(m, "{note}\n");

@@ -134,9 +134,18 @@ fn report_has_the_tables_the_timing_and_the_failures() {
         "| hil-mppt2_slow (MPPT2, slow valve) | 260 | 3.50 | 1.00 |",
         "`cv-270`: boom",
         "`rms_vs_speed.svg`",
+        "Track seed 1, one run per c_v.",
     ] {
         assert!(md.contains(s), "missing {s:?} in\n{md}");
     }
+    // over several seeds each c_v row is their worst, and the report says so
+    let mut two = r.clone();
+    two.settings.seeds = vec![1, 2];
+    let md = report_markdown(&two, &t, &[]);
+    assert!(
+        md.contains("Each row is the largest over the track seeds 1, 2 (one run per seed)"),
+        "{md}"
+    );
 }
 
 #[test]
