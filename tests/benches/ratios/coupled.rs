@@ -33,38 +33,31 @@ pub const PASSIVE_RECORD: [&str; 7] = [
     "damper_right.damper.force",
 ];
 
-/// A coupled run: best wall time of the simulation loop per simulated second, and the recorded
-/// rows of the last run after the start (time, then [`PASSIVE_RECORD`]).
+/// One coupled run: wall time of the simulation loop per simulated second, and the recorded
+/// rows after the start (time, then [`PASSIVE_RECORD`]).
 pub struct Timed {
     pub per_sim_s: f64,
     pub rows: Vec<f64>,
 }
 
-/// Master: preparation (unpacking and loading the FMUs) is not timed. Returns the best wall
-/// time per simulated second and the last run's output; its rows are taken outside (see
-/// [`master_timed`]), so that callgrind's inclusive count of this function holds the runs
-/// and no extraction of result columns.
+/// Master: preparation (unpacking and loading the FMUs) is not timed. Returns the wall time
+/// per simulated second and the output; its rows are taken outside (see [`master_timed`]), so
+/// that callgrind's inclusive count of this function holds the run and no extraction of
+/// result columns.
 #[inline(never)]
-pub fn master_passive(stop_s: f64, repeats: usize) -> (f64, SimOutput) {
+pub fn master_passive(stop_s: f64) -> (f64, SimOutput) {
     let system = PreparedSystem::prepare(&passive_system(stop_s)).unwrap();
     let changes = system
         .changes(&std::collections::BTreeMap::new(), None, "bench")
         .unwrap();
-    let mut best = f64::INFINITY;
-    let mut last = None;
-    for _ in 0..repeats.max(1) {
-        let started = Instant::now();
-        let out = system.run(&changes, &RunOptions::default()).unwrap();
-        best = best.min(started.elapsed().as_secs_f64());
-        last = Some(out);
-    }
-    (best / stop_s, last.unwrap())
+    let started = Instant::now();
+    let out = system.run(&changes, &RunOptions::default()).unwrap();
+    (started.elapsed().as_secs_f64() / stop_s, out)
 }
 
-/// [`master_passive`] with the recorded rows of its last run after the start (time, then
-/// [`PASSIVE_RECORD`]).
-pub fn master_timed(stop_s: f64, repeats: usize) -> Timed {
-    let (per_sim_s, out) = master_passive(stop_s, repeats);
+/// [`master_passive`] with the recorded rows after the start (time, then [`PASSIVE_RECORD`]).
+pub fn master_timed(stop_s: f64) -> Timed {
+    let (per_sim_s, out) = master_passive(stop_s);
     let time = out.column("time").unwrap();
     let columns: Vec<Vec<f64>> = PASSIVE_RECORD
         .iter()
@@ -105,70 +98,66 @@ pub fn largest_difference(direct: &[f64], master: &[f64]) -> f64 {
 /// step as the system's record list: the bogie's outputs at the end of the step with the
 /// dampers' new forces (as the master reads them after the dampers set them).
 #[inline(never)]
-pub fn direct_passive(stop_s: f64, repeats: usize) -> Timed {
+pub fn direct_passive(stop_s: f64) -> Timed {
     let n = (stop_s / STEP_S).round() as usize;
-    let mut best = f64::INFINITY;
     let mut rec: Vec<f64> = Vec::with_capacity((n + 1) * 8);
-    for _ in 0..repeats {
-        rec.clear();
-        let params = Params {
-            speed_mps: 83.333_333_333_333_33,
-            track: TrackSource::Internal {
-                level: PsdLevel::Low,
-                seed: 1,
-            },
-            initial_lateral_m: 0.0,
-            initial_yaw_rad: 0.0,
-            ..Params::default()
-        };
-        let started = Instant::now();
-        let mut bogie = Bogie::new(params).unwrap();
-        let mut left = SemiActiveDamper::new(SemiActiveParams::passive_reference()).unwrap();
-        let mut right = SemiActiveDamper::new(SemiActiveParams::passive_reference()).unwrap();
-        let mut inputs = Inputs::default();
-        let mut out = bogie.outputs(&inputs).unwrap();
-        for k in 0..n {
-            let _t = k as f64 * STEP_S;
-            out = bogie.step(STEP_S, &inputs).unwrap();
-            let l = left
-                .step(
-                    STEP_S,
-                    &SemiActiveInputs {
-                        elongation_m: out.damper_left_elongation_m,
-                        elongation_velocity_mps: out.damper_left_velocity_mps,
-                        ..SemiActiveInputs::default()
-                    },
-                )
-                .unwrap();
-            let r = right
-                .step(
-                    STEP_S,
-                    &SemiActiveInputs {
-                        elongation_m: out.damper_right_elongation_m,
-                        elongation_velocity_mps: out.damper_right_velocity_mps,
-                        ..SemiActiveInputs::default()
-                    },
-                )
-                .unwrap();
-            inputs.damper_left_force_n = l.force_n;
-            inputs.damper_right_force_n = r.force_n;
-            let now = bogie.outputs(&inputs).unwrap();
-            rec.extend_from_slice(&[
-                now.time_s,
-                now.wheelset_front_rel_track_m,
-                now.wheelset_rear_rel_track_m,
-                now.wheelset_front_acc_mps2,
-                now.wheelset_rear_acc_mps2,
-                now.guiding_force_front_n,
-                l.force_n,
-                r.force_n,
-            ]);
-        }
-        best = best.min(started.elapsed().as_secs_f64());
-        std::hint::black_box(&out);
+    let params = Params {
+        speed_mps: 83.333_333_333_333_33,
+        track: TrackSource::Internal {
+            level: PsdLevel::Low,
+            seed: 1,
+        },
+        initial_lateral_m: 0.0,
+        initial_yaw_rad: 0.0,
+        ..Params::default()
+    };
+    let started = Instant::now();
+    let mut bogie = Bogie::new(params).unwrap();
+    let mut left = SemiActiveDamper::new(SemiActiveParams::passive_reference()).unwrap();
+    let mut right = SemiActiveDamper::new(SemiActiveParams::passive_reference()).unwrap();
+    let mut inputs = Inputs::default();
+    let mut out = bogie.outputs(&inputs).unwrap();
+    for k in 0..n {
+        let _t = k as f64 * STEP_S;
+        out = bogie.step(STEP_S, &inputs).unwrap();
+        let l = left
+            .step(
+                STEP_S,
+                &SemiActiveInputs {
+                    elongation_m: out.damper_left_elongation_m,
+                    elongation_velocity_mps: out.damper_left_velocity_mps,
+                    ..SemiActiveInputs::default()
+                },
+            )
+            .unwrap();
+        let r = right
+            .step(
+                STEP_S,
+                &SemiActiveInputs {
+                    elongation_m: out.damper_right_elongation_m,
+                    elongation_velocity_mps: out.damper_right_velocity_mps,
+                    ..SemiActiveInputs::default()
+                },
+            )
+            .unwrap();
+        inputs.damper_left_force_n = l.force_n;
+        inputs.damper_right_force_n = r.force_n;
+        let now = bogie.outputs(&inputs).unwrap();
+        rec.extend_from_slice(&[
+            now.time_s,
+            now.wheelset_front_rel_track_m,
+            now.wheelset_rear_rel_track_m,
+            now.wheelset_front_acc_mps2,
+            now.wheelset_rear_acc_mps2,
+            now.guiding_force_front_n,
+            l.force_n,
+            r.force_n,
+        ]);
     }
+    let elapsed_s = started.elapsed().as_secs_f64();
+    std::hint::black_box(&out);
     Timed {
-        per_sim_s: best / stop_s,
+        per_sim_s: elapsed_s / stop_s,
         rows: rec,
     }
 }

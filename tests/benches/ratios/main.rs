@@ -157,7 +157,7 @@ fn main() {
         let stop: f64 = stop
             .parse()
             .expect("BENCH_COUPLED_ONCE_S: simulated seconds");
-        let (direct, master) = (direct_passive(stop, 1), master_timed(stop, 1));
+        let (direct, master) = (direct_passive(stop), master_timed(stop));
         println!(
             "final front wheelset displacement: direct {:e} m, master {:e} m; largest relative \
              difference of the recorded values {:.1e}",
@@ -224,14 +224,12 @@ fn main() {
         r.line(String::new());
         let load = load_average();
         // in alternation, so that a change of the machine's load falls on both loops
-        let (mut direct, mut master) = (
-            direct_passive(COUPLED_STOP_S, 1),
-            master_timed(COUPLED_STOP_S, 1),
-        );
+        let (mut direct, mut master) =
+            (direct_passive(COUPLED_STOP_S), master_timed(COUPLED_STOP_S));
         let mut round_ratios = vec![master.per_sim_s / direct.per_sim_s];
         for _ in 1..REPEATS {
-            let d = direct_passive(COUPLED_STOP_S, 1);
-            let m = master_timed(COUPLED_STOP_S, 1);
+            let d = direct_passive(COUPLED_STOP_S);
+            let m = master_timed(COUPLED_STOP_S);
             round_ratios.push(m.per_sim_s / d.per_sim_s);
             if d.per_sim_s < direct.per_sim_s {
                 direct = d;
