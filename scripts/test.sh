@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# The project's test command (also what CI runs): installs what it needs, checks formatting and
-# lints, builds and packages every FMU, checks every FMU with the third-party validators (when
-# ../shared/validators is there), runs all Rust tests, validates and simulates every FMU with fmpy
-# and compares fmpy's results with the same physics called directly from Rust.
+# The project's test command (also what CI runs): installs what it needs, checks formatting,
+# lints and the API documentation, builds and packages every FMU, checks every FMU with the
+# third-party validators (when ../shared/validators is there), runs all Rust tests, validates
+# and simulates every FMU with fmpy and compares fmpy's results with the same physics called
+# directly from Rust.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
@@ -21,6 +22,9 @@ cargo fmt --all -- --check
 step "cargo clippy (-D warnings), without and with the FMU exports"
 cargo clippy --workspace --all-targets -- -D warnings
 cargo clippy --workspace --all-targets --features fmi-export -- -D warnings
+
+step "cargo doc (-D warnings): the API documentation has no broken links"
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps -q
 
 step "package the FMUs into dist/"
 package_fmus

@@ -23,9 +23,9 @@ pub struct AssessOptions {
     pub quantity: String,
     pub bogie_mass_t: f64,
     pub wheel_load_kn: f64,
-    /// Start-up excluded [s].
+    /// Start-up excluded \[s\].
     pub skip_s: f64,
-    /// Dominant frequency instead of the spectrum's peak [Hz].
+    /// Dominant frequency instead of the spectrum's peak \[Hz\].
     pub f0_hz: Option<f64>,
     /// Assess although the recorded band is narrower than the assessed one (a warning).
     pub accept_narrow_band: bool,
@@ -39,7 +39,7 @@ pub struct SignalAnswer {
     pub band_hz: (f64, f64),
     pub max_rms: f64,
     pub stable: bool,
-    /// Centre of each 100 m window along the track [m].
+    /// Centre of each 100 m window along the track \[m\].
     pub window_centre_m: Vec<f64>,
     pub rms: Vec<f64>,
 }

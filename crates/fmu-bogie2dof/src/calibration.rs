@@ -3,7 +3,7 @@
 //! decay at 220 km/h, flange-contact limit cycle at 320 km/h).
 //!
 //! # Passive damper (from the fmu-damper characterisation, numbers copied, no dependency)
-//! Passive reference (30 % opening), 1 mm stroke amplitude, per damper, f [Hz] -> k_eq [kN/m]
+//! Passive reference (30 % opening), 1 mm stroke amplitude, per damper, f \[Hz\] -> k_eq [kN/m]
 //! / c_eq [kNs/m]: 2 -> 111/133, 3 -> 230/110, 3.5 -> 304/102, 4 -> 386/95.6, 5 -> 570/85.2
 //! (3 mm: 2 -> 98/83, 3 -> 210/70, 3.5 -> 277/65, 4 -> 349/60.7, 5 -> 502/53.4). The damper is
 //! a Maxwell-like element (pressure state); a spring k_s in series with a dashpot c_s fitted
@@ -76,7 +76,7 @@ pub use crate::params::{
 /// One point of the passive damper characterisation (per damper).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DamperMeasurement {
-    /// Frequency [Hz].
+    /// Frequency \[Hz\].
     pub freq_hz: f64,
     /// Equivalent stiffness [N/m].
     pub k_eq_n_per_m: f64,
@@ -139,7 +139,7 @@ pub fn fit_maxwell(points: &[DamperMeasurement]) -> Option<(f64, f64)> {
     Some((n / a, n / b))
 }
 
-/// Equivalent (k_eq, c_eq) of a Maxwell element at frequency f [Hz].
+/// Equivalent (k_eq, c_eq) of a Maxwell element at frequency f \[Hz\].
 pub fn maxwell_equivalent(k: f64, c: f64, freq_hz: f64) -> (f64, f64) {
     let wc = 2.0 * std::f64::consts::PI * freq_hz * c;
     let d = k * k + wc * wc;

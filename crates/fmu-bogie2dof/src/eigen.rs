@@ -23,7 +23,7 @@ use vehicle_elements::{first_unstable_speed, Crossing};
 /// One point of a frequency-dependent equivalent damper (per damper).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct DamperPoint {
-    /// Frequency [Hz].
+    /// Frequency \[Hz\].
     pub freq_hz: f64,
     /// Equivalent stiffness k_eq [N/m].
     pub k_n_per_m: f64,
@@ -75,7 +75,7 @@ pub struct HuntingMode {
     pub re: f64,
     /// Imaginary part omega [rad/s].
     pub im: f64,
-    /// omega / 2 pi [Hz].
+    /// omega / 2 pi \[Hz\].
     pub freq_hz: f64,
     /// -re/|lambda| [-] (negative = unstable).
     pub damping_ratio: f64,

@@ -17,7 +17,7 @@ use crate::params::{ContactSource, Params, TrackSource};
 
 /// Speed of the FMU's start values (default experiment: hunting with flange contact) [m/s].
 pub const FMU_DEFAULT_SPEED_MPS: f64 = 300.0 / 3.6;
-/// Initial lateral displacement of the FMU's start values [m].
+/// Initial lateral displacement of the FMU's start values \[m\].
 pub const FMU_DEFAULT_INITIAL_LATERAL_M: f64 = 3e-3;
 
 // The FMI Enumeration `TrackSource`, with where this model applies the external input.

@@ -93,7 +93,7 @@ pub enum StepError {
     /// The state became NaN/inf (a smaller step may help).
     #[error("state diverged at t = {time_s} s: {what}")]
     Diverged {
-        /// Time [s].
+        /// Time \[s\].
         time_s: f64,
         /// Description.
         what: String,
@@ -105,11 +105,11 @@ pub enum StepError {
          {front_m:.4} m (front) / {rear_m:.4} m (rear), limit 0.05 m"
     )]
     Derailed {
-        /// Time [s].
+        /// Time \[s\].
         time_s: f64,
-        /// Front wheelset relative displacement [m].
+        /// Front wheelset relative displacement \[m\].
         front_m: f64,
-        /// Rear wheelset relative displacement [m].
+        /// Rear wheelset relative displacement \[m\].
         rear_m: f64,
     },
 }
@@ -117,11 +117,11 @@ pub enum StepError {
 /// Inputs of one communication step.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Inputs {
-    /// Left yaw damper force, tension positive [N].
+    /// Left yaw damper force, tension positive \[N\].
     pub damper_left_force_n: f64,
-    /// Right yaw damper force, tension positive [N].
+    /// Right yaw damper force, tension positive \[N\].
     pub damper_right_force_n: f64,
-    /// Track lateral alignment at the front wheelset, positive right [m] (used when the
+    /// Track lateral alignment at the front wheelset, positive right \[m\] (used when the
     /// track source is External).
     pub track_lateral_m: f64,
 }
@@ -139,11 +139,11 @@ impl Inputs {
 /// Outputs at one instant. Front = wheelset 1 at +p (leading), rear = wheelset 2.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Outputs {
-    /// Time [s].
+    /// Time \[s\].
     pub time_s: f64,
-    /// Left damper elongation e_L = +b sigma [m] (extension positive).
+    /// Left damper elongation e_L = +b sigma \[m\] (extension positive).
     pub damper_left_elongation_m: f64,
-    /// Right damper elongation e_R = -b sigma [m].
+    /// Right damper elongation e_R = -b sigma \[m\].
     pub damper_right_elongation_m: f64,
     /// Left damper elongation velocity [m/s].
     pub damper_left_velocity_mps: f64,
@@ -158,13 +158,13 @@ pub struct Outputs {
     pub frame_acc_front_mps2: f64,
     /// Bogie frame lateral acceleration above the rear wheelset, y'' + p sigma'' [m/s^2].
     pub frame_acc_rear_mps2: f64,
-    /// Front wheelset lateral displacement (absolute) [m].
+    /// Front wheelset lateral displacement (absolute) \[m\].
     pub wheelset_front_lateral_m: f64,
-    /// Rear wheelset lateral displacement (absolute) [m].
+    /// Rear wheelset lateral displacement (absolute) \[m\].
     pub wheelset_rear_lateral_m: f64,
-    /// Front wheelset displacement relative to the track [m].
+    /// Front wheelset displacement relative to the track \[m\].
     pub wheelset_front_rel_track_m: f64,
-    /// Rear wheelset displacement relative to the track [m].
+    /// Rear wheelset displacement relative to the track \[m\].
     pub wheelset_rear_rel_track_m: f64,
     /// Front wheelset lateral acceleration [m/s^2] (rigid primary suspension: equals the
     /// frame acceleration above it).
@@ -172,19 +172,19 @@ pub struct Outputs {
     /// Rear wheelset lateral acceleration [m/s^2].
     pub wheelset_rear_acc_mps2: f64,
     /// Sum of lateral wheel/rail forces on the front wheelset (Sum Y, force of the rails on
-    /// the wheelset, positive right) [N].
+    /// the wheelset, positive right) \[N\].
     pub guiding_force_front_n: f64,
-    /// Same for the rear wheelset [N].
+    /// Same for the rear wheelset \[N\].
     pub guiding_force_rear_n: f64,
-    /// Yaw angle sigma, positive nose-left [rad].
+    /// Yaw angle sigma, positive nose-left \[rad\].
     pub yaw_rad: f64,
     /// Yaw rate [rad/s].
     pub yaw_rate_radps: f64,
-    /// Bogie centre lateral displacement [m].
+    /// Bogie centre lateral displacement \[m\].
     pub bogie_lateral_m: f64,
     /// Bogie centre lateral velocity [m/s].
     pub bogie_lateral_velocity_mps: f64,
-    /// Track alignment under the front / rear wheelset [m].
+    /// Track alignment under the front / rear wheelset \[m\].
     pub track_front_m: f64,
     /// See `track_front_m`.
     pub track_rear_m: f64,
@@ -274,18 +274,18 @@ impl Bogie {
         &self.table
     }
 
-    /// Current time [s].
+    /// Current time \[s\].
     pub fn time_s(&self) -> f64 {
         self.time_s
     }
 
-    /// Largest internal sub-step of the integration [s] (a communication step h is split into
+    /// Largest internal sub-step of the integration \[s\] (a communication step h is split into
     /// ceil(h / substep) equal sub-steps).
     pub fn substep_s(&self) -> f64 {
         self.h_sub_max
     }
 
-    /// Overrides the largest internal sub-step [s] (for convergence studies; the default comes
+    /// Overrides the largest internal sub-step \[s\] (for convergence studies; the default comes
     /// from the dynamics, see the module docs). Must be finite, > 0 and <= 1 s.
     pub fn set_substep_s(&mut self, h_sub_s: f64) -> Result<(), ParamError> {
         if !(h_sub_s.is_finite() && h_sub_s > 0.0 && h_sub_s <= 1.0) {
@@ -526,11 +526,11 @@ fn substep_bound(c: &Consts, table: &GeometryTable, generator: Option<&TrackGene
 }
 
 /// Upper bound of the RK4 sub-step whatever the dynamics (the largest step of the
-/// convergence study) [s].
+/// convergence study) \[s\].
 pub const SUBSTEP_CAP_S: f64 = 2e-3;
 /// Largest decay rate x sub-step (one e-fold per sub-step).
 pub const MAX_DECAY_PER_SUBSTEP: f64 = 1.0;
-/// Largest angular frequency x sub-step [rad].
+/// Largest angular frequency x sub-step \[rad\].
 pub const MAX_PHASE_PER_SUBSTEP_RAD: f64 = 1.0;
 
 #[inline]

@@ -85,7 +85,7 @@ impl Consts {
 pub struct Eval {
     /// Time derivative of the state.
     pub dx: [f64; N_STATES],
-    /// Sum of lateral wheel/rail forces on each wheelset (front, rear) [N], positive right.
+    /// Sum of lateral wheel/rail forces on each wheelset (front, rear) \[N\], positive right.
     pub guiding: [f64; 2],
     /// Yaw moment of everything but the yaw dampers [N m]: the damper forces enter only
     /// `dx[3] = (yaw_moment_without_dampers_nm - b F_L + b F_R) / J`.

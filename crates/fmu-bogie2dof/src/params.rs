@@ -32,9 +32,9 @@ pub use vehicle_elements::ParamError;
 
 /// Tread conicity of the worn-profile surrogate [-] (see [`crate::calibration`]).
 pub const WORN_SURROGATE_CONICITY: f64 = 0.25;
-/// Half-width of the coned tread of the surrogate; the A/A flange rise is kept beyond [m].
+/// Half-width of the coned tread of the surrogate; the A/A flange rise is kept beyond \[m\].
 pub const WORN_SURROGATE_TREAD_HALF_WIDTH_M: f64 = 3.5e-3;
-/// Amplitude at which the linear model's conicity and gravity stiffness are taken [m].
+/// Amplitude at which the linear model's conicity and gravity stiffness are taken \[m\].
 pub const LINEARISATION_AMPLITUDE_M: f64 = 1e-3;
 /// Equivalent conicity of the default table at 1 mm (describing function) [-].
 pub const CALIBRATED_CONICITY: f64 = 0.25;
@@ -93,20 +93,20 @@ pub struct Params {
     pub speed_mps: f64,
     /// Linear or non-linear wheel/rail forces.
     pub model: ModelKind,
-    /// m: bogie frame + two wheelsets [kg]. Seed 4.2: a_lim = 5.39 m/s^2 -> 6.1 t.
+    /// m: bogie frame + two wheelsets \[kg\]. Seed 4.2: a_lim = 5.39 m/s^2 -> 6.1 t.
     pub bogie_mass_kg: f64,
     /// J: yaw inertia of frame + wheelsets about the bogie centre [kg m^2].
     /// Manchester Benchmark: 3067 + 2*(1120 + 1813*1.25^2) = 10 973 kg m^2.
     pub bogie_yaw_inertia_kgm2: f64,
     /// J_w: spin inertia of one wheelset about its axle [kg m^2] (Manchester: 112).
     pub wheelset_spin_inertia_kgm2: f64,
-    /// p: half wheelbase [m] (seed Table 4-1: wheelbase 2.5 m).
+    /// p: half wheelbase \[m\] (seed Table 4-1: wheelbase 2.5 m).
     pub half_wheelbase_m: f64,
-    /// s: half distance between the contact points [m] (MPE 2019: 0.7465 m).
+    /// s: half distance between the contact points \[m\] (MPE 2019: 0.7465 m).
     pub half_contact_gauge_m: f64,
-    /// b: lateral arm of the yaw dampers and of k_ssx [m] (MPE 2019: 1.35 m).
+    /// b: lateral arm of the yaw dampers and of k_ssx \[m\] (MPE 2019: 1.35 m).
     pub damper_arm_m: f64,
-    /// R0: nominal rolling radius [m] (Manchester: 0.46 m).
+    /// R0: nominal rolling radius \[m\] (Manchester: 0.46 m).
     pub wheel_radius_m: f64,
     /// k_ssy: secondary lateral stiffness per side [N/m] (Manchester: 160 kN/m).
     pub k_ssy_n_per_m: f64,
@@ -121,22 +121,22 @@ pub struct Params {
     /// [`wheel_rail::GeometryTable::linearise`]). Not in the seed's (5.18); included here
     /// because the non-linear model (5.20) has it through the contact angles.
     pub gravity_stiffness_n_per_m: f64,
-    /// f11: Kalker longitudinal creep coefficient per wheel [N] (Hertz+Kalker: 11.5 MN).
+    /// f11: Kalker longitudinal creep coefficient per wheel \[N\] (Hertz+Kalker: 11.5 MN).
     pub f11_n: f64,
-    /// f22: Kalker lateral creep coefficient per wheel [N] (Hertz+Kalker: 10.4 MN).
+    /// f22: Kalker lateral creep coefficient per wheel \[N\] (Hertz+Kalker: 10.4 MN).
     pub f22_n: f64,
     /// kappa: reduction factor applied to f11 and f22 in both models (0, 1]. Measured initial
     /// creep slopes are lower than Kalker's theory; Polach (2005, Wear 258) uses reduction
     /// factors of about 0.3-1 (0.5-1 for dry rail). CALIBRATED: 0.6.
     pub creep_reduction: f64,
-    /// P: vertical load per wheel [N] (~140 kN per wheelset; Table 4-1's 27.52 kN is
+    /// P: vertical load per wheel \[N\] (~140 kN per wheelset; Table 4-1's 27.52 kN is
     /// implausible, see REFERENCE.md).
     pub wheel_load_n: f64,
     /// mu: wheel/rail friction coefficient (0..1], dry rail 0.3-0.4.
     pub friction_coefficient: f64,
-    /// Initial lateral displacement of the bogie centre [m].
+    /// Initial lateral displacement of the bogie centre \[m\].
     pub initial_lateral_m: f64,
-    /// Initial yaw angle sigma (positive nose-left) [rad].
+    /// Initial yaw angle sigma (positive nose-left) \[rad\].
     pub initial_yaw_rad: f64,
     /// Track alignment source.
     pub track: TrackSource,

@@ -16,7 +16,7 @@ use crate::model::{Bogie, ModelError, StepError};
 use crate::params::{Params, PsdLevel, TrackSource};
 use crate::sim::{run_closed_loop, LinearDamper};
 
-/// Communication step of the reference run [s].
+/// Communication step of the reference run \[s\].
 pub const REFERENCE_STEP_S: f64 = 1e-3;
 
 /// Track of the reference run.

@@ -92,7 +92,7 @@ pub enum StepError {
     TooManySamples { samples: u64 },
 }
 
-/// Shortest board sample time [s] (a 1 MHz board): a shorter one would make every step cost
+/// Shortest board sample time \[s\] (a 1 MHz board): a shorter one would make every step cost
 /// more samples than any board computes.
 pub const MIN_SAMPLE_TIME_S: f64 = 1e-6;
 

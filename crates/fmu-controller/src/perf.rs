@@ -16,7 +16,7 @@ use crate::mppt::{Mppt, MpptInputs, MpptParams};
 use crate::skyhook::{SkyHook, SkyHookInputs, SkyHookMode, SkyHookParams};
 use crate::{ParamError, StepError};
 
-/// Communication step of the reference cases [s].
+/// Communication step of the reference cases \[s\].
 pub const REFERENCE_STEP_S: f64 = 1e-3;
 
 /// One reference case.
@@ -52,7 +52,7 @@ impl ControllerCase {
     }
 }
 
-/// (lateral acceleration [m/s^2], elongation velocity [m/s], damper force [N]) at step `k`.
+/// (lateral acceleration [m/s^2], elongation velocity [m/s], damper force \[N\]) at step `k`.
 pub fn signals(k: u64) -> (f64, f64, f64) {
     let t = k as f64 * REFERENCE_STEP_S;
     let (w1, w2) = (2.0 * PI * 4.0, 2.0 * PI * 17.0);
@@ -61,7 +61,7 @@ pub fn signals(k: u64) -> (f64, f64, f64) {
     (acc, vel, 10e3 * (w1 * t).cos())
 }
 
-/// Length of the precomputed input sequence (5 s; it repeats after that) [steps].
+/// Length of the precomputed input sequence (5 s; it repeats after that) \[steps\].
 pub const INPUT_STEPS: usize = 5000;
 
 /// The board of one case, ready to step, and its precomputed input signals (so the measured

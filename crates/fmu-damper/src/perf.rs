@@ -17,7 +17,7 @@ use crate::semi_active::{SemiActiveDamper, SemiActiveInputs, SemiActiveParams};
 use crate::valve::ValveParams;
 use crate::{ParamError, StepError};
 
-/// Communication step of the reference cases [s].
+/// Communication step of the reference cases \[s\].
 pub const REFERENCE_STEP_S: f64 = 1e-3;
 
 /// One reference case.
@@ -57,7 +57,7 @@ impl DamperCase {
     }
 }
 
-/// Elongation [m] and its velocity [m/s] at step `k`.
+/// Elongation \[m\] and its velocity [m/s] at step `k`.
 pub fn stroke(k: u64) -> (f64, f64) {
     let t = k as f64 * REFERENCE_STEP_S;
     let (w1, w2) = (2.0 * PI * 4.0, 2.0 * PI * 17.0);
@@ -67,7 +67,7 @@ pub fn stroke(k: u64) -> (f64, f64) {
     )
 }
 
-/// Valve command [V] at step `k`: 2 and 8 V alternating every 60 ms.
+/// Valve command \[V\] at step `k`: 2 and 8 V alternating every 60 ms.
 pub fn valve_command(k: u64) -> f64 {
     if (k / 60) % 2 == 1 {
         8.0
@@ -76,7 +76,7 @@ pub fn valve_command(k: u64) -> f64 {
     }
 }
 
-/// Length of the precomputed input sequence (5 s; it repeats after that) [steps].
+/// Length of the precomputed input sequence (5 s; it repeats after that) \[steps\].
 pub const INPUT_STEPS: usize = 5000;
 
 /// The model of one case, ready to step, and its precomputed inputs (so the measured loop

@@ -54,21 +54,21 @@ pub struct Consts {
     pub linear: LinearContactConsts,
     /// Non-linear contact.
     pub nonlinear: bool,
-    /// kappa f11 [N].
+    /// kappa f11 \[N\].
     pub f11: f64,
-    /// kappa f22 [N].
+    /// kappa f22 \[N\].
     pub f22: f64,
-    /// s [m].
+    /// s \[m\].
     pub s: f64,
-    /// r0 [m].
+    /// r0 \[m\].
     pub r0: f64,
     /// Nominal wheel speed Omega [rad/s].
     pub omega: f64,
     /// 1 / J_w.
     pub jw_inv: f64,
-    /// P [N].
+    /// P \[N\].
     pub load: f64,
-    /// mu P [N].
+    /// mu P \[N\].
     pub mu_p: f64,
 }
 
@@ -109,7 +109,7 @@ impl LinearContactConsts {
 }
 
 impl Consts {
-    /// Largest internal step the explicit RK4 needs for stability and accuracy [s]: 1.5 over
+    /// Largest internal step the explicit RK4 needs for stability and accuracy \[s\]: 1.5 over
     /// the fastest creep-damping rate (lateral 2 kappa f22/(V m_w), yaw 2 kappa f11 s^2/(V I_w),
     /// spin 2 kappa f11 r0^2/(V J_w)), and 1 over the highest frequency bound (Gershgorin bound
     /// of M^-1 K of the suspension, and the contact-angle stiffness P d tan(gamma)/dy of the
@@ -173,13 +173,13 @@ impl Consts {
 /// Wheel/rail forces on one wheelset.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct WheelsetForces {
-    /// Sum of the lateral forces of the rails on the wheelset (guiding force), positive right [N].
+    /// Sum of the lateral forces of the rails on the wheelset (guiding force), positive right \[N\].
     pub lateral_n: f64,
     /// Yaw moment [N m].
     pub yaw_moment_nm: f64,
-    /// Lateral force on the left wheel [N].
+    /// Lateral force on the left wheel \[N\].
     pub left_n: f64,
-    /// Lateral force on the right wheel [N].
+    /// Lateral force on the right wheel \[N\].
     pub right_n: f64,
     /// beta'' [rad/s^2].
     pub spin_acc: f64,

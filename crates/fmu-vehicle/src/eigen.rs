@@ -217,7 +217,7 @@ pub struct Mode {
     pub re: f64,
     /// Imaginary part omega [rad/s].
     pub im: f64,
-    /// omega / 2 pi [Hz].
+    /// omega / 2 pi \[Hz\].
     pub freq_hz: f64,
     /// -re / |lambda| (negative = unstable).
     pub damping_ratio: f64,

@@ -16,7 +16,7 @@ use crate::params::{ContactSource, Initial, VehicleParams};
 
 /// Speed of the FMU's start values (default experiment: hunting into flange contact) [m/s].
 pub const FMU_DEFAULT_SPEED_MPS: f64 = 300.0 / 3.6;
-/// Initial lateral displacement of both bogies in the FMU's start values [m].
+/// Initial lateral displacement of both bogies in the FMU's start values \[m\].
 pub const FMU_DEFAULT_INITIAL_LATERAL_M: f64 = 3e-3;
 
 // The FMI Enumeration `TrackSource`, with where this model applies the external input.

@@ -84,11 +84,11 @@ pub fn damper_side(d: usize) -> f64 {
 /// Longitudinal positions (from the car-body centre, forward positive) and distances.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Positions {
-    /// Bogie centres [m]: +a, -a.
+    /// Bogie centres \[m\]: +a, -a.
     pub bogie_x_m: [f64; N_BOGIES],
-    /// Wheelsets [m]: a + p, a - p, -a + p, -a - p.
+    /// Wheelsets \[m\]: a + p, a - p, -a + p, -a - p.
     pub wheelset_x_m: [f64; N_WHEELSETS],
-    /// Distance of each wheelset behind the leading one [m]: 0, 2p, 2a, 2a + 2p.
+    /// Distance of each wheelset behind the leading one \[m\]: 0, 2p, 2a, 2a + 2p.
     pub wheelset_delay_m: [f64; N_WHEELSETS],
 }
 
@@ -304,7 +304,7 @@ pub fn mass_diagonal(p: &VehicleParams) -> [f64; N_DOF] {
     m
 }
 
-/// Rows of the yaw-damper elongations e = E q [m]: e_left = b (psi_frame - psi_carbody),
+/// Rows of the yaw-damper elongations e = E q \[m\]: e_left = b (psi_frame - psi_carbody),
 /// e_right = -b (psi_frame - psi_carbody) (car-body end ahead of the frame end, extension
 /// positive). A tension force F does the virtual work -F de, so its generalised force is
 /// -E^T F.

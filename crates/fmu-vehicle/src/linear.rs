@@ -17,11 +17,11 @@ use crate::params::VehicleParams;
 /// Linear wheel/rail constants of one wheelset (already multiplied by the reduction factor).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LinearContact {
-    /// kappa f11 [N].
+    /// kappa f11 \[N\].
     pub f11_n: f64,
-    /// kappa f22 [N].
+    /// kappa f22 \[N\].
     pub f22_n: f64,
-    /// s [m].
+    /// s \[m\].
     pub s_m: f64,
     /// lambda / r0 [1/m].
     pub lambda_over_r0: f64,

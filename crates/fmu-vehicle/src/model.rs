@@ -65,7 +65,7 @@ pub enum ModelError {
         side: &'static str,
         /// Largest tan(gamma) of that side.
         max_tan_gamma: f64,
-        /// Range end on that side [mm].
+        /// Range end on that side \[mm\].
         range_mm: f64,
     },
 }
@@ -79,7 +79,7 @@ pub enum StepError {
     /// The state became NaN or infinite.
     #[error("state diverged at t = {time_s} s")]
     Diverged {
-        /// Time [s].
+        /// Time \[s\].
         time_s: f64,
     },
     /// A wheelset left the contact table's range: it has climbed the flange (derailment).
@@ -88,13 +88,13 @@ pub enum StepError {
          relative to the track, beyond the contact table's range ({limit_mm:.2} mm)"
     )]
     Derailed {
-        /// Time [s].
+        /// Time \[s\].
         time_s: f64,
         /// Wheelset number, 1 = leading.
         wheelset: usize,
-        /// Displacement relative to the track [mm].
+        /// Displacement relative to the track \[mm\].
         y_rel_mm: f64,
-        /// Table range on that side [mm].
+        /// Table range on that side \[mm\].
         limit_mm: f64,
     },
 }
@@ -102,9 +102,9 @@ pub enum StepError {
 /// Inputs of one communication step.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Inputs {
-    /// Yaw damper forces, tension positive [N]: front left, front right, rear left, rear right.
+    /// Yaw damper forces, tension positive \[N\]: front left, front right, rear left, rear right.
     pub damper_force_n: [f64; N_DAMPERS],
-    /// Track lateral alignment under the leading wheelset, positive right [m] (used when the
+    /// Track lateral alignment under the leading wheelset, positive right \[m\] (used when the
     /// track source is External).
     pub track_lateral_m: f64,
 }
@@ -125,32 +125,32 @@ impl Inputs {
 /// Outputs of one wheelset.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct WheelsetOutputs {
-    /// Lateral displacement (absolute) [m].
+    /// Lateral displacement (absolute) \[m\].
     pub lateral_m: f64,
-    /// Lateral displacement relative to the track [m].
+    /// Lateral displacement relative to the track \[m\].
     pub lateral_rel_track_m: f64,
     /// Lateral velocity [m/s].
     pub lateral_velocity_mps: f64,
     /// Lateral acceleration [m/s^2].
     pub lateral_acc_mps2: f64,
-    /// Yaw angle, nose-left [rad].
+    /// Yaw angle, nose-left \[rad\].
     pub yaw_rad: f64,
-    /// Guiding force: sum of the lateral forces of the rails on the wheelset, positive right [N].
+    /// Guiding force: sum of the lateral forces of the rails on the wheelset, positive right \[N\].
     pub guiding_force_n: f64,
     /// Y/Q of the wheel with the larger lateral force: max(|Y_L|, |Y_R|) / P [-].
     pub y_over_q: f64,
-    /// Track alignment under the wheelset [m].
+    /// Track alignment under the wheelset \[m\].
     pub track_m: f64,
 }
 
 /// Outputs of one bogie frame.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct FrameOutputs {
-    /// Lateral displacement of the centre [m].
+    /// Lateral displacement of the centre \[m\].
     pub lateral_m: f64,
-    /// Yaw angle, nose-left [rad].
+    /// Yaw angle, nose-left \[rad\].
     pub yaw_rad: f64,
-    /// Roll angle [rad].
+    /// Roll angle \[rad\].
     pub roll_rad: f64,
     /// Lateral acceleration of the frame over its leading axle box, at the frame's centre
     /// height (EN 14363 stability quantity) [m/s^2].
@@ -163,11 +163,11 @@ pub struct FrameOutputs {
 /// component g phi an accelerometer tilting with the body would add).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct CarBodyOutputs {
-    /// Lateral displacement of the centre of gravity [m].
+    /// Lateral displacement of the centre of gravity \[m\].
     pub lateral_m: f64,
-    /// Yaw angle, nose-left [rad].
+    /// Yaw angle, nose-left \[rad\].
     pub yaw_rad: f64,
-    /// Roll angle [rad].
+    /// Roll angle \[rad\].
     pub roll_rad: f64,
     /// Lateral acceleration at floor height above the front bogie centre [m/s^2].
     pub lateral_acc_front_mps2: f64,
@@ -182,7 +182,7 @@ pub struct CarBodyOutputs {
 /// towards the car-body end); elongation velocity = car-body end - frame end.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct DamperOutputs {
-    /// Elongation, extension positive [m].
+    /// Elongation, extension positive \[m\].
     pub elongation_m: f64,
     /// Elongation velocity [m/s].
     pub elongation_velocity_mps: f64,
@@ -199,7 +199,7 @@ pub struct DamperOutputs {
 /// All outputs at one instant.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Outputs {
-    /// Time [s].
+    /// Time \[s\].
     pub time_s: f64,
     /// Wheelsets, leading first.
     pub wheelset: [WheelsetOutputs; N_WHEELSETS],
@@ -324,7 +324,7 @@ impl Vehicle {
         &self.table
     }
 
-    /// Current time [s].
+    /// Current time \[s\].
     pub fn time_s(&self) -> f64 {
         self.time_s
     }
@@ -345,7 +345,7 @@ impl Vehicle {
         Ok(())
     }
 
-    /// Largest internal sub-step [s] (the parameter, lowered where stability needs it).
+    /// Largest internal sub-step \[s\] (the parameter, lowered where stability needs it).
     pub fn substep_s(&self) -> f64 {
         self.substep_s
     }

@@ -49,18 +49,18 @@ pub const MB_PRIMARY_KX_N_PER_M: f64 = 31.391e6;
 pub const MB_PRIMARY_KY_N_PER_M: f64 = 3.884e6;
 /// Factor on the benchmark's primary longitudinal and lateral stiffness, calibrated for R15.
 pub const PRIMARY_STIFFNESS_FACTOR: f64 = 3.15;
-/// Largest RK4 sub-step of the time-domain model [s].
+/// Largest RK4 sub-step of the time-domain model \[s\].
 pub const SOLVER_SUBSTEP_S: f64 = 1e-3;
 
 /// Standard gravity [m/s^2].
 pub const STANDARD_GRAVITY_MPS2: f64 = 9.81;
 
-/// Static wheel load of the 2-dof bogie's calibration [N] (its Kalker coefficients are taken
+/// Static wheel load of the 2-dof bogie's calibration \[N\] (its Kalker coefficients are taken
 /// there).
 pub const BOGIE_WHEEL_LOAD_N: f64 = 70e3;
-/// Kalker f11 at [`BOGIE_WHEEL_LOAD_N`] (Hertz + Kalker, as the bogie) [N].
+/// Kalker f11 at [`BOGIE_WHEEL_LOAD_N`] (Hertz + Kalker, as the bogie) \[N\].
 pub const BOGIE_F11_N: f64 = 11.5e6;
-/// Kalker f22 at [`BOGIE_WHEEL_LOAD_N`] [N].
+/// Kalker f22 at [`BOGIE_WHEEL_LOAD_N`] \[N\].
 pub const BOGIE_F22_N: f64 = 10.4e6;
 
 vehicle_elements::force_law_enum!(
@@ -70,65 +70,65 @@ vehicle_elements::force_law_enum!(
 
 pub use wheel_rail::track::{PsdLevel, TrackSource};
 
-/// Car body [MB].
+/// Car body \[MB\].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CarBody {
-    /// Mass [kg] (MB 32 000).
+    /// Mass \[kg\] (MB 32 000).
     pub mass_kg: f64,
     /// Roll inertia about the centre of gravity [kg m^2] (MB 56 800).
     pub roll_inertia_kgm2: f64,
     /// Yaw inertia [kg m^2] (MB 1 970 000).
     pub yaw_inertia_kgm2: f64,
-    /// Height of the centre of gravity above the rail [m] (MB 1.8).
+    /// Height of the centre of gravity above the rail \[m\] (MB 1.8).
     pub cg_height_m: f64,
-    /// Height above the rail of the comfort measuring points (floor) [m] [chosen] 1.2.
+    /// Height above the rail of the comfort measuring points (floor) \[m\] \[chosen\] 1.2.
     pub floor_height_m: f64,
 }
 
 /// One bogie frame (both identical).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Frame {
-    /// Mass [kg] [seed] 2474 (6.1 t bogie; MB 2615).
+    /// Mass \[kg\] \[seed\] 2474 (6.1 t bogie; MB 2615).
     pub mass_kg: f64,
     /// Roll inertia [kg m^2] (MB 1722).
     pub roll_inertia_kgm2: f64,
     /// Yaw inertia [kg m^2] (MB 3067).
     pub yaw_inertia_kgm2: f64,
-    /// Height of the centre of gravity above the rail [m] (MB 0.6).
+    /// Height of the centre of gravity above the rail \[m\] (MB 0.6).
     pub cg_height_m: f64,
 }
 
 /// One wheelset (all four identical).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Wheelset {
-    /// Mass [kg] (MB 1813).
+    /// Mass \[kg\] (MB 1813).
     pub mass_kg: f64,
     /// Yaw inertia [kg m^2] (MB 1120).
     pub yaw_inertia_kgm2: f64,
     /// Spin inertia about the axle [kg m^2] (MB 112).
     pub spin_inertia_kgm2: f64,
-    /// Nominal rolling radius r0 [m] (MB 0.46); the axle is at this height.
+    /// Nominal rolling radius r0 \[m\] (MB 0.46); the axle is at this height.
     pub wheel_radius_m: f64,
-    /// Half distance between the contact points s [m] [bogie] 0.7465.
+    /// Half distance between the contact points s \[m\] \[bogie\] 0.7465.
     pub half_contact_gauge_m: f64,
 }
 
 /// Longitudinal geometry and lateral arms.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Geometry {
-    /// a: half distance between the bogie centres [m] [seed] 8.75.
+    /// a: half distance between the bogie centres \[m\] \[seed\] 8.75.
     pub half_bogie_spacing_m: f64,
-    /// p: half wheelbase [m] [seed] 1.25.
+    /// p: half wheelbase \[m\] \[seed\] 1.25.
     pub half_wheelbase_m: f64,
-    /// Lateral semi-spacing of the primary springs (axle boxes) [m] (MB 1.0).
+    /// Lateral semi-spacing of the primary springs (axle boxes) \[m\] (MB 1.0).
     pub primary_half_spacing_m: f64,
-    /// Lateral semi-spacing of the air springs [m] (MB 1.0).
+    /// Lateral semi-spacing of the air springs \[m\] (MB 1.0).
     pub secondary_half_spacing_m: f64,
-    /// b: lateral arm of the yaw dampers [m] [bogie] 1.35.
+    /// b: lateral arm of the yaw dampers \[m\] \[bogie\] 1.35.
     pub damper_arm_m: f64,
-    /// Height of the air springs' force plane above the rail [m] (MB 0.8275).
+    /// Height of the air springs' force plane above the rail \[m\] (MB 0.8275).
     pub secondary_height_m: f64,
-    /// Height of the secondary lateral dampers [m] [chosen] = air-spring height.
+    /// Height of the secondary lateral dampers \[m\] \[chosen\] = air-spring height.
     pub lateral_damper_height_m: f64,
 }
 
@@ -171,7 +171,7 @@ pub struct Secondary {
     pub anti_roll_bar_nm_per_rad: f64,
 }
 
-/// Wheel/rail contact [bogie].
+/// Wheel/rail contact \[bogie\].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WheelRail {
     /// lambda: equivalent conicity of the linear model [-] (the default table at 1 mm).
@@ -179,13 +179,13 @@ pub struct WheelRail {
     /// Lateral gravitational (contact-angle) stiffness per wheelset of the linear model [N/m]
     /// (the default table at 1 mm, times the wheel load).
     pub gravity_stiffness_n_per_m: f64,
-    /// f11 per wheel [N] (Hertz + Kalker, scaled to the wheel load).
+    /// f11 per wheel \[N\] (Hertz + Kalker, scaled to the wheel load).
     pub f11_n: f64,
-    /// f22 per wheel [N].
+    /// f22 per wheel \[N\].
     pub f22_n: f64,
     /// kappa: reduction factor on f11, f22 in (0, 1] [-] (0.6, Polach 2005).
     pub creep_reduction: f64,
-    /// P: static vertical load per wheel [N] (weight of the coach / 8).
+    /// P: static vertical load per wheel \[N\] (weight of the coach / 8).
     pub wheel_load_n: f64,
     /// mu: friction coefficient in (0, 1] (0.35).
     pub friction_coefficient: f64,
@@ -194,9 +194,9 @@ pub struct WheelRail {
 /// Initial condition: both bogies (frames and wheelsets) displaced and yawed, car body at rest.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 pub struct Initial {
-    /// Lateral displacement of both bogies [m].
+    /// Lateral displacement of both bogies \[m\].
     pub lateral_m: f64,
-    /// Yaw angle of both bogies, positive nose-left [rad].
+    /// Yaw angle of both bogies, positive nose-left \[rad\].
     pub yaw_rad: f64,
 }
 
@@ -239,23 +239,23 @@ pub struct VehicleParams {
     pub track: TrackSource,
     /// Contact table of the non-linear model.
     pub contact: ContactSource,
-    /// Largest internal integration sub-step [s] (RK4; see the convergence study in
+    /// Largest internal integration sub-step \[s\] (RK4; see the convergence study in
     /// [`crate::calibration`]).
     pub solver_substep_s: f64,
 }
 
 impl VehicleParams {
-    /// Total mass of the coach [kg].
+    /// Total mass of the coach \[kg\].
     pub fn total_mass_kg(&self) -> f64 {
         self.carbody.mass_kg + 2.0 * self.frame.mass_kg + 4.0 * self.wheelset.mass_kg
     }
 
-    /// Mass of one bogie with its two wheelsets [kg] (the EN 14363 a_lim mass).
+    /// Mass of one bogie with its two wheelsets \[kg\] (the EN 14363 a_lim mass).
     pub fn bogie_mass_kg(&self) -> f64 {
         self.frame.mass_kg + 2.0 * self.wheelset.mass_kg
     }
 
-    /// Static wheel load the masses give, g m_total / 8 [N].
+    /// Static wheel load the masses give, g m_total / 8 \[N\].
     pub fn wheel_load_from_masses_n(&self) -> f64 {
         STANDARD_GRAVITY_MPS2 * self.total_mass_kg() / 8.0
     }

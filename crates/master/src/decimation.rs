@@ -31,23 +31,23 @@ pub const PASSBAND_GAIN: f64 = 0.99;
 pub struct Decimation {
     /// Every `factor`-th row of the full-rate record is kept.
     pub factor: usize,
-    /// Sampling rate of the full-rate record [Hz].
+    /// Sampling rate of the full-rate record \[Hz\].
     pub source_rate_hz: f64,
     /// The anti-aliasing filter applied to every Real column before the rows were picked.
     pub filter: String,
     /// Its prototype order (per pass).
     pub filter_order: usize,
-    /// Its -3 dB cut-off (per pass) [Hz].
+    /// Its -3 dB cut-off (per pass) \[Hz\].
     pub cutoff_hz: f64,
 }
 
 /// The sampling of the stored rows, written into every results file's metadata.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Sampling {
-    /// Rate of the stored rows [Hz].
+    /// Rate of the stored rows \[Hz\].
     pub rate_hz: f64,
     /// Highest frequency the stored Real signals carry with less than 1 % amplitude error
-    /// and free of aliases [Hz]: the Nyquist frequency of a full-rate record, the frequency
+    /// and free of aliases \[Hz\]: the Nyquist frequency of a full-rate record, the frequency
     /// where the anti-aliasing filter's gain falls to [`PASSBAND_GAIN`] in a decimated one.
     pub passband_hz: f64,
     /// How the rows were decimated; `None`: every communication point is stored.
@@ -63,7 +63,7 @@ pub enum DecimationError {
     Filter(#[from] signal_processing::DesignError),
 }
 
-/// Mean sampling rate of the recorded rows from the time column [Hz]; `None` with fewer than
+/// Mean sampling rate of the recorded rows from the time column \[Hz\]; `None` with fewer than
 /// two rows or a time column that does not increase.
 pub fn sample_rate_hz(out: &SimOutput) -> Option<f64> {
     let w = out.header.len().max(1);

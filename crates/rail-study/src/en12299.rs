@@ -18,9 +18,9 @@
 
 use signal_processing::WdWeighting;
 
-/// EN 12299 window of the continuous comfort [s].
+/// EN 12299 window of the continuous comfort \[s\].
 pub const WINDOW_S: f64 = 5.0;
-/// Step of the overlapping windows (our interpretation, see the module) [s].
+/// Step of the overlapping windows (our interpretation, see the module) \[s\].
 pub const STEP_S: f64 = 1.0;
 
 /// Why a signal could not be evaluated.

@@ -6,7 +6,7 @@
 //!
 //! EN 14363:2016 (stability, rms criteria) also bounds the rms of the sum of guiding forces
 //! of a wheelset by half the Prud'homme limit with alpha = 1:
-//! `(Sum Y)_lim = (10 + 2 Q0 / 3) / 2` [kN], `Q0` the static wheel load in kN (2 Q0 = axle
+//! `(Sum Y)_lim = (10 + 2 Q0 / 3) / 2` \[kN\], `Q0` the static wheel load in kN (2 Q0 = axle
 //! load P0 in the usual `10 + P0/3`). The same filter and window are used.
 //!
 //! Interpretations: the filter is a zero-phase (forward-backward) Butterworth band-pass
@@ -24,7 +24,7 @@ pub fn acceleration_limit(bogie_mass_t: f64) -> f64 {
     (12.0 - bogie_mass_t / 5.0) / 2.0
 }
 
-/// EN 14363 limit of the rms of the sum of guiding forces [kN] for a static wheel load [kN]:
+/// EN 14363 limit of the rms of the sum of guiding forces \[kN\] for a static wheel load \[kN\]:
 /// (10 + 2 Q0/3)/2.
 pub fn guiding_force_limit_kn(static_wheel_load_kn: f64) -> f64 {
     (10.0 + 2.0 * static_wheel_load_kn / 3.0) / 2.0
@@ -33,19 +33,19 @@ pub fn guiding_force_limit_kn(static_wheel_load_kn: f64) -> f64 {
 /// Settings of the assessment.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StabilitySettings {
-    /// rms window length along the track [m] (EN 14363: 100 m).
+    /// rms window length along the track \[m\] (EN 14363: 100 m).
     pub window_m: f64,
-    /// window advance [m] (EN 14363: 10 m).
+    /// window advance \[m\] (EN 14363: 10 m).
     pub step_m: f64,
-    /// half band width around the dominant frequency [Hz] (EN 14363: 2 Hz).
+    /// half band width around the dominant frequency \[Hz\] (EN 14363: 2 Hz).
     pub half_band_hz: f64,
     /// Butterworth prototype order per pass.
     pub filter_order: usize,
-    /// dominant frequency [Hz]; `None` = find it from the spectrum.
+    /// dominant frequency \[Hz\]; `None` = find it from the spectrum.
     pub dominant_frequency_hz: Option<f64>,
-    /// search range for the dominant frequency [Hz].
+    /// search range for the dominant frequency \[Hz\].
     pub search_hz: (f64, f64),
-    /// samples discarded at the start (initial transient of the simulation) [s].
+    /// samples discarded at the start (initial transient of the simulation) \[s\].
     pub skip_s: f64,
 }
 
@@ -64,7 +64,7 @@ impl Default for StabilitySettings {
 }
 
 impl StabilitySettings {
-    /// Track a record of `duration_s` at `speed_kmh` covers once `skip_s` is dropped [m]: the
+    /// Track a record of `duration_s` at `speed_kmh` covers once `skip_s` is dropped \[m\]: the
     /// assessment needs at least one window of `window_m`.
     pub fn assessed_m(&self, duration_s: f64, speed_kmh: f64) -> f64 {
         (duration_s - self.skip_s) * speed_kmh / 3.6
@@ -85,7 +85,7 @@ pub struct Assessment {
     pub band_hz: (f64, f64),
     pub limit: f64,
     pub max_rms: f64,
-    /// (window centre along the track [m], rms)
+    /// (window centre along the track \[m\], rms)
     pub rms: Vec<(f64, f64)>,
     /// `max_rms <= limit`
     pub stable: bool,
@@ -101,7 +101,7 @@ fn param(
     Ok(check(name, value, ok, reason)?)
 }
 
-/// Filtered sliding-window rms of a signal sampled at `fs` [Hz] at constant `speed_mps`,
+/// Filtered sliding-window rms of a signal sampled at `fs` \[Hz\] at constant `speed_mps`,
 /// compared with `limit` (same unit as the signal).
 pub fn assess_rms(
     signal: &[f64],

@@ -91,7 +91,7 @@ pub fn fft(x: &mut [Complex64]) {
 }
 
 /// Welch power spectral density (Hann window, 50 % overlap, segments of `seg_len` samples
-/// rounded up to a power of two, mean removed per segment). Returns (frequencies [Hz], PSD
+/// rounded up to a power of two, mean removed per segment). Returns (frequencies \[Hz\], PSD
 /// [unit^2/Hz], one-sided).
 pub fn welch(x: &[f64], fs: f64, seg_len: usize) -> Result<(Vec<f64>, Vec<f64>), SignalError> {
     welch_padded(x, fs, seg_len.max(8).next_power_of_two())
@@ -100,7 +100,7 @@ pub fn welch(x: &[f64], fs: f64, seg_len: usize) -> Result<(Vec<f64>, Vec<f64>),
 /// Welch power spectral density over segments of exactly `seg_len` samples (at least 8; Hann
 /// window over the segment, 50 % overlap, mean removed per segment), each zero-padded to the
 /// next power of two for the FFT. The resolution follows the segment's duration, the padding
-/// only samples the same spectrum more finely. Returns (frequencies [Hz], PSD [unit^2/Hz],
+/// only samples the same spectrum more finely. Returns (frequencies \[Hz\], PSD [unit^2/Hz],
 /// one-sided).
 pub fn welch_padded(
     x: &[f64],
@@ -146,7 +146,7 @@ pub fn welch_padded(
     Ok((freqs, psd))
 }
 
-/// Duration of the Welch segments that find the dominant frequency [s]: 8192 samples at
+/// Duration of the Welch segments that find the dominant frequency \[s\]: 8192 samples at
 /// 1 kHz. A duration, not a number of samples: the frequency resolution, and so the peak
 /// found, is the same at any sampling rate (a 100 Hz file gives the full-rate frequency).
 pub const DOMINANT_SEGMENT_S: f64 = 8.192;
@@ -194,7 +194,7 @@ fn spectral_peak(f: &[f64], p: &[f64], f_min: f64, f_max: f64) -> Result<f64, Si
 }
 
 /// RMS over sliding windows of `window_m` metres advanced by `step_m` metres, for a signal
-/// sampled at `fs` while running at constant `speed_mps`. Returns (window centre [m], rms).
+/// sampled at `fs` while running at constant `speed_mps`. Returns (window centre \[m\], rms).
 pub fn sliding_rms_distance(
     x: &[f64],
     fs: f64,

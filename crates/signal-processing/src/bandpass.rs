@@ -55,7 +55,7 @@ pub struct BandPass {
 impl BandPass {
     /// Design from the analogue Butterworth low-pass prototype of order `prototype_order`
     /// (1..=10; the band-pass has twice that order and as many sections) with edges
-    /// `f_low_hz < f_high_hz` [Hz] at sample time `dt_s` [s]. The analogue edges are pre-warped,
+    /// `f_low_hz < f_high_hz` \[Hz\] at sample time `dt_s` \[s\]. The analogue edges are pre-warped,
     /// `w = (2/T) tan(pi f T)`, so the digital -3 dB points are exact.
     pub fn butterworth(
         prototype_order: usize,

@@ -36,7 +36,7 @@ pub fn rms(x: &[f64]) -> f64 {
     (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt()
 }
 
-/// `signal(t)` sampled at `fs` [Hz] for `secs` seconds, `t = i / fs` (test signals).
+/// `signal(t)` sampled at `fs` \[Hz\] for `secs` seconds, `t = i / fs` (test signals).
 pub fn sampled(signal: impl Fn(f64) -> f64, fs: f64, secs: f64) -> Vec<f64> {
     (0..(secs * fs) as usize)
         .map(|i| signal(i as f64 / fs))

@@ -18,7 +18,7 @@ pub struct LowPass {
 
 impl LowPass {
     /// Design from the analogue Butterworth prototype of order `order` (1..=10) with cut-off
-    /// `cutoff_hz` below the Nyquist frequency of the sample time `dt_s` [s], by the bilinear
+    /// `cutoff_hz` below the Nyquist frequency of the sample time `dt_s` \[s\], by the bilinear
     /// transform with a pre-warped cut-off (the digital -3 dB point is exact).
     pub fn butterworth(order: usize, cutoff_hz: f64, dt_s: f64) -> Result<Self, DesignError> {
         let bad = |parameter, reason: String| DesignError { parameter, reason };

@@ -49,7 +49,7 @@ pub struct WdWeighting {
 }
 
 impl WdWeighting {
-    /// The filter for sampling interval `dt_s` [s]; `None` unless `dt_s` is finite, > 0 and
+    /// The filter for sampling interval `dt_s` \[s\]; `None` unless `dt_s` is finite, > 0 and
     /// the sampling rate is above 10 Hz (the transition section at 2 Hz needs it).
     pub fn new(dt_s: f64) -> Option<Self> {
         if !(dt_s.is_finite() && dt_s > 0.0 && 1.0 / dt_s > 10.0) {

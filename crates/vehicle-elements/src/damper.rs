@@ -37,8 +37,8 @@ pub enum LinearDamper {
 
 impl LinearDamper {
     /// Force of one damper held over the next step of length `h_s`, from its elongation
-    /// [m] and elongation velocity [m/s] at the start of the step; `state_n` is the
-    /// Maxwell element's force [N], advanced to the end of the step.
+    /// \[m\] and elongation velocity [m/s] at the start of the step; `state_n` is the
+    /// Maxwell element's force \[N\], advanced to the end of the step.
     pub fn held_force_n(
         &self,
         elongation_m: f64,
@@ -69,17 +69,17 @@ pub trait ClosedLoopModel<const N: usize> {
     /// Error of a step or an output evaluation.
     type Error;
 
-    /// Model time [s].
+    /// Model time \[s\].
     fn time_s(&self) -> f64;
     /// Outputs at the current state for `inputs`.
     fn outputs(&self, inputs: &Self::Inputs) -> Result<Self::Outputs, Self::Error>;
     /// One communication step of length `h_s`.
     fn step(&mut self, h_s: f64, inputs: &Self::Inputs) -> Result<Self::Outputs, Self::Error>;
-    /// Sets the track alignment input [m].
+    /// Sets the track alignment input \[m\].
     fn set_track_lateral_m(inputs: &mut Self::Inputs, track_lateral_m: f64);
-    /// Elongation [m] and elongation velocity [m/s] of each damper.
+    /// Elongation \[m\] and elongation velocity [m/s] of each damper.
     fn damper_motion(outputs: &Self::Outputs) -> [(f64, f64); N];
-    /// Sets the force input [N] of each damper.
+    /// Sets the force input \[N\] of each damper.
     fn set_damper_force_n(inputs: &mut Self::Inputs, force_n: [f64; N]);
 }
 

@@ -27,7 +27,7 @@ pub trait ShellPhysics: Clone + Sized {
     fn build(params: Self::Params) -> Result<Self, Self::BuildError>;
     /// Outputs of the current state with `inputs`.
     fn outputs(&self, inputs: &Self::Inputs) -> Result<Self::Outputs, Self::StepError>;
-    /// One step of `h` [s] with `inputs` held; the physics is unchanged when it fails.
+    /// One step of `h` \[s\] with `inputs` held; the physics is unchanged when it fails.
     fn step(&mut self, h: f64, inputs: &Self::Inputs) -> Result<Self::Outputs, Self::StepError>;
     /// The step or input refused in `e`, if that is what it is.
     fn input_error(e: &Self::StepError) -> Option<&InputError>;

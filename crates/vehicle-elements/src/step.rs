@@ -3,7 +3,7 @@
 
 use model_description::FieldError;
 
-/// The largest communication step a model accepts [s].
+/// The largest communication step a model accepts \[s\].
 pub const MAX_STEP_S: f64 = 1.0;
 
 /// A step refused before it starts; the model is unchanged.
@@ -20,12 +20,12 @@ pub enum InputError {
     /// Step size not usable.
     #[error("invalid communication step {h} s (must be finite, > 0 and <= 1 s)")]
     InvalidStep {
-        /// Step [s].
+        /// Step \[s\].
         h: f64,
     },
 }
 
-/// `h` [s] is finite, > 0 and <= [`MAX_STEP_S`].
+/// `h` \[s\] is finite, > 0 and <= [`MAX_STEP_S`].
 pub fn check_step(h: f64) -> Result<(), InputError> {
     if h.is_finite() && h > 0.0 && h <= MAX_STEP_S {
         Ok(())

@@ -3,7 +3,7 @@
 
 use serde::{de::DeserializeOwned, Serialize};
 
-/// Shortest internal sub-step the vehicle models accept [s]. Their sub-step follows their
+/// Shortest internal sub-step the vehicle models accept \[s\]. Their sub-step follows their
 /// fastest dynamics (creep decay, contact and suspension frequencies); parameters that need a
 /// shorter one are outside any vehicle's range (a mass of a few ulps, a stiffness of 1e300), and
 /// would make a 1 ms step take longer than any host waits.
@@ -13,7 +13,7 @@ pub const MIN_SUBSTEP_S: f64 = 1e-7;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{}{}", .parameter.as_ref().map(|p| format!("`{p}`: ")).unwrap_or_default(), self.reason())]
 pub struct TooStiff {
-    /// The sub-step the dynamics need [s] (NaN when the parameters give no rate at all).
+    /// The sub-step the dynamics need \[s\] (NaN when the parameters give no rate at all).
     pub substep_s: f64,
     /// The parameter to blame (dotted field of the parameter struct, see [`blame_substep`]).
     pub parameter: Option<String>,

@@ -105,13 +105,13 @@ pub enum ConicityError {
         .delta_r_max_m * 1e3
     )]
     NoEquilibrium {
-        /// Range where Δr is known [m].
+        /// Range where Δr is known \[m\].
         y_min_m: f64,
-        /// Range where Δr is known [m].
+        /// Range where Δr is known \[m\].
         y_max_m: f64,
-        /// Δr at `y_min_m` [m].
+        /// Δr at `y_min_m` \[m\].
         delta_r_min_m: f64,
-        /// Δr at `y_max_m` [m].
+        /// Δr at `y_max_m` \[m\].
         delta_r_max_m: f64,
     },
     /// No kinematic oscillation of this amplitude exists on the known Δr.
@@ -137,20 +137,20 @@ pub enum ConicityError {
 /// Result of the reference (Klingel) method.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Conicity {
-    /// Amplitude ŷ [m].
+    /// Amplitude ŷ \[m\].
     pub amplitude_m: f64,
     /// Equivalent conicity tanγe [-]; 0 where Δr does not restore (flat tread).
     pub tan_gamma_e: f64,
-    /// Wavelength of the kinematic oscillation [m] (with `e0_m`, `r0_m`); `f64::INFINITY` when
+    /// Wavelength of the kinematic oscillation \[m\] (with `e0_m`, `r0_m`); `f64::INFINITY` when
     /// tanγe = 0.
     pub wavelength_m: f64,
-    /// Left turning point y1 [m].
+    /// Left turning point y1 \[m\].
     pub y1_m: f64,
-    /// Right turning point y2 = y1 + 2ŷ [m].
+    /// Right turning point y2 = y1 + 2ŷ \[m\].
     pub y2_m: f64,
-    /// Half distance between contact points used for the wavelength [m].
+    /// Half distance between contact points used for the wavelength \[m\].
     pub e0_m: f64,
-    /// Mean nominal rolling radius used for the wavelength [m].
+    /// Mean nominal rolling radius used for the wavelength \[m\].
     pub r0_m: f64,
     /// A turning point lies beyond the table's flange limit (the wheel climbs its flange there).
     pub beyond_flange_limit: bool,
@@ -159,13 +159,13 @@ pub struct Conicity {
 /// Result of the linear-regression method (Annex C).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LinearRegression {
-    /// Amplitude ŷ [m].
+    /// Amplitude ŷ \[m\].
     pub amplitude_m: f64,
     /// Equivalent conicity tanγe = slope / 2 [-].
     pub tan_gamma_e: f64,
-    /// Centre of the regression interval, ym = (y1 + y2) / 2 of the reference method [m].
+    /// Centre of the regression interval, ym = (y1 + y2) / 2 of the reference method \[m\].
     pub centre_m: f64,
-    /// Δr of the regression line at the centre [m].
+    /// Δr of the regression line at the centre \[m\].
     pub intercept_m: f64,
 }
 

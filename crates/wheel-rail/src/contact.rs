@@ -95,17 +95,17 @@ pub enum ContactError {
 /// Contact point of one wheel.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct WheelContact {
-    /// Contact position on the wheel profile, in the wheel profile's own lateral coordinate [m].
+    /// Contact position on the wheel profile, in the wheel profile's own lateral coordinate \[m\].
     pub wheel_lateral_m: f64,
-    /// Contact position on the rail profile, in the rail file's own lateral coordinate [m].
+    /// Contact position on the rail profile, in the rail file's own lateral coordinate \[m\].
     pub rail_lateral_m: f64,
-    /// Contact point in the track frame: lateral [m] (positive right).
+    /// Contact point in the track frame: lateral \[m\] (positive right).
     pub track_lateral_m: f64,
-    /// Contact point in the track frame: vertical [m] (rail surface height).
+    /// Contact point in the track frame: vertical \[m\] (rail surface height).
     pub track_vertical_m: f64,
-    /// Rolling radius [m].
+    /// Rolling radius \[m\].
     pub rolling_radius_m: f64,
-    /// Rolling radius minus the nominal radius of this wheel [m].
+    /// Rolling radius minus the nominal radius of this wheel \[m\].
     pub delta_radius_m: f64,
     /// Tangent of the contact angle in the track frame, positive when the surface rises towards
     /// the field side (conical tread), large on the flange.
@@ -115,17 +115,17 @@ pub struct WheelContact {
 /// Contact state at one lateral displacement.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ContactRow {
-    /// Wheelset lateral displacement [m], positive to the right.
+    /// Wheelset lateral displacement \[m\], positive to the right.
     pub y_m: f64,
     /// Left wheel contact.
     pub left: WheelContact,
     /// Right wheel contact.
     pub right: WheelContact,
-    /// Roll angle [rad], positive = right wheel up.
+    /// Roll angle \[rad\], positive = right wheel up.
     pub roll_rad: f64,
-    /// Height of the axle centre above the rail-profile origin level [m].
+    /// Height of the axle centre above the rail-profile origin level \[m\].
     pub axle_centre_height_m: f64,
-    /// Rolling radius difference r_right - r_left [m].
+    /// Rolling radius difference r_right - r_left \[m\].
     pub delta_r_m: f64,
     /// True if this row lies beyond the flange limit (or the profiles' extent) and repeats the
     /// last reachable row.

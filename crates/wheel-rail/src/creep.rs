@@ -22,13 +22,13 @@ pub fn saturation_factor(f_res: f64, mu_p: f64) -> f64 {
 /// Creep forces of the two wheels of a wheelset, each saturated on its own resultant.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WheelsetCreepForces {
-    /// Lateral creep force on the left wheel [N].
+    /// Lateral creep force on the left wheel \[N\].
     pub lateral_left_n: f64,
-    /// Lateral creep force on the right wheel [N].
+    /// Lateral creep force on the right wheel \[N\].
     pub lateral_right_n: f64,
-    /// Longitudinal creep force on the left wheel [N].
+    /// Longitudinal creep force on the left wheel \[N\].
     pub longitudinal_left_n: f64,
-    /// Longitudinal creep force on the right wheel [N].
+    /// Longitudinal creep force on the right wheel \[N\].
     pub longitudinal_right_n: f64,
 }
 
@@ -98,13 +98,13 @@ pub fn elliptic_ke(k: f64) -> (f64, f64) {
 /// Result of [`hertz_kalker`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HertzKalker {
-    /// Semi-axis in rolling direction [m].
+    /// Semi-axis in rolling direction \[m\].
     pub a_m: f64,
-    /// Lateral semi-axis [m].
+    /// Lateral semi-axis \[m\].
     pub b_m: f64,
-    /// f11 = G a b C11 [N].
+    /// f11 = G a b C11 \[N\].
     pub f11_n: f64,
-    /// f22 = G a b C22 [N].
+    /// f22 = G a b C22 \[N\].
     pub f22_n: f64,
 }
 

@@ -56,9 +56,9 @@ pub enum ProfileError {
         source_name: String,
         /// 1-based line number of the offending point.
         line: usize,
-        /// Offending lateral coordinate [mm].
+        /// Offending lateral coordinate \[mm\].
         value_mm: f64,
-        /// Previous lateral coordinate [mm].
+        /// Previous lateral coordinate \[mm\].
         previous_mm: f64,
         /// "increasing" or "decreasing".
         direction: &'static str,
@@ -82,9 +82,9 @@ pub enum ProfileError {
 pub struct Profile {
     /// Where the profile came from (file name or a label), used in error messages.
     pub name: String,
-    /// Lateral coordinate [m], strictly increasing, positive towards the field side.
+    /// Lateral coordinate \[m\], strictly increasing, positive towards the field side.
     pub lateral_m: Vec<f64>,
-    /// Vertical coordinate [m], positive upwards.
+    /// Vertical coordinate \[m\], positive upwards.
     pub vertical_m: Vec<f64>,
 }
 
@@ -211,7 +211,7 @@ impl Profile {
         self.lateral_m.is_empty()
     }
 
-    /// Vertical coordinate at lateral `s` [m] by linear interpolation, `None` outside the profile.
+    /// Vertical coordinate at lateral `s` \[m\] by linear interpolation, `None` outside the profile.
     pub fn vertical_at(&self, s: f64) -> Option<f64> {
         let xs = &self.lateral_m;
         let n = xs.len();

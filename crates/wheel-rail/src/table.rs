@@ -95,9 +95,9 @@ pub enum TableError {
         source_name: String,
         /// 1-based line.
         line: usize,
-        /// Offending value [m].
+        /// Offending value \[m\].
         y_m: f64,
-        /// Value of the row before [m].
+        /// Value of the row before \[m\].
         previous_m: f64,
     },
     /// Fewer than two data rows (no segment to interpolate on).
@@ -181,9 +181,9 @@ impl TryFrom<TableColumns> for GeometryTable {
 /// Interpolated contact geometry at one lateral displacement.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactGeometry {
-    /// r_L - r0 [m].
+    /// r_L - r0 \[m\].
     pub delta_r_left_m: f64,
-    /// r_R - r0 [m].
+    /// r_R - r0 \[m\].
     pub delta_r_right_m: f64,
     /// tan(gamma_L) >= 0.
     pub tan_gamma_left: f64,
@@ -443,7 +443,7 @@ impl GeometryTable {
         self.y.is_empty()
     }
 
-    /// Range of y covered by the table [m].
+    /// Range of y covered by the table \[m\].
     pub fn y_range(&self) -> (f64, f64) {
         (self.y[0], self.y[self.y.len() - 1])
     }
@@ -480,7 +480,7 @@ impl GeometryTable {
         }
     }
 
-    /// Linear interpolation at y [m] (linear extrapolation of the end segments); binary
+    /// Linear interpolation at y \[m\] (linear extrapolation of the end segments); binary
     /// search, no allocation.
     #[inline]
     pub fn lookup(&self, y: f64) -> ContactGeometry {

@@ -111,11 +111,11 @@ fn psd_primitive(level: PsdLevel, omega: f64) -> f64 {
     psd_a(level) * c * c * prim
 }
 
-/// Default shortest wavelength [m].
+/// Default shortest wavelength \[m\].
 pub const DEFAULT_LAMBDA_MIN_M: f64 = 1.0;
-/// Default longest wavelength [m].
+/// Default longest wavelength \[m\].
 pub const DEFAULT_LAMBDA_MAX_M: f64 = 120.0;
-/// Default grid spacing, 1/8 of the shortest wavelength [m].
+/// Default grid spacing, 1/8 of the shortest wavelength \[m\].
 pub const DEFAULT_SPACING_M: f64 = 0.125;
 /// Default number of grid samples (period 8192 m at the default spacing).
 pub const DEFAULT_SAMPLES: usize = 1 << 16;
@@ -131,11 +131,11 @@ pub struct TrackSpec {
     pub level: PsdLevel,
     /// Seed of the random phases (ChaCha8).
     pub seed: u64,
-    /// Shortest wavelength of the band [m].
+    /// Shortest wavelength of the band \[m\].
     pub lambda_min_m: f64,
-    /// Longest wavelength of the band [m].
+    /// Longest wavelength of the band \[m\].
     pub lambda_max_m: f64,
-    /// Grid spacing [m]; at most a quarter of `lambda_min_m` (1/8 for the accuracy stated in
+    /// Grid spacing \[m\]; at most a quarter of `lambda_min_m` (1/8 for the accuracy stated in
     /// the module docs).
     pub spacing_m: f64,
     /// Number of grid samples, a power of two in [[`MIN_SAMPLES`], [`MAX_SAMPLES`]]; the
@@ -156,7 +156,7 @@ impl TrackSpec {
         }
     }
 
-    /// Period of the realisation [m].
+    /// Period of the realisation \[m\].
     pub fn period_m(&self) -> f64 {
         self.samples as f64 * self.spacing_m
     }
@@ -375,12 +375,12 @@ impl TrackGenerator {
         &self.spec
     }
 
-    /// Grid values y(j dx), j = 0..N-1 (one period) [m].
+    /// Grid values y(j dx), j = 0..N-1 (one period) \[m\].
     pub fn grid(&self) -> &[f64] {
         &self.samples
     }
 
-    /// Lateral alignment at track position x [m] (any x: the track is periodic).
+    /// Lateral alignment at track position x \[m\] (any x: the track is periodic).
     #[inline]
     pub fn eval(&self, x: f64) -> f64 {
         let u = x * self.inv_spacing;
@@ -407,7 +407,7 @@ impl TrackGenerator {
     }
 
     /// Alignment under several wheelsets: `behind_m[k]` is how far wheelset k runs behind the
-    /// track position x [m] (0 for the leading one); entry k is `eval(x - behind_m[k])`.
+    /// track position x \[m\] (0 for the leading one); entry k is `eval(x - behind_m[k])`.
     #[inline]
     pub fn eval_behind<const N: usize>(&self, x: f64, behind_m: [f64; N]) -> [f64; N] {
         behind_m.map(|d| self.eval(x - d))

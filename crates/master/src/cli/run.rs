@@ -14,6 +14,8 @@ use crate::system::{LoadedSystem, SingleFmuOptions};
 /// Run one system description, or one FMU alone, and write the recorded variables as CSV or
 /// Parquet.
 #[derive(Debug, clap::Args)]
+// help texts for a terminal: `[unit]` and `<name>` are plain text, not links or HTML
+#[allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 pub struct Args {
     /// System description: JSON (FMU paths relative to its folder), an SSP (a .ssp archive,
     /// or a .ssd next to its FMUs), or an .fmu to run alone over its DefaultExperiment.

@@ -14,6 +14,8 @@ use crate::system::PreparedSystem;
 
 /// Run a base system with parameter variations (cartesian product and/or list) in parallel.
 #[derive(Debug, clap::Args)]
+// help texts for a terminal: `[unit]` and `<name>` are plain text, not links or HTML
+#[allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 pub struct Args {
     /// Run-set description (JSON).
     pub runset: PathBuf,

@@ -115,7 +115,7 @@ pub struct Summary {
 pub struct Terminated {
     /// The instance that asked.
     pub instance: String,
-    /// The last completed communication point (the last result row) [s].
+    /// The last completed communication point (the last result row) \[s\].
     pub time_s: f64,
 }
 

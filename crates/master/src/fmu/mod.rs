@@ -10,7 +10,7 @@
 //!   set, across worker threads. An FMU that declares `canBeInstantiatedOnlyOncePerProcess`
 //!   gets a private copy per instance instead (a separate file is a separate library image).
 //! * [`FmuSlave`] ([`instance`]): one instance, driven through the FMI 2.0 C functions loaded
-//!   with libloading by their fmi-sys types ([`library`]); implements [`crate::slave::Slave`].
+//!   with libloading by their fmi-sys types (module `library`); implements [`crate::slave::Slave`].
 //! * [`FmuLogger`] ([`logger`]): the FMU logger callback (C, defensive against NULL strings,
 //!   `%n` formats and endless messages) routes messages into the `log` facade with the
 //!   instance name as target; this backend prints them with their category.

@@ -73,9 +73,9 @@ pub enum SspError {
 /// Choices an SSP does not make (or that the user overrides).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ImportOptions {
-    /// Communication step [s]; default: the SSP's libcosim or OMSimulator annotation.
+    /// Communication step \[s\]; default: the SSP's libcosim or OMSimulator annotation.
     pub step: Option<f64>,
-    /// Stop time [s]; default: the DefaultExperiment's stopTime.
+    /// Stop time \[s\]; default: the DefaultExperiment's stopTime.
     pub stop_time: Option<f64>,
     /// Default Jacobi (SSP does not say; libcosim, Ecos and fmpy exchange Jacobi-style).
     pub algorithm: Option<Algorithm>,

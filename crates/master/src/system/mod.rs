@@ -57,7 +57,7 @@ pub struct SystemDescription {
     #[serde(default)]
     pub start_time: f64,
     pub stop_time: f64,
-    /// Communication step [s].
+    /// Communication step \[s\].
     pub step: f64,
     #[serde(default = "default_alg")]
     pub algorithm: Algorithm,

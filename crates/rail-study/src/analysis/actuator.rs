@@ -20,7 +20,7 @@ use crate::plot::Chart;
 /// What to run for the full-active actuator.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ActuatorOptions {
-    /// Band [Hz] (seed Fig. 3.18-3.22: 1-320 Hz).
+    /// Band \[Hz\] (seed Fig. 3.18-3.22: 1-320 Hz).
     pub band_hz: (f64, f64),
     /// Number of log-spaced frequencies.
     pub points: usize,

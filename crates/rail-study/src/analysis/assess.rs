@@ -31,9 +31,9 @@ use master::results::{read_metadata, ResultsFormat};
 /// Which EN 14363 quantity the signals are.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Criterion {
-    /// Lateral acceleration [m/s^2]; limit from the bogie mass [t].
+    /// Lateral acceleration [m/s^2]; limit from the bogie mass \[t\].
     LateralAcceleration { bogie_mass_t: f64 },
-    /// Sum of guiding forces of a wheelset [N]; limit from the static wheel load [N].
+    /// Sum of guiding forces of a wheelset \[N\]; limit from the static wheel load \[N\].
     GuidingForces { static_wheel_load_n: f64 },
 }
 
@@ -218,7 +218,7 @@ impl ResultsTable {
         }
     }
 
-    /// Sampling rate from the time column [Hz]; the sampling must be uniform.
+    /// Sampling rate from the time column \[Hz\]; the sampling must be uniform.
     pub fn sampling_rate_hz(&self) -> Result<f64, AnalysisError> {
         let t = &self.columns[0];
         if t.len() < 3 {

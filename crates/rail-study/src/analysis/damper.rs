@@ -17,9 +17,9 @@ use super::figures::Scale;
 use super::{check_cancel, AnalysisError, Artefacts, Table};
 use crate::plot::Chart;
 
-/// Seed R1: peak force at 0 % opening, 4 Hz, 1 and 3 mm [kN].
+/// Seed R1: peak force at 0 % opening, 4 Hz, 1 and 3 mm \[kN\].
 pub const SEED_R1_CLOSED_KN: (f64, f64) = (12.0, 20.0);
-/// Seed R1: peak force at 100 % opening [kN].
+/// Seed R1: peak force at 100 % opening \[kN\].
 pub const SEED_R1_OPEN_KN: (f64, f64) = (0.5, 1.0);
 /// Seed R3: cylinder eigenfrequency from (3.68) with Table 3-2 [rad/s] (REFERENCE.md: 319.7).
 pub const SEED_R3_RADPS: f64 = 320.0;
@@ -29,17 +29,17 @@ pub const SEED_R4_AGREEMENT_RADPS: f64 = 600.0;
 /// What to run for the semi-active damper.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DamperOptions {
-    /// Frequency of the hysteresis loops [Hz] (seed Fig. 3.10-3.13: 4 Hz).
+    /// Frequency of the hysteresis loops \[Hz\] (seed Fig. 3.10-3.13: 4 Hz).
     pub loop_freq_hz: f64,
-    /// Stroke amplitudes of the loops [m] (seed: 1 and 3 mm).
+    /// Stroke amplitudes of the loops \[m\] (seed: 1 and 3 mm).
     pub loop_amplitudes_m: Vec<f64>,
     /// Valve openings of the loops, 0..1 (seed: 0, 20, 50, 100 %).
     pub loop_openings: Vec<f64>,
     /// Valve openings of the FRFs (seed Fig. 3.14-3.15 plus the passive 30 %).
     pub frf_openings: Vec<f64>,
-    /// Stroke amplitude of the FRFs [m] (seed: 1 mm).
+    /// Stroke amplitude of the FRFs \[m\] (seed: 1 mm).
     pub frf_amplitude_m: f64,
-    /// FRF band [Hz] (seed: 0.5-20 Hz).
+    /// FRF band \[Hz\] (seed: 0.5-20 Hz).
     pub frf_band_hz: (f64, f64),
     /// Number of log-spaced FRF frequencies.
     pub frf_points: usize,
@@ -159,7 +159,7 @@ fn pct(opening: f64) -> f64 {
 }
 
 impl DamperResults {
-    /// Peak |force| of the loop at (opening, amplitude) [N].
+    /// Peak |force| of the loop at (opening, amplitude) \[N\].
     pub fn peak_force_n(&self, opening: f64, amplitude_m: f64) -> Option<f64> {
         self.loops
             .iter()

@@ -30,15 +30,15 @@ pub mod fleet;
 pub const WHEEL_A: &str = include_str!("../../../wheel-rail/data/RUIC519A.dat");
 /// EN 15302 rail profile A, 60E1 head with its inclination (built in).
 pub const RAIL_A: &str = include_str!("../../../wheel-rail/data/SUIC519A.dat");
-/// Gauge of case E1 [mm].
+/// Gauge of case E1 \[mm\].
 pub const E1_GAUGE_MM: f64 = 1435.16;
-/// Nominal rolling radius of case E1 [mm] (920 mm wheels).
+/// Nominal rolling radius of case E1 \[mm\] (920 mm wheels).
 pub const E1_RADIUS_MM: f64 = 460.0;
 /// EN 15302 Annex E equivalent conicity of case E1 at 1, 3, 5, 7 mm (as quoted by the
 /// wheel-rail crate docs).
 pub const E1_REFERENCE_CONICITY: [(f64, f64); 4] =
     [(1.0, 0.125), (3.0, 0.188), (5.0, 0.254), (7.0, 0.505)];
-/// Amplitudes printed in the summary [mm].
+/// Amplitudes printed in the summary \[mm\].
 pub const SUMMARY_AMPLITUDES_MM: [f64; 4] = [1.0, 3.0, 5.0, 7.0];
 
 /// Where a profile comes from.
@@ -103,9 +103,9 @@ pub struct GeometryInputs {
     /// Table covers -y_max..y_max.
     pub y_max_m: f64,
     pub step_m: f64,
-    /// Conicity curve amplitudes: from 1 mm to `amplitude_max_m` in this step [m].
+    /// Conicity curve amplitudes: from 1 mm to `amplitude_max_m` in this step \[m\].
     pub conicity_step_m: f64,
-    /// Largest amplitude of the conicity curve [m].
+    /// Largest amplitude of the conicity curve \[m\].
     pub amplitude_max_m: f64,
     /// Convention of Δr, the detailed table and the conicity (the bogie-format table is always
     /// [`RadiusConvention::RigidRoll`]).
@@ -148,13 +148,13 @@ pub struct ConicityPoint {
     pub amplitude_m: f64,
     /// EN 15302 Annex B tanγe; 0 where Δr does not restore (flat tread).
     pub tan_gamma_e: f64,
-    /// Wavelength of the kinematic oscillation [m] (infinite where tanγe = 0).
+    /// Wavelength of the kinematic oscillation \[m\] (infinite where tanγe = 0).
     pub wavelength_m: f64,
     /// EN 15302 Annex C (linear regression of Δr over the turning points' range) tanγe.
     pub regression: f64,
     /// Harmonic linearisation tanγ.
     pub harmonic: f64,
-    /// Turning points [m].
+    /// Turning points \[m\].
     pub y1_m: f64,
     pub y2_m: f64,
     /// A turning point lies beyond the flange limit (the wheel climbs its flange).
@@ -194,7 +194,7 @@ pub fn conicity_at(d: &DeltaR, a: f64) -> Result<ConicityPoint, AnalysisError> {
 }
 
 /// Amplitudes of the conicity curve: from 1 mm (or the largest amplitude, if smaller) to the
-/// largest amplitude in steps of `step` [m].
+/// largest amplitude in steps of `step` \[m\].
 pub fn curve_amplitudes(amplitude_max_m: f64, step_m: f64) -> Vec<f64> {
     let start = amplitude_max_m.min(1e-3);
     let n = ((amplitude_max_m - start) / step_m).round().max(0.0) as usize;
@@ -343,7 +343,7 @@ fn detail_rows(table: &ContactTable) -> Vec<DetailRow> {
 
 impl GeometryResults {
     /// y of the first reachable row (from the centre outwards) with tanγ > 1 on the right
-    /// (flange contact) [m].
+    /// (flange contact) \[m\].
     pub fn flange_contact_y_m(&self) -> Option<f64> {
         self.table
             .reachable_rows()

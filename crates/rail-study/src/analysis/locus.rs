@@ -26,7 +26,7 @@ use super::{AnalysisError, Artefacts, Table};
 pub const SEED_R5_KMH: f64 = 270.0;
 /// Seed R6: imaginary part of the hunting eigenvalue at onset [rad/s].
 pub const SEED_R6_IM_RADPS: f64 = 21.0;
-/// Seed R6: hunting frequency at onset [Hz].
+/// Seed R6: hunting frequency at onset \[Hz\].
 pub const SEED_R6_HZ: (f64, f64) = (3.0, 4.0);
 /// Speed range searched for the critical speed [m/s] (the bogie model accepts up to 200).
 pub const CRITICAL_SEARCH_MPS: (f64, f64) = (5.0, 199.0);
@@ -57,9 +57,9 @@ pub enum DamperSpec {
 pub struct LinearisedDamper {
     /// Valve opening, 0 (closed) to 1.
     pub opening: f64,
-    /// Stroke amplitude X [m].
+    /// Stroke amplitude X \[m\].
     pub stroke_m: f64,
-    /// Stroke frequency f [Hz].
+    /// Stroke frequency f \[Hz\].
     pub freq_hz: f64,
     /// Equivalent stiffness [N/m].
     pub k_n_per_m: f64,
@@ -67,10 +67,10 @@ pub struct LinearisedDamper {
     pub c_ns_per_m: f64,
 }
 
-/// Largest stroke amplitude a linearisation is asked for [m]: a yaw damper's stroke is a few
+/// Largest stroke amplitude a linearisation is asked for \[m\]: a yaw damper's stroke is a few
 /// centimetres at most.
 pub const MAX_LINEARISATION_STROKE_M: f64 = 0.05;
-/// Frequency of a linearisation when none is given [Hz]: the hunting frequency of the seed's
+/// Frequency of a linearisation when none is given \[Hz\]: the hunting frequency of the seed's
 /// bogie (R6: 3-4 Hz) and of the coach at its critical speed (4.0 Hz).
 pub const DEFAULT_LINEARISATION_FREQ_HZ: f64 = 4.0;
 

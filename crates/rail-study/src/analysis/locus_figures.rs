@@ -7,7 +7,7 @@ use super::figures::ColourScatter;
 use super::{AnalysisError, Artefacts, Table};
 use crate::plot::Chart;
 
-/// omega / 2 pi [Hz] of an eigenvalue's imaginary part.
+/// omega / 2 pi \[Hz\] of an eigenvalue's imaginary part.
 pub fn freq_hz(im: f64) -> f64 {
     im.abs() / (2.0 * std::f64::consts::PI)
 }

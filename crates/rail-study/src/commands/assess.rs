@@ -22,6 +22,8 @@ pub enum Quantity {
 #[command(
     after_help = "Applies the EN 14363 rms stability criterion as the seed does (section 4.2): band-pass +-2 Hz around the dominant frequency of each signal, rms over 100 m of track in 10 m steps at the given constant speed, maximum compared with the limit. Works on our results (`master run`, the study's runs; CSV or Parquet) or on a host's export (Simpack, ...): first column the time in seconds, uniformly sampled; separators comma, semicolon or whitespace; '#' comment lines; or a Parquet file. Our files record their sampling (Parquet inside, CSV in <name>.meta.json): a signal whose recorded band (Nyquist frequency, or the anti-aliasing filter of a decimated file) does not cover the assessed band is refused.\n\nFiles: assess.csv (rms per window), assess_summary.csv (per signal), assess.svg (rms along the track with the limit). Exit status 0 whether or not the limit is exceeded (read the verdict line); 1 when the input cannot be assessed (nothing is written then)."
 )]
+// help texts for a terminal: `[unit]` and `<name>` are plain text, not links or HTML
+#[allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 pub struct Args {
     /// Results table (CSV, whitespace separated, or Parquet).
     pub table: PathBuf,
@@ -57,8 +59,8 @@ pub struct Args {
 }
 
 impl Quantity {
-    /// The criterion of this quantity: the limit from the bogie mass [t] or the static wheel
-    /// load [kN].
+    /// The criterion of this quantity: the limit from the bogie mass \[t\] or the static wheel
+    /// load \[kN\].
     pub fn criterion(self, bogie_mass_t: f64, wheel_load_kn: f64) -> Criterion {
         match self {
             Quantity::Acceleration => Criterion::LateralAcceleration { bogie_mass_t },

@@ -35,6 +35,8 @@ impl From<RadiusConventionArg> for RadiusConvention {
 #[command(
     after_help = "Wheel/rail contact geometry from profiles. Without options: EN 15302 case E1 (wheel A, rail A, 920 mm wheels, gauge 1435.16 mm) with the built-in benchmark profiles.\n\nProfile files: two numbers per line, lateral and vertical in mm (whitespace, comma or semicolon separated), '#' comments, optional header line; lateral positive towards the field side (flange at negative values), vertical up, wheel origin on the nominal rolling circle. A bad file stops the command with file:line and writes nothing.\n\nUnequal radii (--radius-right): delta r, contact_detail.csv and the conicity follow --radius-convention (EN 15302's offset by default, named in the CSV headers); wheel_rail_table.csv is always the rigid wheelset's (rigid-roll), the geometry the bogie model feels.\n\nThe conicity is EN 15302 Annex B (with the Annex C regression and the harmonic linearisation beside it), 0 on a flat tread; an amplitude without a value is an error naming it and why (exit code 1, nothing written).\n\nFiles: wheel_rail_table.csv (the bogie model's contact table format), contact_detail.csv (with the located two-point contacts), conicity.csv (1 mm to --amplitude-max), delta_r.svg, tan_gamma.svg, conicity.svg. With --wheels or --wheel-dir (a fleet of wheel profiles, each on both wheels): fleet_conicity.csv (a row per profile) and fleet_conicity_3mm.svg instead."
 )]
+// help texts for a terminal: `[unit]` and `<name>` are plain text, not links or HTML
+#[allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 pub struct Args {
     /// Wheel profile (both sides unless --wheel-right) [default: built-in EN 15302 wheel A].
     #[arg(long, value_name = "FILE")]

@@ -18,6 +18,8 @@ use master::cli::{CommandError, Context};
 #[command(
     after_help = "Eigenvalues of the linear coach (calibrated fmu-vehicle parameters, --model vehicle) or of the linear 2-dof bogie (calibrated fmu-bogie2dof parameters, --model bogie2dof) over speed. Prints the linear critical speed (bisection) and the mode at onset next to the seed's (coach: 280-290 km/h, R15; bogie: 270 km/h, about 21 rad/s, 3-4 Hz).\n\nFiles: root_locus_eigenvalues.csv (every eigenvalue per speed: real, imaginary, frequency, damping ratio, flag of the hunting / least-damped mode), root_locus_hunting.csv (bogie) or root_locus_least_damped.csv (coach: with the mode's kinetic-energy shares and name), root_locus.svg and root_locus_zoom.svg (points coloured by speed, the mode ringed), damping_ratio.svg, hunting_frequency.svg."
 )]
+// help texts for a terminal: `[unit]` and `<name>` are plain text, not links or HTML
+#[allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 pub struct Args {
     /// Linear model: the coach (`vehicle`) or the 2-dof bogie (`bogie2dof`).
     #[arg(long, value_enum, default_value = "vehicle")]

@@ -17,6 +17,8 @@ use master::results::ResultsFormat;
 
 /// Run the stability study and write REPORT.md, plots and CSVs.
 #[derive(Debug, clap::Args)]
+// help texts for a terminal: `[unit]` and `<name>` are plain text, not links or HTML
+#[allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 pub struct Args {
     /// Vehicle model: the coach with four dampers (`vehicle`, RailVehicle.fmu) or the 2-dof
     /// bogie with two (`bogie2dof`, the seed's HIL configuration).

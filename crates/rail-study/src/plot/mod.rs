@@ -53,7 +53,7 @@ pub struct Series {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Chart {
     pub title: String,
-    /// e.g. "time [s]"
+    /// e.g. "time \[s\]"
     pub x_label: String,
     /// e.g. "lateral acceleration rms [m/s^2]"
     pub y_label: String,
@@ -62,11 +62,11 @@ pub struct Chart {
     pub limit: Option<(f64, String)>,
     /// Captions of the stacked panels, top to bottom; empty: one frame.
     pub panels: Vec<String>,
-    /// Width of the plot without the legend column [px].
+    /// Width of the plot without the legend column \[px\].
     pub width: u32,
-    /// Height of a one-frame chart [px].
+    /// Height of a one-frame chart \[px\].
     pub height: u32,
-    /// Height of each panel [px].
+    /// Height of each panel \[px\].
     pub panel_height: u32,
     /// Dots on the lines' points (a few measured points, e.g. the c_v table).
     pub markers: bool,

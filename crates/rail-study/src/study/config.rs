@@ -5,7 +5,7 @@
 //!
 //! Instance and variable names the study relies on on the bogie (see the JSON files):
 //! * `bogie` (Bogie2Dof): `vehicle.speed` [m/s], `track.source` (0 none, 2 internal ERRI
-//!   generator), `track.seed`, `initial.lateral_displacement` [m]; recorded
+//!   generator), `track.seed`, `initial.lateral_displacement` \[m\]; recorded
 //!   `wheelset_{front,rear}.lateral_{displacement,acceleration}`.
 //! * dampers `damper_left/right` (PassiveYawDamper, SemiActiveDamper) or
 //!   `actuator_left/right` (FullActiveActuator); their `damper.force` is recorded.

@@ -20,7 +20,7 @@ use crate::en14363::{assess_lateral_acceleration, AssessError, StabilitySettings
 use crate::study::vehicle::Signals;
 use master::coupling::SimOutput;
 
-/// Bogie mass of the seed [t] (a_lim = 5.39 m/s^2, seed 4.2).
+/// Bogie mass of the seed \[t\] (a_lim = 5.39 m/s^2, seed 4.2).
 pub const BOGIE_MASS_T: f64 = 6.1;
 
 /// Why a run could not be evaluated.
@@ -49,9 +49,9 @@ pub enum MetricsError {
 /// How a run is evaluated.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct MetricSpec {
-    /// Start-up transient excluded from every number [s].
+    /// Start-up transient excluded from every number \[s\].
     pub skip_s: f64,
-    /// Length of the final part used for amplitudes and mean commands [s].
+    /// Length of the final part used for amplitudes and mean commands \[s\].
     pub tail_s: f64,
     pub speed_kmh: f64,
 }
@@ -62,25 +62,25 @@ pub struct RunMetrics {
     /// EN 14363 max sliding rms of each assessed acceleration, in [`Signals::stability`]
     /// order [m/s^2].
     pub rms_by_signal: Vec<f64>,
-    /// Dominant frequency of the first assessed acceleration [Hz].
+    /// Dominant frequency of the first assessed acceleration \[Hz\].
     pub frequency_hz: f64,
-    /// Half peak-to-peak wheelset displacement over the tail (max of both) [m].
+    /// Half peak-to-peak wheelset displacement over the tail (max of both) \[m\].
     pub tail_amplitude_m: f64,
-    /// Max |wheelset displacement| after the skip [m].
+    /// Max |wheelset displacement| after the skip \[m\].
     pub max_displacement_m: f64,
-    /// Max |damper force| after the skip, both sides [N].
+    /// Max |damper force| after the skip, both sides \[N\].
     pub peak_force_n: f64,
-    /// rms of the damper force after the skip, mean over the dampers [N], if recorded.
+    /// rms of the damper force after the skip, mean over the dampers \[N\], if recorded.
     pub rms_force_n: Option<f64>,
-    /// Max |reference force| of the full-active controllers after the skip [N], if recorded:
+    /// Max |reference force| of the full-active controllers after the skip \[N\], if recorded:
     /// above the actuator's force bound the peak force is the bound, not `c_v v`.
     pub peak_reference_force_n: Option<f64>,
     /// rms of the mechanical power F v per actuator (mean of both sides; the seed's
-    /// "dissipated power" of Table 4-3) [W], if recorded.
+    /// "dissipated power" of Table 4-3) \[W\], if recorded.
     pub rms_power_w: Option<f64>,
-    /// rms of the hydraulic supply power per actuator (mean of both sides) [W], if recorded.
+    /// rms of the hydraulic supply power per actuator (mean of both sides) \[W\], if recorded.
     pub rms_hydraulic_power_w: Option<f64>,
-    /// Mean valve command over the tail (all dampers) [V], if recorded.
+    /// Mean valve command over the tail (all dampers) \[V\], if recorded.
     pub tail_command_v: Option<f64>,
     /// rms of the car-body floor lateral acceleration after the skip, largest over the
     /// measuring points [m/s^2]; `None` without a car body.
@@ -89,7 +89,7 @@ pub struct RunMetrics {
     /// `None` without a car body or when less than one 5 s window follows the skip.
     pub comfort_ny: Option<f64>,
     /// Stroke amplitude of the yaw dampers after the skip, sqrt(2) x the standard deviation of
-    /// the elongation, largest over the dampers [m]; `None` if no elongation is recorded.
+    /// the elongation, largest over the dampers \[m\]; `None` if no elongation is recorded.
     #[serde(default)]
     pub damper_stroke_m: Option<f64>,
 }
@@ -142,7 +142,7 @@ fn col(out: &SimOutput, name: &str) -> Result<Vec<f64>, MetricsError> {
         .ok_or_else(|| MetricsError::MissingColumn(name.to_string()))
 }
 
-/// Sampling rate of the recorded output [Hz] from its time column.
+/// Sampling rate of the recorded output \[Hz\] from its time column.
 pub fn sample_rate(out: &SimOutput) -> Option<f64> {
     let t = out.column("time")?;
     let n = t.len();

@@ -72,7 +72,7 @@ pub struct SpeedPoint {
     pub carbody_per_seed: Vec<Option<f64>>,
     /// EN 12299 lateral comfort N_y per seed (coach).
     pub comfort_per_seed: Vec<Option<f64>>,
-    /// Yaw-damper stroke amplitude per seed, where the elongations are recorded (coach) [m].
+    /// Yaw-damper stroke amplitude per seed, where the elongations are recorded (coach) \[m\].
     pub stroke_per_seed: Vec<Option<f64>>,
 }
 
@@ -102,7 +102,7 @@ impl SpeedPoint {
         max_all(&self.comfort_per_seed)
     }
 
-    /// Yaw-damper stroke amplitude, max over seeds [m].
+    /// Yaw-damper stroke amplitude, max over seeds \[m\].
     pub fn damper_stroke(&self) -> Option<f64> {
         max_all(&self.stroke_per_seed)
     }
@@ -172,7 +172,7 @@ pub struct StudyResults {
     pub failures: Vec<(String, String)>,
     pub runs: usize,
     pub simulated_s: f64,
-    /// Sum of the runs' own wall times (CPU-side effort) [s].
+    /// Sum of the runs' own wall times (CPU-side effort) \[s\].
     pub run_wall_s: f64,
     /// Outputs of the runs the plots need, decimated to the stored rate, by run name.
     #[serde(skip)]

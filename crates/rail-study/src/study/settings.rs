@@ -18,18 +18,18 @@ pub struct StudySettings {
     pub track_level: TrackLevel,
     /// Track seeds of the internal ERRI B176 generator.
     pub seeds: Vec<u32>,
-    /// Length of a sweep run [s].
+    /// Length of a sweep run \[s\].
     pub sweep_stop_s: f64,
-    /// Start-up transient excluded from every number [s].
+    /// Start-up transient excluded from every number \[s\].
     pub skip_s: f64,
-    /// Final part used for oscillation amplitudes and mean valve commands [s].
+    /// Final part used for oscillation amplitudes and mean valve commands \[s\].
     pub tail_s: f64,
     /// Bisection of the critical speed down to this bracket width [km/h]; `None` = no bisection.
     pub bisection_tol_kmh: Option<f64>,
     /// Initial-perturbation runs of the passive vehicle (coach: Figs. 4.4-4.6, R16; bogie:
     /// Figs. 5.11-5.13, R7) [km/h].
     pub perturbation_speeds_kmh: Vec<f64>,
-    /// Initial lateral displacement of the bogie for those runs [m].
+    /// Initial lateral displacement of the bogie for those runs \[m\].
     pub perturbation_lateral_m: f64,
     pub perturbation_stop_s: f64,
     /// Full-active c_v sensitivity (Table 4-3, R14): gains [N s/m], speed, run length.
@@ -43,15 +43,15 @@ pub struct StudySettings {
     /// Speed of the slow-valve runs of the HIL chapter (Figs. 5.19-5.24, R12); ideal track,
     /// initial lateral displacement `perturbation_lateral_m`.
     pub hil_speed_kmh: f64,
-    /// Initial MPPT command of the HIL runs (seed: fully open valve, 80 %) [V].
+    /// Initial MPPT command of the HIL runs (seed: fully open valve, 80 %) \[V\].
     pub hil_initial_command_v: f64,
-    /// Length of the scenario runs (histories, MPPT, HIL) [s].
+    /// Length of the scenario runs (histories, MPPT, HIL) \[s\].
     pub scenario_stop_s: f64,
     /// Format of every run's stored results: Parquet at the full rate, or CSV decimated to
     /// `stored_rate_hz` through an anti-aliasing low-pass.
     pub stored_format: ResultsFormat,
     /// Sampling rate of a run's results when stored as CSV, and of the time histories the
-    /// plots draw [Hz] (the numbers are computed from the full-rate signals).
+    /// plots draw \[Hz\] (the numbers are computed from the full-rate signals).
     pub stored_rate_hz: f64,
 }
 

@@ -154,12 +154,12 @@ impl VehicleModel {
         self.var("track.level")
     }
 
-    /// Initial lateral displacement (of both bogies on the coach) [m].
+    /// Initial lateral displacement (of both bogies on the coach) \[m\].
     pub fn initial_lateral(self) -> String {
         self.var("initial.lateral_displacement")
     }
 
-    /// Wheelset lateral displacements relative to the track, leading first [m].
+    /// Wheelset lateral displacements relative to the track, leading first \[m\].
     pub fn wheelset_displacements(self) -> Vec<String> {
         match self {
             VehicleModel::Coach => (1..=4)
@@ -191,7 +191,7 @@ impl VehicleModel {
     }
 
     /// Yaw-damper elongations, one per damper position (both models name them
-    /// `damper_<position>.elongation`) [m].
+    /// `damper_<position>.elongation`) \[m\].
     pub fn damper_elongations(self) -> Vec<String> {
         self.positions()
             .iter()
@@ -223,7 +223,7 @@ impl VehicleModel {
         format!("{prefix}_{}.{variable}", self.positions()[0].name)
     }
 
-    /// Every recorded damper / actuator force (whichever the configuration has) [N].
+    /// Every recorded damper / actuator force (whichever the configuration has) \[N\].
     pub fn damper_forces(self) -> Vec<String> {
         let mut v = self.per_position("damper", "damper.force");
         v.extend(self.per_position("actuator", "damper.force"));
@@ -243,7 +243,7 @@ pub struct Signals {
     pub hydraulic_powers: Vec<String>,
     /// The full-active controllers' reference forces `c_v v` (what the actuator is asked for).
     pub reference_forces: Vec<String>,
-    /// Yaw-damper elongations (the vehicle's outputs) [m].
+    /// Yaw-damper elongations (the vehicle's outputs) \[m\].
     pub elongations: Vec<String>,
 }
 

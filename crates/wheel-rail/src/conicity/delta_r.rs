@@ -82,22 +82,22 @@ impl DeltaR {
         }
     }
 
-    /// Half distance between the contact points used for the wavelength [m].
+    /// Half distance between the contact points used for the wavelength \[m\].
     pub fn e0_m(&self) -> f64 {
         self.e0_m
     }
 
-    /// Mean nominal rolling radius used for the wavelength [m].
+    /// Mean nominal rolling radius used for the wavelength \[m\].
     pub fn r0_m(&self) -> f64 {
         self.r0_m
     }
 
-    /// The y of the samples [m].
+    /// The y of the samples \[m\].
     pub fn samples_y(&self) -> &[f64] {
         &self.y
     }
 
-    /// Range of y where Δr is known [m].
+    /// Range of y where Δr is known \[m\].
     pub fn range_m(&self) -> (f64, f64) {
         (
             self.y.first().copied().unwrap_or(f64::NAN),
@@ -111,7 +111,7 @@ impl DeltaR {
         self.flange_limits_m
     }
 
-    /// Δr at `y` (linear interpolation, constant extrapolation) [m].
+    /// Δr at `y` (linear interpolation, constant extrapolation) \[m\].
     pub fn delta_r_at(&self, y: f64) -> f64 {
         if y <= self.y[0] {
             return self.dr[0];
@@ -180,7 +180,7 @@ impl DeltaR {
             .fold(0.0, f64::max)
     }
 
-    /// Equilibrium position of the wheelset [m]: the minimiser of S over the whole range, i.e.
+    /// Equilibrium position of the wheelset \[m\]: the minimiser of S over the whole range, i.e.
     /// where Δr crosses zero from negative to positive (the bottom of the potential well). A
     /// stretch with Δr = 0 at the bottom (a flat tread) gives its middle; several separate
     /// minimisers of equal depth (a symmetric hollow tread) give the one nearest to y = 0.

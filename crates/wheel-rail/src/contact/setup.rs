@@ -13,23 +13,23 @@ pub enum WheelPlacement {
     /// Lateral distance between the origins of the two wheel profiles (nominal rolling circles),
     /// e.g. 1.500 m for the EN 15302 benchmark profiles.
     RollingCircleDistance {
-        /// Distance [m].
+        /// Distance \[m\].
         distance_m: f64,
     },
     /// Back-to-back distance of the wheels plus the lateral distance from each wheel's back face
     /// to its profile origin (S1002: 70 mm): origin distance = B + 2 * offset.
     BackToBack {
-        /// Back-to-back distance [m] (1.360 m nominal for standard gauge).
+        /// Back-to-back distance \[m\] (1.360 m nominal for standard gauge).
         back_to_back_m: f64,
-        /// Back face to profile origin (taping line) [m].
+        /// Back face to profile origin (taping line) \[m\].
         back_face_to_origin_m: f64,
     },
     /// Distance between the active flange faces, each measured `measuring_depth_m` below the
     /// profile origin (e.g. 10 mm below the tread datum).
     FlangeFaces {
-        /// Distance [m].
+        /// Distance \[m\].
         distance_m: f64,
-        /// Measuring depth below the profile origin [m].
+        /// Measuring depth below the profile origin \[m\].
         measuring_depth_m: f64,
     },
 }
@@ -41,14 +41,14 @@ pub enum RailPlacement {
     /// point of each (inclined) rail head. The gauge point is the first crossing of that level
     /// coming from the gauge side of the rail profile.
     Gauge {
-        /// Gauge [m].
+        /// Gauge \[m\].
         gauge_m: f64,
-        /// Measuring depth below the top of rail [m].
+        /// Measuring depth below the top of rail \[m\].
         measuring_depth_m: f64,
     },
-    /// Lateral distance between the origins of the two rail profiles [m].
+    /// Lateral distance between the origins of the two rail profiles \[m\].
     OriginDistance {
-        /// Distance [m].
+        /// Distance \[m\].
         distance_m: f64,
     },
 }
@@ -74,9 +74,9 @@ pub struct ContactSetup {
     pub rail_left: Profile,
     /// Right rail profile.
     pub rail_right: Profile,
-    /// Nominal rolling radius of the left wheel at its profile origin [m] (diameter / 2).
+    /// Nominal rolling radius of the left wheel at its profile origin \[m\] (diameter / 2).
     pub nominal_radius_left_m: f64,
-    /// Nominal rolling radius of the right wheel [m].
+    /// Nominal rolling radius of the right wheel \[m\].
     pub nominal_radius_right_m: f64,
     /// Lateral placement of the wheels on the axle.
     pub wheel_placement: WheelPlacement,
@@ -88,7 +88,7 @@ pub struct ContactSetup {
     pub rail_inclination: f64,
     /// Where `y` is measured.
     pub lateral_reference: LateralReference,
-    /// Depth of the contact zone [m] ("virtual penetration"): the contact point of each wheel is
+    /// Depth of the contact zone \[m\] ("virtual penetration"): the contact point of each wheel is
     /// the penetration-weighted centroid of the zone where the wheel/rail gap lies within this
     /// depth of its minimum (see the module docs). 0 gives the bare minimum-distance point.
     /// [`CONTACT_ZONE_DEPTH_M`] by default.

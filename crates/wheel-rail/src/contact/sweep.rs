@@ -35,15 +35,15 @@ const JUMP_MIN_M: f64 = 0.1e-3;
 pub struct ContactTable {
     /// Rows, increasing `y`.
     pub rows: Vec<ContactRow>,
-    /// Nominal radius of the left wheel [m].
+    /// Nominal radius of the left wheel \[m\].
     pub nominal_radius_left_m: f64,
-    /// Nominal radius of the right wheel [m].
+    /// Nominal radius of the right wheel \[m\].
     pub nominal_radius_right_m: f64,
-    /// Half the lateral distance between the left and right contact points at y = 0 [m].
+    /// Half the lateral distance between the left and right contact points at y = 0 \[m\].
     pub e0_m: f64,
-    /// Smallest reachable `y` of the table (rows below repeat this one) [m].
+    /// Smallest reachable `y` of the table (rows below repeat this one) \[m\].
     pub y_reachable_min_m: f64,
-    /// Largest reachable `y` [m].
+    /// Largest reachable `y` \[m\].
     pub y_reachable_max_m: f64,
     /// Convention of the radius difference the rows were computed with.
     pub radius_convention: RadiusConvention,
@@ -64,7 +64,7 @@ pub struct ContactTable {
 pub struct ContactJump {
     /// The wheel whose contact point jumps.
     pub side: WheelSide,
-    /// Location of the two-point contact [m], midpoint of the final bracket.
+    /// Location of the two-point contact \[m\], midpoint of the final bracket.
     pub y_m: f64,
     /// State just below the jump.
     pub before: ContactRow,
@@ -73,7 +73,7 @@ pub struct ContactJump {
 }
 
 impl ContactJump {
-    /// Distance between the two contact points on the wheel profile [m].
+    /// Distance between the two contact points on the wheel profile \[m\].
     pub fn wheel_distance_m(&self) -> f64 {
         (self.after.wheel(self.side).wheel_lateral_m - self.before.wheel(self.side).wheel_lateral_m)
             .abs()
@@ -139,7 +139,7 @@ impl ContactTable {
         all
     }
 
-    /// Mean nominal radius [m].
+    /// Mean nominal radius \[m\].
     pub fn nominal_radius_mean_m(&self) -> f64 {
         0.5 * (self.nominal_radius_left_m + self.nominal_radius_right_m)
     }

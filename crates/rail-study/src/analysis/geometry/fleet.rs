@@ -22,7 +22,7 @@ use master::output::csv_field;
 /// File name endings read from a `--wheel-dir` folder (case-insensitive).
 pub const PROFILE_EXTENSIONS: [&str; 4] = ["dat", "txt", "csv", "prf"];
 
-/// Amplitude of the fleet figure [m].
+/// Amplitude of the fleet figure \[m\].
 pub const FIGURE_AMPLITUDE_M: f64 = 3e-3;
 
 /// The profile files of a folder with one of [`PROFILE_EXTENSIONS`], sorted by name, and the
@@ -64,16 +64,16 @@ pub fn profiles_in(dir: &Path) -> Result<(Vec<PathBuf>, Vec<String>), AnalysisEr
 pub struct FleetRow {
     /// The profile as given (file path).
     pub profile: String,
-    /// Largest reachable y (flange limit) [m].
+    /// Largest reachable y (flange limit) \[m\].
     pub flange_limit_m: f64,
-    /// First y > 0 with flange contact (tanγ > 1 on the right wheel) [m], if any.
+    /// First y > 0 with flange contact (tanγ > 1 on the right wheel) \[m\], if any.
     pub flange_contact_m: Option<f64>,
     /// At 1, 2, ... mm up to the largest amplitude.
     pub conicity: Vec<ConicityPoint>,
 }
 
 impl FleetRow {
-    /// The point at `a` [m], if it is one of the table's amplitudes.
+    /// The point at `a` \[m\], if it is one of the table's amplitudes.
     pub fn at(&self, a: f64) -> Option<&ConicityPoint> {
         self.conicity
             .iter()
@@ -87,7 +87,7 @@ pub struct FleetResults {
     /// Set-up (the wheels of `inputs` are not used).
     pub inputs: GeometryInputs,
     pub rows: Vec<FleetRow>,
-    /// Amplitudes of the table [m]: 1, 2, ... mm up to the largest amplitude.
+    /// Amplitudes of the table \[m\]: 1, 2, ... mm up to the largest amplitude.
     pub amplitudes_m: Vec<f64>,
 }
 

@@ -30,7 +30,7 @@ impl Timing {
     }
 }
 
-/// The seed's Table 4-3 (R14): c_v [kNs/m], rms acc [m/s^2], F_max [kN], rms power [kW].
+/// The seed's Table 4-3 (R14): c_v [kNs/m], rms acc [m/s^2], F_max \[kN\], rms power \[kW\].
 pub const SEED_TABLE_4_3: [(f64, f64, f64, f64); 4] = [
     (210.0, 7.08, 20.369, 0.357),
     (270.0, 5.98, 23.491, 0.280),
