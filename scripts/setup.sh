@@ -39,8 +39,9 @@ if ! "$VENV/bin/python" -c "import maturin, pandas, distributed, tqdm, pytest, p
     "distributed==2026.8.0" "tqdm==4.67.1" "pytest==9.2.0" >/dev/null
 fi
 
-# SSP hosts for tests/tests/ssp_interop.rs: libcosim (libcosimpy, whose libcosimc needs the
-# system's oneTBB runtime libtbb12) and Ecos (ecospy) run the exported SSPs.
+# SSP hosts for tests/tests/ssp_interop.rs and the benchmark's peers: libcosim (libcosimpy,
+# whose libcosimc needs the system's oneTBB runtime libtbb12) and Ecos (ecospy) run the
+# exported SSPs.
 if ! ldconfig -p 2>/dev/null | grep -q 'libtbb\.so\.12'; then
   step "installing libtbb12 (needed by libcosimpy)"
   as_root apt-get update -qq

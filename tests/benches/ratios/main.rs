@@ -12,6 +12,9 @@
 //!    valgrind): the benchmark runs itself under it.
 //! 3. fmpy driving the same three FMUs in a Python loop, same order and step.
 //! 4. A run set of 4 runs of that system on 2 worker threads against 1.
+//!    Peers: the same FMUs exported as one SSP (`master export-ssp`), run from the archive by
+//!    our master and by two third-party C++ hosts, libcosim and Ecos (their Python packages
+//!    call the C++ run-until loop, so no Python runs between steps).
 //! 5. The studies' wall time (`master study` on 2 cores), when `BENCH_STUDY` names the study
 //!    options (scripts/bench.sh sets it).
 //! 6. Results files of one full-rate 15 s study run (the coach with four passive dampers):
@@ -21,8 +24,7 @@
 //! `bash scripts/bench.sh` builds what it needs and runs this; it writes docs/BENCHMARKS.md.
 //! By hand: `cargo bench -p tests --bench ratios` (needs dist/). `BENCH_ONLY=coupled,fmpy`
 //! measures only the named sections (`models`, `coupled`, `instructions`, `fmpy`, `runset`,
-//! `studies`, `results`) and
-//! writes to target/BENCHMARKS.md unless `BENCH_OUT` is set.
+//! `peers`, `studies`, `results`) and writes to target/BENCHMARKS.md unless `BENCH_OUT` is set.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // benchmark code
 
@@ -36,6 +38,7 @@ use fmu_damper::perf::DamperCase;
 
 mod coupled;
 mod instructions;
+mod peers;
 mod results_files;
 
 use coupled::{direct_passive, front_displacement, largest_difference, master_timed, runset_wall};
@@ -65,16 +68,17 @@ pub(crate) fn load_average() -> String {
         .unwrap_or_else(|_| "unknown".into())
 }
 
-/// CPU time (user + system) of this process [s], from /proc/self/stat.
+/// CPU time (user + system, all threads) of this process [s]: the process CPU clock, to the
+/// nanosecond (a run of a few ms would be lost in /proc/self/stat's 10 ms ticks).
 pub(crate) fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
-    rest.split_whitespace()
-        .skip(11)
-        .take(2)
-        .filter_map(|x| x.parse::<f64>().ok())
-        .sum::<f64>()
-        / 100.0
+    let mut t = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `t` is a valid timespec for the call to write.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut t) };
+    assert_eq!(rc, 0, "clock_gettime(CLOCK_PROCESS_CPUTIME_ID) failed");
+    t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
 }
 
 pub(crate) struct Report {
@@ -88,7 +92,7 @@ impl Report {
     }
 }
 
-fn python() -> Option<PathBuf> {
+pub(crate) fn python() -> Option<PathBuf> {
     let p = std::env::var_os("RAIL_PYTHON")
         .map(PathBuf::from)
         .unwrap_or_else(|| repo().join(".venv/bin/python"));
@@ -295,6 +299,59 @@ fn main() {
             w1 / w2,
             c1 / w1,
             c2 / w2,
+            load_average()
+        ));
+    }
+
+    if wanted("peers") {
+        r.line(String::new());
+        r.line(format!(
+            "## Peer hosts on the same SSP (the passive system exported by `master export-ssp`; Jacobi, 1 ms, {COUPLED_STOP_S} s simulated)"
+        ));
+        r.line(String::new());
+        r.line(
+            "libcosim and Ecos cannot set FMI 2.0 Enumeration parameters, so the bogie keeps \
+             its defaults here (non-linear contact, ideal track) and starts from a 3 mm lateral \
+             displacement at 300 km/h. Each host loads the archive untimed; the time is its own \
+             run-until call (libcosim's `simulate_until`, Ecos's `step_until`; ours: the run of \
+             the imported system, recording every output as `master run x.ssp` does), fastest \
+             of 3 (ours: of 7). CPU is the process's user + system time over the call: a host \
+             that steps the FMUs on worker threads uses more CPU than wall time."
+                .into(),
+        );
+        r.line(String::new());
+        let load = load_average();
+        r.line(
+            "| host | wall per simulated s | CPU per simulated s | wall / our master | CPU / our master | final front wheelset displacement |"
+                .into(),
+        );
+        r.line("|---|---|---|---|---|---|".into());
+        let runs = peers::peers();
+        let ours = runs.iter().find_map(|(_, r)| r.as_ref().ok().copied());
+        for (name, run) in &runs {
+            match (run, ours) {
+                (Ok(h), Some(o)) => r.line(format!(
+                    "| {name} | {:.2} ms | {:.2} ms | {:.2} | {:.2} | {:.12e} m |",
+                    h.wall_per_sim_s * 1e3,
+                    h.cpu_per_sim_s * 1e3,
+                    h.wall_per_sim_s / o.wall_per_sim_s,
+                    h.cpu_per_sim_s / o.cpu_per_sim_s,
+                    h.final_value
+                )),
+                (Err(why), _) => r.line(format!("| {name} | not measured: {why} | | | | |")),
+                (Ok(_), None) => unreachable!("our master's run is measured first"),
+            }
+        }
+        let finals: Vec<f64> = runs
+            .iter()
+            .filter_map(|(_, r)| r.as_ref().ok().map(|h| h.final_value))
+            .collect();
+        let spread = finals
+            .iter()
+            .fold(0.0f64, |a, x| a.max((x - finals[0]).abs()));
+        r.line(format!(
+            "- the hosts' final displacements differ by at most {spread:.1e} m; load average \
+             before / after: {load} / {}",
             load_average()
         ));
     }
