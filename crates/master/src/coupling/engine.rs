@@ -49,6 +49,10 @@ pub(super) struct Engine<'p, 's, 'd, 'o> {
     fixed_step: Option<usize>,
     /// Every instance steps at every point (step multiple 1).
     every_point: bool,
+    /// [`Self::fast_step`]: the deferred writes (source, entry of its `Source::dests`) that an
+    /// instance read again within the step owes to a destination that has stepped already
+    /// this step, made once at the end of the step.
+    late: Vec<(usize, usize)>,
     /// The common case runs [`Self::fast_step`]: Gauss-Seidel, every instance stepping at
     /// every point, no step retry (so no split steps) and no String among the exchanged or
     /// recorded variables. The calls of [`Self::step_windows`] in the same order, except that
@@ -122,6 +126,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             lacking_state,
             fixed_step,
             every_point: plan.instances.iter().all(|i| i.step_multiple <= 1),
+            late: Vec::new(),
             fast: fast && Self::fast_applies(plan, exchange),
         }
     }
@@ -289,8 +294,15 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
     /// current point whose outputs depend directly on the inputs just set (ModelStructure) is
     /// read again and passes its fresh outputs on, and so on down the chain (FMI 2.0 allows
     /// reading outputs again after setting inputs at the same instant). Each instance is read
-    /// again at most once per call, so an algebraic loop ends.
-    fn refresh_feedthrough(&mut self, time: f64, from: usize) -> Result<(), SimError> {
+    /// again at most once per call, so an algebraic loop ends. `fast_at`: in
+    /// [`Self::fast_step`], the position in the order being stepped (see
+    /// [`Self::propagate_refreshed`]).
+    fn refresh_feedthrough(
+        &mut self,
+        time: f64,
+        from: usize,
+        fast_at: Option<usize>,
+    ) -> Result<(), SimError> {
         let exchange = self.exchange;
         // a source ahead of the others (a longer step) does not refresh them
         if exchange.sources[from].feeds_through.is_empty() || !self.current[from] {
@@ -306,7 +318,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             for &j in &exchange.sources[s].feeds_through {
                 if self.current[j] && !self.refreshed[j] {
                     self.refreshed[j] = true;
-                    if let Err(e) = self.propagate_from(time, j, false) {
+                    if let Err(e) = self.propagate_refreshed(time, j, fast_at) {
                         result = Err(e);
                         break;
                     }
@@ -318,6 +330,62 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             }
         }
         self.pending = pending;
+        result
+    }
+
+    /// Passes on the outputs of instance `from`, read again within the step. In
+    /// [`Self::fast_step`] (`fast_at`: the position in the order being stepped) a write that
+    /// is deferred there (see [`GaussSeidelWrites`](super::exchange::GaussSeidelWrites)) is
+    /// not made now: the destination's merged write still to come in this step (before its
+    /// step, or at the end) takes the fresh values; if that write has been made already (the
+    /// destination stepped after `from` and before this point), the write is made once at the
+    /// end of the step ([`Self::late_writes`]). Nothing reads such a destination in between
+    /// (its outputs are not read again within a step), so it holds the same values at each
+    /// of its calls as with every write made at once.
+    fn propagate_refreshed(
+        &mut self,
+        time: f64,
+        from: usize,
+        fast_at: Option<usize>,
+    ) -> Result<(), SimError> {
+        let Some(p) = fast_at else {
+            return self.propagate_from(time, from, false).map(|_| ());
+        };
+        self.read_outputs(time, from)?;
+        self.check_outputs(time, from)?;
+        let exchange = self.exchange;
+        let writes = &exchange.gauss_seidel;
+        for (d, dest) in exchange.sources[from].dests.iter().enumerate() {
+            let immediate = writes.immediate[from].get(d).copied().unwrap_or(true);
+            if immediate {
+                self.write_inputs(time, dest, false)?;
+                continue;
+            }
+            let (source_at, dest_at) = (writes.position[from], writes.position[dest.instance]);
+            if source_at < dest_at && dest_at <= p && !self.late.contains(&(from, d)) {
+                self.late.push((from, d));
+            }
+        }
+        Ok(())
+    }
+
+    /// The writes [`Self::propagate_refreshed`] left for the end of the step, from the latest
+    /// outputs.
+    #[inline(never)]
+    fn late_writes(&mut self, time: f64) -> Result<(), SimError> {
+        let exchange = self.exchange;
+        let mut late = std::mem::take(&mut self.late);
+        let mut result = Ok(());
+        for &(from, d) in &late {
+            result = self
+                .write_inputs(time, &exchange.sources[from].dests[d], false)
+                .map(|_| ());
+            if result.is_err() {
+                break;
+            }
+        }
+        late.clear();
+        self.late = late;
         result
     }
 
@@ -348,7 +416,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                 for idx in 0..self.plan.order.len() {
                     let i = self.plan.order[idx];
                     self.propagate_from(time, i, false)?;
-                    self.refresh_feedthrough(time, i)?;
+                    self.refresh_feedthrough(time, i, None)?;
                 }
                 Ok(())
             }
@@ -531,6 +599,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let h = self.t(k + 1) - t;
         let te = t + h;
         self.current.iter_mut().for_each(|c| *c = false);
+        self.late.clear();
         let mut ending: Option<usize> = None;
         let writes = &exchange.gauss_seidel;
         for (p, &i) in plan.order.iter().enumerate() {
@@ -587,8 +656,11 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                 r.map_err(|e| self.slave_err(te, j, e))?;
             }
             if !src.feeds_through.is_empty() {
-                self.refresh_feedthrough(te, i)?;
+                self.refresh_feedthrough(te, i, Some(p))?;
             }
+        }
+        if !self.late.is_empty() {
+            self.late_writes(te)?;
         }
         for w in &writes.at_end {
             self.write_merged(te, w)?;
@@ -607,6 +679,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
     /// gets before fmi2Terminate); not the instance at `p`, whose step failed.
     #[cold]
     fn stopped(&mut self, time: f64, p: usize, end: StepEnd) -> Result<StepEnd, SimError> {
+        self.late_writes(time)?;
         let writes = &self.exchange.gauss_seidel;
         let i = self.plan.order[p];
         for w in writes.before_step[p + 1..].iter().flatten() {
@@ -703,7 +776,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                             // at the same point as the others stepping every point
                             self.current[i] = plan.instances[i].step_multiple <= 1;
                             self.propagate_from(ts + h, i, false)?;
-                            self.refresh_feedthrough(ts + h, i)?;
+                            self.refresh_feedthrough(ts + h, i, None)?;
                         }
                     }
                 }

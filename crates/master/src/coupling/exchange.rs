@@ -77,6 +77,8 @@ pub(super) struct GaussSeidelWrites {
     pub immediate: Vec<Vec<bool>>,
     /// After the last instance stepped: the inputs from instances later in the order.
     pub at_end: Vec<MergedWrite>,
+    /// Per instance: its position in the order (`usize::MAX`: not in it).
+    pub position: Vec<usize>,
 }
 
 impl GaussSeidelWrites {
@@ -131,6 +133,7 @@ impl GaussSeidelWrites {
             before_step,
             immediate,
             at_end,
+            position,
         }
     }
 }
