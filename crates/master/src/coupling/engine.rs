@@ -53,6 +53,11 @@ pub(super) struct Engine<'p, 's, 'd, 'o> {
     /// instance read again within the step owes to a destination that has stepped already
     /// this step, made once at the end of the step.
     late: Vec<(usize, usize)>,
+    /// [`Self::fast_step`]: instances whose inputs changed after their outputs were last read
+    /// within the step and whose outputs only go to deferred writes: read when a write uses
+    /// them, or at the end of the step ([`Self::propagate_refreshed`]).
+    stale: Vec<bool>,
+    any_stale: bool,
     /// The common case runs [`Self::fast_step`]: Gauss-Seidel, every instance stepping at
     /// every point, no step retry (so no split steps) and no String among the exchanged or
     /// recorded variables. The calls of [`Self::step_windows`] in the same order, except that
@@ -127,6 +132,8 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             fixed_step,
             every_point: plan.instances.iter().all(|i| i.step_multiple <= 1),
             late: Vec::new(),
+            stale: vec![false; n],
+            any_stale: false,
             fast: fast && Self::fast_applies(plan, exchange),
         }
     }
@@ -341,7 +348,13 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
     /// destination stepped after `from` and before this point), the write is made once at the
     /// end of the step ([`Self::late_writes`]). Nothing reads such a destination in between
     /// (its outputs are not read again within a step), so it holds the same values at each
-    /// of its calls as with every write made at once.
+    /// of its calls as with every write made at once. When every write of `from` is deferred,
+    /// its outputs are not read now either: it is marked stale and read once, before the
+    /// first write that uses one of its outputs that depend on its inputs (ModelStructure), or
+    /// at the end of the step ([`Self::fresh`]); that read gives the values the last read
+    /// here would give (only its inputs changed since, and each such change brings it here
+    /// again), and its other outputs have not changed since its step. Its outputs are then
+    /// checked once per step, not after each change of its inputs.
     fn propagate_refreshed(
         &mut self,
         time: f64,
@@ -351,10 +364,15 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let Some(p) = fast_at else {
             return self.propagate_from(time, from, false).map(|_| ());
         };
-        self.read_outputs(time, from)?;
-        self.check_outputs(time, from)?;
         let exchange = self.exchange;
         let writes = &exchange.gauss_seidel;
+        if writes.deferred_only[from] {
+            self.stale[from] = true;
+            self.any_stale = true;
+        } else {
+            self.read_outputs(time, from)?;
+            self.check_outputs(time, from)?;
+        }
         for (d, dest) in exchange.sources[from].dests.iter().enumerate() {
             let immediate = writes.immediate[from].get(d).copied().unwrap_or(true);
             if immediate {
@@ -377,6 +395,17 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let mut late = std::mem::take(&mut self.late);
         let mut result = Ok(());
         for &(from, d) in &late {
+            let src = &exchange.sources[from];
+            if src.dests[d]
+                .from
+                .iter()
+                .any(|&(_, k)| src.varies.get(k).copied().unwrap_or(true))
+            {
+                result = self.fresh(time, from);
+                if result.is_err() {
+                    break;
+                }
+            }
             result = self
                 .write_inputs(time, &exchange.sources[from].dests[d], false)
                 .map(|_| ());
@@ -387,6 +416,27 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         late.clear();
         self.late = late;
         result
+    }
+
+    /// Reads the outputs of instance `i` if they are stale (see [`Self::propagate_refreshed`]).
+    #[inline]
+    fn fresh(&mut self, time: f64, i: usize) -> Result<(), SimError> {
+        if self.stale[i] {
+            self.stale[i] = false;
+            self.read_outputs(time, i)?;
+            self.check_outputs(time, i)?;
+        }
+        Ok(())
+    }
+
+    /// Reads every stale instance (the end of a step).
+    #[inline(never)]
+    fn fresh_all(&mut self, time: f64) -> Result<(), SimError> {
+        self.any_stale = false;
+        for i in 0..self.stale.len() {
+            self.fresh(time, i)?;
+        }
+        Ok(())
     }
 
     /// Jacobi exchange: read all connected outputs first, then set all inputs.
@@ -600,6 +650,10 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let te = t + h;
         self.current.iter_mut().for_each(|c| *c = false);
         self.late.clear();
+        if self.any_stale {
+            self.stale.iter_mut().for_each(|s| *s = false);
+            self.any_stale = false;
+        }
         let mut ending: Option<usize> = None;
         let writes = &exchange.gauss_seidel;
         for (p, &i) in plan.order.iter().enumerate() {
@@ -665,6 +719,9 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         for w in &writes.at_end {
             self.write_merged(te, w)?;
         }
+        if self.any_stale {
+            self.fresh_all(te)?;
+        }
         Ok(match ending {
             Some(instance) => StepEnd::Terminated {
                 instance,
@@ -694,6 +751,11 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
     /// One merged write of [`Self::fast_step`] from the latest outputs.
     #[inline(always)]
     fn write_merged(&mut self, time: f64, w: &MergedWrite) -> Result<(), SimError> {
+        if self.any_stale {
+            for &s in &w.sources {
+                self.fresh(time, s)?;
+            }
+        }
         let j = w.instance;
         self.touch(j);
         let r = match w.run {

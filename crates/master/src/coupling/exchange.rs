@@ -17,6 +17,9 @@ pub(super) struct Source {
     /// The instances among `dests` with an input from it that feeds directly through to one
     /// of their outputs (their outputs change when it sets them).
     pub feeds_through: Vec<usize>,
+    /// Per output: it may change within a step when the instance's inputs are set
+    /// (`PlanConnection::source_depends_on_inputs`).
+    pub varies: Vec<bool>,
 }
 
 /// Inputs of one instance written together.
@@ -57,6 +60,9 @@ pub(super) struct MergedWrite {
     /// When every value comes from one source's consecutive outputs: (source, first
     /// position), written from there without a copy.
     pub run: Option<(usize, usize)>,
+    /// The source instances of `from` with an output that may change within a step (see
+    /// `Source::varies`), each once: read again first if stale.
+    pub sources: Vec<usize>,
 }
 
 /// The writes of a Gauss-Seidel macro step in the common case, arranged once. A write of
@@ -79,6 +85,9 @@ pub(super) struct GaussSeidelWrites {
     pub at_end: Vec<MergedWrite>,
     /// Per instance: its position in the order (`usize::MAX`: not in it).
     pub position: Vec<usize>,
+    /// Per instance: every write of its outputs is deferred (none is made at once), so an
+    /// outputs read within the step can wait until a write uses them.
+    pub deferred_only: Vec<bool>,
 }
 
 impl GaussSeidelWrites {
@@ -122,6 +131,14 @@ impl GaussSeidelWrites {
             }
         }
         for w in before_step.iter_mut().flatten().chain(at_end.iter_mut()) {
+            w.sources = w
+                .from
+                .iter()
+                .filter(|&&(s, k)| sources[s].varies.get(k).copied().unwrap_or(true))
+                .map(|&(s, _)| s)
+                .collect();
+            w.sources.sort_unstable();
+            w.sources.dedup();
             w.run = w
                 .from
                 .windows(2)
@@ -129,11 +146,20 @@ impl GaussSeidelWrites {
                 .then(|| w.from.first().copied())
                 .flatten();
         }
+        let deferred_only = (0..n)
+            .map(|i| {
+                position[i] != usize::MAX
+                    && sources[i].feeds_through.is_empty()
+                    && immediate[i].len() == sources[i].dests.len()
+                    && immediate[i].iter().all(|&now| !now)
+            })
+            .collect();
         GaussSeidelWrites {
             before_step,
             immediate,
             at_end,
             position,
+            deferred_only,
         }
     }
 }
@@ -145,6 +171,7 @@ impl MergedWrite {
             vrs: Vec::new(),
             from: Vec::new(),
             run: None,
+            sources: Vec::new(),
         }
     }
 }
@@ -235,6 +262,9 @@ impl Exchange {
                 Source {
                     outputs: VarBatch::new(mine().map(|(_, (c, _))| c.from).collect()),
                     connections: mine().map(|(ci, _)| ci).collect(),
+                    varies: mine()
+                        .map(|(_, (c, _))| c.source_depends_on_inputs)
+                        .collect(),
                     dests: dests(group(mine().map(|(_, (c, at))| (c.to_instance, c.to, at)))),
                     feeds_through: {
                         let mut f: Vec<usize> = mine()

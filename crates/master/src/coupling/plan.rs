@@ -34,6 +34,10 @@ pub struct PlanConnection {
     /// of the target instance that is itself the source of a connection: after setting it,
     /// that output is read again and passed on (Gauss-Seidel).
     pub feedthrough: bool,
+    /// Whether the source output depends directly (ModelStructure/Outputs; an output without
+    /// declared dependencies: yes) on a connected input of its own instance: setting that
+    /// input within a Gauss-Seidel step may change it.
+    pub source_depends_on_inputs: bool,
 }
 
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]

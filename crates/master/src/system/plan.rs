@@ -176,15 +176,19 @@ impl LoadedSystem {
                 },
                 label: c.from.clone(),
                 feedthrough: false,
+                source_depends_on_inputs: false,
             });
         }
         // Gauss-Seidel reads a target's outputs again after setting this input only if one of
         // them that is itself connected depends on it: outputs nothing consumes are read once,
         // when they are recorded.
-        for (c, &(_, (ti, tvi))) in connections.iter_mut().zip(&ends) {
+        for (c, &((fi, fvi), (ti, tvi))) in connections.iter_mut().zip(&ends) {
             c.feedthrough = ends
                 .iter()
                 .any(|&((fi, fvi), _)| fi == ti && models[ti].output_depends_on(fvi, tvi));
+            c.source_depends_on_inputs = ends
+                .iter()
+                .any(|&(_, (ti, tvi))| ti == fi && models[fi].output_depends_on(fvi, tvi));
         }
 
         let order = match &d.order {
