@@ -24,6 +24,11 @@ pub enum OutputError {
         got: usize,
         expected: usize,
     },
+    #[error(
+        "cannot write '{path}': it exists and is not a regular file (a device, FIFO, socket or \
+         folder), which writing results would replace; choose another output path"
+    )]
+    NotAFile { path: PathBuf },
     #[error("cannot serialise '{path}': {source}")]
     Json {
         path: PathBuf,
@@ -41,11 +46,21 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
 
 /// Writes `path` atomically: `fill` writes the content into a buffered temporary file in the
 /// same folder, which is flushed, fsync'ed and renamed onto `path` only if `fill` succeeded.
-/// On any error the temporary file is removed and `path` is left untouched.
+/// On any error the temporary file is removed and `path` is left untouched. A `path` that
+/// exists and is not a regular file (or a symbolic link, which the rename replaces) is
+/// refused: renaming onto it would replace a device such as /dev/null, or a FIFO.
 pub fn write_atomic<F>(path: &Path, fill: F) -> Result<(), OutputError>
 where
     F: FnOnce(&mut dyn Write) -> Result<(), OutputError>,
 {
+    if let Ok(meta) = std::fs::symlink_metadata(path) {
+        let kind = meta.file_type();
+        if !(kind.is_file() || kind.is_symlink()) {
+            return Err(OutputError::NotAFile {
+                path: path.to_path_buf(),
+            });
+        }
+    }
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -197,6 +212,31 @@ mod tests {
         assert_eq!(text, "time [s],\"x,y [m]\"\n0,1.5\n0.1,-0.000000225\n");
         // only the result is left in the folder, no temporary file
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_or_a_folder_is_not_replaced_by_results() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("fifo");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+        let folder = dir.path().join("folder");
+        std::fs::create_dir(&folder).unwrap();
+        for p in [&fifo, &folder] {
+            let err = write_bytes_atomic(p, b"results").unwrap_err();
+            assert!(matches!(err, OutputError::NotAFile { .. }), "{err}");
+            assert!(err.to_string().contains("not a regular file"), "{err}");
+        }
+        use std::os::unix::fs::FileTypeExt;
+        assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
+        assert!(folder.is_dir());
+        // a regular file is replaced as before, and nothing else is left in the folder
+        let file = dir.path().join("r.csv");
+        std::fs::write(&file, "old").unwrap();
+        write_bytes_atomic(&file, b"new").unwrap();
+        assert_eq!(std::fs::read_to_string(&file).unwrap(), "new");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3);
     }
 
     #[test]
