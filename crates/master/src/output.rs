@@ -29,6 +29,12 @@ pub enum OutputError {
          folder), which writing results would replace; choose another output path"
     )]
     NotAFile { path: PathBuf },
+    #[error("cannot write '{output}': it is the same file as {what} '{other}'")]
+    SameFile {
+        output: PathBuf,
+        what: &'static str,
+        other: PathBuf,
+    },
     #[error("cannot serialise '{path}': {source}")]
     Json {
         path: PathBuf,
@@ -87,6 +93,63 @@ where
         path: path.to_path_buf(),
         source: e.error,
     })?;
+    Ok(())
+}
+
+/// What a path names, for telling whether two paths are the same file: the canonical path
+/// of an existing file, else its canonical folder and its name (None: no such folder).
+fn identity(p: &Path) -> Option<PathBuf> {
+    if let Ok(c) = std::fs::canonicalize(p) {
+        return Some(c);
+    }
+    let name = p.file_name()?;
+    let parent = match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    std::fs::canonicalize(parent).ok().map(|d| d.join(name))
+}
+
+/// Two existing paths that are one file under two names (a hard link).
+#[cfg(unix)]
+fn same_inode(a: &Path, b: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (std::fs::metadata(a), std::fs::metadata(b)) {
+        (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
+        _ => false,
+    }
+}
+
+#[cfg(not(unix))]
+fn same_inode(_: &Path, _: &Path) -> bool {
+    false
+}
+
+/// Refuses to start a command whose output files would replace one of its inputs, or each
+/// other: each output is compared with every input and every other output (symbolic links
+/// resolved, hard links too). Called before anything is written.
+pub fn check_outputs_apart(inputs: &[PathBuf], outputs: &[PathBuf]) -> Result<(), OutputError> {
+    let ids = |ps: &[PathBuf]| ps.iter().map(|p| identity(p)).collect::<Vec<_>>();
+    let (input_ids, output_ids) = (ids(inputs), ids(outputs));
+    for (k, (out, id)) in outputs.iter().zip(&output_ids).enumerate() {
+        let same = |other: &Path, other_id: &Option<PathBuf>| {
+            (id.is_some() && id == other_id) || same_inode(out, other)
+        };
+        if let Some(i) = (0..inputs.len()).find(|&i| same(&inputs[i], &input_ids[i])) {
+            return Err(OutputError::SameFile {
+                output: out.clone(),
+                what: "the input",
+                other: inputs[i].clone(),
+            });
+        }
+        if let Some(j) = (0..k).find(|&j| same(&outputs[j], &output_ids[j])) {
+            return Err(OutputError::SameFile {
+                output: out.clone(),
+                what: "the output",
+                other: outputs[j].clone(),
+            });
+        }
+    }
     Ok(())
 }
 
@@ -229,7 +292,10 @@ mod tests {
             assert!(err.to_string().contains("not a regular file"), "{err}");
         }
         use std::os::unix::fs::FileTypeExt;
-        assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
+        assert!(std::fs::symlink_metadata(&fifo)
+            .unwrap()
+            .file_type()
+            .is_fifo());
         assert!(folder.is_dir());
         // a regular file is replaced as before, and nothing else is left in the folder
         let file = dir.path().join("r.csv");
@@ -237,6 +303,51 @@ mod tests {
         write_bytes_atomic(&file, b"new").unwrap();
         assert_eq!(std::fs::read_to_string(&file).unwrap(), "new");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3);
+    }
+
+    #[test]
+    fn an_output_that_is_an_input_or_another_output_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let system = dir.path().join("sys.json");
+        std::fs::write(&system, "{}").unwrap();
+        let results = dir.path().join("r.csv");
+        // the same file under another spelling
+        let spelled = dir.path().join(".").join("sys.json");
+        let err = check_outputs_apart(std::slice::from_ref(&system), &[results.clone(), spelled])
+            .unwrap_err();
+        assert!(
+            matches!(
+                &err,
+                OutputError::SameFile {
+                    what: "the input",
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        assert!(err.to_string().contains("same file as the input"), "{err}");
+        // two outputs that do not exist yet, one name
+        let twice = [results.clone(), dir.path().join("./r.csv")];
+        let err = check_outputs_apart(std::slice::from_ref(&system), &twice).unwrap_err();
+        assert!(
+            matches!(
+                &err,
+                OutputError::SameFile {
+                    what: "the output",
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        // a hard link to the input
+        #[cfg(unix)]
+        {
+            let link = dir.path().join("link.csv");
+            std::fs::hard_link(&system, &link).unwrap();
+            assert!(check_outputs_apart(std::slice::from_ref(&system), &[link]).is_err());
+        }
+        let meta = dir.path().join("r.meta.json");
+        check_outputs_apart(&[system], &[results, meta]).unwrap();
     }
 
     #[test]

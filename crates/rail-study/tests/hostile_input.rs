@@ -550,6 +550,82 @@ fn fifos_and_devices_are_refused_without_reading() {
 }
 
 #[test]
+fn outputs_never_replace_an_input_or_a_device() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    let system = std::fs::read(c.path("system.json")).unwrap();
+    let fmu = std::fs::read(c.path("Hostile.fmu")).unwrap();
+    for args in [
+        &["run", "system.json", "-o", "system.json"][..],
+        &["run", "system.json", "-o", "./Hostile.fmu"],
+        &[
+            "run",
+            "system.json",
+            "-o",
+            "r.csv",
+            "--summary",
+            "system.json",
+        ],
+        &[
+            "run",
+            "system.json",
+            "-o",
+            "r.csv",
+            "--summary",
+            "r.meta.json",
+        ],
+        &["run", "Hostile.fmu", "-o", "Hostile.fmu"],
+        &["export-ssp", "system.json", "system.json"],
+        &["export-ssp", "system.json", "Hostile.fmu"],
+    ] {
+        let e = c.fails(args, &[]);
+        assert!(e.contains("is the same file as the"), "{args:?}: {e}");
+    }
+    // a FIFO named as the results is refused, not replaced by a regular file
+    let fifo = c.path("results.fifo");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let e = c.fails(&["run", "system.json", "-o", "results.fifo"], &[]);
+    assert!(e.contains("not a regular file"), "{e}");
+    use std::os::unix::fs::FileTypeExt;
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+    assert_eq!(std::fs::read(c.path("system.json")).unwrap(), system);
+    assert_eq!(std::fs::read(c.path("Hostile.fmu")).unwrap(), fmu);
+    assert!(!c.path("r.csv").exists());
+    // the assessment's files are not written over the table it reads
+    let rows: String = (0..2001)
+        .map(|k| {
+            let t = k as f64 * 1e-3;
+            format!("{t},{}\n", (2.0 * std::f64::consts::PI * 4.0 * t).sin())
+        })
+        .collect();
+    std::fs::create_dir_all(c.path("as")).unwrap();
+    let table = c.write("as/assess.csv", &format!("time [s],a [m/s2]\n{rows}"));
+    let before = std::fs::read(&table).unwrap();
+    let e = c.fails(
+        &[
+            "assess",
+            "as/assess.csv",
+            "--signal",
+            "a",
+            "--speed",
+            "300",
+            "--out",
+            "as",
+        ],
+        &[],
+    );
+    assert!(e.contains("is the same file as the input"), "{e}");
+    assert_eq!(std::fs::read(&table).unwrap(), before);
+}
+
+#[test]
 fn a_study_option_out_of_range_is_refused_before_anything_is_touched() {
     let case = Case::new();
     std::fs::create_dir_all(case.path("out")).unwrap();

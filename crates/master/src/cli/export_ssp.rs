@@ -19,6 +19,10 @@ pub struct Args {
 
 pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
     let sys = LoadedSystem::load(&args.system)?;
+    let inputs: Vec<PathBuf> = std::iter::once(args.system.clone())
+        .chain((0..sys.desc.instances.len()).map(|i| sys.fmu_path(i)))
+        .collect();
+    crate::output::check_outputs_apart(&inputs, std::slice::from_ref(&args.output))?;
     let summary = crate::ssp::export(&sys, &args.output)?;
     println!("{}: {summary}", args.output.display());
     if sys.desc.algorithm == Algorithm::GaussSeidel {

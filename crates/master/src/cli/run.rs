@@ -6,8 +6,8 @@ use std::path::PathBuf;
 
 use super::{CommandError, Context};
 use crate::coupling::{Algorithm, RunOptions};
-use crate::output::write_json_atomic;
-use crate::results::{write_results, ResultsFormat, RunContext};
+use crate::output::{check_outputs_apart, write_json_atomic};
+use crate::results::{csv_metadata_path, write_results, ResultsFormat, RunContext};
 use crate::ssp::{self, ImportOptions};
 use crate::system::{LoadedSystem, SingleFmuOptions};
 
@@ -122,6 +122,26 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         }
         (LoadedSystem::load(&args.system)?, None)
     };
+    // the files it reads: the system file and every FMU (those of an archive are unpacked)
+    let inputs: Vec<PathBuf> = std::iter::once(args.system.clone())
+        .chain((0..sys.desc.instances.len()).map(|i| sys.fmu_path(i)))
+        .collect();
+    let written = |output: &PathBuf, format: ResultsFormat| {
+        let mut files = vec![output.clone()];
+        if format == ResultsFormat::Csv {
+            files.push(csv_metadata_path(output));
+        }
+        files.extend(args.summary.iter().cloned());
+        files
+    };
+    // known before the run when --output names it: refused before running
+    if let Some(output) = &args.output {
+        let format = args
+            .format
+            .or_else(|| ResultsFormat::of_path(output))
+            .unwrap_or(ResultsFormat::Parquet);
+        check_outputs_apart(&inputs, &written(output, format))?;
+    }
     let bar = if ctx.progress {
         indicatif::ProgressBar::new(0)
     } else {
@@ -153,6 +173,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         .output
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("results.{}", format.extension())));
+    check_outputs_apart(&inputs, &written(&output, format))?;
     let ctx = RunContext {
         system: serde_json::to_value(&sys.desc).ok(),
         ..RunContext::default()

@@ -95,7 +95,11 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             eprintln!("WARNING: {e}\nWARNING: assessed anyway (--accept-narrow-band): the rms below may be wrong");
         }
     }
-    write_analysis(&args.out, ctx.cancel, &report.summary(), |f| {
-        report.add_artefacts(f)
-    })
+    write_analysis(
+        &args.out,
+        std::slice::from_ref(&args.table),
+        ctx.cancel,
+        &report.summary(),
+        |f| report.add_artefacts(f),
+    )
 }

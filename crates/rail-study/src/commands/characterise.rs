@@ -86,7 +86,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         .map(|r| r.summary())
         .chain(actuator.iter().map(|r| r.summary()));
     let summary: String = summary.collect();
-    write_analysis(&args.out, ctx.cancel, &summary, |f| {
+    write_analysis(&args.out, &[], ctx.cancel, &summary, |f| {
         if let Some(r) = &damper {
             r.add_artefacts(f)?;
         }

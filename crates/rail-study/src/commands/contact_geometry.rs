@@ -88,6 +88,13 @@ pub struct Args {
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     let d = GeometryInputs::default();
+    // the profile files read (those of --wheel-dir are found later)
+    let mut read: Vec<PathBuf> = [&args.wheel, &args.rail, &args.wheel_right, &args.rail_right]
+        .into_iter()
+        .flatten()
+        .chain(&args.wheels)
+        .cloned()
+        .collect();
     let file = |p: &Option<PathBuf>| p.as_ref().map(|p| ProfileSource::File(p.clone()));
     let wheel_left = file(&args.wheel).unwrap_or(d.wheel_left);
     let rail_left = file(&args.rail).unwrap_or(d.rail_left);
@@ -115,13 +122,18 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         let mut skipped = Vec::new();
         if let Some(dir) = &args.wheel_dir {
             let (files, other) = profiles_in(dir).map_err(failed)?;
+            read.extend(files.iter().cloned());
             wheels.extend(files.into_iter().map(ProfileSource::File));
             skipped = other;
         }
         let r = fleet(&inputs, &wheels, ctx.cancel).map_err(failed)?;
         let summary = r.summary(&skipped);
-        return write_analysis(&args.out, ctx.cancel, &summary, |f| r.add_artefacts(f));
+        return write_analysis(&args.out, &read, ctx.cancel, &summary, |f| {
+            r.add_artefacts(f)
+        });
     }
     let r = contact_geometry(&inputs).map_err(failed)?;
-    write_analysis(&args.out, ctx.cancel, &r.summary(), |f| r.add_artefacts(f))
+    write_analysis(&args.out, &read, ctx.cancel, &r.summary(), |f| {
+        r.add_artefacts(f)
+    })
 }

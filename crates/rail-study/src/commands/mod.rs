@@ -3,7 +3,7 @@
 //! an `execute(&Args, &Context) -> Result<(), CommandError>`, declare it here and add a variant
 //! to `Command` in `src/main.rs`.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use master::cli::CommandError;
@@ -29,9 +29,11 @@ pub(crate) fn failed(e: AnalysisError) -> CommandError {
 }
 
 /// Ends an analysis command: unless interrupted, collects its files (`add`), writes them into
-/// `out` (only now, after everything is computed) and prints `summary` with the file list.
+/// `out` (only now, after everything is computed, and none over one of the files it read,
+/// `inputs`) and prints `summary` with the file list.
 pub(crate) fn write_analysis(
     out: &Path,
+    inputs: &[PathBuf],
     cancel: &AtomicBool,
     summary: &str,
     add: impl FnOnce(&mut Artefacts) -> Result<(), AnalysisError>,
@@ -39,6 +41,8 @@ pub(crate) fn write_analysis(
     check_cancel(cancel).map_err(failed)?;
     let mut files = Artefacts::default();
     add(&mut files).map_err(failed)?;
+    let paths: Vec<PathBuf> = files.names().iter().map(|n| out.join(n)).collect();
+    master::output::check_outputs_apart(inputs, &paths)?;
     files.write_all(out)?;
     print_report(summary, &files, out);
     Ok(())

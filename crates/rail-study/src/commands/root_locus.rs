@@ -70,7 +70,9 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             }
             let r = vehicle_root_locus(&params, args.damper, args.mounting_stiffness, &speeds)
                 .map_err(failed)?;
-            write_analysis(&args.out, ctx.cancel, &r.summary(), |f| r.add_artefacts(f))
+            write_analysis(&args.out, &[], ctx.cancel, &r.summary(), |f| {
+                r.add_artefacts(f)
+            })
         }
         VehicleModel::Bogie2Dof => {
             if args.mounting_stiffness.is_some() {
@@ -83,7 +85,9 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
                 params.conicity = c;
             }
             let r = root_locus(&params, args.damper, &speeds).map_err(failed)?;
-            write_analysis(&args.out, ctx.cancel, &r.summary(), |f| r.add_artefacts(f))
+            write_analysis(&args.out, &[], ctx.cancel, &r.summary(), |f| {
+                r.add_artefacts(f)
+            })
         }
     }
 }
