@@ -547,6 +547,20 @@ fn fifos_and_devices_are_refused_without_reading() {
     );
     let e = c.fails(&["run", "fifo-fmu.json"], &[]);
     assert!(e.contains("not a regular file"), "{e}");
+    // the tables and profiles of the analysis commands likewise (they would hang or fill
+    // memory)
+    for file in ["system.fifo", "/dev/zero"] {
+        let args = [
+            "assess", file, "--signal", "a", "--speed", "300", "--out", "o",
+        ];
+        let e = c.fails(&args, &[]);
+        assert!(e.contains("not a regular file"), "{e}");
+        for option in ["--wheel", "--rail"] {
+            let e = c.fails(&["contact-geometry", option, file, "--out", "o"], &[]);
+            assert!(e.contains("not a regular file"), "{e}");
+        }
+    }
+    assert!(!c.path("o").exists());
 }
 
 #[test]

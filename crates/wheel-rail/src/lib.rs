@@ -102,6 +102,7 @@ pub mod contact;
 pub mod creep;
 pub mod profile;
 pub mod table;
+pub mod text_file;
 pub mod track;
 
 pub use conicity::{

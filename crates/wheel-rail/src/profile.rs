@@ -93,10 +93,11 @@ impl Profile {
     pub fn from_file(path: impl AsRef<Path>) -> Result<Self, ProfileError> {
         let path = path.as_ref();
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ProfileError::Io {
-            source_name: name.clone(),
-            message: e.to_string(),
-        })?;
+        let text = crate::text_file::read_text_file(path, crate::text_file::MAX_TEXT_FILE_BYTES)
+            .map_err(|message| ProfileError::Io {
+                source_name: name.clone(),
+                message,
+            })?;
         Self::parse_str(&text, &name)
     }
 

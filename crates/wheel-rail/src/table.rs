@@ -318,10 +318,11 @@ impl GeometryTable {
     pub fn load(path: impl AsRef<Path>) -> Result<Self, TableError> {
         let path = path.as_ref();
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| TableError::Io {
-            source_name: name.clone(),
-            message: e.to_string(),
-        })?;
+        let text = crate::text_file::read_text_file(path, crate::text_file::MAX_TEXT_FILE_BYTES)
+            .map_err(|message| TableError::Io {
+                source_name: name.clone(),
+                message,
+            })?;
         Self::parse_csv(&text, &name)
     }
 

@@ -148,7 +148,8 @@ impl ResultsTable {
         if ResultsFormat::of_path(path) == Some(ResultsFormat::Parquet) {
             return Self::load_parquet(path);
         }
-        let text = std::fs::read_to_string(path)
+        // a regular file of bounded size (a FIFO or /dev/zero would hang the command)
+        let text = master::input::read_text_file(path, master::input::MAX_TEXT_FILE_BYTES)
             .map_err(|e| AnalysisError::Input(format!("{}: {e}", path.display())))?;
         let mut table = Self::parse(&text, path)?;
         let meta = read_metadata(path).map_err(|e| input(&e))?;
