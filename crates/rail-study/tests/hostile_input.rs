@@ -640,6 +640,39 @@ fn outputs_never_replace_an_input_or_a_device() {
 }
 
 #[test]
+fn a_variable_recorded_twice_is_refused() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    c.write(
+        "twice.json",
+        &SYSTEM.replace(
+            "\"stop_time\"",
+            "\"record\": [\"h.y\", \"h.gain\", \"h.y\"], \"stop_time\"",
+        ),
+    );
+    let e = c.fails(&["run", "twice.json", "-o", "r.parquet"], &[]);
+    assert!(
+        e.contains("record[2]") && e.contains("recorded already (record[0])"),
+        "{e}"
+    );
+    let e = c.fails(
+        &[
+            "run",
+            "Hostile.fmu",
+            "--record",
+            "y",
+            "--record",
+            "y",
+            "-o",
+            "r.csv",
+        ],
+        &[],
+    );
+    assert!(e.contains("recorded already"), "{e}");
+    assert!(!c.path("r.parquet").exists() && !c.path("r.csv").exists());
+}
+
+#[test]
 fn a_study_option_out_of_range_is_refused_before_anything_is_touched() {
     let case = Case::new();
     std::fs::create_dir_all(case.path("out")).unwrap();

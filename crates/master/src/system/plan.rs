@@ -266,11 +266,31 @@ impl LoadedSystem {
                 },
             }
         };
+        let limits =
+            crate::coupling::RunLimits::from_env().map_err(|r| self.invalid("step", "step", r))?;
+        let steps = limits
+            .steps(d.stop_time - d.start_time, d.step)
+            .map_err(|r| self.invalid("step", "step", r))?;
         let mut record = Vec::new();
         match &d.record {
             Some(list) => {
+                // a list too long is refused before its names are resolved
+                limits
+                    .recorded(steps, list.len() + 1)
+                    .map_err(|r| self.invalid("record", "record", r))?;
+                let mut seen: HashMap<(usize, usize), usize> = HashMap::new();
                 for (k, s) in list.iter().enumerate() {
-                    let (i, _, v) = self.resolve(&format!("record[{k}]"), s, models)?;
+                    let field = format!("record[{k}]");
+                    let (i, vi, v) = self.resolve(&field, s, models)?;
+                    if let Some(first) = seen.insert((i, vi), k) {
+                        // one column per variable: a repeated name would give two columns of
+                        // one name, which Parquet readers refuse
+                        return Err(self.invalid(
+                            field,
+                            s,
+                            format!("'{s}' is recorded already (record[{first}])"),
+                        ));
+                    }
                     record.push(recorded(i, v));
                 }
             }
@@ -287,11 +307,6 @@ impl LoadedSystem {
             }
         }
 
-        let limits =
-            crate::coupling::RunLimits::from_env().map_err(|r| self.invalid("step", "step", r))?;
-        let steps = limits
-            .steps(d.stop_time - d.start_time, d.step)
-            .map_err(|r| self.invalid("step", "step", r))?;
         limits
             .recorded(steps, record.len() + 1)
             .map_err(|r| self.invalid("record", "record", r))?;
