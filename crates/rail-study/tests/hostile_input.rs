@@ -385,6 +385,34 @@ fn archive_limits_and_unsafe_entries_are_refused_before_extraction() {
     z.finish().unwrap();
     let e = c.fails(&["inspect", "Hostile.fmu"], &[]);
     assert!(e.contains("symbolic links are not allowed"), "{e}");
+    // a name stored twice (the zip reader keeps only the last copy): a second
+    // modelDescription.xml, made by renaming an entry of the same length in place
+    let other_md = HOSTILE_MD.replace("guid=\"{hostile}\"", "guid=\"{hostilf}\"");
+    zip_into(
+        &c.path("Hostile.fmu"),
+        &[md, bin, ("modelDescriptioN.xml", other_md.as_bytes())],
+    );
+    let bytes = std::fs::read(c.path("Hostile.fmu")).unwrap();
+    let (from, to): (&[u8], &[u8]) = (b"modelDescriptioN.xml", b"modelDescription.xml");
+    let mut patched = Vec::with_capacity(bytes.len());
+    let mut k = 0;
+    while k < bytes.len() {
+        if bytes[k..].starts_with(from) {
+            patched.extend_from_slice(to);
+            k += from.len();
+        } else {
+            patched.push(bytes[k]);
+            k += 1;
+        }
+    }
+    std::fs::write(c.path("Hostile.fmu"), &patched).unwrap();
+    for sub in [&["inspect", "Hostile.fmu"][..], &["run", "system.json"][..]] {
+        let e = c.fails(sub, &[]);
+        assert!(
+            e.contains("\"modelDescription.xml\": the name is used twice"),
+            "{e}"
+        );
+    }
     assert!(c.extraction_folders().is_empty());
 }
 

@@ -100,6 +100,59 @@ fn too_large(path: &Path, what: String, limit: u64, var: &'static str) -> FmuErr
     }
 }
 
+/// The first entry name stored twice in the central directory of the zip at `path`, read
+/// from the file itself: the zip reader keeps one entry per name (the last), so a second
+/// `modelDescription.xml` or `SystemStructure.ssd` would be read silently in place of the
+/// first. Reads the fixed-size headers and names only, at most `max_entries` of them.
+pub(crate) fn duplicate_entry_name<R: Read + std::io::Seek>(
+    path: &Path,
+    zip: &zip::ZipArchive<R>,
+    max_entries: u64,
+) -> std::io::Result<Option<String>> {
+    use std::io::{BufReader, Seek, SeekFrom};
+    const CENTRAL_HEADER: u32 = 0x0201_4b50;
+    let mut file = BufReader::new(crate::input::open_regular_file(path)?);
+    // the directory's offset as the reader gives it, or past data prepended to the archive
+    let mut found = false;
+    for start in [
+        zip.central_directory_start(),
+        zip.offset().saturating_add(zip.central_directory_start()),
+    ] {
+        let mut signature = [0u8; 4];
+        file.seek(SeekFrom::Start(start))?;
+        if file.read_exact(&mut signature).is_ok()
+            && u32::from_le_bytes(signature) == CENTRAL_HEADER
+        {
+            file.seek(SeekFrom::Start(start))?;
+            found = true;
+            break;
+        }
+    }
+    if !found {
+        return Ok(None);
+    }
+    let mut names: HashSet<Vec<u8>> = HashSet::new();
+    let mut header = [0u8; 46];
+    for _ in 0..max_entries.saturating_add(1) {
+        if file.read_exact(&mut header).is_err()
+            || u32::from_le_bytes([header[0], header[1], header[2], header[3]]) != CENTRAL_HEADER
+        {
+            break;
+        }
+        let field = |at: usize| usize::from(u16::from_le_bytes([header[at], header[at + 1]]));
+        let (name_len, extra_len, comment_len) = (field(28), field(30), field(32));
+        let mut name = vec![0u8; name_len];
+        file.read_exact(&mut name)?;
+        file.seek_relative((extra_len + comment_len) as i64)?;
+        // a folder entry `x/` and a file `x` count as one name, as in `check_entries`
+        let key = name.strip_suffix(b"/").unwrap_or(&name).to_vec();
+        if !names.insert(key) {
+            return Ok(Some(String::from_utf8_lossy(&name).into_owned()));
+        }
+    }
+    Ok(None)
+}
+
 /// Checks every entry's name and declared size against `limits` (reads only the central
 /// directory, nothing is inflated).
 pub(crate) fn check_entries<R: Read + std::io::Seek>(
@@ -115,6 +168,18 @@ pub(crate) fn check_entries<R: Read + std::io::Seek>(
             limits.max_entries,
             MAX_ENTRIES_VAR,
         ));
+    }
+    let stored_twice =
+        duplicate_entry_name(path, zip, limits.max_entries).map_err(|e| FmuError::NotAZip {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
+    if let Some(name) = stored_twice {
+        return Err(FmuError::UnsafeEntry {
+            path: path.to_path_buf(),
+            entry: name.escape_debug().to_string(),
+            reason: "the name is used twice (which copy would be used is undefined)".into(),
+        });
     }
     let mut total: u64 = 0;
     let mut names = HashSet::new();

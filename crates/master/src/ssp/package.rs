@@ -39,6 +39,17 @@ impl Package {
                 let f = std::fs::File::open(path).map_err(|e| read_err(e.to_string()))?;
                 let zip = zip::ZipArchive::new(f)
                     .map_err(|e| read_err(format!("not a zip archive: {e}")))?;
+                let limits =
+                    crate::fmu::ArchiveLimits::from_env().map_err(|e| read_err(e.to_string()))?;
+                let twice =
+                    crate::fmu::extract::duplicate_entry_name(path, &zip, limits.max_entries)
+                        .map_err(|e| read_err(e.to_string()))?;
+                if let Some(name) = twice {
+                    return Err(read_err(format!(
+                        "the entry '{}' is stored twice (which copy would be read is undefined)",
+                        name.escape_debug()
+                    )));
+                }
                 Ok(Package::Zip {
                     path: path.to_path_buf(),
                     zip: Box::new(zip),
