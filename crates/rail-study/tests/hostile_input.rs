@@ -249,6 +249,52 @@ fn rerun_replaces_the_run_folder_and_a_failed_sweep_reports_failure() {
 }
 
 #[test]
+fn a_sweep_into_a_used_folder_holds_its_own_runs_and_replaces_nothing_else() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    let sweep = |set: &str, format: &str| {
+        c.write("set.json", set);
+        c.master(&["sweep", "set.json", "-o", "out", "--format", format], &[])
+    };
+    let runs_from = |base: &str, names: &[&str]| {
+        let list: Vec<String> = names
+            .iter()
+            .map(|n| format!(r#"{{"name": "{n}", "parameters": {{}}}}"#))
+            .collect();
+        format!(r#"{{"base": "{base}", "runs": [{}]}}"#, list.join(", "))
+    };
+    let runs = |names: &[&str]| runs_from("system.json", names);
+    let listing = |dir: &str| {
+        let mut names: Vec<String> = std::fs::read_dir(c.path(dir))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .collect();
+        names.sort();
+        names
+    };
+    std::fs::create_dir_all(c.path("out")).unwrap();
+    std::fs::write(c.path("out/notes.txt"), "the user's").unwrap();
+    assert!(sweep(&runs(&["a", "b", "c"]), "parquet").status.success());
+    assert!(sweep(&runs(&["b"]), "parquet").status.success());
+    // the earlier set's other runs are gone, the user's file is not
+    assert_eq!(listing("out"), ["b", "notes.txt", "results", "sweep.json"]);
+    assert_eq!(listing("out/results"), ["b.parquet"]);
+    // a run named like something that is not a run folder is refused, nothing replaced
+    c.write("set.json", &runs(&["notes.txt"]));
+    // the run set itself, in the output folder
+    c.write("out/set.json", &runs_from("../system.json", &["set.json"]));
+    for set_file in ["set.json", "out/set.json"] {
+        let e = c.fails(&["sweep", set_file, "-o", "out"], &[]);
+        assert!(e.contains("is not a run folder of an earlier sweep"), "{e}");
+    }
+    assert_eq!(
+        std::fs::read_to_string(c.path("out/notes.txt")).unwrap(),
+        "the user's"
+    );
+    assert!(c.path("out/set.json").is_file() && c.path("out/b").is_dir());
+}
+
+#[test]
 fn huge_runs_are_refused_up_front() {
     let c = Case::new();
     hostile_fmu(&c, HOSTILE_MD);

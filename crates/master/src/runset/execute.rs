@@ -164,6 +164,7 @@ where
         source,
     };
     std::fs::create_dir_all(outdir).map_err(dir_err)?;
+    check_run_folders(jobs, outdir)?;
     let report_path = outdir.join("sweep.json");
     match std::fs::remove_file(&report_path) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
@@ -212,6 +213,63 @@ where
     bar.finish_and_clear();
     write_json_atomic(&report_path, &reports)?;
     Ok(reports)
+}
+
+/// Whether `dir` is a run folder written by a sweep (it holds the run's `system.json` or
+/// `summary.json`; a folder is swapped into place only with its description in it).
+fn is_run_folder(dir: &Path) -> bool {
+    dir.symlink_metadata().is_ok_and(|m| m.is_dir())
+        && ["system.json", "summary.json"]
+            .iter()
+            .any(|f| dir.join(f).symlink_metadata().is_ok_and(|m| m.is_file()))
+}
+
+/// Refuses a run whose folder `<outdir>/<run>` would replace something that is not a run
+/// folder of an earlier sweep (a file or folder of the user's, the run set itself).
+pub fn check_run_folders(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> {
+    for job in jobs {
+        let dest = outdir.join(&job.name);
+        if dest.symlink_metadata().is_ok() && !is_run_folder(&dest) {
+            return Err(SweepError::NotARunFolder {
+                path: dest,
+                run: job.name.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Removes from `outdir` the runs of an earlier sweep that are not among `names` (the whole
+/// set of this one, kept runs included): their run folders and their
+/// `results/<run>.parquet`, so that the folder, and the results folder read as one table,
+/// hold this set's runs only. Nothing else in `outdir` is touched.
+pub fn remove_other_runs(outdir: &Path, names: &[&str]) -> Result<(), SweepError> {
+    let keep: std::collections::HashSet<&str> = names.iter().copied().collect();
+    let remove_err = |path: PathBuf| move |source| SweepError::Dir { path, source };
+    if let Ok(entries) = std::fs::read_dir(outdir) {
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().to_string();
+            if keep.contains(name.as_str()) || name.starts_with('.') {
+                continue;
+            }
+            let path = e.path();
+            if name != PARQUET_FOLDER && is_run_folder(&path) {
+                std::fs::remove_dir_all(&path).map_err(remove_err(path.clone()))?;
+            }
+        }
+    }
+    if let Ok(entries) = std::fs::read_dir(outdir.join(PARQUET_FOLDER)) {
+        for e in entries.flatten() {
+            let path = e.path();
+            let is_table = path.extension().is_some_and(|x| x == "parquet")
+                && e.file_type().is_ok_and(|t| t.is_file());
+            let run = path.file_stem().map(|s| s.to_string_lossy().to_string());
+            if is_table && run.is_some_and(|r| !keep.contains(r.as_str())) {
+                std::fs::remove_file(&path).map_err(remove_err(path.clone()))?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Removes the hidden run folders an interrupted sweep left in `outdir`.

@@ -86,6 +86,11 @@ pub enum SweepError {
     },
     #[error("cannot start {jobs} worker threads: {reason}")]
     Pool { jobs: usize, reason: String },
+    #[error(
+        "'{path}' exists and is not a run folder of an earlier sweep, which run '{run}' would \
+         replace; choose another output folder or rename the run"
+    )]
+    NotARunFolder { path: PathBuf, run: String },
 }
 
 fn invalid(file: &str, field: String, reason: String) -> SystemError {

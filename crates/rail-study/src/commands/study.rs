@@ -298,6 +298,8 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             _ => {}
         }
     }
+    // bisection rounds of an earlier study beyond this one's would be left beside its runs
+    remove_batches(&args.out.join("runs"), "bisect-")?;
     let results = run_study(&settings, &opts)?;
     let timing = Timing {
         wall_s: start.elapsed().as_secs_f64(),
@@ -320,6 +322,29 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         timing.sim_per_wall(&results),
         args.out.join("REPORT.md").display()
     );
+    Ok(())
+}
+
+/// Removes the batch folders `<runs>/<prefix>*` an earlier study wrote (each holds its
+/// `sweep.json` or run folders; anything else is left alone).
+fn remove_batches(runs: &std::path::Path, prefix: &str) -> Result<(), CommandError> {
+    let Ok(entries) = std::fs::read_dir(runs) else {
+        return Ok(());
+    };
+    for e in entries.flatten() {
+        let path = e.path();
+        let ours = e.file_name().to_string_lossy().starts_with(prefix)
+            && e.file_type().is_ok_and(|t| t.is_dir())
+            && path.join("sweep.json").is_file();
+        if ours {
+            std::fs::remove_dir_all(&path).map_err(|err| {
+                CommandError::Failed(format!(
+                    "cannot remove the earlier study's '{}': {err}",
+                    path.display()
+                ))
+            })?;
+        }
+    }
     Ok(())
 }
 
