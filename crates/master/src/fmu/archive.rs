@@ -424,5 +424,25 @@ mod tests {
         drop(lock);
         assert_eq!(crate::fmu::remove_stale_extractions(root.path()), 1);
         assert!(!live.exists());
+        // lockless and older than the grace period: removed only if empty and named as an
+        // extraction is (a killed master left it before taking its lock)
+        let hour_ago = std::time::SystemTime::now() - std::time::Duration::from_secs(3600);
+        let old = |name: &str, with_file: bool| {
+            let dir = root.path().join(name);
+            std::fs::create_dir_all(&dir).unwrap();
+            if with_file {
+                std::fs::write(dir.join("notes.txt"), b"the user's").unwrap();
+            }
+            std::fs::File::open(&dir)
+                .unwrap()
+                .set_modified(hour_ago)
+                .unwrap();
+            dir
+        };
+        let empty = old("master-fmu-a1B2c3", false);
+        let users = old("master-fmu-study", true);
+        let full = old("master-fmu-x9Y8z7", true);
+        assert_eq!(crate::fmu::remove_stale_extractions(root.path()), 1);
+        assert!(!empty.exists() && users.exists() && full.exists());
     }
 }

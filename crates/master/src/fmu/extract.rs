@@ -278,8 +278,16 @@ pub(crate) fn try_lock(_file: &std::fs::File) -> bool {
     true
 }
 
+/// Whether `name` is an extraction folder's: the prefix and the 6 random letters or digits
+/// `unpack` gives it.
+fn is_extraction_name(name: &str) -> bool {
+    name.strip_prefix(EXTRACTION_PREFIX)
+        .is_some_and(|rest| rest.len() == 6 && rest.chars().all(|c| c.is_ascii_alphanumeric()))
+}
+
 /// Removes the extraction folders in `root` that no live process holds (their lock can be
-/// taken, or they have no lock file and are older than the grace period). Returns how many.
+/// taken, or they have no lock file, are empty and older than the grace period). Returns how
+/// many.
 pub fn remove_stale_extractions(root: &Path) -> usize {
     let Ok(entries) = std::fs::read_dir(root) else {
         return 0;
@@ -297,12 +305,19 @@ pub fn remove_stale_extractions(root: &Path) -> usize {
         }
         let stale = match std::fs::File::open(dir.join(".lock")) {
             Ok(lock) => try_lock(&lock),
-            Err(_) => entry
-                .metadata()
-                .and_then(|m| m.modified())
-                .ok()
-                .and_then(|t| t.elapsed().ok())
-                .is_some_and(|age| age.as_secs() > LOCKLESS_GRACE_S),
+            // a master killed between creating the folder and its lock left it empty; a
+            // folder of someone else's under our prefix (not our name pattern, or not empty)
+            // is left alone
+            Err(_) => {
+                is_extraction_name(&name.to_string_lossy())
+                    && std::fs::read_dir(&dir).is_ok_and(|mut d| d.next().is_none())
+                    && entry
+                        .metadata()
+                        .and_then(|m| m.modified())
+                        .ok()
+                        .and_then(|t| t.elapsed().ok())
+                        .is_some_and(|age| age.as_secs() > LOCKLESS_GRACE_S)
+            }
         };
         if stale && std::fs::remove_dir_all(&dir).is_ok() {
             removed += 1;
@@ -328,6 +343,7 @@ pub(crate) fn unpack(
     check_entries(path, &mut zip, limits)?;
     let dir = tempfile::Builder::new()
         .prefix(EXTRACTION_PREFIX)
+        .rand_bytes(6)
         .tempdir_in(root)
         .map_err(|e| {
             err(format!(
