@@ -94,6 +94,9 @@ class RunSet:
         """
         out = Path(output_dir)
         out.mkdir(parents=True, exist_ok=True)
+        # this set's runs only: nothing of the user's is replaced by a run folder, and an
+        # earlier set's other runs are removed (the kept ones are in this set)
+        _railfmu.prepare_run_folder(os.fspath(out), self._jobs_json)
         reports: List[Optional[str]] = [None] * len(self)
         if resume:
             # decided over every job before the kept runs, as a fresh run set decides it

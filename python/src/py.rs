@@ -21,7 +21,8 @@ use master::coupling::{RunOptions, SimError, SimOutput, Summary};
 use master::output::write_csv_atomic;
 use master::results::ResultsFormat;
 use master::runset::{
-    execute_with, format_by_size, run_job, Job, ResultsOptions, RunReport, RunSet, SweepError,
+    check_run_folders, execute_with, format_by_size, remove_other_runs, run_job, Job,
+    ResultsOptions, RunReport, RunSet, SweepError,
 };
 use master::system::{LoadedSystem, PreparedSystem, RunError, SystemError};
 
@@ -96,7 +97,9 @@ fn run_err(e: &RunError) -> PyErr {
 fn sweep_err(e: &SweepError) -> PyErr {
     match e {
         SweepError::System(s) => system_err(s),
-        SweepError::Output(_) | SweepError::Dir { .. } => OutputError::new_err(error_message(e)),
+        SweepError::Output(_) | SweepError::Dir { .. } | SweepError::NotARunFolder { .. } => {
+            OutputError::new_err(error_message(e))
+        }
         SweepError::Pool { .. } => Error::new_err(error_message(e)),
     }
 }
@@ -441,6 +444,18 @@ impl PySystem {
     }
 }
 
+/// Before a run set writes into `outdir`: refuses a run whose folder would replace a file or
+/// folder that is not a run folder of an earlier sweep, then removes the earlier set's runs
+/// that are not among `jobs_json` (all of this set's jobs, kept ones included), as
+/// `master sweep` does.
+#[pyfunction]
+fn prepare_run_folder(outdir: PathBuf, jobs_json: Vec<String>) -> PyResult<()> {
+    let jobs = parse_jobs(&jobs_json)?;
+    check_run_folders(&jobs, &outdir).map_err(|e| sweep_err(&e))?;
+    let names: Vec<&str> = jobs.iter().map(|j| j.name.as_str()).collect();
+    remove_other_runs(&outdir, &names).map_err(|e| sweep_err(&e))
+}
+
 fn report_json(r: &RunReport) -> PyResult<String> {
     serde_json::to_string(r).map_err(|e| Error::new_err(format!("internal: report: {e}")))
 }
@@ -673,6 +688,7 @@ fn _railfmu(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(write_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(results_format_by_size, m)?)?;
     m.add_class::<PyRunWriter>()?;
+    m.add_function(wrap_pyfunction!(prepare_run_folder, m)?)?;
     m.add_function(wrap_pyfunction!(read_csv, m)?)?;
     m.add_function(wrap_pyfunction!(write_csv, m)?)?;
     Ok(())

@@ -86,6 +86,23 @@ def test_a_resumed_set_skips_finished_runs(dist, tmp_path):
     assert [n for n in ran if n] == []
 
 
+def test_a_run_set_into_a_used_folder_holds_its_own_runs_and_replaces_nothing_else(dist, tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("the user's")
+    railfmu.run_set(speed_set(dist, [50.0, 60.0, 70.0], stop_time=0.2), out, format="parquet")
+    railfmu.run_set(speed_set(dist, [55.0], stop_time=0.2), out, format="parquet")
+    # the earlier set's other runs are gone (also from the table), the user's file is not
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt", "results", "run-000", "sweep.json"]
+    assert [p.name for p in (out / "results").iterdir()] == ["run-000.parquet"]
+    # a run whose folder would replace something that is not a run folder is refused
+    rs = speed_set(dist, [55.0], stop_time=0.2)
+    rs["runs"] = [{"name": "notes.txt", "parameters": {}}]
+    with pytest.raises(railfmu.OutputError, match="not a run folder of an earlier sweep"):
+        railfmu.run_set(rs, out)
+    assert (out / "notes.txt").read_text() == "the user's"
+
+
 def test_the_readme_run_set_expands_to_eight_resolved_runs():
     rs = railfmu.RunSet.load(Path(__file__).parents[1] / "examples" / "passive_speeds.json")
     assert len(rs) == 8 and rs.names[0] == "run-000"
