@@ -142,13 +142,14 @@ pub fn assess(table: &ResultsTable, options: &AssessOptions) -> Result<AssessAns
         options.accept_narrow_band,
     )
     .map_err(|e| e.to_string())?;
-    let notes = match remark {
+    let mut notes = match remark {
         None => Vec::new(),
         Some(BandRemark::Unrecorded(note)) => vec![note],
         Some(BandRemark::Narrow(e)) => vec![format!(
             "{e} (assessed anyway: accept_narrow_band; the rms may be wrong)"
         )],
     };
+    notes.extend(report.unit_notes());
     Ok(AssessAnswer {
         quantity: options.quantity.clone(),
         unit: report.unit(),

@@ -279,6 +279,9 @@ pub struct AssessReport {
     pub speed_kmh: f64,
     /// (signal name as given, its assessment)
     pub signals: Vec<(String, Assessment)>,
+    /// The assessed columns whose names give no unit (` [unit]`): their values are taken in
+    /// the criterion's unit (m/s2, or N), which [`Self::unit_notes`] says.
+    pub unitless: Vec<String>,
 }
 
 impl AssessReport {
@@ -306,6 +309,28 @@ impl AssessReport {
     }
 
     /// Text printed by the command.
+    /// One note per assessed column without a unit: its values were taken as m/s2 (or N).
+    pub fn unit_notes(&self) -> Vec<String> {
+        let assumed = match self.criterion {
+            Criterion::LateralAcceleration { .. } => "m/s2",
+            Criterion::GuidingForces { .. } => "N",
+        };
+        self.unitless
+            .iter()
+            .map(|c| {
+                format!(
+                    "column '{c}' names no unit: its values were taken in {assumed} (name it \
+                     '{c} [unit]' to have it checked{})",
+                    if assumed == "N" {
+                        ", or converted from kN"
+                    } else {
+                        ""
+                    }
+                )
+            })
+            .collect()
+    }
+
     pub fn summary(&self) -> String {
         let u = self.unit();
         let mut s = format!(
@@ -323,6 +348,9 @@ impl AssessReport {
                 a.rms.len(),
                 if a.stable { "within the limit" } else { "LIMIT EXCEEDED" }
             ));
+        }
+        for note in self.unit_notes() {
+            s.push_str(&format!("note: {note}\n"));
         }
         s.push_str(&format!(
             "verdict: {} (max rms {:.3} {u}, {:.0} % of the limit)\n",
@@ -513,9 +541,13 @@ pub fn assess_table(
         )));
     }
     let mut out = Vec::with_capacity(signals.len());
+    let mut unitless = Vec::new();
     for name in signals {
         let col = table.find(name)?;
         let scale = check_unit(table, col, criterion)?;
+        if split_unit(&table.names[col]).1.is_none() {
+            unitless.push(table.names[col].clone());
+        }
         let x: Vec<f64> = table.columns[col].iter().map(|v| v * scale).collect();
         let a = match criterion {
             Criterion::LateralAcceleration { bogie_mass_t } => {
@@ -532,6 +564,7 @@ pub fn assess_table(
         criterion,
         speed_kmh,
         signals: out,
+        unitless,
     })
 }
 
@@ -589,6 +622,45 @@ mod tests {
                 "verdict: unstable"
             }));
         }
+    }
+
+    #[test]
+    fn a_column_without_a_unit_is_assessed_with_a_note_saying_what_was_assumed() {
+        let text = sine_table(20.0, 5.0, 500.0, 10.0, "kN").replace(" [kN]", "");
+        let table = ResultsTable::parse(&text, Path::new("f.csv")).unwrap();
+        let r = assess_table(
+            &table,
+            &["a, quoted".to_string()],
+            300.0,
+            Criterion::GuidingForces {
+                static_wheel_load_n: 70e3,
+            },
+            &StabilitySettings::default(),
+        )
+        .unwrap();
+        assert_eq!(r.unitless, ["a, quoted"]);
+        let summary = r.summary();
+        assert!(
+            summary.contains("note: column 'a, quoted' names no unit: its values were taken in N"),
+            "{summary}"
+        );
+        // a labelled column gets no note
+        let labelled = ResultsTable::parse(
+            &sine_table(20.0, 5.0, 500.0, 10.0, "kN"),
+            Path::new("f.csv"),
+        )
+        .unwrap();
+        let r = assess_table(
+            &labelled,
+            &["a, quoted".to_string()],
+            300.0,
+            Criterion::GuidingForces {
+                static_wheel_load_n: 70e3,
+            },
+            &StabilitySettings::default(),
+        )
+        .unwrap();
+        assert!(r.unit_notes().is_empty() && !r.summary().contains("note:"));
     }
 
     #[test]
