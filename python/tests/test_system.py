@@ -125,6 +125,10 @@ def test_bad_input_raises_with_the_masters_message_and_changes_nothing(passive_f
     with pytest.raises(railfmu.SystemDescriptionError, match=r"stop_time"):
         sys.stop_time = -1.0
     assert sys.parameters == {} and sys.stop_time == 1.0
+    # a value only the FMU refuses: the exception carries the FMU's own reason (its log is
+    # not seen in a notebook or on a Dask worker)
+    with pytest.raises(railfmu.SimulationError, match=r"fmi2Error: .*'vehicle.speed': must be > 0, got 0"):
+        sys.run({"bogie.vehicle.speed": 0.0}, stop_time=0.01)
     assert len(sys.run(stop_time=0.01)) == 11  # still usable
     # files: missing, malformed JSON (line and column), broken FMU
     with pytest.raises(railfmu.SystemDescriptionError, match=r"cannot read"):

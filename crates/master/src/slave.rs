@@ -181,11 +181,17 @@ impl std::fmt::Display for FailStatus {
 
 /// A failed call on one slave.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("instance '{instance}': {call} failed with {status}")]
+#[error(
+    "instance '{instance}': {call} failed with {status}{}",
+    reason.as_deref().map(|r| format!(": {r}")).unwrap_or_default()
+)]
 pub struct SlaveError {
     pub instance: String,
     pub call: &'static str,
     pub status: FailStatus,
+    /// What the FMU logged with that status during the call (its logger messages), if
+    /// anything: the cause, also where the log is not seen (Python, a Dask worker).
+    pub reason: Option<Box<str>>,
 }
 
 /// One co-simulation unit (FMI 2.0 co-simulation slave semantics).
@@ -215,6 +221,7 @@ pub trait Slave {
             instance: self.name().to_string(),
             call: "fmi2GetString",
             status: FailStatus::Other("this slave has no String variables".into()),
+            reason: None,
         })
     }
     /// fmi2SetString of `vrs` to `values` (same length).
@@ -224,6 +231,7 @@ pub trait Slave {
             instance: self.name().to_string(),
             call: "fmi2SetString",
             status: FailStatus::Other("this slave has no String variables".into()),
+            reason: None,
         })
     }
     /// After a step returned fmi2Discard: whether the slave asks to end the simulation

@@ -27,8 +27,9 @@ pub struct Context {
 /// Error of any subcommand; the binary prints it and exits non-zero.
 #[derive(Debug, thiserror::Error)]
 pub enum CommandError {
+    /// Boxed: a run's error carries the FMU's messages and would make every result large.
     #[error(transparent)]
-    Run(#[from] crate::system::RunError),
+    Run(Box<crate::system::RunError>),
     #[error(transparent)]
     System(#[from] crate::system::SystemError),
     #[error(transparent)]
@@ -44,6 +45,12 @@ pub enum CommandError {
     /// An error of a subcommand defined outside this crate (its source chain is printed).
     #[error(transparent)]
     Other(Box<dyn std::error::Error + Send + Sync>),
+}
+
+impl From<crate::system::RunError> for CommandError {
+    fn from(e: crate::system::RunError) -> Self {
+        CommandError::Run(Box::new(e))
+    }
 }
 
 /// Options of every subcommand.

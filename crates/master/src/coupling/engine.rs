@@ -218,7 +218,10 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         if e.status == FailStatus::Fatal {
             self.fatal[i] = true;
         }
-        SimError::Slave { time, source: e }
+        SimError::Slave {
+            time,
+            source: Box::new(e),
+        }
     }
 
     /// Reads the connected outputs of instance `i` (one call per type).
@@ -558,7 +561,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                                 _ => x.to_string(),
                             }
                         ),
-                        source,
+                        source: Box::new(source),
                     })?;
             }
             self.touch(i);
@@ -964,7 +967,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                 if let Err(e) = self.slaves[i].terminate() {
                     first.get_or_insert(SimError::Slave {
                         time: self.plan.stop_time,
-                        source: e,
+                        source: Box::new(e),
                     });
                 }
             }

@@ -207,13 +207,13 @@ pub enum SimError {
         /// `'name' = value`.
         assignment: String,
         #[source]
-        source: SlaveError,
+        source: Box<SlaveError>,
     },
     #[error("at t = {time} s: {source}")]
     Slave {
         time: f64,
         #[source]
-        source: SlaveError,
+        source: Box<SlaveError>,
     },
     #[error("at t = {time} s: instance '{instance}' discarded the step of {step} s: {reason}")]
     Discarded {

@@ -177,6 +177,7 @@ impl<M: Model + Clone> Slave for Mock<M> {
                     instance: self.name.clone(),
                     call: "fmi2SetReal",
                     status: crate::slave::FailStatus::Error,
+                    reason: None,
                 });
             }
             self.m.values()[v.vr as usize] = *x;

@@ -112,6 +112,7 @@ impl FmuSlave {
             instance: self.name.clone(),
             call,
             status,
+            reason: super::logger::take_errors(&self.name),
         })
     }
 
@@ -120,6 +121,7 @@ impl FmuSlave {
             instance: self.name.clone(),
             call,
             status: FailStatus::Other(format!("internal: {reason}")),
+            reason: None,
         }
     }
 
@@ -128,6 +130,7 @@ impl FmuSlave {
             instance: self.name.clone(),
             call,
             status: FailStatus::Other(format!("the binary does not export {call}")),
+            reason: None,
         }
     }
 
@@ -136,6 +139,7 @@ impl FmuSlave {
             instance: self.name.clone(),
             call,
             status: FailStatus::Other("the FMU does not support FMU state".into()),
+            reason: None,
         }
     }
 }
@@ -285,6 +289,7 @@ impl Slave for FmuSlave {
                     instance: self.name.clone(),
                     call: "fmi2GetString",
                     status: FailStatus::Other("returned a NULL string".into()),
+                    reason: None,
                 });
             }
             // SAFETY: FMI 2.0 (2.1.7): the FMU's strings stay valid until its next call; they
@@ -310,6 +315,7 @@ impl Slave for FmuSlave {
                 instance: self.name.clone(),
                 call: "fmi2SetString",
                 status: FailStatus::Other(format!("the string {v:?} contains a NUL byte")),
+                reason: None,
             })?);
         }
         let ptrs: Vec<ffi::fmi2String> = texts.iter().map(|t| t.as_ptr()).collect();
@@ -358,11 +364,16 @@ impl Slave for FmuSlave {
         let s = unsafe { (self.lib().do_step)(self.component, t, h, 1) };
         match status(s) {
             Ok(()) => Ok(StepStatus::Ok),
-            Err(FailStatus::Discard) => Ok(StepStatus::Discard),
+            Err(FailStatus::Discard) => {
+                // the engine retries or reports the discard itself; its messages were logged
+                let _ = super::logger::take_errors(&self.name);
+                Ok(StepStatus::Discard)
+            }
             Err(status) => Err(SlaveError {
                 instance: self.name.clone(),
                 call: "fmi2DoStep",
                 status,
+                reason: super::logger::take_errors(&self.name),
             }),
         }
     }
@@ -389,6 +400,7 @@ impl Slave for FmuSlave {
                 instance: self.name.clone(),
                 call: "fmi2SetFMUstate",
                 status: FailStatus::Other("no saved state".into()),
+                reason: None,
             });
         }
         let s = unsafe { (f.set)(self.component, self.saved) };

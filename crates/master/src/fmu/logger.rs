@@ -46,6 +46,57 @@ impl log::Log for FmuLogger {
 
 static LOGGER: FmuLogger = FmuLogger;
 
+/// How many failure messages are kept per thread (the latest).
+const KEPT_FAILURES: usize = 4;
+/// Longest failure message kept [bytes].
+const KEPT_FAILURE_BYTES: usize = 2048;
+
+std::thread_local! {
+    /// Messages logged with fmi2Discard, fmi2Error or fmi2Fatal on this thread, as (instance,
+    /// text), oldest first: an FMU logs within the call that fails, on the caller's thread,
+    /// so the failed call's error can carry them ([`take_errors`]).
+    static FAILURES: std::cell::RefCell<Vec<(String, String)>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// The failure messages `instance` logged on this thread since the last take, joined; they
+/// are removed. None when it logged none.
+pub(crate) fn take_errors(instance: &str) -> Option<Box<str>> {
+    FAILURES
+        .try_with(|f| {
+            let mut f = f.try_borrow_mut().ok()?;
+            let mine: Vec<String> = f
+                .iter()
+                .filter(|(i, _)| i == instance)
+                .map(|(_, m)| m.clone())
+                .collect();
+            f.retain(|(i, _)| i != instance);
+            (!mine.is_empty()).then(|| mine.join("; ").into_boxed_str())
+        })
+        .ok()
+        .flatten()
+}
+
+fn keep_failure(instance: &str, text: &str) {
+    let mut text = text.to_string();
+    if text.len() > KEPT_FAILURE_BYTES {
+        let mut cut = KEPT_FAILURE_BYTES;
+        while !text.is_char_boundary(cut) {
+            cut -= 1;
+        }
+        text.truncate(cut);
+        text.push_str("...");
+    }
+    let _ = FAILURES.try_with(|f| {
+        if let Ok(mut f) = f.try_borrow_mut() {
+            if f.len() >= KEPT_FAILURES {
+                f.remove(0);
+            }
+            f.push((instance.to_string(), text));
+        }
+    });
+}
+
 /// Installs [`FmuLogger`] (once per process; later calls only change the level).
 pub fn install_logger(level: log::LevelFilter) {
     let _ = log::set_logger(&LOGGER);
@@ -109,6 +160,12 @@ pub unsafe extern "C" fn master_fmi2_log(
         } else {
             format!("[{category}] ")
         };
+        if !matches!(
+            status,
+            ffi::fmi2Status_fmi2OK | ffi::fmi2Status_fmi2Warning | ffi::fmi2Status_fmi2Pending
+        ) {
+            keep_failure(&instance, &format!("{body}{note}"));
+        }
         log::logger().log(
             &log::Record::builder()
                 .args(format_args!("{category}{body}{note}"))

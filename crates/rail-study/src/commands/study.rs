@@ -214,7 +214,7 @@ impl From<StudyError> for CommandError {
     fn from(e: StudyError) -> Self {
         match e {
             StudyError::System(e) => CommandError::System(e),
-            StudyError::Prepare(e) => CommandError::Run(e),
+            StudyError::Prepare(e) => CommandError::Run(Box::new(e)),
             StudyError::Sweep(e) => CommandError::Sweep(e),
             StudyError::Output(e) => CommandError::Output(e),
             StudyError::Plot(e) => e.into(),
