@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Mapping, Optional, Union
 
@@ -92,8 +93,13 @@ class RunSet:
           set): runs kept in the other format are run again, so the folder stays in one format.
         * ``progress``: True for a bar, or ``f(done, total, run_name, error_or_None)``.
         """
+        if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1):
+            raise ValueError(f"threads must be a whole number >= 1 (or None: all cores), got {threads!r}")
         out = Path(output_dir)
-        out.mkdir(parents=True, exist_ok=True)
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as e:
+            raise _railfmu.OutputError(f"cannot create the output folder '{out}': {e}") from e
         # this set's runs only: nothing of the user's is replaced by a run folder, and an
         # earlier set's other runs are removed (the kept ones are in this set)
         _railfmu.prepare_run_folder(os.fspath(out), self._jobs_json)
@@ -140,7 +146,17 @@ class RunSet:
                     reports[i] = r
         final = [r for r in reports if r is not None]
         _railfmu.write_sweep(os.fspath(out), final)
-        return RunSetResults(out, [json.loads(r) for r in final])
+        results = RunSetResults(out, [json.loads(r) for r in final])
+        if results.reports and all(not r.get("ok") for r in results.reports):
+            # as `master sweep` exits with status 1: a set with no result is not quietly empty
+            first = results.reports[0]
+            warnings.warn(
+                f"no run of the set succeeded ({len(results.reports)} failed); the first, "
+                f"'{first.get('name')}': {first.get('error')}",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+        return results
 
     def _format_by_size(self, client: Any, ship_fmus: bool, retries: int) -> str:
         """The results format a fresh run of every job chooses by size ("csv" or "parquet")."""

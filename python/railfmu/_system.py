@@ -85,8 +85,11 @@ class System:
         return self._prepared.header()
 
     def variables(self, instance: str) -> List[Dict[str, Any]]:
-        """The variables of one instance's FMU (name, causality, variability, type, unit,
-        start, description, ...), from its modelDescription.xml."""
+        """The variables of one instance's FMU, from its modelDescription.xml: one dict per
+        variable with ``name``, ``value_reference``, ``causality`` and ``variability`` (as
+        ``'Parameter'``, ``'Output'``, ``'Fixed'``, ...), ``initial``, ``var_type`` (``'Real'``,
+        ``'Integer'``, ``'Enumeration'``, ``'Boolean'``, ``'String'``), ``unit``, ``start``
+        (the text of the XML attribute, or None), ``description`` and ``declared_type``."""
         names = self.instances
         if instance not in names:
             raise KeyError(f"no instance '{instance}' (instances: {', '.join(names)})")

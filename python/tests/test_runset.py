@@ -103,6 +103,23 @@ def test_a_run_set_into_a_used_folder_holds_its_own_runs_and_replaces_nothing_el
     assert (out / "notes.txt").read_text() == "the user's"
 
 
+def test_bad_run_set_options_raise_python_errors(dist, tmp_path):
+    rs = speed_set(dist, [50.0], stop_time=0.2)
+    for threads in (-1, 0, 1.5, True):
+        with pytest.raises(ValueError, match="threads must be a whole number >= 1"):
+            railfmu.run_set(rs, tmp_path / "out", threads=threads)
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    with pytest.raises(railfmu.OutputError, match="cannot create the output folder"):
+        railfmu.run_set(rs, a_file / "out")
+    # a set in which no run succeeds warns, naming the first failure
+    bad = speed_set(dist, [50.0, 60.0], stop_time=0.2)
+    bad["product"] = {"bogie.vehicle.sped": [50.0, 60.0]}
+    with pytest.warns(RuntimeWarning, match=r"no run of the set succeeded \(2 failed\).*vehicle.sped"):
+        res = railfmu.run_set(bad, tmp_path / "bad")
+    assert len(res) == 0 and set(res.failed) == {"run-000", "run-001"}
+
+
 def test_the_readme_run_set_expands_to_eight_resolved_runs():
     rs = railfmu.RunSet.load(Path(__file__).parents[1] / "examples" / "passive_speeds.json")
     assert len(rs) == 8 and rs.names[0] == "run-000"
