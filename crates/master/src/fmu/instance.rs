@@ -107,7 +107,19 @@ impl FmuSlave {
         self.fmu.library()
     }
 
+    /// fmi2OK at once; any other status through [`Self::checked`] (kept out of line, so that
+    /// the calls of a step stay small).
+    #[inline(always)]
     fn check(&self, call: &'static str, s: ffi::fmi2Status) -> Result<(), SlaveError> {
+        if s == ffi::fmi2Status_fmi2OK {
+            return Ok(());
+        }
+        self.checked(call, s)
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn checked(&self, call: &'static str, s: ffi::fmi2Status) -> Result<(), SlaveError> {
         status(s).map_err(|status| SlaveError {
             instance: self.name.clone(),
             call,
