@@ -5,7 +5,7 @@
 use std::io::Read;
 use std::path::Path;
 
-/// Largest profile or contact-table file read [bytes] (a measured profile is some kB, a table
+/// Largest profile or contact-table file read, in bytes (a measured profile is some kB, a table
 /// some MB).
 pub const MAX_TEXT_FILE_BYTES: u64 = 64 << 20;
 
