@@ -617,6 +617,14 @@ pub unsafe fn get_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2S
                 Err(s) => s,
             }
         } else {
+            // bytes serialised from this state before are out of date now
+            if cc
+                .serialized
+                .as_ref()
+                .is_some_and(|(p, _)| *p == (*state) as usize)
+            {
+                cc.serialized = None;
+            }
             let snapshot = &mut *((*state) as *mut Snapshot);
             cc.component.update_fmu_state(snapshot)
         }
@@ -736,6 +744,8 @@ pub unsafe fn deserialize_fmu_state(
         };
         match cc.component.deserialize_fmu_state(bytes) {
             Ok(snapshot) => {
+                // the new state may get the address of one whose bytes are cached
+                cc.serialized = None;
                 if !(*state).is_null() {
                     drop(Box::from_raw((*state) as *mut Snapshot));
                 }

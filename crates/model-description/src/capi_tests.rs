@@ -104,3 +104,68 @@ fn a_panic_is_an_error_and_leaves_the_instance_in_the_error_state_until_reset() 
         free_instance(c);
     }
 }
+
+#[test]
+fn a_state_updated_in_place_serialises_its_new_content_and_an_overflowing_step_is_refused() {
+    let (component, _log) = rust_component::<Fragile>(InstanceContext::default()).unwrap();
+    let c = Box::into_raw(Box::new(CComponent {
+        component,
+        serialized: None,
+        booleans: Vec::new(),
+    })) as fmi2Component;
+    let u = [value_reference::<Fragile>("u").unwrap()];
+    let serialise = |c, state| unsafe {
+        let mut size = 0usize;
+        assert_eq!(serialized_fmu_state_size(c, state, &mut size), FMI2_OK);
+        let mut bytes = vec![0u8; size];
+        assert_eq!(
+            serialize_fmu_state(c, state, bytes.as_mut_ptr().cast(), size),
+            FMI2_OK
+        );
+        bytes
+    };
+    unsafe {
+        assert_eq!(setup_experiment(c, 0, 0.0, 0.0, 0, 0.0), FMI2_OK);
+        assert_eq!(enter_initialization_mode(c), FMI2_OK);
+        assert_eq!(exit_initialization_mode(c), FMI2_OK);
+        let mut state: fmi2FMUstate = std::ptr::null_mut();
+        assert_eq!(get_fmu_state(c, &mut state), FMI2_OK);
+        let mut size = 0usize;
+        // the size is asked first (the bytes are computed then), the state updated after
+        assert_eq!(serialized_fmu_state_size(c, state, &mut size), FMI2_OK);
+        let at_start = serialise(c, state);
+        assert_eq!(set_real(c, u.as_ptr(), 1, [1.0].as_ptr()), FMI2_OK);
+        assert_eq!(do_step(c, 0.0, 0.1), FMI2_OK);
+        // size asked (bytes computed from the old content), state updated, then serialised
+        // without asking the size again: the host's usual order
+        assert_eq!(serialized_fmu_state_size(c, state, &mut size), FMI2_OK);
+        assert_eq!(get_fmu_state(c, &mut state), FMI2_OK);
+        let mut bytes = vec![0u8; size];
+        assert_eq!(
+            serialize_fmu_state(c, state, bytes.as_mut_ptr().cast(), size),
+            FMI2_OK
+        );
+        assert_ne!(
+            bytes, at_start,
+            "the serialised bytes are those of the old state"
+        );
+        assert_eq!(bytes, serialise(c, state));
+        assert_eq!(free_fmu_state(c, &mut state), FMI2_OK);
+        free_instance(c);
+    }
+    // a step whose end overflows is refused as an argument, and the instance steps on
+    let (component, _log) = rust_component::<Fragile>(InstanceContext::default()).unwrap();
+    let c = Box::into_raw(Box::new(CComponent {
+        component,
+        serialized: None,
+        booleans: Vec::new(),
+    })) as fmi2Component;
+    unsafe {
+        assert_eq!(setup_experiment(c, 0, 0.0, 1.7e308, 0, 0.0), FMI2_OK);
+        assert_eq!(enter_initialization_mode(c), FMI2_OK);
+        assert_eq!(exit_initialization_mode(c), FMI2_OK);
+        assert_eq!(do_step(c, 1.7e308, 1e308), FMI2_ERROR);
+        assert_eq!(do_step(c, 1.7e308, 1e300), FMI2_OK);
+        free_instance(c);
+    }
+}

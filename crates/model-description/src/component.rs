@@ -747,6 +747,7 @@ impl Component {
             && current.is_finite()
             && step.is_finite()
             && step >= 0.0
+            && target.is_finite()
             && (current - self.time).abs() <= tol
             && self.stop_time.is_none_or(|stop| target <= stop + tol);
         if !valid {
@@ -774,7 +775,8 @@ impl Component {
         if self.state != FmiState::StepComplete {
             return self.wrong_state(CALL);
         }
-        if !current.is_finite() || !step.is_finite() || step < 0.0 {
+        if !current.is_finite() || !step.is_finite() || step < 0.0 || !(current + step).is_finite()
+        {
             let msg = format!("{CALL}: invalid communication point {current} or step {step}");
             return self.error(&msg);
         }
