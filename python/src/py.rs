@@ -21,8 +21,7 @@ use master::coupling::{RunOptions, SimError, SimOutput, Summary};
 use master::output::write_csv_atomic;
 use master::results::ResultsFormat;
 use master::runset::{
-    check_run_folders, execute_with, format_by_size, remove_other_runs, run_job, Job,
-    ResultsOptions, RunReport, RunSet, SweepError,
+    execute_with, format_by_size, run_job, Job, ResultsOptions, RunReport, RunSet, SweepError,
 };
 use master::system::{LoadedSystem, PreparedSystem, RunError, SystemError};
 
@@ -451,9 +450,7 @@ impl PySystem {
 #[pyfunction]
 fn prepare_run_folder(outdir: PathBuf, jobs_json: Vec<String>) -> PyResult<()> {
     let jobs = parse_jobs(&jobs_json)?;
-    check_run_folders(&jobs, &outdir).map_err(|e| sweep_err(&e))?;
-    let names: Vec<&str> = jobs.iter().map(|j| j.name.as_str()).collect();
-    remove_other_runs(&outdir, &names).map_err(|e| sweep_err(&e))
+    master::runset::prepare_run_folder(&jobs, &outdir).map_err(|e| sweep_err(&e))
 }
 
 fn report_json(r: &RunReport) -> PyResult<String> {

@@ -4,7 +4,7 @@
 
 use super::*;
 use crate::model::{DefaultExperiment, ModelInfo, StepError};
-use crate::{declare, rust_component, value_reference, Diagnostics, Variable};
+use crate::{declare, rust_component, value_reference, CollectLog, Diagnostics, Variable};
 
 /// x grows by u per step; a step with u < 0 panics (an invariant broken, as by a bad state).
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -60,20 +60,29 @@ impl FmuModel for Fragile {
     }
 }
 
-#[test]
-fn a_panic_is_an_error_and_leaves_the_instance_in_the_error_state_until_reset() {
+/// A Fragile instance behind the C API, and its log.
+fn fragile() -> (fmi2Component, CollectLog) {
     let (component, log) = rust_component::<Fragile>(InstanceContext::default()).unwrap();
     let c = Box::into_raw(Box::new(CComponent {
         component,
         serialized: None,
         booleans: Vec::new(),
     })) as fmi2Component;
+    (c, log)
+}
+
+/// fmi2SetupExperiment from `start` and through initialisation.
+unsafe fn start_at(c: fmi2Component, start: f64) {
+    assert_eq!(setup_experiment(c, 0, 0.0, start, 0, 0.0), FMI2_OK);
+    assert_eq!(enter_initialization_mode(c), FMI2_OK);
+    assert_eq!(exit_initialization_mode(c), FMI2_OK);
+}
+
+#[test]
+fn a_panic_is_an_error_and_leaves_the_instance_in_the_error_state_until_reset() {
+    let (c, log) = fragile();
     let u = [value_reference::<Fragile>("u").unwrap()];
-    let start = |c| unsafe {
-        assert_eq!(setup_experiment(c, 0, 0.0, 0.0, 0, 0.0), FMI2_OK);
-        assert_eq!(enter_initialization_mode(c), FMI2_OK);
-        assert_eq!(exit_initialization_mode(c), FMI2_OK);
-    };
+    let start = |c| unsafe { start_at(c, 0.0) };
     unsafe {
         start(c);
         assert_eq!(set_real(c, u.as_ptr(), 1, [1.0].as_ptr()), FMI2_OK);
@@ -107,12 +116,7 @@ fn a_panic_is_an_error_and_leaves_the_instance_in_the_error_state_until_reset() 
 
 #[test]
 fn a_state_updated_in_place_serialises_its_new_content_and_an_overflowing_step_is_refused() {
-    let (component, _log) = rust_component::<Fragile>(InstanceContext::default()).unwrap();
-    let c = Box::into_raw(Box::new(CComponent {
-        component,
-        serialized: None,
-        booleans: Vec::new(),
-    })) as fmi2Component;
+    let (c, _log) = fragile();
     let u = [value_reference::<Fragile>("u").unwrap()];
     let serialise = |c, state| unsafe {
         let mut size = 0usize;
@@ -125,9 +129,7 @@ fn a_state_updated_in_place_serialises_its_new_content_and_an_overflowing_step_i
         bytes
     };
     unsafe {
-        assert_eq!(setup_experiment(c, 0, 0.0, 0.0, 0, 0.0), FMI2_OK);
-        assert_eq!(enter_initialization_mode(c), FMI2_OK);
-        assert_eq!(exit_initialization_mode(c), FMI2_OK);
+        start_at(c, 0.0);
         let mut state: fmi2FMUstate = std::ptr::null_mut();
         assert_eq!(get_fmu_state(c, &mut state), FMI2_OK);
         let mut size = 0usize;
@@ -154,16 +156,9 @@ fn a_state_updated_in_place_serialises_its_new_content_and_an_overflowing_step_i
         free_instance(c);
     }
     // a step whose end overflows is refused as an argument, and the instance steps on
-    let (component, _log) = rust_component::<Fragile>(InstanceContext::default()).unwrap();
-    let c = Box::into_raw(Box::new(CComponent {
-        component,
-        serialized: None,
-        booleans: Vec::new(),
-    })) as fmi2Component;
+    let (c, _log) = fragile();
     unsafe {
-        assert_eq!(setup_experiment(c, 0, 0.0, 1.7e308, 0, 0.0), FMI2_OK);
-        assert_eq!(enter_initialization_mode(c), FMI2_OK);
-        assert_eq!(exit_initialization_mode(c), FMI2_OK);
+        start_at(c, 1.7e308);
         assert_eq!(do_step(c, 1.7e308, 1e308), FMI2_ERROR);
         assert_eq!(do_step(c, 1.7e308, 1e300), FMI2_OK);
         free_instance(c);

@@ -99,27 +99,42 @@ pub(crate) fn python() -> Option<PathBuf> {
     p.exists().then_some(p)
 }
 
-/// fmpy's loop over the passive system: wall per simulated second, or why not measured.
-fn fmpy_passive() -> Result<f64, String> {
-    let py = python().ok_or("no python with fmpy (set RAIL_PYTHON or create .venv)")?;
+/// Runs the repository's Python `script` (relative path) with the venv's Python and `args`:
+/// its standard output, or why it did not run.
+pub(crate) fn python_script(script: &str, args: &[&std::ffi::OsStr]) -> Result<String, String> {
+    let py = python().ok_or("no Python with the hosts (set RAIL_PYTHON or create .venv)")?;
     let out = Command::new(&py)
-        .arg(repo().join("tests/fmpy/bench_fmpy_system.py"))
-        .arg(repo().join("systems/passive.json"))
-        .arg(FMPY_STOP_S.to_string())
-        .arg("2")
+        .arg(repo().join(script))
+        .args(args)
         .output()
         .map_err(|e| format!("{}: {e}", py.display()))?;
     let text = String::from_utf8_lossy(&out.stdout).to_string();
     if !out.status.success() {
         return Err(format!(
-            "bench_fmpy_system.py failed: {text}{}",
-            String::from_utf8_lossy(&out.stderr)
+            "{script} failed: {text}{}",
+            String::from_utf8_lossy(&out.stderr).trim()
         ));
     }
+    Ok(text)
+}
+
+/// The number a script printed on its line `key value`.
+pub(crate) fn reported(text: &str, key: &str) -> Result<f64, String> {
     text.lines()
-        .find_map(|l| l.strip_prefix("fmpy_wall_per_sim_s "))
+        .find_map(|l| l.strip_prefix(key)?.strip_prefix(' '))
         .and_then(|x| x.trim().parse().ok())
-        .ok_or_else(|| format!("unexpected output: {text}"))
+        .ok_or_else(|| format!("no {key} in: {text}"))
+}
+
+/// fmpy's loop over the passive system: wall per simulated second, or why not measured.
+fn fmpy_passive() -> Result<f64, String> {
+    let system = repo().join("systems/passive.json");
+    let stop = FMPY_STOP_S.to_string();
+    let text = python_script(
+        "tests/fmpy/bench_fmpy_system.py",
+        &[system.as_os_str(), stop.as_ref(), "2".as_ref()],
+    )?;
+    reported(&text, "fmpy_wall_per_sim_s")
 }
 
 /// `master study OPTIONS` into a temporary folder: (wall [s], its last line).

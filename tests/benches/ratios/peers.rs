@@ -2,14 +2,13 @@
 //! passive system exported by `master export-ssp`, run by each host from the archive.
 
 use std::path::Path;
-use std::process::Command;
 use std::time::Instant;
 
 use master::coupling::RunOptions;
 use master::ssp::{export, import, ImportOptions};
 use master::system::{LoadedSystem, PreparedSystem};
 
-use crate::{cpu_seconds, python, repo, COUPLED_STOP_S, REPEATS, STEP_S};
+use crate::{cpu_seconds, python_script, repo, reported, COUPLED_STOP_S, REPEATS, STEP_S};
 
 /// The variable every host reports after the last step (to check that they ran the same).
 pub const FINAL_VARIABLE: &str = "bogie.wheelset_front.lateral_displacement_relative";
@@ -67,34 +66,22 @@ fn ours(ssp: &Path) -> HostRun {
 
 /// A third-party host through `tests/ssp/bench_hosts.py`, or why it was not measured.
 fn host(name: &str, ssp: &Path) -> Result<HostRun, String> {
-    let py = python().ok_or("no python with the hosts (set RAIL_PYTHON or create .venv)")?;
-    let out = Command::new(&py)
-        .arg(repo().join("tests/ssp/bench_hosts.py"))
-        .arg(name)
-        .arg(ssp)
-        .arg(COUPLED_STOP_S.to_string())
-        .arg(STEP_S.to_string())
-        .arg("3")
-        .arg(FINAL_VARIABLE)
-        .output()
-        .map_err(|e| format!("{}: {e}", py.display()))?;
-    let text = String::from_utf8_lossy(&out.stdout).to_string();
-    if !out.status.success() {
-        return Err(format!(
-            "bench_hosts.py failed: {text}{}",
-            String::from_utf8_lossy(&out.stderr).trim()
-        ));
-    }
-    let value = |key: &str| -> Result<f64, String> {
-        text.lines()
-            .find_map(|l| l.strip_prefix(key))
-            .and_then(|x| x.trim().parse().ok())
-            .ok_or_else(|| format!("no {key} in: {text}"))
-    };
+    let (stop, step) = (COUPLED_STOP_S.to_string(), STEP_S.to_string());
+    let text = python_script(
+        "tests/ssp/bench_hosts.py",
+        &[
+            name.as_ref(),
+            ssp.as_os_str(),
+            stop.as_ref(),
+            step.as_ref(),
+            "3".as_ref(),
+            FINAL_VARIABLE.as_ref(),
+        ],
+    )?;
     Ok(HostRun {
-        wall_per_sim_s: value("wall_per_sim_s ")?,
-        cpu_per_sim_s: value("cpu_per_sim_s ")?,
-        final_value: value("final ")?,
+        wall_per_sim_s: reported(&text, "wall_per_sim_s")?,
+        cpu_per_sim_s: reported(&text, "cpu_per_sim_s")?,
+        final_value: reported(&text, "final")?,
     })
 }
 

@@ -134,13 +134,17 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         files.extend(args.summary.iter().cloned());
         files
     };
-    // known before the run when --output names it: refused before running
+    // the format, unless the results' size decides it: checked before the run as far as
+    // the files are known then (a named --output, with its metadata file if CSV), and once
+    // more after the run only for what the run decided
+    let chosen = args
+        .format
+        .or_else(|| args.output.as_deref().and_then(ResultsFormat::of_path));
     if let Some(output) = &args.output {
-        let format = args
-            .format
-            .or_else(|| ResultsFormat::of_path(output))
-            .unwrap_or(ResultsFormat::Parquet);
-        check_outputs_apart(&inputs, &written(output, format))?;
+        check_outputs_apart(
+            &inputs,
+            &written(output, chosen.unwrap_or(ResultsFormat::Parquet)),
+        )?;
     }
     let bar = if ctx.progress {
         indicatif::ProgressBar::new(0)
@@ -163,17 +167,16 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     let out = sys.run(&opts);
     bar.finish_and_clear();
     let out = out?;
-    let format = args
-        .format
-        .or_else(|| args.output.as_deref().and_then(ResultsFormat::of_path))
-        .unwrap_or_else(|| {
-            ResultsFormat::by_size(out.rows().count() as u64, out.header.len() as u64)
-        });
+    let format = chosen.unwrap_or_else(|| {
+        ResultsFormat::by_size(out.rows().count() as u64, out.header.len() as u64)
+    });
     let output = args
         .output
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("results.{}", format.extension())));
-    check_outputs_apart(&inputs, &written(&output, format))?;
+    if args.output.is_none() || (chosen.is_none() && format == ResultsFormat::Csv) {
+        check_outputs_apart(&inputs, &written(&output, format))?;
+    }
     let ctx = RunContext {
         system: serde_json::to_value(&sys.desc).ok(),
         ..RunContext::default()

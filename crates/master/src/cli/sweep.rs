@@ -7,8 +7,8 @@ use super::{CommandError, Context};
 use crate::output::write_json_atomic;
 use crate::results::ResultsFormat;
 use crate::runset::{
-    check_run_folders, completed, execute_with as run_all, format_by_description,
-    remove_other_runs, run_job, Job, ResultsOptions, RunReport, RunSet,
+    completed, execute_with as run_all, format_by_description, prepare_run_folder, run_job, Job,
+    ResultsOptions, RunReport, RunSet,
 };
 use crate::system::PreparedSystem;
 
@@ -70,9 +70,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         .collect();
     // the runs of this set only: nothing of the user's is replaced by a run folder, and
     // runs of an earlier set into this folder are removed (the kept ones are in this set)
-    check_run_folders(&jobs, &args.output)?;
-    let names: Vec<&str> = jobs.iter().map(|j| j.name.as_str()).collect();
-    remove_other_runs(&args.output, &names)?;
+    prepare_run_folder(&jobs, &args.output)?;
     let mut fresh = Vec::new();
     if !todo.is_empty() || !args.resume {
         let system = PreparedSystem::prepare(&base)?;

@@ -398,20 +398,14 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let mut late = std::mem::take(&mut self.late);
         let mut result = Ok(());
         for &(from, d) in &late {
-            let src = &exchange.sources[from];
-            if src.dests[d]
-                .from
-                .iter()
-                .any(|&(_, k)| src.varies.get(k).copied().unwrap_or(true))
-            {
+            let dest = &exchange.sources[from].dests[d];
+            if dest.varies {
                 result = self.fresh(time, from);
                 if result.is_err() {
                     break;
                 }
             }
-            result = self
-                .write_inputs(time, &exchange.sources[from].dests[d], false)
-                .map(|_| ());
+            result = self.write_inputs(time, dest, false).map(|_| ());
             if result.is_err() {
                 break;
             }

@@ -32,6 +32,9 @@ pub(super) struct Dest {
     /// When every input comes from one source's consecutive outputs: the first position
     /// (the inputs are that slice of the source's outputs, written without a copy).
     pub run: Option<usize>,
+    /// One of its inputs comes from an output that may change within a step (see
+    /// `Source::varies`; set by `Exchange::new` for a source's dests).
+    pub varies: bool,
 }
 
 /// Recorded variables of one instance.
@@ -232,6 +235,7 @@ fn dests(groups: Vec<Grouped<(usize, usize)>>) -> Vec<Dest> {
                 .then(|| g.payload.first().map(|&(_, k)| k))
                 .flatten(),
             from: g.payload,
+            varies: true,
         })
         .collect()
 }
@@ -252,7 +256,7 @@ impl Exchange {
             })
             .collect();
         let links = || plan.connections.iter().zip(connection_at.iter().copied());
-        let sources: Vec<Source> = (0..n)
+        let mut sources: Vec<Source> = (0..n)
             .map(|i| {
                 let mine = || {
                     links()
@@ -279,6 +283,15 @@ impl Exchange {
                 }
             })
             .collect();
+        for src in &mut sources {
+            let Source { dests, varies, .. } = src;
+            for d in dests.iter_mut() {
+                d.varies = d
+                    .from
+                    .iter()
+                    .any(|&(_, k)| varies.get(k).copied().unwrap_or(true));
+            }
+        }
         let jacobi = dests(group(links().map(|(c, at)| (c.to_instance, c.to, at))));
         let record = group(
             plan.record

@@ -65,13 +65,10 @@ pub(crate) fn take_errors(instance: &str) -> Option<Box<str>> {
     FAILURES
         .try_with(|f| {
             let mut f = f.try_borrow_mut().ok()?;
-            let mine: Vec<String> = f
-                .iter()
-                .filter(|(i, _)| i == instance)
-                .map(|(_, m)| m.clone())
-                .collect();
-            f.retain(|(i, _)| i != instance);
-            (!mine.is_empty()).then(|| mine.join("; ").into_boxed_str())
+            let (mine, others): (Vec<_>, Vec<_>) = f.drain(..).partition(|(i, _)| i == instance);
+            *f = others;
+            let texts: Vec<String> = mine.into_iter().map(|(_, m)| m).collect();
+            (!texts.is_empty()).then(|| texts.join("; ").into_boxed_str())
         })
         .ok()
         .flatten()

@@ -239,12 +239,14 @@ pub fn check_run_folders(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> 
     Ok(())
 }
 
-/// Removes from `outdir` the runs of an earlier sweep that are not among `names` (the whole
-/// set of this one, kept runs included): their run folders and their
-/// `results/<run>.parquet`, so that the folder, and the results folder read as one table,
-/// hold this set's runs only. Nothing else in `outdir` is touched.
-pub fn remove_other_runs(outdir: &Path, names: &[&str]) -> Result<(), SweepError> {
-    let keep: std::collections::HashSet<&str> = names.iter().copied().collect();
+/// Readies `outdir` for a run set whose whole set of runs (kept ones included) is `jobs`:
+/// refuses, before anything is removed, a run whose folder would replace what is not a run
+/// folder ([`check_run_folders`]); then removes the runs of an earlier set that are not among
+/// `jobs` (their run folders and `results/<run>.parquet`), so that the folder, and the
+/// results folder read as one table, hold this set's runs only. Nothing else is touched.
+pub fn prepare_run_folder(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> {
+    check_run_folders(jobs, outdir)?;
+    let keep: std::collections::HashSet<&str> = jobs.iter().map(|j| j.name.as_str()).collect();
     let remove_err = |path: PathBuf| move |source| SweepError::Dir { path, source };
     if let Ok(entries) = std::fs::read_dir(outdir) {
         for e in entries.flatten() {

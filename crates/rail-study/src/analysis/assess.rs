@@ -624,11 +624,16 @@ mod tests {
         }
     }
 
-    #[test]
-    fn a_column_without_a_unit_is_assessed_with_a_note_saying_what_was_assumed() {
-        let text = sine_table(20.0, 5.0, 500.0, 10.0, "kN").replace(" [kN]", "");
+    /// The guiding-force criterion (70 kN wheel load) on the quoted column of a 20 kN sine
+    /// table at 300 km/h, its header's unit replaced by `header_unit` (None: no unit).
+    fn assess_forces(header_unit: Option<&str>) -> Result<AssessReport, AnalysisError> {
+        let text = sine_table(20.0, 5.0, 500.0, 10.0, "kN");
+        let text = match header_unit {
+            Some(u) => text.replace("[kN]", &format!("[{u}]")),
+            None => text.replace(" [kN]", ""),
+        };
         let table = ResultsTable::parse(&text, Path::new("f.csv")).unwrap();
-        let r = assess_table(
+        assess_table(
             &table,
             &["a, quoted".to_string()],
             300.0,
@@ -637,7 +642,11 @@ mod tests {
             },
             &StabilitySettings::default(),
         )
-        .unwrap();
+    }
+
+    #[test]
+    fn a_column_without_a_unit_is_assessed_with_a_note_saying_what_was_assumed() {
+        let r = assess_forces(None).unwrap();
         assert_eq!(r.unitless, ["a, quoted"]);
         let summary = r.summary();
         assert!(
@@ -645,21 +654,7 @@ mod tests {
             "{summary}"
         );
         // a labelled column gets no note
-        let labelled = ResultsTable::parse(
-            &sine_table(20.0, 5.0, 500.0, 10.0, "kN"),
-            Path::new("f.csv"),
-        )
-        .unwrap();
-        let r = assess_table(
-            &labelled,
-            &["a, quoted".to_string()],
-            300.0,
-            Criterion::GuidingForces {
-                static_wheel_load_n: 70e3,
-            },
-            &StabilitySettings::default(),
-        )
-        .unwrap();
+        let r = assess_forces(Some("kN")).unwrap();
         assert!(r.unit_notes().is_empty() && !r.summary().contains("note:"));
     }
 

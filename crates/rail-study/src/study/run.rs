@@ -310,9 +310,7 @@ impl Executor<'_> {
         };
         let dir = self.opts.out.join("runs").join(batch);
         // this batch's runs only (an earlier study's other runs would read as part of it)
-        master::runset::check_run_folders(&jobs, &dir)?;
-        let names: Vec<&str> = jobs.iter().map(|j| j.name.as_str()).collect();
-        master::runset::remove_other_runs(&dir, &names)?;
+        master::runset::prepare_run_folder(&jobs, &dir)?;
         let reports = execute_with(
             &jobs,
             &dir,
