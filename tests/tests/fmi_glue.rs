@@ -393,3 +393,54 @@ fn a_literal_hash_reaches_the_host_logger_doubled() {
         assert!(!m.replace("##", "").contains('#'), "a bare '#' in: {m}");
     }
 }
+
+#[test]
+fn a_step_longer_than_1000_s_is_discarded_and_the_instance_keeps_its_time() {
+    for name in ["MassSpring", "SpringDamperMass", "Bogie2Dof", "RailVehicle"] {
+        let f = TestFmu::open_dist(name).expect(name);
+        for h in [2000.0, 1.0e300] {
+            let inst = f.instantiate("long").unwrap();
+            assert_eq!(inst.initialize(0.0), OK, "{name}");
+            assert_eq!(inst.do_step(0.0, h), DISCARD, "{name}: h = {h}");
+            assert!(
+                inst.messages()
+                    .iter()
+                    .any(|m| m.contains("longer than 1000 s: take several shorter steps")),
+                "{name}: {:?}",
+                inst.messages()
+            );
+            let mut last = f64::NAN;
+            let status = unsafe {
+                inst.b().fmi2GetRealStatus(
+                    inst.component,
+                    ffi::fmi2StatusKind_fmi2LastSuccessfulTime,
+                    &mut last,
+                )
+            };
+            assert_eq!((status, last), (OK, 0.0), "{name}");
+            assert_eq!(inst.terminate(), OK, "{name}");
+        }
+    }
+}
+
+#[test]
+fn a_communication_point_off_by_more_than_a_billionth_of_the_step_is_refused() {
+    let f = fmu();
+    let inst = f.instantiate("off").unwrap();
+    assert_eq!(inst.initialize(0.0), OK);
+    // 0.9 ms off the instance time: a long step does not widen the tolerance to that
+    assert_eq!(inst.do_step(9.0e-4, 1000.0), ERROR);
+    assert!(
+        inst.messages()
+            .iter()
+            .any(|m| m.contains("communication point 0.0009 does not match")),
+        "{:?}",
+        inst.messages()
+    );
+    // refused, nothing changed: the step from the instance time goes on
+    assert_eq!(inst.do_step(0.0, 1.0e-3), OK);
+    // a point a few ulps off a long step's end is still accepted
+    let end = 1.0e-3 + 500.0;
+    assert_eq!(inst.do_step(1.0e-3, 500.0), OK);
+    assert_eq!(inst.do_step(end * (1.0 + 4.0 * f64::EPSILON), 1.0e-3), OK);
+}

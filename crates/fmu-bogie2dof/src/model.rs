@@ -32,7 +32,7 @@
 //! [`Bogie::outputs`] with the current inputs to get them without stepping.
 
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{check_inputs, check_step, stable_substep, TooStiff};
+use vehicle_elements::{check_inputs, check_step, stable_substep, substep_count, TooStiff};
 
 pub use vehicle_elements::InputError;
 
@@ -431,7 +431,7 @@ impl Bogie {
         let yt0 = self.track_at_start(inputs);
         let x0 = self.position_m;
         let x_end = x0 + c.v * h;
-        let n = (h / self.h_sub_max - 1e-9).ceil().max(1.0) as usize;
+        let n = substep_count(h, self.h_sub_max)?;
         let hs = h / n as f64;
         let (fl, fr) = (inputs.damper_left_force_n, inputs.damper_right_force_n);
         let table = &self.table;

@@ -17,7 +17,7 @@
 //! acceleration at once. [`Vehicle::outputs`] evaluates them without stepping.
 
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{check_inputs, check_step, stable_substep, TooStiff};
+use vehicle_elements::{check_inputs, check_step, stable_substep, substep_count, TooStiff};
 
 pub use vehicle_elements::InputError;
 use wheel_rail::{GeometryTable, SegmentHint, TableError};
@@ -351,8 +351,8 @@ impl Vehicle {
     }
 
     /// Number of internal sub-steps for a communication step h.
-    pub fn substeps(&self, h: f64) -> usize {
-        (h / self.substep_s - 1e-9).ceil().max(1.0) as usize
+    pub fn substeps(&self, h: f64) -> Result<usize, InputError> {
+        substep_count(h, self.substep_s)
     }
 
     /// Alignment under each wheelset when the leading one is at `x` and the external input
@@ -484,7 +484,7 @@ impl Vehicle {
         let c = &self.consts;
         let yt0 = self.track_at(x0, input);
         let yt1 = self.track_at(x1, input);
-        let n = self.substeps(h);
+        let n = self.substeps(h)?;
         let hs = h / n as f64;
         let forces = &inputs.damper_force_n;
         let table = &self.table;

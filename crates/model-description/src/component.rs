@@ -732,9 +732,10 @@ impl Component {
     }
 
     /// Tolerance for comparing a host's communication point with our time: hosts accumulate
-    /// t += h and drift by a few ulps per step.
+    /// t += h or compute n h, and drift by a few ulps of t (or of h) per step; a billionth of
+    /// either leaves room for that and for a step of 1000 s refuses a point 1 µs off.
     fn time_tolerance(&self, step: f64) -> f64 {
-        1.0e-9 * self.time.abs().max(1.0) + 1.0e-6 * step.abs()
+        1.0e-9 * (self.time.abs().max(1.0) + step.abs())
     }
 
     #[inline]

@@ -34,6 +34,9 @@ pub use params::{finite, in_range, non_negative, positive, ParamError};
 pub use resources::resource_or_given;
 pub use shell::{Shell, ShellPhysics};
 pub use stability::{first_unstable_speed, Crossing};
-pub use step::{check_inputs, check_step, host_step, InputError};
+pub use step::{
+    check_inputs, check_step, host_step, substep_count, InputError, MAX_HOST_STEP_S, MAX_STEP_S,
+    MAX_SUBSTEPS,
+};
 pub use substep::{blame_substep, check_substep, stable_substep, TooStiff, MIN_SUBSTEP_S};
 pub use track::{TrackChoiceSource, TrackLevel, TrackSetting};

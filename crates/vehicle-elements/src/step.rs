@@ -3,8 +3,17 @@
 
 use model_description::FieldError;
 
-/// The largest communication step a model accepts \[s\].
+/// The largest communication step a model's physics takes at once \[s\] (a longer host step is
+/// split, see [`host_step`]).
 pub const MAX_STEP_S: f64 = 1.0;
+
+/// The longest communication step a model accepts in one call \[s\]: longer ones are refused
+/// (fmi2Discard) rather than computed for minutes while the host waits.
+pub const MAX_HOST_STEP_S: f64 = 1000.0;
+
+/// The most internal sub-steps one physics step of at most [`MAX_STEP_S`] takes: a 1 s step
+/// at the smallest sub-step any model's parameters allow (1 µs).
+pub const MAX_SUBSTEPS: usize = 1_000_000;
 
 /// A step refused before it starts; the model is unchanged.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -23,6 +32,26 @@ pub enum InputError {
         /// Step \[s\].
         h: f64,
     },
+    /// A host step longer than [`MAX_HOST_STEP_S`].
+    #[error(
+        "communication step {h:e} s is longer than {MAX_HOST_STEP_S} s: take several shorter steps"
+    )]
+    StepTooLong {
+        /// Step \[s\].
+        h: f64,
+    },
+    /// The internal sub-step does not divide the step into at most [`MAX_SUBSTEPS`] parts (only
+    /// a corrupted state has such a sub-step; the parameters' ranges exclude it).
+    #[error(
+        "internal sub-step {substep_s:e} s would split the step of {h:e} s into more than \
+         {MAX_SUBSTEPS} parts"
+    )]
+    TooManySubsteps {
+        /// Step \[s\].
+        h: f64,
+        /// Internal sub-step \[s\].
+        substep_s: f64,
+    },
 }
 
 /// `h` \[s\] is finite, > 0 and <= [`MAX_STEP_S`].
@@ -31,6 +60,17 @@ pub fn check_step(h: f64) -> Result<(), InputError> {
         Ok(())
     } else {
         Err(InputError::InvalidStep { h })
+    }
+}
+
+/// The number of equal sub-steps of at most `substep_s` that make up `h` (at least one; a
+/// sub-step within a billionth of dividing `h` counts as dividing it), at most [`MAX_SUBSTEPS`].
+pub fn substep_count(h: f64, substep_s: f64) -> Result<usize, InputError> {
+    let n = (h / substep_s - 1e-9).ceil().max(1.0);
+    if substep_s > 0.0 && n <= MAX_SUBSTEPS as f64 {
+        Ok(n as usize)
+    } else {
+        Err(InputError::TooManySubsteps { h, substep_s })
     }
 }
 
@@ -74,7 +114,9 @@ impl FieldError for InputError {
     fn field(&self) -> Option<&str> {
         match self {
             InputError::NonFiniteInput { name, .. } => Some(name),
-            InputError::InvalidStep { .. } => None,
+            InputError::InvalidStep { .. }
+            | InputError::StepTooLong { .. }
+            | InputError::TooManySubsteps { .. } => None,
         }
     }
 
@@ -108,6 +150,25 @@ mod tests {
         // 3 s fails in its first sub-step: nothing changes
         assert_eq!(host_step(&mut t, 3.0, step), Err(3.0));
         assert_eq!(t, 2.0);
+    }
+
+    #[test]
+    fn the_substep_count_is_bounded_for_any_substep() {
+        assert_eq!(substep_count(1e-3, 2.5e-4), Ok(4));
+        // a sub-step dividing the step up to rounding gives no extra sliver
+        assert_eq!(substep_count(1e-3, 1e-3 / 3.0), Ok(3));
+        assert_eq!(substep_count(1e-3, 1.0), Ok(1));
+        assert_eq!(substep_count(1.0, 1e-6), Ok(MAX_SUBSTEPS));
+        // what only a corrupted state holds: refused, never a loop of 1e297 sub-steps
+        for substep_s in [1e-300, 0.0, -1e-3, f64::NAN] {
+            assert!(
+                matches!(
+                    substep_count(1e-3, substep_s),
+                    Err(InputError::TooManySubsteps { .. })
+                ),
+                "{substep_s}"
+            );
+        }
     }
 
     #[test]

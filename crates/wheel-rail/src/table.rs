@@ -271,7 +271,7 @@ impl GeometryTable {
                     return Err(TableError::Header {
                         source_name: source_name.to_string(),
                         line: line_no,
-                        found: line.to_string(),
+                        found: echo(line),
                     });
                 }
                 header_seen = true;
@@ -538,6 +538,16 @@ impl GeometryTable {
     }
 }
 
+/// At most the first 80 characters of a line read from a file, for an error message: enough to
+/// recognise a wrong file, not a copy of whatever file a parameter named.
+fn echo(line: &str) -> String {
+    const MAX_CHARS: usize = 80;
+    match line.char_indices().nth(MAX_CHARS) {
+        Some((cut, _)) => format!("{}... ({} bytes)", &line[..cut], line.len()),
+        None => line.to_string(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -648,6 +658,14 @@ mod tests {
         let e = GeometryTable::parse_csv("y,a\n1,2", "t.csv").unwrap_err();
         assert!(matches!(e, TableError::Header { line: 1, .. }), "{e:?}");
         assert!(e.to_string().starts_with("t.csv:1: "), "{e}");
+        assert!(e.to_string().ends_with("got `y,a`"), "{e}");
+        // a long first line (any file a parameter may name) is echoed in part only
+        let long = "é".repeat(100_000);
+        let e = GeometryTable::parse_csv(&long, "t.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.len() < 300, "{} bytes", e.len());
+        assert!(e.ends_with("... (200000 bytes)`"), "{e}");
         let e = GeometryTable::parse_csv(&format!("{h}\n0,0,0,0,0\n"), "t.csv").unwrap_err();
         assert!(matches!(e, TableError::TooFewRows { rows: 1, .. }), "{e:?}");
         let text = format!("# comment\n{h}\n0,0,0,0,0\n0,0,0,0,0\n");
