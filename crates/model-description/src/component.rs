@@ -243,7 +243,7 @@ impl Component {
     #[inline(never)]
     fn trace_call(&mut self, call: &str) {
         let msg = format!(
-            "{call} (state {}, t = {})",
+            "{call} (state {}, t = {:?})",
             state_name(self.state),
             self.time
         );
@@ -585,7 +585,7 @@ impl Component {
         }
         if meta.min.is_some_and(|lo| value < lo) || meta.max.is_some_and(|hi| value > hi) {
             let msg = format!(
-                "{call}: '{}' = {value} is outside its range [{}, {}]",
+                "{call}: '{}' = {value:?} is outside its range [{}, {}]",
                 meta.name,
                 meta.min.map_or("-inf".into(), |v| v.to_string()),
                 meta.max.map_or("+inf".into(), |v| v.to_string())
@@ -778,13 +778,13 @@ impl Component {
         }
         if !current.is_finite() || !step.is_finite() || step < 0.0 || !(current + step).is_finite()
         {
-            let msg = format!("{CALL}: invalid communication point {current} or step {step}");
+            let msg = format!("{CALL}: invalid communication point {current:?} or step {step:?}");
             return self.error(&msg);
         }
         let tol = self.time_tolerance(step);
         if (current - self.time).abs() > tol {
             let msg = format!(
-                "{CALL}: communication point {current} does not match the instance time {} \
+                "{CALL}: communication point {current:?} does not match the instance time {:?} \
                  (restore an FMU state to go back in time)",
                 self.time
             );
@@ -793,11 +793,11 @@ impl Component {
         let target = current + step;
         if let Some(stop) = self.stop_time {
             if target > stop + tol {
-                let msg = format!("{CALL}: step to {target} goes beyond the stop time {stop}");
+                let msg = format!("{CALL}: step to {target:?} goes beyond the stop time {stop:?}");
                 return self.error(&msg);
             }
         }
-        let msg = format!("{CALL}: internal: step from {current} over {step} refused");
+        let msg = format!("{CALL}: internal: step from {current:?} over {step:?} refused");
         self.error(&msg)
     }
 
@@ -811,7 +811,7 @@ impl Component {
             StepError::Discard(reason) => {
                 self.state = FmiState::StepFailed;
                 let msg = format!(
-                    "{CALL}: step from {} over {effective} s discarded: {reason}",
+                    "{CALL}: step from {:?} over {effective:?} s discarded: {reason}",
                     self.time
                 );
                 self.sink.log(Status::Discard, "logStatusDiscard", &msg);
@@ -819,7 +819,7 @@ impl Component {
             }
             StepError::Error(e) => {
                 self.state = FmiState::Error;
-                let msg = format!("{CALL}: step from {} failed: {e}", self.time);
+                let msg = format!("{CALL}: step from {:?} failed: {e}", self.time);
                 self.error(&msg)
             }
         }
@@ -915,7 +915,7 @@ impl Component {
                 .is_none_or(|s| s.is_finite() && s >= header.start_time);
         if !times_ok {
             let msg = format!(
-                "{CALL}: the serialised state has an invalid time (t = {}, start {}, stop {:?})",
+                "{CALL}: the serialised state has an invalid time (t = {:?}, start {:?}, stop {:?})",
                 header.time, header.start_time, header.stop_time
             );
             return Err(self.error(&msg));
