@@ -11,6 +11,7 @@ use crate::{declare, rust_component, value_reference, CollectLog, Diagnostics, V
 struct Fragile {
     u: f64,
     x: f64,
+    gain: f64,
 }
 
 impl FmuModel for Fragile {
@@ -35,12 +36,18 @@ impl FmuModel for Fragile {
             input "u" => u;
             /// State
             output "x" => x;
+            /// A parameter with a range
+            parameter "gain" [range = 0.0..=10.0] => gain;
         }
         v
     }
 
     fn instantiate(_ctx: &InstanceContext) -> Result<Self, ModelError> {
-        Ok(Fragile { u: 0.0, x: 0.0 })
+        Ok(Fragile {
+            u: 0.0,
+            x: 0.0,
+            gain: 1.0,
+        })
     }
 
     fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
@@ -161,6 +168,57 @@ fn a_state_updated_in_place_serialises_its_new_content_and_an_overflowing_step_i
         start_at(c, 1.7e308);
         assert_eq!(do_step(c, 1.7e308, 1e308), FMI2_ERROR);
         assert_eq!(do_step(c, 1.7e308, 1e300), FMI2_OK);
+        free_instance(c);
+    }
+}
+
+#[test]
+fn a_deserialised_state_with_a_parameter_out_of_its_range_is_refused() {
+    let (c, log) = fragile();
+    let gain = [value_reference::<Fragile>("gain").unwrap()];
+    let marker = 0.123_456_789_f64;
+    unsafe {
+        assert_eq!(setup_experiment(c, 0, 0.0, 0.0, 0, 0.0), FMI2_OK);
+        assert_eq!(enter_initialization_mode(c), FMI2_OK);
+        assert_eq!(set_real(c, gain.as_ptr(), 1, [marker].as_ptr()), FMI2_OK);
+        assert_eq!(exit_initialization_mode(c), FMI2_OK);
+        let mut state: fmi2FMUstate = std::ptr::null_mut();
+        assert_eq!(get_fmu_state(c, &mut state), FMI2_OK);
+        let mut size = 0usize;
+        assert_eq!(serialized_fmu_state_size(c, state, &mut size), FMI2_OK);
+        let mut bytes = vec![0u8; size];
+        assert_eq!(
+            serialize_fmu_state(c, state, bytes.as_mut_ptr().cast(), size),
+            FMI2_OK
+        );
+        let deserialise = |bytes: &[u8]| {
+            let mut restored: fmi2FMUstate = std::ptr::null_mut();
+            let status =
+                deserialize_fmu_state(c, bytes.as_ptr().cast(), bytes.len(), &mut restored);
+            if !restored.is_null() {
+                assert_eq!(free_fmu_state(c, &mut restored), FMI2_OK);
+            }
+            status
+        };
+        assert_eq!(deserialise(&bytes), FMI2_OK);
+        // the same bytes with the parameter's value altered
+        let at = bytes
+            .windows(8)
+            .position(|w| w == marker.to_le_bytes())
+            .unwrap();
+        for (bad, shown) in [(-5.0_f64, "-5.0"), (1e300, "1e300")] {
+            let mut altered = bytes.clone();
+            altered[at..at + 8].copy_from_slice(&bad.to_le_bytes());
+            assert_eq!(deserialise(&altered), FMI2_ERROR);
+            let expected = format!("'gain' = {shown} is outside its range");
+            assert!(
+                log.take().iter().any(|(_, _, m)| m.contains(&expected)),
+                "{expected}"
+            );
+        }
+        // refused, nothing changed: the instance steps on
+        assert_eq!(do_step(c, 0.0, 0.1), FMI2_OK);
+        assert_eq!(free_fmu_state(c, &mut state), FMI2_OK);
         free_instance(c);
     }
 }

@@ -57,6 +57,38 @@ pub struct Typed<M: FmuModel> {
 }
 
 impl<M: FmuModel> Typed<M> {
+    /// Every parameter and input of `model` holds what fmi2SetXXX would accept: a Real within
+    /// its declared range, an Enumeration one of its items. A state decoded from bytes a host
+    /// altered is refused here rather than reaching the physics (a negative stiffness, an
+    /// unknown model choice).
+    fn check_settable_values(&self, model: &M) -> Result<(), String> {
+        for v in self.vars.iter().filter(|v| v.meta.causality.is_settable()) {
+            let m = &v.meta;
+            let bad = match &v.access {
+                Access::Real { get, .. } => {
+                    let x = get(model);
+                    (m.min.is_some_and(|lo| x < lo) || m.max.is_some_and(|hi| x > hi))
+                        .then(|| format!("{x:?} is outside its range"))
+                }
+                Access::Integer { get, .. } => {
+                    let x = get(model);
+                    let outside = m.min.is_some_and(|lo| f64::from(x) < lo)
+                        || m.max.is_some_and(|hi| f64::from(x) > hi)
+                        || m.enumeration.is_some_and(|e| e.item(x).is_none());
+                    outside.then(|| format!("{x} is outside its range or items"))
+                }
+                Access::Boolean { .. } | Access::String { .. } => None,
+            };
+            if let Some(reason) = bad {
+                return Err(format!(
+                    "the serialised state holds '{}' = {reason}: not a state this FMU produced",
+                    m.name
+                ));
+            }
+        }
+        Ok(())
+    }
+
     pub fn new(ctx: &InstanceContext) -> Result<Self, ModelError> {
         let vars = M::variables();
         let metas = vars.iter().map(|v| v.meta.clone()).collect();
@@ -227,6 +259,7 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
             ));
         }
         crate::finite::check_finite(&tagged.model).map_err(|e| e.to_string())?;
+        self.check_settable_values(&tagged.model)?;
         Ok(Box::new(tagged.model))
     }
 }
