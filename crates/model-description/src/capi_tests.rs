@@ -121,20 +121,22 @@ fn a_panic_is_an_error_and_leaves_the_instance_in_the_error_state_until_reset() 
     }
 }
 
+/// The bytes fmi2SerializeFMUstate gives for `state` (size asked first).
+unsafe fn serialise(c: fmi2Component, state: fmi2FMUstate) -> Vec<u8> {
+    let mut size = 0usize;
+    assert_eq!(serialized_fmu_state_size(c, state, &mut size), FMI2_OK);
+    let mut bytes = vec![0u8; size];
+    assert_eq!(
+        serialize_fmu_state(c, state, bytes.as_mut_ptr().cast(), size),
+        FMI2_OK
+    );
+    bytes
+}
+
 #[test]
 fn a_state_updated_in_place_serialises_its_new_content_and_an_overflowing_step_is_refused() {
     let (c, _log) = fragile();
     let u = [value_reference::<Fragile>("u").unwrap()];
-    let serialise = |c, state| unsafe {
-        let mut size = 0usize;
-        assert_eq!(serialized_fmu_state_size(c, state, &mut size), FMI2_OK);
-        let mut bytes = vec![0u8; size];
-        assert_eq!(
-            serialize_fmu_state(c, state, bytes.as_mut_ptr().cast(), size),
-            FMI2_OK
-        );
-        bytes
-    };
     unsafe {
         start_at(c, 0.0);
         let mut state: fmi2FMUstate = std::ptr::null_mut();
@@ -184,13 +186,7 @@ fn a_deserialised_state_with_a_parameter_out_of_its_range_is_refused() {
         assert_eq!(exit_initialization_mode(c), FMI2_OK);
         let mut state: fmi2FMUstate = std::ptr::null_mut();
         assert_eq!(get_fmu_state(c, &mut state), FMI2_OK);
-        let mut size = 0usize;
-        assert_eq!(serialized_fmu_state_size(c, state, &mut size), FMI2_OK);
-        let mut bytes = vec![0u8; size];
-        assert_eq!(
-            serialize_fmu_state(c, state, bytes.as_mut_ptr().cast(), size),
-            FMI2_OK
-        );
+        let bytes = serialise(c, state);
         let deserialise = |bytes: &[u8]| {
             let mut restored: fmi2FMUstate = std::ptr::null_mut();
             let status =
