@@ -146,8 +146,8 @@ class System:
         from ._progress import bar
 
         with bar(progress, "steps") as cb:
-            header, data, summary = self._prepared.run(merged, stop, cb)
-        return Results._from_bytes(header, data, json.loads(summary), full_rate=True)
+            header, data, texts, summary, meta = self._prepared.run(merged, stop, cb)
+        return Results._from_bytes(header, data, json.loads(summary), True, texts, json.loads(meta))
 
     def __repr__(self) -> str:
         return f"<System {self.file}: {', '.join(self.instances)}>"

@@ -18,11 +18,11 @@ use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyString};
 use serde_json::Value;
 
 use master::coupling::{RunOptions, SimError, SimOutput, Summary};
-use master::output::write_csv_atomic;
-use master::results::ResultsFormat;
+use master::results::{ResultsFormat, ResultsMetadata, RunContext};
 use master::runset::{
     execute_with, format_by_size, run_job, Job, ResultsOptions, RunReport, RunSet, SweepError,
 };
+use master::slave::ScalarType;
 use master::system::{LoadedSystem, PreparedSystem, RunError, SystemError};
 
 use crate::assess::{self, AssessOptions};
@@ -208,16 +208,28 @@ fn in_background<'s, T: Send>(
     })
 }
 
-/// Results as (header, data bytes, summary JSON).
-type Table<'py> = (Vec<String>, Bound<'py, PyBytes>, String);
+/// Results as (header, data bytes, texts, summary JSON, metadata JSON): the columns of the
+/// master's files ([`results::expand`]), each text column's values by column index.
+type Table<'py> = (
+    Vec<String>,
+    Bound<'py, PyBytes>,
+    Vec<(usize, Vec<String>)>,
+    String,
+    String,
+);
 
-fn table<'py>(py: Python<'py>, out: &SimOutput) -> PyResult<Table<'py>> {
+fn table<'py>(py: Python<'py>, out: &SimOutput, ctx: &RunContext) -> PyResult<Table<'py>> {
     let summary = serde_json::to_string(&out.summary)
         .map_err(|e| Error::new_err(format!("internal: summary: {e}")))?;
+    let meta = serde_json::to_string(&ResultsMetadata::of(out, ctx))
+        .map_err(|e| Error::new_err(format!("internal: metadata: {e}")))?;
+    let t = results::expand(out);
     Ok((
-        out.header.clone(),
-        PyBytes::new(py, &f64_bytes(&out.data)),
+        t.header,
+        PyBytes::new(py, &f64_bytes(&t.data)),
+        t.texts,
         summary,
+        meta,
     ))
 }
 
@@ -291,10 +303,16 @@ impl PySystem {
         self.models_json.clone()
     }
 
-    /// The CSV header of a run: `time [s]` and each recorded variable's `name [unit]`.
+    /// The CSV header of a run, as `master run` writes it: `time [s]` and each recorded
+    /// variable's `name [unit]`, an Enumeration followed by its item names (`name (item)`).
     fn header(&self) -> Vec<String> {
         let mut h = vec!["time [s]".to_string()];
-        h.extend(self.prepared.plan().record.iter().map(|r| r.label.clone()));
+        for r in &self.prepared.plan().record {
+            h.push(r.label.clone());
+            if r.info.scalar_type() == ScalarType::Enumeration {
+                h.push(results::item_label(&r.label));
+            }
+        }
         h
     }
 
@@ -312,8 +330,9 @@ impl PySystem {
             .map_err(|e| system_err(&e))
     }
 
-    /// One run with the given start values and stop time; returns (header, data bytes, summary
-    /// JSON). `progress(steps_done, steps_total)` is called about a hundred times.
+    /// One run with the given start values and stop time; returns (header, data bytes, texts,
+    /// summary JSON, metadata JSON) as [`table`]. `progress(steps_done, steps_total)` is
+    /// called about a hundred times.
     #[pyo3(signature = (parameters=None, stop_time=None, progress=None))]
     fn run<'py>(
         &self,
@@ -354,7 +373,7 @@ impl PySystem {
             },
         )?;
         let out = out.map_err(|e| run_err(&e))?;
-        table(py, &out)
+        table(py, &out, &RunContext::default())
     }
 
     /// Runs one job of this system's run set (JSON, as from `load_run_set`), as a run set's
@@ -385,10 +404,12 @@ impl PySystem {
         )?;
         match out {
             Ok(out) => {
-                let (h, d, s) = table(py, &out)?;
+                let summary = serde_json::to_string(&out.summary)
+                    .map_err(|e| Error::new_err(format!("internal: summary: {e}")))?;
                 let c = serde_json::to_string(&runs::ColumnsWire::of(&out))
                     .map_err(|e| Error::new_err(format!("internal: columns: {e}")))?;
-                Ok((Some(h), Some(d), Some(s), Some(c), None))
+                let d = PyBytes::new(py, &f64_bytes(&out.data));
+                Ok((Some(out.header), Some(d), Some(summary), Some(c), None))
             }
             Err(e) => Ok((None, None, None, None, Some(e))),
         }
@@ -598,27 +619,60 @@ impl PyRunWriter {
     }
 }
 
-/// Reads a results CSV: (header, data bytes), every value exactly as written.
+/// A results table read back: (header, data bytes, texts, metadata JSON or None).
+type ReadTable<'py> = (
+    Vec<String>,
+    Bound<'py, PyBytes>,
+    Vec<(usize, Vec<String>)>,
+    Option<String>,
+);
+
+/// Reads a results file written by the master (CSV, with its metadata beside it when there
+/// is one, or Parquet) as [`table`], every value exactly as written.
 #[pyfunction]
-fn read_csv<'py>(py: Python<'py>, path: PathBuf) -> PyResult<(Vec<String>, Bound<'py, PyBytes>)> {
-    let t = py
-        .detach(|| results::read_csv(&path))
+fn read_results<'py>(py: Python<'py>, path: PathBuf) -> PyResult<ReadTable<'py>> {
+    let (t, meta) = py
+        .detach(|| results::read_results(&path))
         .map_err(OutputError::new_err)?;
-    Ok((t.header, PyBytes::new(py, &f64_bytes(&t.data))))
+    let meta = meta
+        .map(|m| serde_json::to_string(&m))
+        .transpose()
+        .map_err(|e| Error::new_err(format!("internal: metadata: {e}")))?;
+    Ok((
+        t.header,
+        PyBytes::new(py, &f64_bytes(&t.data)),
+        t.texts,
+        meta,
+    ))
 }
 
-/// Writes a results CSV atomically, exactly as `master run` does.
+/// Writes a results CSV atomically, exactly as `master run` does: the table (header, data
+/// bytes, texts, as [`read_results`] gives them) with its columns described by the metadata
+/// JSON (None: Reals, and Strings where there are texts).
 #[pyfunction]
-fn write_csv(path: PathBuf, header: Vec<String>, data: &[u8]) -> PyResult<()> {
-    let data = f64_from_bytes(data).map_err(OutputError::new_err)?;
-    let cols = header.len().max(1);
-    if !data.len().is_multiple_of(cols) {
-        return Err(OutputError::new_err(format!(
-            "{} values do not fill rows of {cols} columns",
-            data.len()
-        )));
-    }
-    write_csv_atomic(Path::new(&path), &header, data.chunks(cols))
+#[pyo3(signature = (path, header, data, texts, metadata_json=None))]
+fn write_results_csv(
+    path: PathBuf,
+    header: Vec<String>,
+    data: &[u8],
+    texts: Vec<(usize, Vec<String>)>,
+    metadata_json: Option<&str>,
+) -> PyResult<()> {
+    let columns = match metadata_json {
+        Some(m) => {
+            serde_json::from_str::<ResultsMetadata>(m)
+                .map_err(|e| OutputError::new_err(format!("results metadata: {e}")))?
+                .columns
+        }
+        None => Vec::new(),
+    };
+    let table = results::Table {
+        header,
+        data: f64_from_bytes(data).map_err(OutputError::new_err)?,
+        texts,
+    };
+    let out = results::collapse(&table, &columns).map_err(OutputError::new_err)?;
+    master::output::write_results_csv(&path, &out)
         .map_err(|e| OutputError::new_err(error_message(&e)))
 }
 
@@ -686,7 +740,7 @@ fn _railfmu(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(results_format_by_size, m)?)?;
     m.add_class::<PyRunWriter>()?;
     m.add_function(wrap_pyfunction!(prepare_run_folder, m)?)?;
-    m.add_function(wrap_pyfunction!(read_csv, m)?)?;
-    m.add_function(wrap_pyfunction!(write_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(read_results, m)?)?;
+    m.add_function(wrap_pyfunction!(write_results_csv, m)?)?;
     Ok(())
 }

@@ -206,3 +206,63 @@ def test_an_ssp_loads_and_runs_as_the_command_line_runs_it(passive_file, master_
     broken.write_bytes(b"not a zip")
     with pytest.raises(railfmu.Error, match="broken.ssp"):
         railfmu.System.load(broken)
+
+
+def test_strings_and_enumerations_are_the_columns_the_command_line_writes(dist, master_cmd, tmp_path):
+    # a String (the contact table) and an Enumeration (the force law) recorded beside numbers
+    desc = {
+        "instances": [
+            {
+                "name": "bogie",
+                "fmu": str(dist / "Bogie2Dof.fmu"),
+                "parameters": {"contact.model": "nonlinear", "contact.table": "AA"},
+            }
+        ],
+        "stop_time": 0.01,
+        "step": 0.001,
+        "record": [
+            "bogie.wheelset_front.lateral_displacement",
+            "bogie.contact.model",
+            "bogie.contact.table",
+            "bogie.track.seed",
+        ],
+    }
+    path = tmp_path / "typed.json"
+    path.write_text(json.dumps(desc))
+    sys = railfmu.System.load(path)
+    res = sys.run()
+    header = [
+        "time [s]",
+        "bogie.wheelset_front.lateral_displacement [m]",
+        "bogie.contact.model",
+        "bogie.contact.model (item)",
+        "bogie.contact.table",
+        "bogie.track.seed",
+    ]
+    assert res.header == header and sys.columns == header
+    assert list(res["bogie.contact.table"]) == ["AA"] * 11
+    assert list(res["bogie.contact.model (item)"]) == ["nonlinear"] * 11
+    assert np.all(res["bogie.contact.model"] == 1.0)
+    df = res.to_pandas()
+    assert list(df.columns) == res.names[1:]
+    assert list(df["bogie.contact.table"]) == ["AA"] * 11
+    assert list(df["bogie.contact.model (item)"]) == ["nonlinear"] * 11
+    assert res.to_numpy()["bogie.contact.table"][0] == "AA"
+    # the command line's CSV and Parquet read back to the same columns, values and texts
+    for name in ("cli.csv", "cli.parquet"):
+        r = run_master(master_cmd, "run", path, "-o", tmp_path / name)
+        assert r.returncode == 0, r.stderr
+        cli = railfmu.read_results(tmp_path / name)
+        assert cli.header == res.header, name
+        assert np.array_equal(bits(cli.values), bits(res.values)), name
+        assert cli.texts.keys() == res.texts.keys(), name
+        for k in res.texts:
+            assert list(cli.texts[k]) == list(res.texts[k]), (name, k)
+    # written from Python, the CSV is the command line's byte for byte
+    res.to_csv(tmp_path / "py.csv")
+    assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()
+    # a run set's results read back with their texts too, in either format
+    for fmt in ("csv", "parquet"):
+        runs = railfmu.RunSet.from_dict({"system": desc}).run(tmp_path / fmt, format=fmt, threads=1)
+        assert list(runs["base"]["bogie.contact.table"]) == ["AA"] * 11, fmt
+        assert runs["base"].header == header, fmt
