@@ -56,7 +56,9 @@ class System:
     @classmethod
     def load(cls, path: PathLike) -> "System":
         """Loads a system description file: JSON (FMU paths relative to its folder), or an SSP
-        (a ``.ssp`` archive, or a bare ``.ssd`` next to its FMUs) as ``master run`` reads it."""
+        (a ``.ssp`` archive, or a bare ``.ssd`` next to its FMUs) as ``master run`` reads it.
+        An ``.fmu`` is not a system description (:class:`SystemDescriptionError`): describe
+        a system of its instances with :meth:`from_dict`."""
         return cls(_railfmu.PreparedSystem.load(os.fspath(path)))
 
     @classmethod

@@ -267,6 +267,7 @@ impl PySystem {
     /// or an SSP (`.ssp` archive, or a bare `.ssd` next to its FMUs) as `master run` reads it.
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        refuse_fmu(&path, false)?;
         if master::ssp::is_ssp_path(&path) {
             let imported = master::ssp::import(&path, &master::ssp::ImportOptions::default())
                 .map_err(|e| ssp_err(&e))?;
@@ -478,9 +479,49 @@ fn report_json(r: &RunReport) -> PyResult<String> {
     serde_json::to_string(r).map_err(|e| Error::new_err(format!("internal: report: {e}")))
 }
 
+/// Refuses an FMU given where a system description (or, `run_set`, a run-set description) is
+/// read, saying how a system of FMUs is described in Python (read as text, the archive would
+/// only be "not valid UTF-8").
+fn refuse_fmu(path: &Path, run_set: bool) -> PyResult<()> {
+    if !path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("fmu"))
+    {
+        return Ok(());
+    }
+    // an instance name has no dots
+    let name = path
+        .file_stem()
+        .map_or("model".into(), |s| s.to_string_lossy().replace('.', "_"));
+    let system = format!(
+        "{{\"instances\": [{{\"name\": \"{name}\", \"fmu\": {}}}], \"stop_time\": 1.0, \
+         \"step\": 0.001}}",
+        serde_json::Value::String(path.display().to_string())
+    );
+    let (what, example, file) = if run_set {
+        (
+            "a run-set description",
+            format!("railfmu.RunSet.from_dict({{\"system\": {system}, \"product\": {{...}}}})"),
+            "a run-set file whose system names it",
+        )
+    } else {
+        (
+            "a system description",
+            format!("railfmu.System.from_dict({system})"),
+            "a JSON or SSP system file that names it",
+        )
+    };
+    Err(SystemDescriptionError::new_err(format!(
+        "'{}' is an FMU, not {what}: describe a system of its instances, e.g. {example}, or \
+         load {file}",
+        path.display()
+    )))
+}
+
 /// Reads a run-set file: (resolved base system JSON, base label, each job as JSON).
 #[pyfunction]
 fn load_run_set(path: PathBuf) -> PyResult<(String, String, Vec<String>)> {
+    refuse_fmu(&path, true)?;
     let (base, jobs) = RunSet::load(&path).map_err(|e| system_err(&e))?;
     run_set_parts(&base, &jobs)
 }

@@ -266,3 +266,17 @@ def test_strings_and_enumerations_are_the_columns_the_command_line_writes(dist, 
         runs = railfmu.RunSet.from_dict({"system": desc}).run(tmp_path / fmt, format=fmt, threads=1)
         assert list(runs["base"]["bogie.contact.table"]) == ["AA"] * 11, fmt
         assert runs["base"].header == header, fmt
+
+
+def test_an_fmu_given_as_a_description_is_refused_saying_how_to_describe_a_system(dist):
+    fmu = dist / "Bogie2Dof.fmu"
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"is an FMU, not a system description") as e:
+        railfmu.System.load(fmu)
+    message = str(e.value)
+    assert "UTF-8" not in message and str(fmu) in message
+    # the system the message suggests loads and runs
+    suggested = json.loads(message.split("System.from_dict(", 1)[1].split("), or", 1)[0])
+    assert suggested["instances"][0]["fmu"] == str(fmu)
+    assert len(railfmu.System.from_dict(suggested).run(stop_time=0.01)) == 11
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"is an FMU, not a run-set description.*RunSet.from_dict"):
+        railfmu.RunSet.load(fmu)
