@@ -67,4 +67,5 @@ def write_results_csv(
     data: bytes,
     texts: List[Tuple[int, List[str]]],
     metadata_json: Optional[str] = None,
+    summary_json: Optional[str] = None,
 ) -> None: ...

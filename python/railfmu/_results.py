@@ -165,11 +165,15 @@ class Results:
 
     def to_csv(self, path: PathLike) -> None:
         """Writes the table as ``master run`` does (atomically, shortest round-trip numbers,
-        texts quoted as the master quotes them)."""
+        texts quoted as the master quotes them), with its metadata file beside it
+        (``results.csv`` -> ``results.meta.json``: each column's type, unit and FMU variable,
+        the sampling, the summary and the system as run), which :func:`read_results` and
+        ``master assess`` read."""
         texts = [(self.names.index(n), list(t)) for n, t in self.texts.items()]
         meta = json.dumps(self.metadata) if self.metadata is not None else None
         data = np.ascontiguousarray(self.values, dtype=np.float64).tobytes()
-        _railfmu.write_results_csv(os.fspath(path), self.header, data, texts, meta)
+        summary = json.dumps(self.summary)
+        _railfmu.write_results_csv(os.fspath(path), self.header, data, texts, meta, summary)
 
 
 class RunSetResults(Mapping[str, Results]):

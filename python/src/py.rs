@@ -18,12 +18,15 @@ use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyString};
 use serde_json::Value;
 
 use master::coupling::{RunOptions, SimError, SimOutput, Summary};
-use master::results::{ResultsFormat, ResultsMetadata, RunContext};
+use master::output::check_outputs_apart;
+use master::results::{
+    csv_metadata_path, write_results, ResultsFormat, ResultsMetadata, RunContext,
+};
 use master::runset::{
     execute_with, format_by_size, run_job, Job, ResultsOptions, RunReport, RunSet, SweepError,
 };
 use master::slave::ScalarType;
-use master::system::{LoadedSystem, PreparedSystem, RunError, SystemError};
+use master::system::{split_ref, LoadedSystem, PreparedSystem, RunError, SystemError};
 
 use crate::assess::{self, AssessOptions};
 use crate::{error_message, f64_bytes, f64_from_bytes, results, runs};
@@ -261,6 +264,31 @@ impl PySystem {
     }
 }
 
+impl PySystem {
+    /// The description (FMU paths absolute) with a run's start values and stop time, as
+    /// JSON.
+    fn run_description(
+        &self,
+        params: &BTreeMap<String, Value>,
+        stop_time: Option<f64>,
+    ) -> PyResult<Value> {
+        let mut desc = self.prepared.system().resolved();
+        for (key, value) in params {
+            let spec = split_ref(key).and_then(|(inst, var)| {
+                Some((desc.instances.iter_mut().find(|i| i.name == inst)?, var))
+            });
+            if let Some((spec, var)) = spec {
+                spec.parameters.insert(var.to_string(), value.clone());
+            }
+        }
+        if let Some(t) = stop_time {
+            desc.stop_time = t;
+        }
+        serde_json::to_value(&desc)
+            .map_err(|e| Error::new_err(format!("internal: description: {e}")))
+    }
+}
+
 #[pymethods]
 impl PySystem {
     /// Loads a system description and prepares it: JSON (FMU paths relative to its folder),
@@ -374,7 +402,12 @@ impl PySystem {
             },
         )?;
         let out = out.map_err(|e| run_err(&e))?;
-        table(py, &out, &RunContext::default())
+        // the metadata describe the system as run, as those of a run of a run set do
+        let ctx = RunContext {
+            system: Some(self.run_description(&params, stop_time)?),
+            ..RunContext::default()
+        };
+        table(py, &out, &ctx)
     }
 
     /// Runs one job of this system's run set (JSON, as from `load_run_set`), as a run set's
@@ -687,33 +720,46 @@ fn read_results<'py>(py: Python<'py>, path: PathBuf) -> PyResult<ReadTable<'py>>
     ))
 }
 
-/// Writes a results CSV atomically, exactly as `master run` does: the table (header, data
-/// bytes, texts, as [`read_results`] gives them) with its columns described by the metadata
-/// JSON (None: Reals, and Strings where there are texts).
+/// Writes results as `master run` does, atomically: the CSV and its metadata file beside it
+/// (`<name>.meta.json`). The table (header, data bytes, texts, as [`read_results`] gives
+/// them) has its columns described by the metadata JSON (None: Reals, and Strings where there
+/// are texts), which also gives the run's name, parameters and system description, if any;
+/// `summary_json` is the run's summary (missing statistics are 0).
 #[pyfunction]
-#[pyo3(signature = (path, header, data, texts, metadata_json=None))]
+#[pyo3(signature = (path, header, data, texts, metadata_json=None, summary_json=None))]
 fn write_results_csv(
     path: PathBuf,
     header: Vec<String>,
     data: &[u8],
     texts: Vec<(usize, Vec<String>)>,
     metadata_json: Option<&str>,
+    summary_json: Option<&str>,
 ) -> PyResult<()> {
-    let columns = match metadata_json {
-        Some(m) => {
-            serde_json::from_str::<ResultsMetadata>(m)
-                .map_err(|e| OutputError::new_err(format!("results metadata: {e}")))?
-                .columns
-        }
-        None => Vec::new(),
-    };
+    let meta = metadata_json
+        .map(serde_json::from_str::<ResultsMetadata>)
+        .transpose()
+        .map_err(|e| OutputError::new_err(format!("results metadata: {e}")))?;
     let table = results::Table {
         header,
         data: f64_from_bytes(data).map_err(OutputError::new_err)?,
         texts,
     };
-    let out = results::collapse(&table, &columns).map_err(OutputError::new_err)?;
-    master::output::write_results_csv(&path, &out)
+    let columns = meta.as_ref().map_or(&[][..], |m| &m.columns[..]);
+    let mut out = results::collapse(&table, columns).map_err(OutputError::new_err)?;
+    if let Some(s) = summary_json {
+        out.summary = results::summary(s).map_err(OutputError::new_err)?;
+    }
+    let mut ctx = RunContext::default();
+    if let Some(m) = meta {
+        out.decimation = m.sampling.and_then(|s| s.decimation);
+        ctx.run = m.run;
+        ctx.parameters = m.parameters;
+        ctx.labels = m.labels;
+        ctx.system = m.system;
+    }
+    let paths = [path.clone(), csv_metadata_path(&path)];
+    check_outputs_apart(&[], &paths).map_err(|e| OutputError::new_err(error_message(&e)))?;
+    write_results(&path, &out, ResultsFormat::Csv, &ctx)
         .map_err(|e| OutputError::new_err(error_message(&e)))
 }
 

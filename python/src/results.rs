@@ -12,7 +12,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use master::coupling::{ColumnInfo, SimOutput};
+use master::coupling::{ColumnInfo, SimOutput, Summary};
 use master::output::results_header;
 use master::results::{read_metadata, ColumnMetadata, ResultsFormat, ResultsMetadata};
 use master::slave::ScalarType;
@@ -77,6 +77,24 @@ pub fn expand(out: &SimOutput) -> Table {
         data,
         texts,
     }
+}
+
+/// A run's summary from JSON: the statistics given, 0 for those missing (a table that did
+/// not come from a run has none).
+pub fn summary(json: &str) -> Result<Summary, String> {
+    let mut v = serde_json::json!({
+        "steps": 0, "rejected_steps": 0, "simulated_time_s": 0.0, "wall_time_s": 0.0,
+        "realtime_ratio": 0.0,
+    });
+    let given: serde_json::Value =
+        serde_json::from_str(json).map_err(|e| format!("summary: {e}"))?;
+    let serde_json::Value::Object(given) = given else {
+        return Err(format!("summary: {given} is not an object"));
+    };
+    if let Some(o) = v.as_object_mut() {
+        o.extend(given);
+    }
+    serde_json::from_value(v).map_err(|e| format!("summary: {e}"))
 }
 
 /// The header the master writes for the columns of `meta`, and which of its columns hold
@@ -173,7 +191,7 @@ pub fn collapse(table: &Table, columns: &[ColumnMetadata]) -> Result<SimOutput, 
     Ok(SimOutput {
         header: keep.iter().map(|&c| table.header[c].clone()).collect(),
         data,
-        summary: master::coupling::Summary {
+        summary: Summary {
             steps: 0,
             rejected_steps: 0,
             simulated_time_s: 0.0,
@@ -489,6 +507,17 @@ mod tests {
             e.contains("column 'a.e (item)': 'Option, 2' is not a number"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn a_summary_has_every_statistic() {
+        let s = summary(r#"{"steps": 3, "wall_time_s": 0.5}"#).unwrap();
+        assert_eq!((s.steps, s.rejected_steps, s.wall_time_s), (3, 0, 0.5));
+        assert_eq!(summary("{}").unwrap().simulated_time_s, 0.0);
+        assert!(summary(r#"{"steps": "many"}"#)
+            .unwrap_err()
+            .starts_with("summary: "));
+        assert!(summary("[]").unwrap_err().contains("not an object"));
     }
 
     #[test]

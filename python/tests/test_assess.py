@@ -52,8 +52,12 @@ def test_a_runs_results_are_assessed_as_the_command_line_assesses_their_file(hun
         assert s.max_rms == pytest.approx(float(row["max rms"]), rel=1e-12)
         assert s.dominant_frequency_hz == pytest.approx(float(row["dominant frequency [Hz]"]), rel=1e-12)
         assert (row["stable"] == "true") == s.stable
-    # and from Python on the file: the same numbers, with the note that a CSV without
-    # metadata cannot say how it was sampled
+    # and from Python on the file: the same numbers; its metadata file records how it was
+    # sampled, and without it a note says the band could not be checked
+    f = railfmu.assess_stability(path, SIGNALS, 320.0, skip_s=5.0)
+    assert f.max_rms == pytest.approx(a.max_rms, rel=1e-12)
+    assert f.notes == []
+    path.with_suffix(".meta.json").unlink()
     f = railfmu.assess_stability(path, SIGNALS, 320.0, skip_s=5.0)
     assert f.max_rms == pytest.approx(a.max_rms, rel=1e-12)
     assert len(f.notes) == 1

@@ -280,3 +280,32 @@ def test_an_fmu_given_as_a_description_is_refused_saying_how_to_describe_a_syste
     assert len(railfmu.System.from_dict(suggested).run(stop_time=0.01)) == 11
     with pytest.raises(railfmu.SystemDescriptionError, match=r"is an FMU, not a run-set description.*RunSet.from_dict"):
         railfmu.RunSet.load(fmu)
+
+
+def test_to_csv_writes_the_metadata_file_the_command_line_writes(dist, master_cmd, tmp_path):
+    changed = tmp_path / "changed.json"
+    changed.write_text(json.dumps(passive(dist, 0.5, **{"vehicle.speed": 55.0, "track.seed": 7})))
+    cli_csv = tmp_path / "cli.csv"
+    assert run_master(master_cmd, "run", changed, "-o", cli_csv).returncode == 0
+    base = tmp_path / "base.json"
+    base.write_text(json.dumps(passive(dist, 2.0)))
+    res = railfmu.System.load(base).run({"bogie.vehicle.speed": 55.0, "bogie.track.seed": 7}, stop_time=0.5)
+    py_csv = tmp_path / "py.csv"
+    res.to_csv(py_csv)
+    assert py_csv.read_bytes() == cli_csv.read_bytes()
+    cli_meta = json.loads((tmp_path / "cli.meta.json").read_text())
+    py_meta = json.loads((tmp_path / "py.meta.json").read_text())
+    # the same metadata but for the wall time of the run: columns, sampling, the system as run
+    for m in (cli_meta, py_meta):
+        m["summary"].pop("wall_time_s")
+        m["summary"].pop("realtime_ratio")
+    assert py_meta == cli_meta
+    assert py_meta["system"]["stop_time"] == 0.5
+    assert py_meta["system"]["instances"][0]["parameters"]["vehicle.speed"] == 55.0
+    assert py_meta["sampling"]["rate_hz"] == 1000.0
+    # read back, the results keep their metadata, and write it again
+    back = railfmu.read_results(py_csv)
+    assert back.metadata == res.metadata
+    back.to_csv(tmp_path / "again.csv")
+    assert (tmp_path / "again.csv").read_bytes() == py_csv.read_bytes()
+    assert (tmp_path / "again.meta.json").read_bytes() == (tmp_path / "py.meta.json").read_bytes()
