@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from pathlib import Path
 from typing import Any, Dict, Iterator, List, Mapping, Optional, Union
 
@@ -194,6 +195,7 @@ class RunSetResults(Mapping[str, Results]):
         self.reports: List[Dict[str, Any]] = list(reports)
         """Each run's report in job order: name, parameters, ok, error, summary, results."""
         self._cache: Dict[str, Results] = {}
+        self._parameter_units: Optional[Dict[str, Optional[str]]] = None
 
     @property
     def ok(self) -> bool:
@@ -231,8 +233,26 @@ class RunSetResults(Mapping[str, Results]):
     def __repr__(self) -> str:
         return f"<RunSetResults {self.folder}: {len(self)} of {len(self.reports)} runs ok>"
 
+    @property
+    def parameter_units(self) -> Dict[str, Optional[str]]:
+        """The unit of each parameter of the set (``instance.variable`` -> unit, None where
+        its FMU declares none), from the model descriptions of the FMUs a run's
+        ``system.json`` names. Raises :class:`FmuError` when they cannot be read."""
+        if self._parameter_units is None:
+            names = list(dict.fromkeys(k for r in self.reports for k in r.get("parameters", {})))
+            units: List[Optional[str]] = [None] * len(names)
+            systems = (self.folder / r["name"] / "system.json" for r in self.reports)
+            system = next((p for p in systems if p.is_file()), None)
+            if names and system is not None:
+                units = _railfmu.parameter_units(os.fspath(system), names)
+            self._parameter_units = dict(zip(names, units))
+        return dict(self._parameter_units)
+
     def summary_frame(self):
-        """One row per run: its parameters, ok, error and run statistics (pandas)."""
+        """One row per run: its parameters, ok, error and run statistics (pandas).
+        ``df.attrs["units"]`` maps each column to its unit: a parameter's as its FMU declares
+        it (see :attr:`parameter_units`), seconds for ``simulated_time_s`` and
+        ``wall_time_s``, None for the others."""
         import pandas as pd
 
         rows = []
@@ -240,7 +260,15 @@ class RunSetResults(Mapping[str, Results]):
             row: Dict[str, Any] = {"run": r["name"], **r.get("parameters", {}), "ok": r["ok"], "error": r.get("error")}
             row.update(r.get("summary") or {})
             rows.append(row)
-        return pd.DataFrame(rows).set_index("run")
+        df = pd.DataFrame(rows).set_index("run")
+        try:
+            parameters = self.parameter_units
+        except _railfmu.Error as e:
+            warnings.warn(f"the parameters' units are unknown: {e}", RuntimeWarning, stacklevel=2)
+            parameters = {}
+        seconds = {"simulated_time_s": "s", "wall_time_s": "s"}
+        df.attrs["units"] = {c: parameters.get(c, seconds.get(c)) for c in df.columns}
+        return df
 
     def to_pandas(self):
         """All successful runs in one DataFrame indexed by (run, time); units in

@@ -592,6 +592,15 @@ fn completed_report(outdir: PathBuf, job_json: &str, format: &str) -> PyResult<O
         .transpose()
 }
 
+/// The unit of each parameter (`instance.variable`) of the system described in `path` (a run
+/// folder's `system.json`), from its FMUs' model descriptions (None: no unit, or no such
+/// variable).
+#[pyfunction]
+fn parameter_units(path: PathBuf, names: Vec<String>) -> PyResult<Vec<Option<String>>> {
+    let system = LoadedSystem::load(&path).map_err(|e| system_err(&e))?;
+    runs::parameter_units(&system, &names).map_err(|e| system_err(&e))
+}
+
 /// Writes `<outdir>/sweep.json` from reports (JSON) in job order.
 #[pyfunction]
 fn write_sweep(outdir: PathBuf, reports_json: Vec<String>) -> PyResult<()> {
@@ -824,6 +833,7 @@ fn _railfmu(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_set_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(completed_report, m)?)?;
     m.add_function(wrap_pyfunction!(write_sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(parameter_units, m)?)?;
     m.add_function(wrap_pyfunction!(results_format_by_size, m)?)?;
     m.add_class::<PyRunWriter>()?;
     m.add_function(wrap_pyfunction!(prepare_run_folder, m)?)?;
