@@ -17,7 +17,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyString};
 use serde_json::Value;
 
-use master::coupling::{RunOptions, SimError, SimOutput, Summary};
+use master::coupling::{Algorithm, RunOptions, SimError, SimOutput, Summary};
 use master::output::check_outputs_apart;
 use master::results::{
     csv_metadata_path, write_results, ResultsFormat, ResultsMetadata, RunContext,
@@ -80,7 +80,12 @@ fn ssp_err(e: &master::ssp::SspError) -> PyErr {
     match e {
         master::ssp::SspError::System(s) => system_err(s),
         master::ssp::SspError::Output(_) => OutputError::new_err(error_message(e)),
-        _ => SystemDescriptionError::new_err(error_message(e)),
+        // a missing stop time or step is given as the argument of System.load
+        _ => SystemDescriptionError::new_err(
+            error_message(e)
+                .replace("with --stop-time)", "with System.load(..., stop_time=...))")
+                .replace("with --step)", "with System.load(..., step=...))"),
+        ),
     }
 }
 
@@ -293,15 +298,49 @@ impl PySystem {
 impl PySystem {
     /// Loads a system description and prepares it: JSON (FMU paths relative to its folder),
     /// or an SSP (`.ssp` archive, or a bare `.ssd` next to its FMUs) as `master run` reads it.
+    /// An SSP's communication step, stop time and coupling algorithm ("jacobi" or
+    /// "gauss-seidel") can be given (`master run --step --stop-time --algorithm`); a JSON
+    /// description sets them itself.
     #[staticmethod]
-    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+    #[pyo3(signature = (path, step=None, stop_time=None, algorithm=None))]
+    fn load(
+        py: Python<'_>,
+        path: PathBuf,
+        step: Option<f64>,
+        stop_time: Option<f64>,
+        algorithm: Option<&str>,
+    ) -> PyResult<Self> {
         refuse_fmu(&path, false)?;
+        let algorithm = algorithm.map(parse_algorithm).transpose()?;
         if master::ssp::is_ssp_path(&path) {
-            let imported = master::ssp::import(&path, &master::ssp::ImportOptions::default())
-                .map_err(|e| ssp_err(&e))?;
+            let opts = master::ssp::ImportOptions {
+                step,
+                stop_time,
+                algorithm,
+            };
+            let imported = master::ssp::import(&path, &opts).map_err(|e| ssp_err(&e))?;
             let mut system = Self::prepare(py, imported.system.clone())?;
             system._ssp = Some(imported);
             return Ok(system);
+        }
+        let given: Vec<&str> = [
+            ("step", step.is_some()),
+            ("stop_time", stop_time.is_some()),
+            ("algorithm", algorithm.is_some()),
+        ]
+        .iter()
+        .filter(|(_, g)| *g)
+        .map(|(n, _)| *n)
+        .collect();
+        if !given.is_empty() {
+            return Err(SystemDescriptionError::new_err(format!(
+                "{}: {} of System.load apply to an SSP (.ssp, .ssd); a JSON system description \
+                 sets its own \"step\", \"stop_time\" and \"algorithm\" (System.from_dict \
+                 takes a changed description; System.stop_time changes the stop time of later \
+                 runs)",
+                path.display(),
+                given.join(", ")
+            )));
         }
         let system = LoadedSystem::load(&path).map_err(|e| system_err(&e))?;
         Self::prepare(py, system)
@@ -616,6 +655,15 @@ fn parse_jobs(jobs_json: &[String]) -> PyResult<Vec<Job>> {
         .iter()
         .map(|j| serde_json::from_str::<Job>(j).map_err(|e| json_err("job", &e)))
         .collect()
+}
+
+/// A coupling algorithm by its name in a system description.
+fn parse_algorithm(name: &str) -> PyResult<Algorithm> {
+    serde_json::from_value(Value::String(name.to_string())).map_err(|_| {
+        PyValueError::new_err(format!(
+            "algorithm '{name}': expected 'jacobi' or 'gauss-seidel'"
+        ))
+    })
 }
 
 fn parse_format(format: &str) -> PyResult<ResultsFormat> {

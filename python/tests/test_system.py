@@ -309,3 +309,46 @@ def test_to_csv_writes_the_metadata_file_the_command_line_writes(dist, master_cm
     back.to_csv(tmp_path / "again.csv")
     assert (tmp_path / "again.csv").read_bytes() == py_csv.read_bytes()
     assert (tmp_path / "again.meta.json").read_bytes() == (tmp_path / "py.meta.json").read_bytes()
+
+
+def test_an_ssps_step_stop_time_and_algorithm_are_set_as_the_command_line_sets_them(passive_file, master_cmd, tmp_path):
+    ssp = tmp_path / "passive.ssp"
+    assert run_master(master_cmd, "export-ssp", passive_file, ssp).returncode == 0
+    cli_csv = tmp_path / "cli.csv"
+    options = ["--step", "0.002", "--stop-time", "0.5", "--algorithm", "gauss-seidel"]
+    r = run_master(master_cmd, "run", ssp, "-o", cli_csv, *options)
+    assert r.returncode == 0, r.stderr
+    sys = railfmu.System.load(ssp, step=0.002, stop_time=0.5, algorithm="gauss-seidel")
+    d = sys.description
+    assert (d["step"], d["stop_time"], d["algorithm"]) == (0.002, 0.5, "gauss-seidel")
+    res = sys.run()
+    assert len(res) == 251
+    cli = railfmu.read_results(cli_csv)
+    assert cli.header == res.header
+    assert np.array_equal(bits(cli.values), bits(res.values))
+    # the SSP's own timing and Jacobi (the default) give other results
+    jacobi = railfmu.System.load(ssp, step=0.002, stop_time=0.5).run()
+    assert jacobi.header == res.header and not np.array_equal(jacobi.values, res.values)
+    assert railfmu.System.load(ssp).description["step"] == 0.001
+    # an SSD without a stop time or a step: the message names the argument to give it with
+    folder = tmp_path / "unpacked"
+    with zipfile.ZipFile(ssp) as z:
+        z.extractall(folder)
+    ssd = folder / "SystemStructure.ssd"
+    text = ssd.read_text()
+    for attribute in ('stopTime="1.0"', 'stepSize="0.001"', 'baseStepSize="0.001"'):
+        assert attribute in text
+        text = text.replace(attribute, "")
+    ssd.write_text(text)
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"no stop time.*System.load\(\.\.\., stop_time=") as e:
+        railfmu.System.load(ssd)
+    assert "--" not in str(e.value)
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"no communication step.*System.load\(\.\.\., step=") as e:
+        railfmu.System.load(ssd, stop_time=0.5)
+    assert "--" not in str(e.value)
+    assert len(railfmu.System.load(ssd, stop_time=0.5, step=0.002).run()) == 251
+    # a JSON description sets them itself; an unknown algorithm is refused by name
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"step, algorithm of System.load apply to an SSP"):
+        railfmu.System.load(passive_file, step=0.002, algorithm="jacobi")
+    with pytest.raises(ValueError, match=r"algorithm 'seidel': expected 'jacobi' or 'gauss-seidel'"):
+        railfmu.System.load(ssp, algorithm="seidel")
