@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from pathlib import Path
 from typing import Any, Dict, Iterator, List, Mapping, Optional, Union
 
@@ -24,12 +25,17 @@ def split_label(label: str) -> "tuple[str, Optional[str]]":
 
 
 class Results:
-    """The recorded variables of one run: time plus one column per recorded variable.
+    """The recorded variables of one run: time plus one column per recorded variable, the
+    columns of the results file ``master run`` writes.
 
     ``values`` holds the numbers exactly as the master computed them (the same bits as the
     ``results.csv`` that ``master run`` writes). Columns are named ``instance.variable``; units
     are in ``units`` and travel with :meth:`to_pandas` (``DataFrame.attrs["units"]``) and
-    :meth:`to_numpy` (each field's dtype metadata ``{"unit": ...}``).
+    :meth:`to_numpy` (each field's dtype metadata ``{"unit": ...}``). Integers, Booleans (0/1)
+    and Enumerations (their integers) are numbers too; a String variable is a column of texts,
+    and an Enumeration is followed by the column of its item names (``name (item)``), as in
+    the master's files: their texts are in ``texts`` (and in :meth:`to_pandas`,
+    :meth:`to_numpy`, ``results[name]``), their entries in ``values`` are NaN.
     """
 
     def __init__(
@@ -38,13 +44,15 @@ class Results:
         values: np.ndarray,
         summary: Optional[Dict[str, Any]] = None,
         full_rate: bool = False,
+        texts: Optional[Mapping[str, Any]] = None,
+        metadata: Optional[Dict[str, Any]] = None,
     ):
         if values.ndim != 2 or values.shape[1] != len(header):
             raise ValueError(f"{values.shape} values do not match {len(header)} columns")
         self.header: List[str] = list(header)
         """The CSV header: ``time [s]``, then ``instance.variable [unit]``."""
         self.values: np.ndarray = values
-        """The table, one row per communication point, float64."""
+        """The table, one row per communication point, float64 (NaN in a text column)."""
         self.summary: Dict[str, Any] = dict(summary or {})
         """Run statistics: steps, rejected_steps, simulated_time_s, wall_time_s, realtime_ratio."""
         self.full_rate: bool = full_rate
@@ -56,38 +64,56 @@ class Results:
         """Column names without units; the first is ``time``."""
         self.units: Dict[str, Optional[str]] = {n: u for n, u in split}
         """Unit of each column (None where the FMU declares none)."""
+        self.texts: Dict[str, np.ndarray] = {}
+        """The values of each text column (a String variable, an Enumeration's item names) by
+        column name, as arrays of str (dtype object)."""
+        for name, column in (texts or {}).items():
+            if name not in self.units:
+                raise ValueError(f"texts of '{name}', which is no column; columns: {', '.join(self.names)}")
+            column = np.asarray(column, dtype=object)
+            if column.shape != (len(self),):
+                raise ValueError(f"{column.shape} texts of '{name}' do not match {len(self)} rows")
+            self.texts[name] = column
+        self.metadata: Optional[Dict[str, Any]] = metadata
+        """What the master's results files carry besides the values (``<name>.meta.json``
+        beside a CSV, inside a Parquet file): each column's type, unit and FMU variable, the
+        sampling, the summary, ...; None when unknown (a CSV without its metadata file)."""
 
     @classmethod
     def _from_bytes(
-        cls, header: List[str], data: bytes, summary: Optional[Dict[str, Any]] = None, full_rate: bool = False
+        cls,
+        header: List[str],
+        data: bytes,
+        summary: Optional[Dict[str, Any]] = None,
+        full_rate: bool = False,
+        texts: Optional[List[Any]] = None,
+        metadata: Optional[Dict[str, Any]] = None,
     ) -> "Results":
+        """From the native module's parts: ``texts`` as (column index, texts) pairs."""
         values = np.frombuffer(data, dtype=np.float64).reshape(-1, max(len(header), 1))
-        return cls(header, values, summary, full_rate)
+        named = {split_label(header[c])[0]: t for c, t in (texts or [])}
+        return cls(header, values, summary, full_rate, named, metadata)
+
+    @classmethod
+    def _read(cls, path: PathLike) -> "Results":
+        header, data, texts, meta = _railfmu.read_results(os.fspath(path))
+        meta = json.loads(meta) if meta is not None else None
+        summary = meta.get("summary") if meta is not None else None
+        return cls._from_bytes(header, data, summary, texts=texts, metadata=meta)
 
     @classmethod
     def read_csv(cls, path: PathLike) -> "Results":
-        """Reads a ``results.csv`` written by the master, every value exactly as written."""
-        header, data = _railfmu.read_csv(os.fspath(path))
-        return cls._from_bytes(header, data)
+        """Reads a ``results.csv`` written by the master, every value exactly as written (the
+        texts of Strings and Enumeration items by the metadata file beside it)."""
+        return cls._read(path)
 
     @classmethod
     def read_parquet(cls, path: PathLike) -> "Results":
-        """Reads a Parquet results file written by the master (needs pyarrow): time and the
-        recorded numeric columns (Reals, Integers, Booleans as 0/1, Enumerations as integers),
-        every value as written; the run statistics from the file's metadata."""
-        import pyarrow.parquet as pq
-
-        try:
-            table = pq.read_table(os.fspath(path))
-        except (OSError, ValueError) as e:
-            raise _railfmu.OutputError(f"cannot read '{path}': {e}") from None
-        raw = (table.schema.metadata or {}).get(b"railfmu.results")
-        if raw is None:
-            raise _railfmu.OutputError(f"'{path}' has no railfmu.results metadata: not written by the master")
-        meta = json.loads(raw)
-        header = [table.column_names[0]] + [c["label"] for c in meta["columns"] if c.get("ty") != "String"]
-        values = np.column_stack([table.column(h).to_numpy().astype(np.float64) for h in header])
-        return cls(header, values, meta.get("summary"))
+        """Reads a Parquet results file written by the master: time and the recorded columns
+        (Reals, Integers, Booleans as 0/1, Enumerations as integers with their item names,
+        Strings as texts), every value as written; the run statistics from the file's
+        metadata."""
+        return cls._read(path)
 
     @property
     def time(self) -> np.ndarray:
@@ -101,40 +127,54 @@ class Results:
         return name in self.units or name in self.header
 
     def __getitem__(self, name: str) -> np.ndarray:
-        """A column by name (``bogie.x``) or by its header label (``bogie.x [m]``)."""
+        """A column by name (``bogie.x``) or by its header label (``bogie.x [m]``): numbers,
+        or the texts of a text column."""
         for i, (n, h) in enumerate(zip(self.names, self.header)):
             if name == n or name == h:
-                return self.values[:, i]
+                return self.texts[n] if n in self.texts else self.values[:, i]
         raise KeyError(f"no column '{name}'; columns: {', '.join(self.names)}")
 
     def __repr__(self) -> str:
         return f"<Results {len(self)} rows x {len(self.names)} columns: {', '.join(self.names[:4])}{', ...' if len(self.names) > 4 else ''}>"
 
     def to_numpy(self) -> np.ndarray:
-        """A structured array with one float64 field per column (``time`` first); each field's
-        dtype carries ``metadata={"unit": unit}``."""
+        """A structured array with one field per column (``time`` first): float64, or object
+        (str) for a text column; each field's dtype carries ``metadata={"unit": unit}``."""
         dtype = np.dtype(
-            [(n, np.dtype(np.float64, metadata={"unit": u})) for n, u in zip(self.names, self.units.values())]
+            [
+                (n, np.dtype(object if n in self.texts else np.float64, metadata={"unit": u}))
+                for n, u in zip(self.names, self.units.values())
+            ]
         )
         out = np.empty(len(self), dtype=dtype)
         for i, n in enumerate(self.names):
-            out[n] = self.values[:, i]
+            out[n] = self.texts[n] if n in self.texts else self.values[:, i]
         return out
 
     def to_pandas(self):
-        """A ``pandas.DataFrame`` indexed by ``time`` [s], one column per recorded variable.
-        ``df.attrs["units"]`` maps each column (and ``time``) to its unit, ``df.attrs["summary"]``
-        holds the run statistics."""
+        """A ``pandas.DataFrame`` indexed by ``time`` [s], one column per recorded variable
+        (texts for a String and an Enumeration's item names). ``df.attrs["units"]`` maps each
+        column (and ``time``) to its unit, ``df.attrs["summary"]`` holds the run statistics."""
         import pandas as pd
 
         df = pd.DataFrame(self.values[:, 1:], columns=self.names[1:], index=pd.Index(self.values[:, 0], name=self.names[0]))
+        for n, t in self.texts.items():
+            df[n] = t
         df.attrs["units"] = dict(self.units)
         df.attrs["summary"] = dict(self.summary)
         return df
 
     def to_csv(self, path: PathLike) -> None:
-        """Writes the table as ``master run`` does (atomically, shortest round-trip numbers)."""
-        _railfmu.write_csv(os.fspath(path), self.header, np.ascontiguousarray(self.values, dtype=np.float64).tobytes())
+        """Writes the table as ``master run`` does (atomically, shortest round-trip numbers,
+        texts quoted as the master quotes them), with its metadata file beside it
+        (``results.csv`` -> ``results.meta.json``: each column's type, unit and FMU variable,
+        the sampling, the summary and the system as run), which :func:`read_results` and
+        ``master assess`` read."""
+        texts = [(self.names.index(n), list(t)) for n, t in self.texts.items()]
+        meta = json.dumps(self.metadata) if self.metadata is not None else None
+        data = np.ascontiguousarray(self.values, dtype=np.float64).tobytes()
+        summary = json.dumps(self.summary)
+        _railfmu.write_results_csv(os.fspath(path), self.header, data, texts, meta, summary)
 
 
 class RunSetResults(Mapping[str, Results]):
@@ -155,6 +195,7 @@ class RunSetResults(Mapping[str, Results]):
         self.reports: List[Dict[str, Any]] = list(reports)
         """Each run's report in job order: name, parameters, ok, error, summary, results."""
         self._cache: Dict[str, Results] = {}
+        self._parameter_units: Optional[Dict[str, Optional[str]]] = None
 
     @property
     def ok(self) -> bool:
@@ -192,8 +233,26 @@ class RunSetResults(Mapping[str, Results]):
     def __repr__(self) -> str:
         return f"<RunSetResults {self.folder}: {len(self)} of {len(self.reports)} runs ok>"
 
+    @property
+    def parameter_units(self) -> Dict[str, Optional[str]]:
+        """The unit of each parameter of the set (``instance.variable`` -> unit, None where
+        its FMU declares none), from the model descriptions of the FMUs a run's
+        ``system.json`` names. Raises :class:`FmuError` when they cannot be read."""
+        if self._parameter_units is None:
+            names = list(dict.fromkeys(k for r in self.reports for k in r.get("parameters", {})))
+            units: List[Optional[str]] = [None] * len(names)
+            systems = (self.folder / r["name"] / "system.json" for r in self.reports)
+            system = next((p for p in systems if p.is_file()), None)
+            if names and system is not None:
+                units = _railfmu.parameter_units(os.fspath(system), names)
+            self._parameter_units = dict(zip(names, units))
+        return dict(self._parameter_units)
+
     def summary_frame(self):
-        """One row per run: its parameters, ok, error and run statistics (pandas)."""
+        """One row per run: its parameters, ok, error and run statistics (pandas).
+        ``df.attrs["units"]`` maps each column to its unit: a parameter's as its FMU declares
+        it (see :attr:`parameter_units`), seconds for ``simulated_time_s`` and
+        ``wall_time_s``, None for the others."""
         import pandas as pd
 
         rows = []
@@ -201,7 +260,15 @@ class RunSetResults(Mapping[str, Results]):
             row: Dict[str, Any] = {"run": r["name"], **r.get("parameters", {}), "ok": r["ok"], "error": r.get("error")}
             row.update(r.get("summary") or {})
             rows.append(row)
-        return pd.DataFrame(rows).set_index("run")
+        df = pd.DataFrame(rows).set_index("run")
+        try:
+            parameters = self.parameter_units
+        except _railfmu.Error as e:
+            warnings.warn(f"the parameters' units are unknown: {e}", RuntimeWarning, stacklevel=2)
+            parameters = {}
+        seconds = {"simulated_time_s": "s", "wall_time_s": "s"}
+        df.attrs["units"] = {c: parameters.get(c, seconds.get(c)) for c in df.columns}
+        return df
 
     def to_pandas(self):
         """All successful runs in one DataFrame indexed by (run, time); units in

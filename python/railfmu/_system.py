@@ -54,10 +54,32 @@ class System:
         self._stop_time: Optional[float] = None
 
     @classmethod
-    def load(cls, path: PathLike) -> "System":
+    def load(
+        cls,
+        path: PathLike,
+        *,
+        step: Optional[float] = None,
+        stop_time: Optional[float] = None,
+        algorithm: Optional[str] = None,
+    ) -> "System":
         """Loads a system description file: JSON (FMU paths relative to its folder), or an SSP
-        (a ``.ssp`` archive, or a bare ``.ssd`` next to its FMUs) as ``master run`` reads it."""
-        return cls(_railfmu.PreparedSystem.load(os.fspath(path)))
+        (a ``.ssp`` archive, or a bare ``.ssd`` next to its FMUs) as ``master run`` reads it.
+        An ``.fmu`` is not a system description (:class:`SystemDescriptionError`): describe
+        a system of its instances with :meth:`from_dict`.
+
+        For an SSP, as ``master run --step --stop-time --algorithm``: ``step``, the
+        communication step [s] (default: the SSP's libcosim or OMSimulator annotation);
+        ``stop_time`` [s] (default: its DefaultExperiment's); ``algorithm``, the coupling
+        algorithm, ``"jacobi"`` (default) or ``"gauss-seidel"``. A JSON description sets
+        them itself: given with one, they raise :class:`SystemDescriptionError`."""
+        return cls(
+            _railfmu.PreparedSystem.load(
+                os.fspath(path),
+                None if step is None else float(step),
+                None if stop_time is None else float(stop_time),
+                algorithm,
+            )
+        )
 
     @classmethod
     def from_dict(cls, description: Mapping[str, Any], base_dir: PathLike = ".", label: str = "<dict>") -> "System":
@@ -146,8 +168,8 @@ class System:
         from ._progress import bar
 
         with bar(progress, "steps") as cb:
-            header, data, summary = self._prepared.run(merged, stop, cb)
-        return Results._from_bytes(header, data, json.loads(summary), full_rate=True)
+            header, data, texts, summary, meta = self._prepared.run(merged, stop, cb)
+        return Results._from_bytes(header, data, json.loads(summary), True, texts, json.loads(meta))
 
     def __repr__(self) -> str:
         return f"<System {self.file}: {', '.join(self.instances)}>"

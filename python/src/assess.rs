@@ -117,7 +117,42 @@ pub fn table_from_file(path: &Path) -> Result<ResultsTable, String> {
     ResultsTable::load(path).map_err(|e| e.to_string())
 }
 
-/// Assesses `table` as `master assess` would; `Err` is the message the command would print.
+/// The options the computation would refuse, named as the arguments of
+/// `railfmu.assess_stability` (the computation's own messages name the command's options or
+/// its internal parameters, e.g. the wheel load in N).
+fn check_options(o: &AssessOptions, quantity: Quantity) -> Result<(), String> {
+    let bad = |name: &str, value: f64, reason: &str| Err(format!("{name} = {value}: {reason}"));
+    if o.signals.is_empty() {
+        return Err("signals: none given (name at least one column)".into());
+    }
+    if !(o.speed_kmh.is_finite() && o.speed_kmh > 0.0) {
+        return bad("speed_kmh", o.speed_kmh, "must be a speed > 0 km/h");
+    }
+    if o.skip_s.is_nan() || o.skip_s < 0.0 {
+        return bad("skip_s", o.skip_s, "must be >= 0 s");
+    }
+    if let Some(f) = o.f0_hz.filter(|f| f.is_nan() || *f <= 0.0) {
+        return bad("f0_hz", f, "must be a frequency > 0 Hz");
+    }
+    match quantity {
+        Quantity::Acceleration if !(o.bogie_mass_t > 0.0 && o.bogie_mass_t < 60.0) => {
+            bad("bogie_mass_t", o.bogie_mass_t, "must be in (0, 60) t")
+        }
+        Quantity::GuidingForce if o.wheel_load_kn.is_nan() || o.wheel_load_kn <= 0.0 => {
+            bad("wheel_load_kn", o.wheel_load_kn, "must be a load > 0 kN")
+        }
+        _ => Ok(()),
+    }
+}
+
+/// A message of the assessment with the command's option names replaced by the arguments of
+/// `railfmu.assess_stability`.
+fn python_names(message: &str) -> String {
+    message.replace("--accept-narrow-band", "accept_narrow_band=True")
+}
+
+/// Assesses `table` as `master assess` would; `Err` is the message the command would print,
+/// naming the arguments of `railfmu.assess_stability` instead of the command's options.
 pub fn assess(table: &ResultsTable, options: &AssessOptions) -> Result<AssessAnswer, String> {
     let quantity = match options.quantity.as_str() {
         "acceleration" => Quantity::Acceleration,
@@ -128,6 +163,7 @@ pub fn assess(table: &ResultsTable, options: &AssessOptions) -> Result<AssessAns
             ))
         }
     };
+    check_options(options, quantity)?;
     let settings = StabilitySettings {
         skip_s: options.skip_s,
         dominant_frequency_hz: options.f0_hz,
@@ -141,12 +177,13 @@ pub fn assess(table: &ResultsTable, options: &AssessOptions) -> Result<AssessAns
         &settings,
         options.accept_narrow_band,
     )
-    .map_err(|e| e.to_string())?;
+    .map_err(|e| python_names(&e.to_string()))?;
     let mut notes = match remark {
         None => Vec::new(),
         Some(BandRemark::Unrecorded(note)) => vec![note],
         Some(BandRemark::Narrow(e)) => vec![format!(
-            "{e} (assessed anyway: accept_narrow_band; the rms may be wrong)"
+            "{} (assessed anyway: accept_narrow_band; the rms may be wrong)",
+            python_names(&e.to_string())
         )],
     };
     notes.extend(report.unit_notes());
@@ -239,9 +276,36 @@ mod tests {
         let mut o = options("acc");
         o.quantity = "jerk".into();
         assert!(assess(&table, &o).unwrap_err().contains("jerk"));
-        let mut o = options("acc");
-        o.speed_kmh = -1.0;
-        assert!(assess(&table, &o).unwrap_err().contains("speed"));
+        // the options are named as the Python arguments, not as the command's options
+        type Case = (&'static str, fn(&mut AssessOptions));
+        let cases: [Case; 7] = [
+            ("signals: none given", |o| o.signals.clear()),
+            ("speed_kmh = -1: must be a speed > 0 km/h", |o| {
+                o.speed_kmh = -1.0
+            }),
+            ("skip_s = -1: must be >= 0 s", |o| o.skip_s = -1.0),
+            ("f0_hz = 0: must be a frequency > 0 Hz", |o| {
+                o.f0_hz = Some(0.0)
+            }),
+            ("bogie_mass_t = 70: must be in (0, 60) t", |o| {
+                o.bogie_mass_t = 70.0
+            }),
+            ("wheel_load_kn = -5: must be a load > 0 kN", |o| {
+                o.quantity = "guiding_force".into();
+                o.wheel_load_kn = -5.0;
+            }),
+            ("speed_kmh = NaN", |o| o.speed_kmh = f64::NAN),
+        ];
+        for (want, change) in cases {
+            let mut o = options("acc");
+            change(&mut o);
+            let e = assess(&table, &o).unwrap_err();
+            assert!(e.contains(want) && !e.contains("--"), "{e}");
+        }
+        assert_eq!(
+            python_names("record at a higher rate (or pass --accept-narrow-band to assess anyway)"),
+            "record at a higher rate (or pass accept_narrow_band=True to assess anyway)"
+        );
         let mut o = options("acc");
         o.skip_s = 9.9;
         assert!(assess(&table, &o).unwrap_err().contains("window"));

@@ -6,7 +6,9 @@
 //! so `cargo test --workspace` checks them without a Python installation.
 //!
 //! * [`assess`]: the EN 14363 stability assessment of results, as `master assess` makes it.
-//! * [`results`]: reading a `results.csv` back, exactly (shortest round-trip numbers).
+//! * [`results`]: results tables with the columns of the master's files (Strings and
+//!   Enumeration item names as texts), read back exactly and turned back into a run's output
+//!   for the master's writers.
 //! * [`runs`]: which runs of a run set are complete in an output folder (resuming a set) and
 //!   a job's wire format.
 

@@ -17,13 +17,16 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyString};
 use serde_json::Value;
 
-use master::coupling::{RunOptions, SimError, SimOutput, Summary};
-use master::output::write_csv_atomic;
-use master::results::ResultsFormat;
+use master::coupling::{Algorithm, RunOptions, SimError, SimOutput, Summary};
+use master::output::check_outputs_apart;
+use master::results::{
+    csv_metadata_path, write_results, ResultsFormat, ResultsMetadata, RunContext,
+};
 use master::runset::{
     execute_with, format_by_size, run_job, Job, ResultsOptions, RunReport, RunSet, SweepError,
 };
-use master::system::{LoadedSystem, PreparedSystem, RunError, SystemError};
+use master::slave::ScalarType;
+use master::system::{split_ref, LoadedSystem, PreparedSystem, RunError, SystemError};
 
 use crate::assess::{self, AssessOptions};
 use crate::{error_message, f64_bytes, f64_from_bytes, results, runs};
@@ -77,7 +80,12 @@ fn ssp_err(e: &master::ssp::SspError) -> PyErr {
     match e {
         master::ssp::SspError::System(s) => system_err(s),
         master::ssp::SspError::Output(_) => OutputError::new_err(error_message(e)),
-        _ => SystemDescriptionError::new_err(error_message(e)),
+        // a missing stop time or step is given as the argument of System.load
+        _ => SystemDescriptionError::new_err(
+            error_message(e)
+                .replace("with --stop-time)", "with System.load(..., stop_time=...))")
+                .replace("with --step)", "with System.load(..., step=...))"),
+        ),
     }
 }
 
@@ -208,16 +216,28 @@ fn in_background<'s, T: Send>(
     })
 }
 
-/// Results as (header, data bytes, summary JSON).
-type Table<'py> = (Vec<String>, Bound<'py, PyBytes>, String);
+/// Results as (header, data bytes, texts, summary JSON, metadata JSON): the columns of the
+/// master's files ([`results::expand`]), each text column's values by column index.
+type Table<'py> = (
+    Vec<String>,
+    Bound<'py, PyBytes>,
+    Vec<(usize, Vec<String>)>,
+    String,
+    String,
+);
 
-fn table<'py>(py: Python<'py>, out: &SimOutput) -> PyResult<Table<'py>> {
+fn table<'py>(py: Python<'py>, out: &SimOutput, ctx: &RunContext) -> PyResult<Table<'py>> {
     let summary = serde_json::to_string(&out.summary)
         .map_err(|e| Error::new_err(format!("internal: summary: {e}")))?;
+    let meta = serde_json::to_string(&ResultsMetadata::of(out, ctx))
+        .map_err(|e| Error::new_err(format!("internal: metadata: {e}")))?;
+    let t = results::expand(out);
     Ok((
-        out.header.clone(),
-        PyBytes::new(py, &f64_bytes(&out.data)),
+        t.header,
+        PyBytes::new(py, &f64_bytes(&t.data)),
+        t.texts,
         summary,
+        meta,
     ))
 }
 
@@ -249,18 +269,78 @@ impl PySystem {
     }
 }
 
+impl PySystem {
+    /// The description (FMU paths absolute) with a run's start values and stop time, as
+    /// JSON.
+    fn run_description(
+        &self,
+        params: &BTreeMap<String, Value>,
+        stop_time: Option<f64>,
+    ) -> PyResult<Value> {
+        let mut desc = self.prepared.system().resolved();
+        for (key, value) in params {
+            let spec = split_ref(key).and_then(|(inst, var)| {
+                Some((desc.instances.iter_mut().find(|i| i.name == inst)?, var))
+            });
+            if let Some((spec, var)) = spec {
+                spec.parameters.insert(var.to_string(), value.clone());
+            }
+        }
+        if let Some(t) = stop_time {
+            desc.stop_time = t;
+        }
+        serde_json::to_value(&desc)
+            .map_err(|e| Error::new_err(format!("internal: description: {e}")))
+    }
+}
+
 #[pymethods]
 impl PySystem {
     /// Loads a system description and prepares it: JSON (FMU paths relative to its folder),
     /// or an SSP (`.ssp` archive, or a bare `.ssd` next to its FMUs) as `master run` reads it.
+    /// An SSP's communication step, stop time and coupling algorithm ("jacobi" or
+    /// "gauss-seidel") can be given (`master run --step --stop-time --algorithm`); a JSON
+    /// description sets them itself.
     #[staticmethod]
-    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+    #[pyo3(signature = (path, step=None, stop_time=None, algorithm=None))]
+    fn load(
+        py: Python<'_>,
+        path: PathBuf,
+        step: Option<f64>,
+        stop_time: Option<f64>,
+        algorithm: Option<&str>,
+    ) -> PyResult<Self> {
+        refuse_fmu(&path, false)?;
+        let algorithm = algorithm.map(parse_algorithm).transpose()?;
         if master::ssp::is_ssp_path(&path) {
-            let imported = master::ssp::import(&path, &master::ssp::ImportOptions::default())
-                .map_err(|e| ssp_err(&e))?;
+            let opts = master::ssp::ImportOptions {
+                step,
+                stop_time,
+                algorithm,
+            };
+            let imported = master::ssp::import(&path, &opts).map_err(|e| ssp_err(&e))?;
             let mut system = Self::prepare(py, imported.system.clone())?;
             system._ssp = Some(imported);
             return Ok(system);
+        }
+        let given: Vec<&str> = [
+            ("step", step.is_some()),
+            ("stop_time", stop_time.is_some()),
+            ("algorithm", algorithm.is_some()),
+        ]
+        .iter()
+        .filter(|(_, g)| *g)
+        .map(|(n, _)| *n)
+        .collect();
+        if !given.is_empty() {
+            return Err(SystemDescriptionError::new_err(format!(
+                "{}: {} of System.load apply to an SSP (.ssp, .ssd); a JSON system description \
+                 sets its own \"step\", \"stop_time\" and \"algorithm\" (System.from_dict \
+                 takes a changed description; System.stop_time changes the stop time of later \
+                 runs)",
+                path.display(),
+                given.join(", ")
+            )));
         }
         let system = LoadedSystem::load(&path).map_err(|e| system_err(&e))?;
         Self::prepare(py, system)
@@ -291,10 +371,16 @@ impl PySystem {
         self.models_json.clone()
     }
 
-    /// The CSV header of a run: `time [s]` and each recorded variable's `name [unit]`.
+    /// The CSV header of a run, as `master run` writes it: `time [s]` and each recorded
+    /// variable's `name [unit]`, an Enumeration followed by its item names (`name (item)`).
     fn header(&self) -> Vec<String> {
         let mut h = vec!["time [s]".to_string()];
-        h.extend(self.prepared.plan().record.iter().map(|r| r.label.clone()));
+        for r in &self.prepared.plan().record {
+            h.push(r.label.clone());
+            if r.info.scalar_type() == ScalarType::Enumeration {
+                h.push(results::item_label(&r.label));
+            }
+        }
         h
     }
 
@@ -312,8 +398,9 @@ impl PySystem {
             .map_err(|e| system_err(&e))
     }
 
-    /// One run with the given start values and stop time; returns (header, data bytes, summary
-    /// JSON). `progress(steps_done, steps_total)` is called about a hundred times.
+    /// One run with the given start values and stop time; returns (header, data bytes, texts,
+    /// summary JSON, metadata JSON) as [`table`]. `progress(steps_done, steps_total)` is
+    /// called about a hundred times.
     #[pyo3(signature = (parameters=None, stop_time=None, progress=None))]
     fn run<'py>(
         &self,
@@ -354,7 +441,12 @@ impl PySystem {
             },
         )?;
         let out = out.map_err(|e| run_err(&e))?;
-        table(py, &out)
+        // the metadata describe the system as run, as those of a run of a run set do
+        let ctx = RunContext {
+            system: Some(self.run_description(&params, stop_time)?),
+            ..RunContext::default()
+        };
+        table(py, &out, &ctx)
     }
 
     /// Runs one job of this system's run set (JSON, as from `load_run_set`), as a run set's
@@ -385,10 +477,12 @@ impl PySystem {
         )?;
         match out {
             Ok(out) => {
-                let (h, d, s) = table(py, &out)?;
+                let summary = serde_json::to_string(&out.summary)
+                    .map_err(|e| Error::new_err(format!("internal: summary: {e}")))?;
                 let c = serde_json::to_string(&runs::ColumnsWire::of(&out))
                     .map_err(|e| Error::new_err(format!("internal: columns: {e}")))?;
-                Ok((Some(h), Some(d), Some(s), Some(c), None))
+                let d = PyBytes::new(py, &f64_bytes(&out.data));
+                Ok((Some(out.header), Some(d), Some(summary), Some(c), None))
             }
             Err(e) => Ok((None, None, None, None, Some(e))),
         }
@@ -457,9 +551,49 @@ fn report_json(r: &RunReport) -> PyResult<String> {
     serde_json::to_string(r).map_err(|e| Error::new_err(format!("internal: report: {e}")))
 }
 
+/// Refuses an FMU given where a system description (or, `run_set`, a run-set description) is
+/// read, saying how a system of FMUs is described in Python (read as text, the archive would
+/// only be "not valid UTF-8").
+fn refuse_fmu(path: &Path, run_set: bool) -> PyResult<()> {
+    if !path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("fmu"))
+    {
+        return Ok(());
+    }
+    // an instance name has no dots
+    let name = path
+        .file_stem()
+        .map_or("model".into(), |s| s.to_string_lossy().replace('.', "_"));
+    let system = format!(
+        "{{\"instances\": [{{\"name\": \"{name}\", \"fmu\": {}}}], \"stop_time\": 1.0, \
+         \"step\": 0.001}}",
+        serde_json::Value::String(path.display().to_string())
+    );
+    let (what, example, file) = if run_set {
+        (
+            "a run-set description",
+            format!("railfmu.RunSet.from_dict({{\"system\": {system}, \"product\": {{...}}}})"),
+            "a run-set file whose system names it",
+        )
+    } else {
+        (
+            "a system description",
+            format!("railfmu.System.from_dict({system})"),
+            "a JSON or SSP system file that names it",
+        )
+    };
+    Err(SystemDescriptionError::new_err(format!(
+        "'{}' is an FMU, not {what}: describe a system of its instances, e.g. {example}, or \
+         load {file}",
+        path.display()
+    )))
+}
+
 /// Reads a run-set file: (resolved base system JSON, base label, each job as JSON).
 #[pyfunction]
 fn load_run_set(path: PathBuf) -> PyResult<(String, String, Vec<String>)> {
+    refuse_fmu(&path, true)?;
     let (base, jobs) = RunSet::load(&path).map_err(|e| system_err(&e))?;
     run_set_parts(&base, &jobs)
 }
@@ -497,6 +631,15 @@ fn completed_report(outdir: PathBuf, job_json: &str, format: &str) -> PyResult<O
         .transpose()
 }
 
+/// The unit of each parameter (`instance.variable`) of the system described in `path` (a run
+/// folder's `system.json`), from its FMUs' model descriptions (None: no unit, or no such
+/// variable).
+#[pyfunction]
+fn parameter_units(path: PathBuf, names: Vec<String>) -> PyResult<Vec<Option<String>>> {
+    let system = LoadedSystem::load(&path).map_err(|e| system_err(&e))?;
+    runs::parameter_units(&system, &names).map_err(|e| system_err(&e))
+}
+
 /// Writes `<outdir>/sweep.json` from reports (JSON) in job order.
 #[pyfunction]
 fn write_sweep(outdir: PathBuf, reports_json: Vec<String>) -> PyResult<()> {
@@ -512,6 +655,15 @@ fn parse_jobs(jobs_json: &[String]) -> PyResult<Vec<Job>> {
         .iter()
         .map(|j| serde_json::from_str::<Job>(j).map_err(|e| json_err("job", &e)))
         .collect()
+}
+
+/// A coupling algorithm by its name in a system description.
+fn parse_algorithm(name: &str) -> PyResult<Algorithm> {
+    serde_json::from_value(Value::String(name.to_string())).map_err(|_| {
+        PyValueError::new_err(format!(
+            "algorithm '{name}': expected 'jacobi' or 'gauss-seidel'"
+        ))
+    })
 }
 
 fn parse_format(format: &str) -> PyResult<ResultsFormat> {
@@ -598,27 +750,73 @@ impl PyRunWriter {
     }
 }
 
-/// Reads a results CSV: (header, data bytes), every value exactly as written.
+/// A results table read back: (header, data bytes, texts, metadata JSON or None).
+type ReadTable<'py> = (
+    Vec<String>,
+    Bound<'py, PyBytes>,
+    Vec<(usize, Vec<String>)>,
+    Option<String>,
+);
+
+/// Reads a results file written by the master (CSV, with its metadata beside it when there
+/// is one, or Parquet) as [`table`], every value exactly as written.
 #[pyfunction]
-fn read_csv<'py>(py: Python<'py>, path: PathBuf) -> PyResult<(Vec<String>, Bound<'py, PyBytes>)> {
-    let t = py
-        .detach(|| results::read_csv(&path))
+fn read_results<'py>(py: Python<'py>, path: PathBuf) -> PyResult<ReadTable<'py>> {
+    let (t, meta) = py
+        .detach(|| results::read_results(&path))
         .map_err(OutputError::new_err)?;
-    Ok((t.header, PyBytes::new(py, &f64_bytes(&t.data))))
+    let meta = meta
+        .map(|m| serde_json::to_string(&m))
+        .transpose()
+        .map_err(|e| Error::new_err(format!("internal: metadata: {e}")))?;
+    Ok((
+        t.header,
+        PyBytes::new(py, &f64_bytes(&t.data)),
+        t.texts,
+        meta,
+    ))
 }
 
-/// Writes a results CSV atomically, exactly as `master run` does.
+/// Writes results as `master run` does, atomically: the CSV and its metadata file beside it
+/// (`<name>.meta.json`). The table (header, data bytes, texts, as [`read_results`] gives
+/// them) has its columns described by the metadata JSON (None: Reals, and Strings where there
+/// are texts), which also gives the run's name, parameters and system description, if any;
+/// `summary_json` is the run's summary (missing statistics are 0).
 #[pyfunction]
-fn write_csv(path: PathBuf, header: Vec<String>, data: &[u8]) -> PyResult<()> {
-    let data = f64_from_bytes(data).map_err(OutputError::new_err)?;
-    let cols = header.len().max(1);
-    if !data.len().is_multiple_of(cols) {
-        return Err(OutputError::new_err(format!(
-            "{} values do not fill rows of {cols} columns",
-            data.len()
-        )));
+#[pyo3(signature = (path, header, data, texts, metadata_json=None, summary_json=None))]
+fn write_results_csv(
+    path: PathBuf,
+    header: Vec<String>,
+    data: &[u8],
+    texts: Vec<(usize, Vec<String>)>,
+    metadata_json: Option<&str>,
+    summary_json: Option<&str>,
+) -> PyResult<()> {
+    let meta = metadata_json
+        .map(serde_json::from_str::<ResultsMetadata>)
+        .transpose()
+        .map_err(|e| OutputError::new_err(format!("results metadata: {e}")))?;
+    let table = results::Table {
+        header,
+        data: f64_from_bytes(data).map_err(OutputError::new_err)?,
+        texts,
+    };
+    let columns = meta.as_ref().map_or(&[][..], |m| &m.columns[..]);
+    let mut out = results::collapse(&table, columns).map_err(OutputError::new_err)?;
+    if let Some(s) = summary_json {
+        out.summary = results::summary(s).map_err(OutputError::new_err)?;
     }
-    write_csv_atomic(Path::new(&path), &header, data.chunks(cols))
+    let mut ctx = RunContext::default();
+    if let Some(m) = meta {
+        out.decimation = m.sampling.and_then(|s| s.decimation);
+        ctx.run = m.run;
+        ctx.parameters = m.parameters;
+        ctx.labels = m.labels;
+        ctx.system = m.system;
+    }
+    let paths = [path.clone(), csv_metadata_path(&path)];
+    check_outputs_apart(&[], &paths).map_err(|e| OutputError::new_err(error_message(&e)))?;
+    write_results(&path, &out, ResultsFormat::Csv, &ctx)
         .map_err(|e| OutputError::new_err(error_message(&e)))
 }
 
@@ -683,10 +881,11 @@ fn _railfmu(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_set_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(completed_report, m)?)?;
     m.add_function(wrap_pyfunction!(write_sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(parameter_units, m)?)?;
     m.add_function(wrap_pyfunction!(results_format_by_size, m)?)?;
     m.add_class::<PyRunWriter>()?;
     m.add_function(wrap_pyfunction!(prepare_run_folder, m)?)?;
-    m.add_function(wrap_pyfunction!(read_csv, m)?)?;
-    m.add_function(wrap_pyfunction!(write_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(read_results, m)?)?;
+    m.add_function(wrap_pyfunction!(write_results_csv, m)?)?;
     Ok(())
 }

@@ -11,10 +11,31 @@ use master::output::{write_json_atomic, OutputError};
 use master::results::{constant_kinds, ConstantKind, ResultsFormat};
 pub use master::runset::{completed, format_by_description};
 use master::runset::{run_one_with, Job, ResultsOptions, RunReport};
+use master::system::{split_ref, LoadedSystem, SystemError};
 
 /// Writes `<outdir>/sweep.json`, the reports in job order (the master's format).
 pub fn write_sweep(outdir: &Path, reports: &[RunReport]) -> Result<(), OutputError> {
     write_json_atomic(&outdir.join("sweep.json"), &reports)
+}
+
+/// The unit of each `instance.variable` in `names` (a run set's parameters), as the model
+/// description of the instance's FMU declares it; `None` where it declares none or where
+/// the name is not one of the system's variables.
+pub fn parameter_units(
+    system: &LoadedSystem,
+    names: &[String],
+) -> Result<Vec<Option<String>>, SystemError> {
+    let archives = system.open_fmus()?;
+    let instances = &system.desc.instances;
+    Ok(names
+        .iter()
+        .map(|name| {
+            let (inst, var) = split_ref(name)?;
+            let i = instances.iter().position(|s| s.name == inst)?;
+            let v = archives[i].model.variables.iter().find(|v| v.name == var)?;
+            v.unit.clone()
+        })
+        .collect())
 }
 
 /// What a run's table carries besides its numbers (each column's FMU variable, the texts of

@@ -52,8 +52,12 @@ def test_a_runs_results_are_assessed_as_the_command_line_assesses_their_file(hun
         assert s.max_rms == pytest.approx(float(row["max rms"]), rel=1e-12)
         assert s.dominant_frequency_hz == pytest.approx(float(row["dominant frequency [Hz]"]), rel=1e-12)
         assert (row["stable"] == "true") == s.stable
-    # and from Python on the file: the same numbers, with the note that a CSV without
-    # metadata cannot say how it was sampled
+    # and from Python on the file: the same numbers; its metadata file records how it was
+    # sampled, and without it a note says the band could not be checked
+    f = railfmu.assess_stability(path, SIGNALS, 320.0, skip_s=5.0)
+    assert f.max_rms == pytest.approx(a.max_rms, rel=1e-12)
+    assert f.notes == []
+    path.with_suffix(".meta.json").unlink()
     f = railfmu.assess_stability(path, SIGNALS, 320.0, skip_s=5.0)
     assert f.max_rms == pytest.approx(a.max_rms, rel=1e-12)
     assert len(f.notes) == 1
@@ -83,3 +87,34 @@ def test_what_cannot_be_assessed_raises_with_the_reason(hunting, tmp_path):
     with pytest.raises(railfmu.OutputError, match="missing.csv"):
         railfmu.assess_stability(tmp_path / "missing.csv", SIGNALS, 320.0)
     assert issubclass(railfmu.AssessmentError, railfmu.Error)
+
+
+def test_messages_name_the_python_arguments_not_the_command_options(hunting, tmp_path):
+    cases = [
+        ({"signals": []}, "signals: none given"),
+        ({"speed_kmh": -1.0}, "speed_kmh = -1: must be a speed > 0 km/h"),
+        ({"skip_s": -1.0}, "skip_s = -1: must be >= 0 s"),
+        ({"f0_hz": -2.0}, "f0_hz = -2: must be a frequency > 0 Hz"),
+        ({"bogie_mass_t": 80.0}, r"bogie_mass_t = 80: must be in \(0, 60\) t"),
+        ({"quantity": "guiding_force", "wheel_load_kn": -5.0}, "wheel_load_kn = -5: must be a load > 0 kN"),
+    ]
+    for change, message in cases:
+        args = {"signals": SIGNALS, "speed_kmh": 320.0, **change}
+        with pytest.raises(railfmu.AssessmentError, match=message) as e:
+            railfmu.assess_stability(hunting, **args)
+        assert "--" not in str(e.value), change
+    # a file whose metadata records too narrow a band: refused, naming the argument to pass
+    path = tmp_path / "narrow.csv"
+    hunting.to_csv(path)
+    meta = {
+        "version": 1,
+        "sampling": {"rate_hz": 1000.0, "passband_hz": 3.0, "decimation": None},
+        "columns": [],
+        "summary": hunting.summary,
+    }
+    path.with_suffix(".meta.json").write_text(json.dumps(meta))
+    with pytest.raises(railfmu.AssessmentError, match=r"accept_narrow_band=True") as e:
+        railfmu.assess_stability(path, SIGNALS, 320.0, skip_s=5.0)
+    assert "--" not in str(e.value)
+    a = railfmu.assess_stability(path, SIGNALS, 320.0, skip_s=5.0, accept_narrow_band=True)
+    assert len(a.notes) == 1 and "accept_narrow_band=True" in a.notes[0] and "--" not in a.notes[0]

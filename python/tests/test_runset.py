@@ -200,3 +200,28 @@ def test_a_run_set_resumed_in_another_format_runs_again_into_one_format(dist, ma
     assert r.returncode == 0, r.stderr
     assert "0 complete run(s) kept, 3 run" in r.stdout
     assert sorted(csv_bytes(cli)) == rs.names and not (cli / "results").exists()
+
+
+def test_the_parameters_of_a_run_set_carry_their_units(dist, master_cmd, tmp_path):
+    set_file = tmp_path / "set.json"
+    set_file.write_text(json.dumps(speed_set(dist, [50.0, 60.0], stop_time=0.1)))
+    r = run_master(master_cmd, "sweep", set_file, "-o", tmp_path / "cli", "--jobs", "1")
+    assert r.returncode == 0, r.stderr
+    units = {"bogie.track.seed": None, "bogie.vehicle.speed": "m/s"}
+    for res in (railfmu.run_set(set_file, tmp_path / "py", threads=1), railfmu.read_results(tmp_path / "cli")):
+        assert res.parameter_units == units
+        table = res.summary_frame()
+        assert table.attrs["units"]["bogie.vehicle.speed"] == "m/s"
+        assert table.attrs["units"]["wall_time_s"] == "s"
+        assert set(table.attrs["units"]) == set(table.columns)
+    # FMUs that cannot be read any more: the table without the units, and a warning why
+    moved = tmp_path / "moved"
+    shutil.copytree(tmp_path / "cli", moved)
+    for run in ("run-000", "run-001"):
+        p = moved / run / "system.json"
+        p.write_text(p.read_text().replace(str(dist), str(tmp_path / "nowhere")))
+    with pytest.warns(RuntimeWarning, match="units are unknown.*nowhere"):
+        table = railfmu.read_results(moved).summary_frame()
+    assert table.attrs["units"]["bogie.vehicle.speed"] is None
+    with pytest.raises(railfmu.FmuError, match="nowhere"):
+        railfmu.read_results(moved).parameter_units

@@ -206,3 +206,149 @@ def test_an_ssp_loads_and_runs_as_the_command_line_runs_it(passive_file, master_
     broken.write_bytes(b"not a zip")
     with pytest.raises(railfmu.Error, match="broken.ssp"):
         railfmu.System.load(broken)
+
+
+def test_strings_and_enumerations_are_the_columns_the_command_line_writes(dist, master_cmd, tmp_path):
+    # a String (the contact table) and an Enumeration (the force law) recorded beside numbers
+    desc = {
+        "instances": [
+            {
+                "name": "bogie",
+                "fmu": str(dist / "Bogie2Dof.fmu"),
+                "parameters": {"contact.model": "nonlinear", "contact.table": "AA"},
+            }
+        ],
+        "stop_time": 0.01,
+        "step": 0.001,
+        "record": [
+            "bogie.wheelset_front.lateral_displacement",
+            "bogie.contact.model",
+            "bogie.contact.table",
+            "bogie.track.seed",
+        ],
+    }
+    path = tmp_path / "typed.json"
+    path.write_text(json.dumps(desc))
+    sys = railfmu.System.load(path)
+    res = sys.run()
+    header = [
+        "time [s]",
+        "bogie.wheelset_front.lateral_displacement [m]",
+        "bogie.contact.model",
+        "bogie.contact.model (item)",
+        "bogie.contact.table",
+        "bogie.track.seed",
+    ]
+    assert res.header == header and sys.columns == header
+    assert list(res["bogie.contact.table"]) == ["AA"] * 11
+    assert list(res["bogie.contact.model (item)"]) == ["nonlinear"] * 11
+    assert np.all(res["bogie.contact.model"] == 1.0)
+    df = res.to_pandas()
+    assert list(df.columns) == res.names[1:]
+    assert list(df["bogie.contact.table"]) == ["AA"] * 11
+    assert list(df["bogie.contact.model (item)"]) == ["nonlinear"] * 11
+    assert res.to_numpy()["bogie.contact.table"][0] == "AA"
+    # the command line's CSV and Parquet read back to the same columns, values and texts
+    for name in ("cli.csv", "cli.parquet"):
+        r = run_master(master_cmd, "run", path, "-o", tmp_path / name)
+        assert r.returncode == 0, r.stderr
+        cli = railfmu.read_results(tmp_path / name)
+        assert cli.header == res.header, name
+        assert np.array_equal(bits(cli.values), bits(res.values)), name
+        assert cli.texts.keys() == res.texts.keys(), name
+        for k in res.texts:
+            assert list(cli.texts[k]) == list(res.texts[k]), (name, k)
+    # written from Python, the CSV is the command line's byte for byte
+    res.to_csv(tmp_path / "py.csv")
+    assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()
+    # a run set's results read back with their texts too, in either format
+    for fmt in ("csv", "parquet"):
+        runs = railfmu.RunSet.from_dict({"system": desc}).run(tmp_path / fmt, format=fmt, threads=1)
+        assert list(runs["base"]["bogie.contact.table"]) == ["AA"] * 11, fmt
+        assert runs["base"].header == header, fmt
+
+
+def test_an_fmu_given_as_a_description_is_refused_saying_how_to_describe_a_system(dist):
+    fmu = dist / "Bogie2Dof.fmu"
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"is an FMU, not a system description") as e:
+        railfmu.System.load(fmu)
+    message = str(e.value)
+    assert "UTF-8" not in message and str(fmu) in message
+    # the system the message suggests loads and runs
+    suggested = json.loads(message.split("System.from_dict(", 1)[1].split("), or", 1)[0])
+    assert suggested["instances"][0]["fmu"] == str(fmu)
+    assert len(railfmu.System.from_dict(suggested).run(stop_time=0.01)) == 11
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"is an FMU, not a run-set description.*RunSet.from_dict"):
+        railfmu.RunSet.load(fmu)
+
+
+def test_to_csv_writes_the_metadata_file_the_command_line_writes(dist, master_cmd, tmp_path):
+    changed = tmp_path / "changed.json"
+    changed.write_text(json.dumps(passive(dist, 0.5, **{"vehicle.speed": 55.0, "track.seed": 7})))
+    cli_csv = tmp_path / "cli.csv"
+    assert run_master(master_cmd, "run", changed, "-o", cli_csv).returncode == 0
+    base = tmp_path / "base.json"
+    base.write_text(json.dumps(passive(dist, 2.0)))
+    res = railfmu.System.load(base).run({"bogie.vehicle.speed": 55.0, "bogie.track.seed": 7}, stop_time=0.5)
+    py_csv = tmp_path / "py.csv"
+    res.to_csv(py_csv)
+    assert py_csv.read_bytes() == cli_csv.read_bytes()
+    cli_meta = json.loads((tmp_path / "cli.meta.json").read_text())
+    py_meta = json.loads((tmp_path / "py.meta.json").read_text())
+    # the same metadata but for the wall time of the run: columns, sampling, the system as run
+    for m in (cli_meta, py_meta):
+        m["summary"].pop("wall_time_s")
+        m["summary"].pop("realtime_ratio")
+    assert py_meta == cli_meta
+    assert py_meta["system"]["stop_time"] == 0.5
+    assert py_meta["system"]["instances"][0]["parameters"]["vehicle.speed"] == 55.0
+    assert py_meta["sampling"]["rate_hz"] == 1000.0
+    # read back, the results keep their metadata, and write it again
+    back = railfmu.read_results(py_csv)
+    assert back.metadata == res.metadata
+    back.to_csv(tmp_path / "again.csv")
+    assert (tmp_path / "again.csv").read_bytes() == py_csv.read_bytes()
+    assert (tmp_path / "again.meta.json").read_bytes() == (tmp_path / "py.meta.json").read_bytes()
+
+
+def test_an_ssps_step_stop_time_and_algorithm_are_set_as_the_command_line_sets_them(passive_file, master_cmd, tmp_path):
+    ssp = tmp_path / "passive.ssp"
+    assert run_master(master_cmd, "export-ssp", passive_file, ssp).returncode == 0
+    cli_csv = tmp_path / "cli.csv"
+    options = ["--step", "0.002", "--stop-time", "0.5", "--algorithm", "gauss-seidel"]
+    r = run_master(master_cmd, "run", ssp, "-o", cli_csv, *options)
+    assert r.returncode == 0, r.stderr
+    sys = railfmu.System.load(ssp, step=0.002, stop_time=0.5, algorithm="gauss-seidel")
+    d = sys.description
+    assert (d["step"], d["stop_time"], d["algorithm"]) == (0.002, 0.5, "gauss-seidel")
+    res = sys.run()
+    assert len(res) == 251
+    cli = railfmu.read_results(cli_csv)
+    assert cli.header == res.header
+    assert np.array_equal(bits(cli.values), bits(res.values))
+    # the SSP's own timing and Jacobi (the default) give other results
+    jacobi = railfmu.System.load(ssp, step=0.002, stop_time=0.5).run()
+    assert jacobi.header == res.header and not np.array_equal(jacobi.values, res.values)
+    assert railfmu.System.load(ssp).description["step"] == 0.001
+    # an SSD without a stop time or a step: the message names the argument to give it with
+    folder = tmp_path / "unpacked"
+    with zipfile.ZipFile(ssp) as z:
+        z.extractall(folder)
+    ssd = folder / "SystemStructure.ssd"
+    text = ssd.read_text()
+    for attribute in ('stopTime="1.0"', 'stepSize="0.001"', 'baseStepSize="0.001"'):
+        assert attribute in text
+        text = text.replace(attribute, "")
+    ssd.write_text(text)
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"no stop time.*System.load\(\.\.\., stop_time=") as e:
+        railfmu.System.load(ssd)
+    assert "--" not in str(e.value)
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"no communication step.*System.load\(\.\.\., step=") as e:
+        railfmu.System.load(ssd, stop_time=0.5)
+    assert "--" not in str(e.value)
+    assert len(railfmu.System.load(ssd, stop_time=0.5, step=0.002).run()) == 251
+    # a JSON description sets them itself; an unknown algorithm is refused by name
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"step, algorithm of System.load apply to an SSP"):
+        railfmu.System.load(passive_file, step=0.002, algorithm="jacobi")
+    with pytest.raises(ValueError, match=r"algorithm 'seidel': expected 'jacobi' or 'gauss-seidel'"):
+        railfmu.System.load(ssp, algorithm="seidel")
