@@ -86,10 +86,10 @@ pub enum StepError {
     NonFiniteOutput { name: &'static str, value: f64 },
     /// The step holds more board samples than one step may compute (its cost is bounded).
     #[error(
-        "the step holds {samples} board samples, more than {MAX_SAMPLES_PER_STEP} \
+        "the step holds {samples:e} board samples, more than {MAX_SAMPLES_PER_STEP} \
          (communication step / board.sample_time): use a shorter communication step"
     )]
-    TooManySamples { samples: u64 },
+    TooManySamples { samples: f64 },
 }
 
 /// Shortest board sample time \[s\] (a 1 MHz board): a shorter one would make every step cost
@@ -271,7 +271,9 @@ impl SampleClock {
         };
         let n = last_excl.saturating_sub(self.next_sample);
         if n > MAX_SAMPLES_PER_STEP {
-            return Err(StepError::TooManySamples { samples: n });
+            // counted in floating point: the integer count saturates for a huge step
+            let samples = limit.ceil() - self.next_sample as f64;
+            return Err(StepError::TooManySamples { samples });
         }
         self.next_sample += n;
         self.time_s = t_end;
@@ -304,10 +306,18 @@ mod tests {
         let before = c.clone();
         let e = c.advance(20.0).unwrap_err();
         assert!(
-            matches!(e, StepError::TooManySamples { samples } if samples > MAX_SAMPLES_PER_STEP)
+            matches!(e, StepError::TooManySamples { samples } if samples > MAX_SAMPLES_PER_STEP as f64)
         );
         assert!(e.to_string().contains("shorter communication step"), "{e}");
+        assert!(
+            e.to_string()
+                .starts_with("the step holds 2e7 board samples"),
+            "{e}"
+        );
         assert_eq!(c, before);
+        // a huge step is counted, not saturated to 2^64 - 1
+        let e = c.advance(1e300).unwrap_err().to_string();
+        assert!(e.contains("e306 board samples, more than 10000000"), "{e}");
         assert_eq!(c.advance(1e-3).unwrap(), 1000);
     }
 
