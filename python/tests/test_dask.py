@@ -1,15 +1,18 @@
 """Run sets on a dask.distributed LocalCluster of 2 worker processes: the same results as the
 local run set bit for bit (CSV and Parquet, the format chosen by size as locally), a killed
-worker does not lose the set, bad input fails its own run only, and the command line reaches
-the cluster too."""
+worker does not lose the set, bad input fails its own run only, the command line reaches the
+cluster too, and the workers' FMU cache stays bounded."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import signal
 import subprocess
 import sys
+import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -237,3 +240,61 @@ def test_a_set_resumed_on_the_cluster_in_another_format_runs_again_into_one_form
     again = rs.run(out, client=client, resume=True, progress=lambda d, t, n, e: ran.append(n))
     assert again.ok and sorted(n for n in ran if n) == rs.names
     assert sorted(csv_bytes(out)) == rs.names and not (out / "results").exists()
+
+
+def test_the_fmu_cache_of_the_workers_stays_bounded(monkeypatch, tmp_path):
+    from railfmu import dask as rdask
+
+    # the workers' temporary folder (TMPDIR), as tempfile reads it
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    root = rdask._fmu_cache_dir()
+    assert root.parent == tmp_path
+    root.mkdir()
+    now = time.time()
+    hour, day = 3600, 24 * 3600
+
+    def plant(name, unused_s, content=b"fmu"):
+        folder = root / name
+        folder.mkdir()
+        (folder / "Model.fmu").write_bytes(content)
+        os.utime(folder, (now - unused_s, now - unused_s))
+        return folder
+
+    def unpack(content):
+        digest = hashlib.sha256(content).hexdigest()
+        return Path(rdask._local_copy(digest, "New.fmu", content))
+
+    # not cache entries: never touched, however old
+    mine = root / "not-an-entry"
+    mine.mkdir()
+    os.utime(mine, (now - 30 * day, now - 30 * day))
+    (root / "note.txt").write_text("kept")
+
+    def entries():
+        return {p.name for p in root.iterdir() if p.is_dir() and p != mine and not p.name.startswith(".")}
+
+    old = plant("0" * 32, 8 * day)
+    recent = plant("1" * 32, 2 * day)
+    path = unpack(b"first")
+    assert path.read_bytes() == b"first" and path.parent.name in entries()
+    assert not old.exists()  # unused for more than 7 days
+    assert recent.is_dir() and mine.is_dir() and (root / "note.txt").read_text() == "kept"
+    assert not [p for p in root.iterdir() if p.name.startswith(".")]  # nothing left aside
+    # a copy found again is marked as used, not written again
+    os.utime(path.parent, (now - 8 * day, now - 8 * day))
+    inode = path.stat().st_ino
+    assert unpack(b"first") == path and path.stat().st_ino == inode
+    assert path.parent.stat().st_mtime > now - 60
+    # beyond the 16 most recently used, those not used for an hour go, least recently used
+    # first
+    aged = [plant(f"{k:030x}aa", 2 * day + (k + 1) * hour) for k in range(20)]
+    in_use = [plant(f"{k:030x}bb", 10 * 60) for k in range(5)]
+    second = unpack(b"second").parent
+    kept = {second.name, path.parent.name, recent.name} | {f.name for f in in_use + aged[:8]}
+    assert entries() == kept and len(kept) == 16
+    # those used within the hour stay, even beyond 16 (a worker may be reading them)
+    in_use += [plant(f"{k:030x}cc", 10 * 60) for k in range(18)]
+    third = unpack(b"third").parent
+    assert entries() == {third.name, second.name, path.parent.name} | {f.name for f in in_use}
+    assert mine.is_dir() and (root / "note.txt").read_text() == "kept"
+    assert not [p for p in root.iterdir() if p.name.startswith(".")]
