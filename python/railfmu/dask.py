@@ -228,31 +228,41 @@ def run_jobs_on_cluster(
     ship_fmus: bool = True,
     retries: int = 3,
     format: Optional[str] = None,
+    reports: Optional[List[Optional[str]]] = None,
 ) -> List[str]:
     """Submits one task per job to ``client``, writes each run's folder as its result arrives
     and returns the reports (JSON) in job order. ``format``: "csv" or "parquet"; None chooses
     by size as a local run set does (from the FMUs' model descriptions, read on this client).
     A task that raises (even after its retries, e.g. every worker running it died) gives a
-    failed run carrying the exception's message."""
+    failed run carrying the exception's message.
+
+    ``reports``, when given, is a list of one entry per job that receives each report as its
+    run's folder is written. A set stopped part way (Ctrl-C, an exception of ``on_done``, a
+    client that fails) ends as a local run set does: the remaining tasks are cancelled, the
+    folder of each run not finished is written as a cancelled run, so that every job has its
+    folder and its report in ``reports``, and the exception is raised."""
     from distributed import as_completed
 
+    from ._runset import remove_sweep_report
 
     if format is None:
         format = results_format(client, base_json, label, jobs_json, ship_fmus=ship_fmus, retries=retries)
     fmus_arg = _scatter_fmus(client, base_json) if ship_fmus else None
     writer = _railfmu.RunWriter(os.fspath(outdir), jobs_json, format)
+    if reports is None:
+        reports = [None] * len(jobs_json)
     # keys unique per submission: a key resubmitted while the scheduler still releases it from
     # an earlier set would be cancelled
     token = uuid.uuid4().hex[:16]
     futures = {}
-    for i, job_json in enumerate(jobs_json):
-        name = json.loads(job_json)["name"]
-        fut = client.submit(
-            run_task, base_json, label, job_json, fmus_arg, key=f"railfmu-{name}-{token}", retries=retries, pure=False
-        )
-        futures[fut] = (i, name, job_json)
-    reports: List[Optional[str]] = [None] * len(jobs_json)
+    remove_sweep_report(Path(outdir))
     try:
+        for i, job_json in enumerate(jobs_json):
+            name = json.loads(job_json)["name"]
+            fut = client.submit(
+                run_task, base_json, label, job_json, fmus_arg, key=f"railfmu-{name}-{token}", retries=retries, pure=False
+            )
+            futures[fut] = (i, name, job_json)
         for fut in as_completed(list(futures)):
             i, name, job_json = futures[fut]
             try:
@@ -264,7 +274,26 @@ def run_jobs_on_cluster(
                 report = writer.write(job_json, error=error)
             reports[i] = report
             on_done(name, error)
-    finally:
-        for fut in futures:
-            fut.cancel()
+    except BaseException as stop:
+        _cancel(futures)
+        if isinstance(stop, KeyboardInterrupt):
+            error = "cancelled: the run set was interrupted before this run finished"
+        else:
+            error = f"cancelled: the run set stopped before this run finished ({type(stop).__name__}: {stop})"
+        for i, job_json in enumerate(jobs_json):
+            if reports[i] is None:
+                reports[i] = writer.write(job_json, error=error)
+        raise
+    else:
+        _cancel(futures)
     return [r for r in reports if r is not None]
+
+
+def _cancel(futures: Any) -> None:
+    """Cancels the tasks of ``futures`` still pending (a client that lost its scheduler
+    cannot, and has no tasks left)."""
+    for fut in futures:
+        try:
+            fut.cancel()
+        except Exception:
+            pass

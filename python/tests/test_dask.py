@@ -173,6 +173,55 @@ def test_a_killed_worker_does_not_lose_the_set_and_a_resumed_set_skips_finished_
     assert again.ok and csv_bytes(tmp_path / "dask") == csv_bytes(tmp_path / "local")
 
 
+def test_an_interrupted_set_leaves_a_whole_folder_that_a_resumed_set_completes(dist, client, tmp_path):
+    rs = eight_runs(dist, stop_time=1.0)
+    local = rs.run(tmp_path / "local", threads=2)
+    assert local.ok
+    out = tmp_path / "dask"
+    rs.run(out, threads=2)  # an earlier set's report, which must not outlive what follows
+
+    def stop_after_first(error_type, finished):
+        def progress(done, total, name, error):
+            if name:
+                finished.append(name)
+                raise error_type("stop")
+
+        return progress
+
+    def check(finished, cancelled):
+        # every run has its folder and its report: the finished ones as on the local threads,
+        # the others cancelled
+        sweep = json.loads((out / "sweep.json").read_text())
+        assert [r["name"] for r in sweep] == rs.names
+        assert {r["name"] for r in sweep if r["ok"]} == set(finished)
+        for r in sweep:
+            assert json.loads((out / r["name"] / "summary.json").read_text()) == r
+            if not r["ok"]:
+                assert r["error"] == cancelled
+                assert not (out / r["name"] / "results.csv").exists()
+        assert csv_bytes(out) == {n: b for n, b in csv_bytes(tmp_path / "local").items() if n in finished}
+        assert not [p for p in out.iterdir() if p.name.startswith(".")]
+
+    first = []
+    with pytest.raises(KeyboardInterrupt):
+        rs.run(out, client=client, progress=stop_after_first(KeyboardInterrupt, first))
+    assert len(first) == 1
+    check(first, "cancelled: the run set was interrupted before this run finished")
+    # resumed and stopped again (an exception of the progress callback): the kept run is
+    # listed too
+    second = []
+    with pytest.raises(ValueError, match="stop"):
+        rs.run(out, client=client, resume=True, progress=stop_after_first(ValueError, second))
+    assert len(second) == 1 and second != first
+    check(first + second, "cancelled: the run set stopped before this run finished (ValueError: stop)")
+    # resumed to the end: only the runs not finished run
+    ran = []
+    again = rs.run(out, client=client, resume=True, progress=lambda d, t, n, e: ran.append(n))
+    assert sorted(n for n in ran if n) == sorted(set(rs.names) - set(first + second))
+    assert again.ok and csv_bytes(out) == csv_bytes(tmp_path / "local")
+    assert [r["name"] for r in json.loads((out / "sweep.json").read_text()) if r["ok"]] == rs.names
+
+
 def test_the_command_line_runs_a_set_on_the_cluster(dist, client, master_cmd, tmp_path):
     set_file = tmp_path / "set.json"
     set_file.write_text(json.dumps(speed_set(dist, [50.0, 70.0], stop_time=0.2)))
