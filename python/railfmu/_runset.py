@@ -3,6 +3,7 @@ threads or as Dask tasks, into the master's run-set folder."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import warnings
@@ -92,6 +93,11 @@ class RunSet:
           format is decided first (``format``, else by size over every job, as a fresh run
           set): runs kept in the other format are run again, so the folder stays in one format.
         * ``progress``: True for a bar, or ``f(done, total, run_name, error_or_None)``.
+
+        A set stopped part way (Ctrl-C, an exception of ``progress``) ends as ``master sweep``
+        ends it, then raises: each run not finished is written as a cancelled (failed) run and
+        ``sweep.json`` lists every run, so the folder is whole and ``resume=True`` runs only
+        what is missing.
         """
         if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1):
             raise ValueError(f"threads must be a whole number >= 1 (or None: all cores), got {threads!r}")
@@ -124,24 +130,43 @@ class RunSet:
 
             if todo:
                 jobs = [self._jobs_json[i] for i in todo]
-                if client is None:
-                    system = _railfmu.PreparedSystem.from_json(self._base_json, "", self._label)
-                    threads = threads or os.cpu_count() or 1
-                    new = system.run_jobs(jobs, os.fspath(out), threads, on_done, format)
-                else:
-                    from .dask import run_jobs_on_cluster
+                new: List[Optional[str]] = [None] * len(jobs)
+                local_runs = False
+                try:
+                    if client is None:
+                        system = _railfmu.PreparedSystem.from_json(self._base_json, "", self._label)
+                        threads = threads or os.cpu_count() or 1
+                        remove_sweep_report(out)
+                        local_runs = True
+                        new = system.run_jobs(jobs, os.fspath(out), threads, on_done, format)
+                    else:
+                        from .dask import run_jobs_on_cluster
 
-                    new = run_jobs_on_cluster(
-                        client,
-                        self._base_json,
-                        self._label,
-                        jobs,
-                        out,
-                        on_done,
-                        ship_fmus=ship_fmus,
-                        retries=retries,
-                        format=format,
-                    )
+                        run_jobs_on_cluster(
+                            client,
+                            self._base_json,
+                            self._label,
+                            jobs,
+                            out,
+                            on_done,
+                            ship_fmus=ship_fmus,
+                            retries=retries,
+                            format=format,
+                            reports=new,
+                        )
+                except BaseException:
+                    # stopped part way (Ctrl-C, an exception of `progress`, ...): the runners
+                    # end every started set with a folder per run, finished or cancelled, as
+                    # `master sweep` does; sweep.json lists them all, the kept ones too, so
+                    # that the folder is whole and `resume=True` carries on from it
+                    if local_runs:
+                        new = _reports_of_stopped_set(out, jobs)
+                    if all(r is not None for r in new):
+                        for i, r in zip(todo, new):
+                            reports[i] = r
+                        with contextlib.suppress(Exception):  # the set's own exception is raised
+                            _railfmu.write_sweep(os.fspath(out), [r for r in reports if r is not None])
+                    raise
                 for i, r in zip(todo, new):
                     reports[i] = r
         final = [r for r in reports if r is not None]
@@ -165,6 +190,32 @@ class RunSet:
         from .dask import results_format
 
         return results_format(client, self._base_json, self._label, self._jobs_json, ship_fmus=ship_fmus, retries=retries)
+
+
+def remove_sweep_report(out: Path) -> None:
+    """Removes ``<out>/sweep.json`` before the runs of a set are written, as ``master sweep``
+    does: a set stopped part way never leaves an earlier set's report looking current."""
+    path = out / "sweep.json"
+    try:
+        path.unlink()
+    except FileNotFoundError:
+        pass
+    except OSError as e:
+        raise _railfmu.OutputError(f"cannot remove the earlier report '{path}': {e}") from e
+
+
+def _reports_of_stopped_set(out: Path, jobs_json: List[str]) -> List[Optional[str]]:
+    """The reports (JSON) of the local runs of ``jobs_json`` that were stopped part way, as
+    their runner wrote them in ``<out>/sweep.json`` before it raised (every run: finished or
+    cancelled); None for each when it wrote none."""
+    names = [json.loads(j)["name"] for j in jobs_json]
+    try:
+        written = json.loads((out / "sweep.json").read_text(encoding="utf-8"))
+        if [r["name"] for r in written] == names:
+            return [json.dumps(r) for r in written]
+    except (OSError, ValueError, TypeError, KeyError):
+        pass
+    return [None] * len(names)
 
 
 def run_set(

@@ -11,12 +11,22 @@ FMUs reach the workers in one of two ways:
 
 * ``ship_fmus=True`` (default): the client reads each FMU file once, scatters its bytes to every
   worker (``Client.scatter(..., broadcast=True)``, once per run set, not once per task) and each
-  worker keeps a copy under its temporary folder, named by the file's SHA-256. This works on any
+  worker keeps a copy in its FMU cache (below), named by the file's SHA-256. This works on any
   deployment (LocalCluster, dask-jobqueue on Slurm/PBS, cloud clusters) without a shared file
   system, and the workers run exactly the bytes the client has.
 * ``ship_fmus=False``: the workers open the FMU paths of the description as they are (absolute
   paths on the client). Use it when all nodes see the FMUs on one shared file system (typical on
   HPC): nothing is copied.
+
+The FMU cache of a worker machine is the folder ``railfmu-fmus-<uid>`` in the workers' temporary
+folder (``tempfile.gettempdir()``: set ``TMPDIR`` in the workers' environment to move it), shared
+by the workers of one user on that machine: one sub-folder per FMU, named by its SHA-256, holding
+the FMU under its file name, written atomically. A task marks the copies it uses as used (the
+sub-folder's modification time). It stays bounded: whenever a worker writes a new copy, it
+removes the copies not used for 7 days and, beyond the 16 most recently used, those not used for
+an hour (a copy is only read while a worker prepares the system, so an hour is ample). A copy is
+first renamed aside (``.removed-*``), then removed, so no worker finds it half-removed; one
+removed and needed again is written again. Nothing else in the folder is touched.
 
 A worker prepares a system (unpacks and loads its FMUs) once and keeps it for the later tasks of
 the same run set. A simulation that fails is the run's result (its error is kept in its
@@ -29,8 +39,11 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
+import shutil
 import tempfile
 import threading
+import time
 import uuid
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Tuple
@@ -46,12 +59,25 @@ def _fmu_cache_dir() -> Path:
     return Path(tempfile.gettempdir()) / f"railfmu-fmus-{os.getuid() if hasattr(os, 'getuid') else 'user'}"
 
 
+# The FMU cache's bounds (see the module's documentation).
+_CACHE_MAX_AGE_S = 7 * 24 * 3600
+_CACHE_KEEP = 16
+_CACHE_IN_USE_S = 3600
+_CACHE_ENTRY = re.compile(r"[0-9a-f]{32}")
+# Prefix of a cache entry renamed aside to be removed.
+_CACHE_REMOVED = ".removed-"
+
+
 def _local_copy(digest: str, name: str, data: bytes) -> str:
     """Path of this worker's copy of an FMU (written once, atomically)."""
     folder = _fmu_cache_dir() / digest[:32]
     path = folder / name
     if path.is_file() and path.stat().st_size == len(data):
-        return str(path)
+        try:
+            os.utime(folder)  # used now: kept by the cache's trimming
+            return str(path)
+        except OSError:  # removed in between as unused: written again
+            pass
     if hashlib.sha256(data).hexdigest() != digest:
         raise RuntimeError(f"FMU '{name}' arrived damaged (SHA-256 differs)")
     folder.mkdir(parents=True, exist_ok=True)
@@ -64,7 +90,49 @@ def _local_copy(digest: str, name: str, data: bytes) -> str:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
+    _trim_cache(folder.parent, folder.name)
     return str(path)
+
+
+def _trim_cache(root: Path, current: str) -> None:
+    """Removes the cache entries of ``root`` not used for ``_CACHE_MAX_AGE_S`` and, beyond the
+    ``_CACHE_KEEP`` most recently used (``current`` among them), those not used for
+    ``_CACHE_IN_USE_S``. Each is renamed aside first (atomic: another worker finds the entry
+    whole or not at all), then removed; one used again meanwhile is put back. Never fails the
+    task: what cannot be removed stays."""
+    now = time.time()
+    entries = []
+    try:
+        with os.scandir(root) as it:
+            for e in it:
+                try:
+                    if not e.is_dir(follow_symlinks=False):
+                        continue
+                    used = e.stat(follow_symlinks=False).st_mtime
+                except OSError:
+                    continue
+                if e.name.startswith(_CACHE_REMOVED):
+                    # left by a worker that died while removing it
+                    if now - used > _CACHE_IN_USE_S:
+                        shutil.rmtree(e.path, ignore_errors=True)
+                elif _CACHE_ENTRY.fullmatch(e.name) and e.name != current:
+                    entries.append((used, e.name))
+    except OSError:
+        return
+    entries.sort(reverse=True)
+    for rank, (used, name) in enumerate(entries, start=2):  # `current` is the most recent
+        unused = now - used
+        if unused <= _CACHE_MAX_AGE_S and (rank <= _CACHE_KEEP or unused <= _CACHE_IN_USE_S):
+            continue
+        aside = root / f"{_CACHE_REMOVED}{name}-{uuid.uuid4().hex[:8]}"
+        try:
+            os.rename(root / name, aside)
+            if aside.stat().st_mtime != used:  # used again just before the rename: put back
+                os.rename(aside, root / name)
+                continue
+        except OSError:  # removed by another worker meanwhile
+            continue
+        shutil.rmtree(aside, ignore_errors=True)
 
 
 def _localise(description: Dict[str, Any], paths: Dict[str, str]) -> Dict[str, Any]:
@@ -160,31 +228,41 @@ def run_jobs_on_cluster(
     ship_fmus: bool = True,
     retries: int = 3,
     format: Optional[str] = None,
+    reports: Optional[List[Optional[str]]] = None,
 ) -> List[str]:
     """Submits one task per job to ``client``, writes each run's folder as its result arrives
     and returns the reports (JSON) in job order. ``format``: "csv" or "parquet"; None chooses
     by size as a local run set does (from the FMUs' model descriptions, read on this client).
     A task that raises (even after its retries, e.g. every worker running it died) gives a
-    failed run carrying the exception's message."""
+    failed run carrying the exception's message.
+
+    ``reports``, when given, is a list of one entry per job that receives each report as its
+    run's folder is written. A set stopped part way (Ctrl-C, an exception of ``on_done``, a
+    client that fails) ends as a local run set does: the remaining tasks are cancelled, the
+    folder of each run not finished is written as a cancelled run, so that every job has its
+    folder and its report in ``reports``, and the exception is raised."""
     from distributed import as_completed
 
+    from ._runset import remove_sweep_report
 
     if format is None:
         format = results_format(client, base_json, label, jobs_json, ship_fmus=ship_fmus, retries=retries)
     fmus_arg = _scatter_fmus(client, base_json) if ship_fmus else None
     writer = _railfmu.RunWriter(os.fspath(outdir), jobs_json, format)
+    if reports is None:
+        reports = [None] * len(jobs_json)
     # keys unique per submission: a key resubmitted while the scheduler still releases it from
     # an earlier set would be cancelled
     token = uuid.uuid4().hex[:16]
     futures = {}
-    for i, job_json in enumerate(jobs_json):
-        name = json.loads(job_json)["name"]
-        fut = client.submit(
-            run_task, base_json, label, job_json, fmus_arg, key=f"railfmu-{name}-{token}", retries=retries, pure=False
-        )
-        futures[fut] = (i, name, job_json)
-    reports: List[Optional[str]] = [None] * len(jobs_json)
+    remove_sweep_report(Path(outdir))
     try:
+        for i, job_json in enumerate(jobs_json):
+            name = json.loads(job_json)["name"]
+            fut = client.submit(
+                run_task, base_json, label, job_json, fmus_arg, key=f"railfmu-{name}-{token}", retries=retries, pure=False
+            )
+            futures[fut] = (i, name, job_json)
         for fut in as_completed(list(futures)):
             i, name, job_json = futures[fut]
             try:
@@ -196,7 +274,26 @@ def run_jobs_on_cluster(
                 report = writer.write(job_json, error=error)
             reports[i] = report
             on_done(name, error)
-    finally:
-        for fut in futures:
-            fut.cancel()
+    except BaseException as stop:
+        _cancel(futures)
+        if isinstance(stop, KeyboardInterrupt):
+            error = "cancelled: the run set was interrupted before this run finished"
+        else:
+            error = f"cancelled: the run set stopped before this run finished ({type(stop).__name__}: {stop})"
+        for i, job_json in enumerate(jobs_json):
+            if reports[i] is None:
+                reports[i] = writer.write(job_json, error=error)
+        raise
+    else:
+        _cancel(futures)
     return [r for r in reports if r is not None]
+
+
+def _cancel(futures: Any) -> None:
+    """Cancels the tasks of ``futures`` still pending (a client that lost its scheduler
+    cannot, and has no tasks left)."""
+    for fut in futures:
+        try:
+            fut.cancel()
+        except Exception:
+            pass

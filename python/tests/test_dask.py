@@ -1,15 +1,18 @@
 """Run sets on a dask.distributed LocalCluster of 2 worker processes: the same results as the
 local run set bit for bit (CSV and Parquet, the format chosen by size as locally), a killed
-worker does not lose the set, bad input fails its own run only, and the command line reaches
-the cluster too."""
+worker does not lose the set, bad input fails its own run only, the command line reaches the
+cluster too, and the workers' FMU cache stays bounded."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import signal
 import subprocess
 import sys
+import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -170,6 +173,55 @@ def test_a_killed_worker_does_not_lose_the_set_and_a_resumed_set_skips_finished_
     assert again.ok and csv_bytes(tmp_path / "dask") == csv_bytes(tmp_path / "local")
 
 
+def test_an_interrupted_set_leaves_a_whole_folder_that_a_resumed_set_completes(dist, client, tmp_path):
+    rs = eight_runs(dist, stop_time=1.0)
+    local = rs.run(tmp_path / "local", threads=2)
+    assert local.ok
+    out = tmp_path / "dask"
+    rs.run(out, threads=2)  # an earlier set's report, which must not outlive what follows
+
+    def stop_after_first(error_type, finished):
+        def progress(done, total, name, error):
+            if name:
+                finished.append(name)
+                raise error_type("stop")
+
+        return progress
+
+    def check(finished, cancelled):
+        # every run has its folder and its report: the finished ones as on the local threads,
+        # the others cancelled
+        sweep = json.loads((out / "sweep.json").read_text())
+        assert [r["name"] for r in sweep] == rs.names
+        assert {r["name"] for r in sweep if r["ok"]} == set(finished)
+        for r in sweep:
+            assert json.loads((out / r["name"] / "summary.json").read_text()) == r
+            if not r["ok"]:
+                assert r["error"] == cancelled
+                assert not (out / r["name"] / "results.csv").exists()
+        assert csv_bytes(out) == {n: b for n, b in csv_bytes(tmp_path / "local").items() if n in finished}
+        assert not [p for p in out.iterdir() if p.name.startswith(".")]
+
+    first = []
+    with pytest.raises(KeyboardInterrupt):
+        rs.run(out, client=client, progress=stop_after_first(KeyboardInterrupt, first))
+    assert len(first) == 1
+    check(first, "cancelled: the run set was interrupted before this run finished")
+    # resumed and stopped again (an exception of the progress callback): the kept run is
+    # listed too
+    second = []
+    with pytest.raises(ValueError, match="stop"):
+        rs.run(out, client=client, resume=True, progress=stop_after_first(ValueError, second))
+    assert len(second) == 1 and second != first
+    check(first + second, "cancelled: the run set stopped before this run finished (ValueError: stop)")
+    # resumed to the end: only the runs not finished run
+    ran = []
+    again = rs.run(out, client=client, resume=True, progress=lambda d, t, n, e: ran.append(n))
+    assert sorted(n for n in ran if n) == sorted(set(rs.names) - set(first + second))
+    assert again.ok and csv_bytes(out) == csv_bytes(tmp_path / "local")
+    assert [r["name"] for r in json.loads((out / "sweep.json").read_text()) if r["ok"]] == rs.names
+
+
 def test_the_command_line_runs_a_set_on_the_cluster(dist, client, master_cmd, tmp_path):
     set_file = tmp_path / "set.json"
     set_file.write_text(json.dumps(speed_set(dist, [50.0, 70.0], stop_time=0.2)))
@@ -237,3 +289,61 @@ def test_a_set_resumed_on_the_cluster_in_another_format_runs_again_into_one_form
     again = rs.run(out, client=client, resume=True, progress=lambda d, t, n, e: ran.append(n))
     assert again.ok and sorted(n for n in ran if n) == rs.names
     assert sorted(csv_bytes(out)) == rs.names and not (out / "results").exists()
+
+
+def test_the_fmu_cache_of_the_workers_stays_bounded(monkeypatch, tmp_path):
+    from railfmu import dask as rdask
+
+    # the workers' temporary folder (TMPDIR), as tempfile reads it
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    root = rdask._fmu_cache_dir()
+    assert root.parent == tmp_path
+    root.mkdir()
+    now = time.time()
+    hour, day = 3600, 24 * 3600
+
+    def plant(name, unused_s, content=b"fmu"):
+        folder = root / name
+        folder.mkdir()
+        (folder / "Model.fmu").write_bytes(content)
+        os.utime(folder, (now - unused_s, now - unused_s))
+        return folder
+
+    def unpack(content):
+        digest = hashlib.sha256(content).hexdigest()
+        return Path(rdask._local_copy(digest, "New.fmu", content))
+
+    # not cache entries: never touched, however old
+    mine = root / "not-an-entry"
+    mine.mkdir()
+    os.utime(mine, (now - 30 * day, now - 30 * day))
+    (root / "note.txt").write_text("kept")
+
+    def entries():
+        return {p.name for p in root.iterdir() if p.is_dir() and p != mine and not p.name.startswith(".")}
+
+    old = plant("0" * 32, 8 * day)
+    recent = plant("1" * 32, 2 * day)
+    path = unpack(b"first")
+    assert path.read_bytes() == b"first" and path.parent.name in entries()
+    assert not old.exists()  # unused for more than 7 days
+    assert recent.is_dir() and mine.is_dir() and (root / "note.txt").read_text() == "kept"
+    assert not [p for p in root.iterdir() if p.name.startswith(".")]  # nothing left aside
+    # a copy found again is marked as used, not written again
+    os.utime(path.parent, (now - 8 * day, now - 8 * day))
+    inode = path.stat().st_ino
+    assert unpack(b"first") == path and path.stat().st_ino == inode
+    assert path.parent.stat().st_mtime > now - 60
+    # beyond the 16 most recently used, those not used for an hour go, least recently used
+    # first
+    aged = [plant(f"{k:030x}aa", 2 * day + (k + 1) * hour) for k in range(20)]
+    in_use = [plant(f"{k:030x}bb", 10 * 60) for k in range(5)]
+    second = unpack(b"second").parent
+    kept = {second.name, path.parent.name, recent.name} | {f.name for f in in_use + aged[:8]}
+    assert entries() == kept and len(kept) == 16
+    # those used within the hour stay, even beyond 16 (a worker may be reading them)
+    in_use += [plant(f"{k:030x}cc", 10 * 60) for k in range(18)]
+    third = unpack(b"third").parent
+    assert entries() == {third.name, second.name, path.parent.name} | {f.name for f in in_use}
+    assert mine.is_dir() and (root / "note.txt").read_text() == "kept"
+    assert not [p for p in root.iterdir() if p.name.startswith(".")]

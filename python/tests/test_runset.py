@@ -1,5 +1,6 @@
 """Run sets on local threads: the same folders as `master sweep`, a progress callback, failures
-kept per run, resuming skips finished runs, and the folder reads back."""
+kept per run, resuming skips finished runs (also after an interruption), and the folder reads
+back."""
 
 from __future__ import annotations
 
@@ -84,6 +85,38 @@ def test_a_resumed_set_skips_finished_runs(dist, tmp_path):
     ran.clear()
     rs.run(out, resume=True, progress=lambda d, t, n, e: ran.append(n))
     assert [n for n in ran if n] == []
+
+
+def test_an_interrupted_resumed_set_lists_every_run(dist, tmp_path):
+    rs = railfmu.RunSet.from_dict(speed_set(dist, [50.0, 60.0, 70.0, 80.0], seeds=[1, 2], stop_time=1.0))
+    out = tmp_path / "out"
+
+    def interrupt(done, total, name, error):
+        if name:
+            raise KeyboardInterrupt
+
+    def listed():
+        sweep = json.loads((out / "sweep.json").read_text())
+        assert [r["name"] for r in sweep] == rs.names
+        for r in sweep:
+            assert json.loads((out / r["name"] / "summary.json").read_text()) == r
+            assert (out / r["name"] / "results.csv").is_file() == r["ok"]
+            assert r["ok"] or r["error"].startswith("cancelled")
+        return {r["name"] for r in sweep if r["ok"]}
+
+    with pytest.raises(KeyboardInterrupt):
+        rs.run(out, threads=1, progress=interrupt)
+    first = listed()
+    assert first and len(first) < len(rs)
+    # interrupted again when resumed: sweep.json lists the kept runs too
+    with pytest.raises(KeyboardInterrupt):
+        rs.run(out, threads=1, resume=True, progress=interrupt)
+    second = listed()
+    assert first < second < set(rs.names)
+    ran = []
+    again = rs.run(out, threads=1, resume=True, progress=lambda d, t, n, e: ran.append(n))
+    assert sorted(n for n in ran if n) == sorted(set(rs.names) - second)
+    assert again.ok and listed() == set(rs.names)
 
 
 def test_a_run_set_into_a_used_folder_holds_its_own_runs_and_replaces_nothing_else(dist, tmp_path):
