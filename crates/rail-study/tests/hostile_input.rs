@@ -602,6 +602,41 @@ fn logger_messages_with_format_attacks_are_printed_not_executed() {
 }
 
 #[test]
+fn a_default_results_file_leaves_no_other_format_beside_it() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    let run = |args: &[&str]| {
+        let out = c.master(args, &[]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "master {args:?}: {stderr}");
+    };
+    let (csv, meta, parquet) = (
+        c.path("results.csv"),
+        c.path("results.meta.json"),
+        c.path("results.parquet"),
+    );
+    c.write("results.txt", "the user's");
+    c.write("results.meta.parquet", "the user's");
+    run(&["run", "system.json", "--format", "parquet"]);
+    assert!(parquet.is_file() && !csv.exists() && !meta.exists());
+    // small results: CSV by default, and the Parquet file of the earlier run is gone
+    run(&["run", "system.json"]);
+    assert!(csv.is_file() && meta.is_file() && !parquet.exists());
+    run(&["run", "system.json", "--format", "parquet"]);
+    assert!(parquet.is_file() && !csv.exists() && !meta.exists());
+    // a named output leaves the default files alone
+    run(&["run", "system.json", "-o", "named.csv"]);
+    assert!(parquet.is_file() && c.path("named.csv").is_file());
+    // a folder of the default name is not removed
+    std::fs::create_dir(&csv).unwrap();
+    run(&["run", "system.json", "--format", "parquet"]);
+    assert!(csv.is_dir() && parquet.is_file());
+    for f in ["results.txt", "results.meta.parquet"] {
+        assert_eq!(std::fs::read_to_string(c.path(f)).unwrap(), "the user's");
+    }
+}
+
+#[test]
 fn fifos_and_devices_are_refused_without_reading() {
     let c = Case::new();
     hostile_fmu(&c, HOSTILE_MD);
