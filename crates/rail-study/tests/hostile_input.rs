@@ -782,6 +782,38 @@ fn a_variable_recorded_twice_is_refused() {
 }
 
 #[test]
+fn a_failed_study_leaves_no_result_of_an_earlier_one() {
+    let case = Case::new();
+    std::fs::create_dir_all(case.path("out")).unwrap();
+    std::fs::create_dir_all(case.path("no-fmus")).unwrap();
+    let earlier = [
+        "REPORT.md",
+        "study.json",
+        "rms_vs_speed.svg",
+        "rms_vs_speed.csv",
+        "history_force.svg",
+        "cv_sensitivity.csv",
+    ];
+    for f in earlier {
+        case.write(&format!("out/{f}"), "an earlier study's");
+    }
+    case.write("out/notes.svg", "the user's");
+    // the study starts, then finds no FMU
+    let err = case.fails(
+        &["study", "--quick", "--fmus", "no-fmus", "--out", "out"],
+        &[],
+    );
+    assert!(err.contains("not found"), "{err}");
+    for f in earlier {
+        assert!(!case.path(&format!("out/{f}")).exists(), "{f} is left");
+    }
+    assert_eq!(
+        std::fs::read_to_string(case.path("out/notes.svg")).unwrap(),
+        "the user's"
+    );
+}
+
+#[test]
 fn a_study_option_out_of_range_is_refused_before_anything_is_touched() {
     let case = Case::new();
     std::fs::create_dir_all(case.path("out")).unwrap();

@@ -8,6 +8,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use crate::study::report::output_files;
 use crate::study::{
     run_study, write_outputs, Sources, StudyError, StudyOptions, StudySettings, Timing, TrackLevel,
     VehicleModel,
@@ -27,7 +28,8 @@ pub struct Args {
     /// Folder with the FMUs (RailVehicle.fmu, Bogie2Dof.fmu, SemiActiveDamper.fmu, ...).
     #[arg(long)]
     pub fmus: Option<PathBuf>,
-    /// Output folder.
+    /// Output folder. An earlier study's report, figures and tables in it are removed when
+    /// the study starts (the user's other files stay).
     #[arg(long, default_value = "results")]
     pub out: PathBuf,
     /// Reduced study for CI: 1 seed, shorter runs, fewer speeds, coarser bisection.
@@ -285,19 +287,10 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         settings.planned_runs(),
         args.out.display()
     );
-    // An interrupted or failed study must not leave the previous report looking current: it
-    // is removed before the first run and written again only when every output is ready.
-    for old in ["REPORT.md", "study.json"] {
-        match std::fs::remove_file(args.out.join(old)) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(CommandError::Failed(format!(
-                    "cannot remove the previous '{}': {e}",
-                    args.out.join(old).display()
-                )))
-            }
-            _ => {}
-        }
-    }
+    // An interrupted or failed study must not leave the previous study's results looking
+    // current: its report, figures and tables are removed before the first run and written
+    // again only when every output is ready.
+    remove_earlier_outputs(&args.out)?;
     // bisection rounds of an earlier study beyond this one's would be left beside its runs
     remove_batches(&args.out.join("runs"), "bisect-")?;
     let results = run_study(&settings, &opts)?;
@@ -322,6 +315,30 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         timing.sim_per_wall(&results),
         args.out.join("REPORT.md").display()
     );
+    Ok(())
+}
+
+/// Removes the files an earlier study wrote into `out` ([`output_files`]: report, figures,
+/// tables): regular files (and symbolic links) of these names only; a user's other files, and
+/// a folder or FIFO of such a name, stay.
+fn remove_earlier_outputs(out: &std::path::Path) -> Result<(), CommandError> {
+    for name in output_files() {
+        let path = out.join(name);
+        let ours = std::fs::symlink_metadata(&path)
+            .is_ok_and(|m| m.file_type().is_file() || m.file_type().is_symlink());
+        if !ours {
+            continue;
+        }
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(CommandError::Failed(format!(
+                    "cannot remove the previous '{}': {e}",
+                    path.display()
+                )))
+            }
+            _ => {}
+        }
+    }
     Ok(())
 }
 
@@ -427,6 +444,47 @@ mod tests {
             e.contains("at 51.4 km/h") && e.contains("is 51.5 km/h"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn an_earlier_studys_outputs_are_removed_and_nothing_else() {
+        let d = tempfile::tempdir().unwrap();
+        let out = d.path();
+        let earlier = [
+            "REPORT.md",
+            "study.json",
+            "rms_vs_speed.svg",
+            "rms_vs_speed.csv",
+            "history_carbody.svg",
+            "cv_sensitivity.csv",
+        ];
+        for f in earlier {
+            std::fs::write(out.join(f), "an earlier study's").unwrap();
+        }
+        let users = [
+            "notes.svg",
+            "my_table.csv",
+            "cv_sensitivity.svg",
+            "REPORT.txt",
+        ];
+        for f in users {
+            std::fs::write(out.join(f), "the user's").unwrap();
+        }
+        std::fs::create_dir(out.join("perturbation.svg")).unwrap();
+        remove_earlier_outputs(out).unwrap();
+        for f in earlier {
+            assert!(!out.join(f).exists(), "{f} is left");
+        }
+        for f in users {
+            assert_eq!(
+                std::fs::read_to_string(out.join(f)).unwrap(),
+                "the user's",
+                "{f}"
+            );
+        }
+        assert!(out.join("perturbation.svg").is_dir());
+        // no folder yet: nothing to remove
+        remove_earlier_outputs(&out.join("none")).unwrap();
     }
 
     #[test]
