@@ -602,6 +602,79 @@ fn logger_messages_with_format_attacks_are_printed_not_executed() {
 }
 
 #[test]
+fn messages_show_a_long_text_by_its_beginning_and_a_huge_number_short() {
+    let c = Case::new();
+    let label = r#"<ScalarVariable name="label" valueReference="2" causality="parameter" variability="fixed"><String start="a"/></ScalarVariable>"#;
+    hostile_fmu(
+        &c,
+        &HOSTILE_MD.replace("</ModelVariables>", &format!("{label}</ModelVariables>")),
+    );
+    let long = "x".repeat(10 << 20);
+    let with = |name: &str| {
+        SYSTEM.replace(
+            r#""fmu": "Hostile.fmu""#,
+            &format!(r#""fmu": "Hostile.fmu", "parameters": {{"{name}": "{long}"}}"#),
+        )
+    };
+    let shown = "x".repeat(200);
+    // a String start value the FMU refuses (its binary has no fmi2SetString)
+    c.write("label.json", &with("label"));
+    let e = c.fails(&["run", "label.json", "-o", "r.csv"], &[]);
+    assert!(
+        e.contains(&format!(
+            "setting start value 'label' = \"{shown}\"... (10485760 bytes) failed"
+        )),
+        "{}",
+        &e[..e.len().min(2000)]
+    );
+    assert!(e.len() < 2000, "{} bytes", e.len());
+    // a text given to a Real
+    c.write("gain.json", &with("gain"));
+    let e = c.fails(&["run", "gain.json", "-o", "r.csv"], &[]);
+    assert!(
+        e.contains(&format!(
+            "a Real variable cannot take the value \"{shown}\"... (10485760 bytes)"
+        )),
+        "{}",
+        &e[..e.len().min(2000)]
+    );
+    assert!(e.len() < 2000, "{} bytes", e.len());
+    // --set without '=', and an unknown variable to record
+    let arg = "y".repeat(100_000);
+    for args in [["--set", &arg], ["--record", &arg]] {
+        let e = c.fails(
+            &["run", "Hostile.fmu", args[0], args[1], "-o", "r.csv"],
+            &[],
+        );
+        assert!(e.contains("... (100"), "{}", &e[..e.len().min(2000)]);
+        assert!(e.len() < 2000, "{args:?}: {} bytes", e.len());
+    }
+    // huge and tiny numbers
+    c.write(
+        "huge.json",
+        &SYSTEM.replace("\"stop_time\": 0.01", "\"stop_time\": 1e308"),
+    );
+    let e = c.fails(&["run", "huge.json", "-o", "r.csv"], &[]);
+    assert!(e.contains("1e308 s at a step of 0.001 s"), "{e}");
+    let e = c.fails(
+        &["run", "Hostile.fmu", "--start", "1e308", "-o", "r.csv"],
+        &[],
+    );
+    assert!(e.contains("start_time (1e308), got 1"), "{e}");
+    let e = c.fails(
+        &["run", "Hostile.fmu", "--stop", "1e-300", "-o", "r.csv"],
+        &[],
+    );
+    assert!(e.contains("(1e-300)"), "{e}");
+    let e = c.fails(&["study", "--quick", "--cv-speed", "1e308"], &[]);
+    assert!(e.contains("--cv-speed 1e308: "), "{e}");
+    let out = c.master(&["study", "--quick", "--speeds", "250,1e308"], &[]);
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains(": 1e308 km/h: speeds must lie"), "{e}");
+    assert!(!c.path("r.csv").exists() && !c.path("results").exists());
+}
+
+#[test]
 fn a_default_results_file_leaves_no_other_format_beside_it() {
     let c = Case::new();
     hostile_fmu(&c, HOSTILE_MD);

@@ -65,7 +65,10 @@ fn parse_algorithm(s: &str) -> Result<Algorithm, String> {
     match s {
         "jacobi" => Ok(Algorithm::Jacobi),
         "gauss-seidel" => Ok(Algorithm::GaussSeidel),
-        _ => Err(format!("'{s}' is neither jacobi nor gauss-seidel")),
+        _ => Err(format!(
+            "'{}' is neither jacobi nor gauss-seidel",
+            crate::show::text(s)
+        )),
     }
 }
 

@@ -172,10 +172,11 @@ impl Package {
     /// Normalises a relative URI reference of the SSD: percent-decoded, `.` and `..`
     /// resolved; `Err` is the reason it is refused.
     pub fn resolve(&self, reference: &str) -> Result<String, String> {
+        let shown = crate::show::text(reference);
         let r = reference.trim();
         if r.contains('#') {
             return Err(format!(
-                "'{reference}' has a fragment (references into other SSDs are not supported)"
+                "'{shown}' has a fragment (references into other SSDs are not supported)"
             ));
         }
         if let Some((scheme, _)) = r.split_once(':') {
@@ -185,17 +186,15 @@ impl Package {
                     .all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c))
             {
                 return Err(format!(
-                    "'{reference}' is an absolute URI (only references relative to the SSD)"
+                    "'{shown}' is an absolute URI (only references relative to the SSD)"
                 ));
             }
         }
         if r.starts_with('/') || r.is_empty() {
-            return Err(format!(
-                "'{reference}' is not a relative reference to a file"
-            ));
+            return Err(format!("'{shown}' is not a relative reference to a file"));
         }
         let decoded = percent_decode(r)
-            .ok_or_else(|| format!("'{reference}' has an invalid percent-encoding"))?;
+            .ok_or_else(|| format!("'{shown}' has an invalid percent-encoding"))?;
         let mut parts: Vec<&str> = Vec::new();
         let in_zip = matches!(self, Package::Zip { .. });
         let mut ups = 0usize;
@@ -205,7 +204,7 @@ impl Package {
                 ".." => {
                     if parts.pop().is_none() {
                         if in_zip {
-                            return Err(format!("'{reference}' points outside the archive"));
+                            return Err(format!("'{shown}' points outside the archive"));
                         }
                         ups += 1;
                     }
@@ -214,7 +213,7 @@ impl Package {
             }
         }
         if parts.is_empty() {
-            return Err(format!("'{reference}' names no file"));
+            return Err(format!("'{shown}' names no file"));
         }
         let mut out = "../".repeat(ups);
         out.push_str(&parts.join("/"));

@@ -15,6 +15,7 @@ use crate::study::{
 };
 use master::cli::{CommandError, Context};
 use master::results::ResultsFormat;
+use master::show;
 
 /// Run the stability study and write REPORT.md, plots and CSVs.
 #[derive(Debug, clap::Args)]
@@ -96,10 +97,11 @@ fn parse_speed(text: &str) -> Result<f64, String> {
     let v: f64 = text
         .trim()
         .parse()
-        .map_err(|_| format!("'{text}' is not a speed in km/h"))?;
+        .map_err(|_| format!("'{}' is not a speed in km/h", show::text(text)))?;
     if !SPEED_RANGE_KMH.contains(&v) {
         return Err(format!(
-            "{v} km/h: speeds must lie between {} and {} km/h",
+            "{} km/h: speeds must lie between {} and {} km/h",
+            show::num(v),
             SPEED_RANGE_KMH.start(),
             SPEED_RANGE_KMH.end()
         ));
@@ -120,16 +122,20 @@ fn parse_speeds(text: &str) -> Result<SpeedList, String> {
             let step: f64 = step
                 .trim()
                 .parse()
-                .map_err(|_| format!("'{step}' is not a speed step in km/h"))?;
+                .map_err(|_| format!("'{}' is not a speed step in km/h", show::text(step)))?;
             if !(step.is_finite() && step >= 0.1) || to < from {
                 return Err(format!(
-                    "{text}: FROM:TO:STEP needs FROM <= TO and a step of at least 0.1 km/h"
+                    "{}: FROM:TO:STEP needs FROM <= TO and a step of at least 0.1 km/h",
+                    show::text(text)
                 ));
             }
             // slack for rounding only: TO is in when the step divides the range, never past it
             let n = ((to - from) / step + 1e-9).floor();
             if n >= MAX_SPEEDS as f64 {
-                return Err(format!("{text}: more than {MAX_SPEEDS} speeds"));
+                return Err(format!(
+                    "{}: more than {MAX_SPEEDS} speeds",
+                    show::text(text)
+                ));
             }
             (0..=n as usize)
                 .map(|k| to_tenth(from + k as f64 * step))
@@ -140,7 +146,12 @@ fn parse_speeds(text: &str) -> Result<SpeedList, String> {
             .split(',')
             .map(|v| parse_speed(v).map(to_tenth))
             .collect::<Result<Vec<_>, _>>()?,
-        _ => return Err(format!("'{text}': FROM:TO:STEP or a list V,V,...")),
+        _ => {
+            return Err(format!(
+                "'{}': FROM:TO:STEP or a list V,V,...",
+                show::text(text)
+            ))
+        }
     };
     speeds.sort_by(f64::total_cmp);
     speeds.dedup();
@@ -182,7 +193,8 @@ fn chosen_configurations(
 ) -> Result<Vec<&'static str>, CommandError> {
     if let Some(bad) = ids.iter().find(|id| !available.contains(&id.trim())) {
         return Err(CommandError::Failed(format!(
-            "--configurations: '{bad}' is not a configuration of this vehicle (one of {})",
+            "--configurations: '{}' is not a configuration of this vehicle (one of {})",
+            show::text(bad),
             available.join(", ")
         )));
     }
@@ -201,7 +213,12 @@ fn parse_seeds(text: &str) -> Result<SeedList, String> {
             .parse()
             .ok()
             .filter(|&s| s <= MAX_SEED)
-            .ok_or_else(|| format!("'{part}' is not a track seed (0 to {MAX_SEED})"))?;
+            .ok_or_else(|| {
+                format!(
+                    "'{}' is not a track seed (0 to {MAX_SEED})",
+                    show::text(part)
+                )
+            })?;
         if !seeds.contains(&seed) {
             seeds.push(seed);
         }
@@ -253,7 +270,8 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     if let Some(v) = args.cv_speed {
         if !SPEED_RANGE_KMH.contains(&v) {
             return Err(CommandError::Failed(format!(
-                "--cv-speed {v}: the speed of the c_v runs must lie between {} and {} km/h",
+                "--cv-speed {}: the speed of the c_v runs must lie between {} and {} km/h",
+                show::num(v),
                 SPEED_RANGE_KMH.start(),
                 SPEED_RANGE_KMH.end()
             )));
