@@ -721,6 +721,19 @@ fn fifos_and_devices_are_refused_without_reading() {
         .success());
     let e = c.fails(&["run", "system.fifo"], &[]);
     assert!(e.contains("not a regular file"), "{e}");
+    // an SSP (a .ssd or a .ssp) likewise, not as a missing file and without blocking
+    for name in ["system.ssd", "system.ssp"] {
+        assert!(Command::new("mkfifo")
+            .arg(c.path(name))
+            .status()
+            .unwrap()
+            .success());
+        let e = c.fails(&["run", name], &[]);
+        assert!(
+            e.contains("not a regular file") && !e.contains("no such file"),
+            "{name}: {e}"
+        );
+    }
     let e = c.fails(&["run", "/dev/zero"], &[]);
     assert!(e.contains("not a regular file"), "{e}");
     c.write(

@@ -36,7 +36,9 @@ impl Package {
             .map(str::to_ascii_lowercase);
         match ext.as_deref() {
             Some("ssp") => {
-                let f = std::fs::File::open(path).map_err(|e| read_err(e.to_string()))?;
+                // a FIFO or device is refused without blocking on it or reading it
+                let f =
+                    crate::input::open_regular_file(path).map_err(|e| read_err(e.to_string()))?;
                 let zip = zip::ZipArchive::new(f)
                     .map_err(|e| read_err(format!("not a zip archive: {e}")))?;
                 let limits =
@@ -56,8 +58,13 @@ impl Package {
                 })
             }
             Some("ssd") => {
-                if !path.is_file() {
-                    return Err(read_err("no such file".into()));
+                // the .ssd itself is read later (read_ssd); here only what it is
+                match std::fs::metadata(path) {
+                    Err(e) => return Err(read_err(e.to_string())),
+                    Ok(m) if !m.is_file() => {
+                        return Err(read_err(crate::input::NOT_A_REGULAR_FILE.into()))
+                    }
+                    Ok(_) => {}
                 }
                 Ok(Package::Dir {
                     ssd: path.to_path_buf(),
@@ -226,7 +233,7 @@ fn read_file_limited(path: &Path, limit: u64) -> Result<String, SspError> {
         path: path.to_path_buf(),
         reason,
     };
-    let f = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
+    let f = crate::input::open_regular_file(path).map_err(|e| err(e.to_string()))?;
     let mut buf = Vec::new();
     f.take(limit + 1)
         .read_to_end(&mut buf)
