@@ -9,6 +9,9 @@ use std::path::Path;
 /// Largest system description or run-set file read [bytes].
 pub const MAX_TEXT_FILE_BYTES: u64 = 256 << 20;
 
+/// Why a path that is not a regular file is not read.
+pub const NOT_A_REGULAR_FILE: &str = "not a regular file (a FIFO, device, socket or folder)";
+
 /// Opens `path` for reading if it is a regular file. On Unix it is opened non-blocking, so
 /// opening a FIFO returns at once and is then refused.
 pub fn open_regular_file(path: &Path) -> std::io::Result<std::fs::File> {
@@ -23,7 +26,7 @@ pub fn open_regular_file(path: &Path) -> std::io::Result<std::fs::File> {
     if !file.metadata()?.is_file() {
         return Err(std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
-            "not a regular file",
+            NOT_A_REGULAR_FILE,
         ));
     }
     Ok(file)

@@ -13,6 +13,7 @@
 //! * [`input`]: input files read without hanging (regular files only) or filling memory.
 //! * [`decimation`]: results decimated without aliasing, and the sampling record of a file.
 //! * [`output`]: atomic CSV/JSON output.
+//! * [`show`]: how messages show values a user gave (long texts cut, numbers short).
 //! * [`results`]: results files, CSV or Parquet ([`parquet_file`]), and their metadata.
 //! * [`cli`]: the generic subcommands (run, sweep, inspect, export-ssp) and the binary's common main.
 //!
@@ -35,6 +36,7 @@ pub mod output;
 pub mod parquet_file;
 pub mod results;
 pub mod runset;
+pub mod show;
 pub mod slave;
 pub mod ssp;
 pub mod system;

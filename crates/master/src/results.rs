@@ -215,6 +215,33 @@ pub fn write_results(
     }
 }
 
+/// Removes the results file `path` written as `format` (a CSV together with its metadata
+/// file), if there is one. Only regular files and symbolic links are removed (a folder or a
+/// FIFO of that name is left alone); a missing file is no error.
+pub fn remove_results(path: &Path, format: ResultsFormat) -> Result<(), OutputError> {
+    let mut files = vec![path.to_path_buf()];
+    if format == ResultsFormat::Csv {
+        files.push(csv_metadata_path(path));
+    }
+    for file in files {
+        let removable = std::fs::symlink_metadata(&file)
+            .is_ok_and(|m| m.file_type().is_file() || m.file_type().is_symlink());
+        if !removable {
+            continue;
+        }
+        match std::fs::remove_file(&file) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(OutputError::Io {
+                    path: file,
+                    source: e,
+                })
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 /// Why a results file cannot be read.
 #[derive(Debug, thiserror::Error)]
 pub enum ReadError {

@@ -10,7 +10,7 @@ use signal_processing::{Complex64, DesignError};
 /// A signal-processing input problem, naming the parameter.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SignalError {
-    #[error("parameter '{name}' = {value}: {reason}")]
+    #[error("parameter '{name}' = {}: {reason}", master::show::num(*.value))]
     InvalidParameter {
         name: &'static str,
         value: f64,
@@ -24,7 +24,11 @@ pub enum SignalError {
     },
     #[error("signal contains a non-finite value at sample {index}")]
     NonFinite { index: usize },
-    #[error("no spectral peak between {f_min} and {f_max} Hz")]
+    #[error(
+        "no spectral peak between {} and {} Hz",
+        master::show::num(*.f_min),
+        master::show::num(*.f_max)
+    )]
     NoPeak { f_min: f64, f_max: f64 },
     #[error("band-pass design: {0}")]
     Design(#[from] DesignError),

@@ -602,6 +602,114 @@ fn logger_messages_with_format_attacks_are_printed_not_executed() {
 }
 
 #[test]
+fn messages_show_a_long_text_by_its_beginning_and_a_huge_number_short() {
+    let c = Case::new();
+    let label = r#"<ScalarVariable name="label" valueReference="2" causality="parameter" variability="fixed"><String start="a"/></ScalarVariable>"#;
+    hostile_fmu(
+        &c,
+        &HOSTILE_MD.replace("</ModelVariables>", &format!("{label}</ModelVariables>")),
+    );
+    let long = "x".repeat(10 << 20);
+    let with = |name: &str| {
+        SYSTEM.replace(
+            r#""fmu": "Hostile.fmu""#,
+            &format!(r#""fmu": "Hostile.fmu", "parameters": {{"{name}": "{long}"}}"#),
+        )
+    };
+    let shown = "x".repeat(200);
+    // a String start value the FMU refuses (its binary has no fmi2SetString)
+    c.write("label.json", &with("label"));
+    let e = c.fails(&["run", "label.json", "-o", "r.csv"], &[]);
+    assert!(
+        e.contains(&format!(
+            "setting start value 'label' = \"{shown}\"... (10485760 bytes) failed"
+        )),
+        "{}",
+        &e[..e.len().min(2000)]
+    );
+    assert!(e.len() < 2000, "{} bytes", e.len());
+    // a text given to a Real
+    c.write("gain.json", &with("gain"));
+    let e = c.fails(&["run", "gain.json", "-o", "r.csv"], &[]);
+    assert!(
+        e.contains(&format!(
+            "a Real variable cannot take the value \"{shown}\"... (10485760 bytes)"
+        )),
+        "{}",
+        &e[..e.len().min(2000)]
+    );
+    assert!(e.len() < 2000, "{} bytes", e.len());
+    // --set without '=', and an unknown variable to record
+    let arg = "y".repeat(100_000);
+    for args in [["--set", &arg], ["--record", &arg]] {
+        let e = c.fails(
+            &["run", "Hostile.fmu", args[0], args[1], "-o", "r.csv"],
+            &[],
+        );
+        assert!(e.contains("... (100"), "{}", &e[..e.len().min(2000)]);
+        assert!(e.len() < 2000, "{args:?}: {} bytes", e.len());
+    }
+    // huge and tiny numbers
+    c.write(
+        "huge.json",
+        &SYSTEM.replace("\"stop_time\": 0.01", "\"stop_time\": 1e308"),
+    );
+    let e = c.fails(&["run", "huge.json", "-o", "r.csv"], &[]);
+    assert!(e.contains("1e308 s at a step of 0.001 s"), "{e}");
+    let e = c.fails(
+        &["run", "Hostile.fmu", "--start", "1e308", "-o", "r.csv"],
+        &[],
+    );
+    assert!(e.contains("start_time (1e308), got 1"), "{e}");
+    let e = c.fails(
+        &["run", "Hostile.fmu", "--stop", "1e-300", "-o", "r.csv"],
+        &[],
+    );
+    assert!(e.contains("(1e-300)"), "{e}");
+    let e = c.fails(&["study", "--quick", "--cv-speed", "1e308"], &[]);
+    assert!(e.contains("--cv-speed 1e308: "), "{e}");
+    let out = c.master(&["study", "--quick", "--speeds", "250,1e308"], &[]);
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains(": 1e308 km/h: speeds must lie"), "{e}");
+    assert!(!c.path("r.csv").exists() && !c.path("results").exists());
+}
+
+#[test]
+fn a_default_results_file_leaves_no_other_format_beside_it() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    let run = |args: &[&str]| {
+        let out = c.master(args, &[]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "master {args:?}: {stderr}");
+    };
+    let (csv, meta, parquet) = (
+        c.path("results.csv"),
+        c.path("results.meta.json"),
+        c.path("results.parquet"),
+    );
+    c.write("results.txt", "the user's");
+    c.write("results.meta.parquet", "the user's");
+    run(&["run", "system.json", "--format", "parquet"]);
+    assert!(parquet.is_file() && !csv.exists() && !meta.exists());
+    // small results: CSV by default, and the Parquet file of the earlier run is gone
+    run(&["run", "system.json"]);
+    assert!(csv.is_file() && meta.is_file() && !parquet.exists());
+    run(&["run", "system.json", "--format", "parquet"]);
+    assert!(parquet.is_file() && !csv.exists() && !meta.exists());
+    // a named output leaves the default files alone
+    run(&["run", "system.json", "-o", "named.csv"]);
+    assert!(parquet.is_file() && c.path("named.csv").is_file());
+    // a folder of the default name is not removed
+    std::fs::create_dir(&csv).unwrap();
+    run(&["run", "system.json", "--format", "parquet"]);
+    assert!(csv.is_dir() && parquet.is_file());
+    for f in ["results.txt", "results.meta.parquet"] {
+        assert_eq!(std::fs::read_to_string(c.path(f)).unwrap(), "the user's");
+    }
+}
+
+#[test]
 fn fifos_and_devices_are_refused_without_reading() {
     let c = Case::new();
     hostile_fmu(&c, HOSTILE_MD);
@@ -613,6 +721,19 @@ fn fifos_and_devices_are_refused_without_reading() {
         .success());
     let e = c.fails(&["run", "system.fifo"], &[]);
     assert!(e.contains("not a regular file"), "{e}");
+    // an SSP (a .ssd or a .ssp) likewise, not as a missing file and without blocking
+    for name in ["system.ssd", "system.ssp"] {
+        assert!(Command::new("mkfifo")
+            .arg(c.path(name))
+            .status()
+            .unwrap()
+            .success());
+        let e = c.fails(&["run", name], &[]);
+        assert!(
+            e.contains("not a regular file") && !e.contains("no such file"),
+            "{name}: {e}"
+        );
+    }
     let e = c.fails(&["run", "/dev/zero"], &[]);
     assert!(e.contains("not a regular file"), "{e}");
     c.write(
@@ -744,6 +865,38 @@ fn a_variable_recorded_twice_is_refused() {
     );
     assert!(e.contains("recorded already"), "{e}");
     assert!(!c.path("r.parquet").exists() && !c.path("r.csv").exists());
+}
+
+#[test]
+fn a_failed_study_leaves_no_result_of_an_earlier_one() {
+    let case = Case::new();
+    std::fs::create_dir_all(case.path("out")).unwrap();
+    std::fs::create_dir_all(case.path("no-fmus")).unwrap();
+    let earlier = [
+        "REPORT.md",
+        "study.json",
+        "rms_vs_speed.svg",
+        "rms_vs_speed.csv",
+        "history_force.svg",
+        "cv_sensitivity.csv",
+    ];
+    for f in earlier {
+        case.write(&format!("out/{f}"), "an earlier study's");
+    }
+    case.write("out/notes.svg", "the user's");
+    // the study starts, then finds no FMU
+    let err = case.fails(
+        &["study", "--quick", "--fmus", "no-fmus", "--out", "out"],
+        &[],
+    );
+    assert!(err.contains("not found"), "{err}");
+    for f in earlier {
+        assert!(!case.path(&format!("out/{f}")).exists(), "{f} is left");
+    }
+    assert_eq!(
+        std::fs::read_to_string(case.path("out/notes.svg")).unwrap(),
+        "the user's"
+    );
 }
 
 #[test]

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use super::{CommandError, Context};
 use crate::coupling::{Algorithm, RunOptions};
 use crate::output::{check_outputs_apart, write_json_atomic};
-use crate::results::{csv_metadata_path, write_results, ResultsFormat, RunContext};
+use crate::results::{csv_metadata_path, remove_results, write_results, ResultsFormat, RunContext};
 use crate::ssp::{self, ImportOptions};
 use crate::system::{LoadedSystem, SingleFmuOptions};
 
@@ -21,7 +21,8 @@ pub struct Args {
     /// or a .ssd next to its FMUs), or an .fmu to run alone over its DefaultExperiment.
     pub system: PathBuf,
     /// Results file (time plus recorded variables, units in the header); written atomically.
-    /// Default: results.csv, or results.parquet for large results (see --format).
+    /// Default: results.csv, or results.parquet for large results (see --format); the other
+    /// one of these two, from an earlier run, is then removed (a CSV with its metadata file).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Results format; default: by the extension of --output (.csv, .parquet), else Parquet
@@ -64,7 +65,10 @@ fn parse_algorithm(s: &str) -> Result<Algorithm, String> {
     match s {
         "jacobi" => Ok(Algorithm::Jacobi),
         "gauss-seidel" => Ok(Algorithm::GaussSeidel),
-        _ => Err(format!("'{s}' is neither jacobi nor gauss-seidel")),
+        _ => Err(format!(
+            "'{}' is neither jacobi nor gauss-seidel",
+            crate::show::text(s)
+        )),
     }
 }
 
@@ -81,6 +85,12 @@ impl Args {
             || !self.record.is_empty()
             || self.fmu_logging
     }
+}
+
+/// The results file of a run without --output: `results.csv` or `results.parquet` in the
+/// current folder.
+fn default_output(format: ResultsFormat) -> PathBuf {
+    PathBuf::from(format!("results.{}", format.extension()))
 }
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
@@ -173,7 +183,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     let output = args
         .output
         .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("results.{}", format.extension())));
+        .unwrap_or_else(|| default_output(format));
     if args.output.is_none() || (chosen.is_none() && format == ResultsFormat::Csv) {
         check_outputs_apart(&inputs, &written(&output, format))?;
     }
@@ -182,6 +192,14 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         ..RunContext::default()
     };
     write_results(&output, &out, format, &ctx)?;
+    if args.output.is_none() {
+        // the default file of the other format, from an earlier run, would read as a result
+        // of this one (unless it is an input or the --summary file, which stay)
+        let other = default_output(format.other());
+        if check_outputs_apart(&inputs, &written(&other, format.other())).is_ok() {
+            remove_results(&other, format.other())?;
+        }
+    }
     if let Some(p) = &args.summary {
         write_json_atomic(p, &out.summary)?;
     }

@@ -5,6 +5,7 @@ use std::sync::atomic::Ordering;
 
 use super::exchange::{Dest, Exchange, MergedWrite};
 use super::{Algorithm, CouplingPlan, RunOptions, SimError};
+use crate::show;
 use crate::slave::{FailStatus, ScalarType, Slave, SlaveError, StepStatus, StringTable, VarBatch};
 
 pub(super) struct Engine<'p, 's, 'd, 'o> {
@@ -544,15 +545,15 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                         instance: inst.name.clone(),
                         assignment: format!(
                             "'{}' = {}",
-                            inst.parameter_names
-                                .get(k)
-                                .cloned()
-                                .unwrap_or_else(|| format!("vr {}", v.vr)),
+                            inst.parameter_names.get(k).map_or_else(
+                                || format!("vr {}", v.vr),
+                                |n| show::text(n).to_string()
+                            ),
                             match v.ty {
                                 ScalarType::String => {
-                                    format!("{:?}", self.strings.text(x).unwrap_or(""))
+                                    format!("{:?}", show::text(self.strings.text(x).unwrap_or("")))
                                 }
-                                _ => x.to_string(),
+                                _ => show::num(x).to_string(),
                             }
                         ),
                         source: Box::new(source),

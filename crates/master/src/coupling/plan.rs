@@ -1,6 +1,7 @@
 //! The plan the coupling algorithm runs (validated by [`crate::system`]), its results and
 //! errors, and the checks made before any call.
 
+use crate::show::{num, text};
 use crate::slave::{ScalarType, SlaveError, VarRef};
 
 /// Coupling algorithm.
@@ -209,28 +210,35 @@ pub enum SimError {
         #[source]
         source: Box<SlaveError>,
     },
-    #[error("at t = {time} s: {source}")]
+    #[error("at t = {} s: {source}", num(*.time))]
     Slave {
         time: f64,
         #[source]
         source: Box<SlaveError>,
     },
-    #[error("at t = {time} s: instance '{instance}' discarded the step of {step} s: {reason}")]
+    #[error(
+        "at t = {} s: instance '{instance}' discarded the step of {} s: {reason}",
+        num(*.time),
+        num(*.step)
+    )]
     Discarded {
         time: f64,
         instance: String,
         step: f64,
         reason: String,
     },
-    #[error("at t = {time} s: '{label}' is not finite ({value})")]
+    #[error("at t = {} s: '{label}' is not finite ({value})", num(*.time))]
     NonFinite {
         time: f64,
         label: String,
         value: f64,
     },
-    #[error("cancelled at t = {time} s")]
+    #[error("cancelled at t = {} s", num(*.time))]
     Cancelled { time: f64 },
-    #[error("at t = {time} s: out of memory for the recorded results ({values} values so far)")]
+    #[error(
+        "at t = {} s: out of memory for the recorded results ({values} values so far)",
+        num(*.time)
+    )]
     OutOfMemory { time: f64, values: usize },
 }
 
@@ -272,7 +280,10 @@ impl RunLimits {
             if let Some(v) = std::env::var_os(var) {
                 let s = v.to_string_lossy();
                 *field = s.trim().parse::<u64>().map_err(|_| {
-                    format!("environment variable {var}='{s}' is not a non-negative integer")
+                    format!(
+                        "environment variable {var}='{}' is not a non-negative integer",
+                        text(&s)
+                    )
                 })?;
             }
         }
@@ -286,9 +297,11 @@ impl RunLimits {
         let n = (span_s / step_s).round();
         if n.is_nan() || n > self.max_steps as f64 {
             return Err(format!(
-                "{span_s} s at a step of {step_s} s is {n:e} communication steps, more than the \
-                 {} allowed (a larger step, or raise the limit with the environment variable \
+                "{} s at a step of {} s is {n:e} communication steps, more than the {} \
+                 allowed (a larger step, or raise the limit with the environment variable \
                  {MAX_STEPS_VAR})",
+                num(span_s),
+                num(step_s),
                 self.max_steps
             ));
         }
@@ -360,14 +373,15 @@ pub fn check_plan(plan: &CouplingPlan, n_slaves: usize) -> Result<u64, SimError>
         ));
     }
     if !(plan.step.is_finite() && plan.step > 0.0) {
-        return bad(format!("step must be > 0, got {}", plan.step));
+        return bad(format!("step must be > 0, got {}", num(plan.step)));
     }
     if !(plan.start_time.is_finite() && plan.stop_time.is_finite())
         || plan.stop_time <= plan.start_time
     {
         return bad(format!(
             "stop_time ({}) must be finite and greater than start_time ({})",
-            plan.stop_time, plan.start_time
+            num(plan.stop_time),
+            num(plan.start_time)
         ));
     }
     let span = plan.stop_time - plan.start_time;
@@ -376,8 +390,9 @@ pub fn check_plan(plan: &CouplingPlan, n_slaves: usize) -> Result<u64, SimError>
     let n = (span / plan.step).round();
     if n < 1.0 || (n * plan.step - span).abs() > 1e-9 * span.max(plan.step) {
         return bad(format!(
-            "stop_time - start_time ({span}) is not an integer multiple of step ({})",
-            plan.step
+            "stop_time - start_time ({}) is not an integer multiple of step ({})",
+            num(span),
+            num(plan.step)
         ));
     }
     let mut seen = vec![false; n_slaves];

@@ -549,6 +549,21 @@ fn failure_during_initialisation_names_the_parameter_and_does_not_terminate() {
     );
     // ms is in initialisation mode: fmi2Terminate is not allowed there, only freeing
     assert_eq!(*log.borrow(), vec!["ms:setup", "ms:enter", "sdm:setup"]);
+    // a huge value is named in its short form, not in 309 digits
+    let mut plan = plan;
+    for p in plan.instances[1].parameters.iter_mut() {
+        if p.0.vr == 1 {
+            p.1 = 1e308;
+        }
+    }
+    let (mut a, mut b) = slaves();
+    b.hooks.fail_set_vr = Some(1);
+    let e = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("instance 'sdm': setting start value 'k' = 1e308 failed"),
+        "{e}"
+    );
 }
 
 #[test]

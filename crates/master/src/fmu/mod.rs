@@ -96,7 +96,10 @@ pub enum FmuError {
         entry: String,
         reason: String,
     },
-    #[error("environment variable {variable}='{value}' is not a non-negative integer")]
+    #[error(
+        "environment variable {variable}='{}' is not a non-negative integer",
+        crate::show::text(.value)
+    )]
     LimitSetting {
         variable: &'static str,
         value: String,

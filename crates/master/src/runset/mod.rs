@@ -28,6 +28,7 @@ use serde_json::Value;
 
 use crate::coupling::Summary;
 use crate::output::OutputError;
+use crate::show::text;
 use crate::system::{split_ref, LoadedSystem, SystemDescription, SystemError};
 
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -137,8 +138,10 @@ pub fn run_folder_name(name: &str) -> Result<String, String> {
     }
     if folder.starts_with('.') {
         return Err(format!(
-            "run name '{name}' would be the folder '{folder}': a run folder may not start with \
-             '.' ('.' and '..' are not folders of their own)"
+            "run name '{}' would be the folder '{}': a run folder may not start with '.' ('.' \
+             and '..' are not folders of their own)",
+            text(name),
+            text(&folder)
         ));
     }
     if folder.eq_ignore_ascii_case("sweep.json") {
@@ -214,7 +217,7 @@ impl RunSet {
                 if self.product[*k].is_empty() {
                     return Err(invalid(
                         file,
-                        format!("product.{k}"),
+                        format!("product.{}", text(k)),
                         "empty list of values".into(),
                     ));
                 }
@@ -272,16 +275,20 @@ impl RunSet {
         for (n, (name, params, field)) in sets.into_iter().enumerate() {
             let mut sys = resolved.clone();
             for (key, value) in &params {
-                let f = format!("{field}.{key}");
+                let f = format!("{field}.{}", text(key));
                 let Some((inst, var)) = split_ref(key) else {
                     return Err(invalid(
                         file,
                         f,
-                        format!("'{key}' is not of the form 'instance.variable'"),
+                        format!("'{}' is not of the form 'instance.variable'", text(key)),
                     ));
                 };
                 let Some(spec) = sys.instances.iter_mut().find(|i| i.name == inst) else {
-                    return Err(invalid(file, f, format!("unknown instance '{inst}'")));
+                    return Err(invalid(
+                        file,
+                        f,
+                        format!("unknown instance '{}'", text(inst)),
+                    ));
                 };
                 spec.parameters.insert(var.to_string(), value.clone());
             }

@@ -36,7 +36,9 @@ impl Package {
             .map(str::to_ascii_lowercase);
         match ext.as_deref() {
             Some("ssp") => {
-                let f = std::fs::File::open(path).map_err(|e| read_err(e.to_string()))?;
+                // a FIFO or device is refused without blocking on it or reading it
+                let f =
+                    crate::input::open_regular_file(path).map_err(|e| read_err(e.to_string()))?;
                 let zip = zip::ZipArchive::new(f)
                     .map_err(|e| read_err(format!("not a zip archive: {e}")))?;
                 let limits =
@@ -56,8 +58,13 @@ impl Package {
                 })
             }
             Some("ssd") => {
-                if !path.is_file() {
-                    return Err(read_err("no such file".into()));
+                // the .ssd itself is read later (read_ssd); here only what it is
+                match std::fs::metadata(path) {
+                    Err(e) => return Err(read_err(e.to_string())),
+                    Ok(m) if !m.is_file() => {
+                        return Err(read_err(crate::input::NOT_A_REGULAR_FILE.into()))
+                    }
+                    Ok(_) => {}
                 }
                 Ok(Package::Dir {
                     ssd: path.to_path_buf(),
@@ -172,10 +179,11 @@ impl Package {
     /// Normalises a relative URI reference of the SSD: percent-decoded, `.` and `..`
     /// resolved; `Err` is the reason it is refused.
     pub fn resolve(&self, reference: &str) -> Result<String, String> {
+        let shown = crate::show::text(reference);
         let r = reference.trim();
         if r.contains('#') {
             return Err(format!(
-                "'{reference}' has a fragment (references into other SSDs are not supported)"
+                "'{shown}' has a fragment (references into other SSDs are not supported)"
             ));
         }
         if let Some((scheme, _)) = r.split_once(':') {
@@ -185,17 +193,15 @@ impl Package {
                     .all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c))
             {
                 return Err(format!(
-                    "'{reference}' is an absolute URI (only references relative to the SSD)"
+                    "'{shown}' is an absolute URI (only references relative to the SSD)"
                 ));
             }
         }
         if r.starts_with('/') || r.is_empty() {
-            return Err(format!(
-                "'{reference}' is not a relative reference to a file"
-            ));
+            return Err(format!("'{shown}' is not a relative reference to a file"));
         }
         let decoded = percent_decode(r)
-            .ok_or_else(|| format!("'{reference}' has an invalid percent-encoding"))?;
+            .ok_or_else(|| format!("'{shown}' has an invalid percent-encoding"))?;
         let mut parts: Vec<&str> = Vec::new();
         let in_zip = matches!(self, Package::Zip { .. });
         let mut ups = 0usize;
@@ -205,7 +211,7 @@ impl Package {
                 ".." => {
                     if parts.pop().is_none() {
                         if in_zip {
-                            return Err(format!("'{reference}' points outside the archive"));
+                            return Err(format!("'{shown}' points outside the archive"));
                         }
                         ups += 1;
                     }
@@ -214,7 +220,7 @@ impl Package {
             }
         }
         if parts.is_empty() {
-            return Err(format!("'{reference}' names no file"));
+            return Err(format!("'{shown}' names no file"));
         }
         let mut out = "../".repeat(ups);
         out.push_str(&parts.join("/"));
@@ -227,7 +233,7 @@ fn read_file_limited(path: &Path, limit: u64) -> Result<String, SspError> {
         path: path.to_path_buf(),
         reason,
     };
-    let f = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
+    let f = crate::input::open_regular_file(path).map_err(|e| err(e.to_string()))?;
     let mut buf = Vec::new();
     f.take(limit + 1)
         .read_to_end(&mut buf)

@@ -6,6 +6,7 @@ use roxmltree::Node;
 use super::ssv::{self, Mapping, ParameterSet};
 use super::xml::{self, elements, is, line, Ctx, NS_SSC, NS_SSD};
 use super::SspError;
+use crate::show;
 
 /// SSP's connector types as far as FMI 2.0 has them.
 #[derive(Debug, Clone, PartialEq)]
@@ -119,7 +120,10 @@ pub(super) fn parse(file: &str, text: &str) -> Result<Ssd, SspError> {
     if !(version == "2.0" || version == "1.0" || version.starts_with("1.0-")) {
         return Err(ctx.unsupported(
             root,
-            format!("SSP version '{version}' (1.0 and 2.0 are read)"),
+            format!(
+                "SSP version '{}' (1.0 and 2.0 are read)",
+                show::text(&version)
+            ),
         ));
     }
     let mut system = None;
@@ -408,7 +412,12 @@ fn parse_connection(ctx: Ctx, e: Node) -> Result<Connection, SspError> {
                 if factor != 1.0 || offset != 0.0 {
                     return Err(ctx.unsupported(
                         t,
-                        format!("connection transformation (factor {factor}, offset {offset}): the master copies values unchanged"),
+                        format!(
+                            "connection transformation (factor {}, offset {}): the master \
+                             copies values unchanged",
+                            show::num(factor),
+                            show::num(offset)
+                        ),
                     ));
                 }
             }
@@ -441,7 +450,10 @@ fn check_source_base(ctx: Ctx, n: Node) -> Result<(), SspError> {
         "SSD" => Ok(()),
         other => Err(ctx.unsupported(
             n,
-            format!("sourceBase=\"{other}\" (sources relative to the SSD only)"),
+            format!(
+                "sourceBase=\"{}\" (sources relative to the SSD only)",
+                show::text(other)
+            ),
         )),
     }
 }
@@ -456,7 +468,9 @@ fn parse_bindings(ctx: Ctx, n: Node) -> Result<Vec<Binding>, SspError> {
             .attribute("type")
             .unwrap_or("application/x-ssp-parameter-set");
         if ty != "application/x-ssp-parameter-set" {
-            return Err(ctx.unsupported(b, format!("parameter binding of type '{ty}'")));
+            return Err(
+                ctx.unsupported(b, format!("parameter binding of type '{}'", show::text(ty)))
+            );
         }
         check_source_base(ctx, b)?;
         let mut inline = None;
@@ -480,9 +494,10 @@ fn parse_bindings(ctx: Ctx, n: Node) -> Result<Vec<Binding>, SspError> {
                         .attribute("type")
                         .unwrap_or("application/x-ssp-parameter-mapping");
                     if mty != "application/x-ssp-parameter-mapping" {
-                        return Err(
-                            ctx.unsupported(c, format!("parameter mapping of type '{mty}'"))
-                        );
+                        return Err(ctx.unsupported(
+                            c,
+                            format!("parameter mapping of type '{}'", show::text(mty)),
+                        ));
                     }
                     check_source_base(ctx, c)?;
                     mapping = Some(match c.attribute("source") {

@@ -5,6 +5,7 @@ use roxmltree::Node;
 
 use super::xml::{self, elements, is, line, qualified, scalar, Ctx, NS_SSC, NS_SSM, NS_SSV};
 use super::SspError;
+use crate::show;
 
 /// A scalar parameter value by SSP type family.
 #[derive(Debug, Clone, PartialEq)]
@@ -71,7 +72,7 @@ fn check_version(ctx: Ctx, n: Node) -> Result<(), SspError> {
     if v == "1.0" || v == "2.0" || v.starts_with("1.0-") {
         Ok(())
     } else {
-        Err(ctx.unsupported(n, format!("<{}> version '{v}'", qualified(n))))
+        Err(ctx.unsupported(n, format!("<{}> version '{}'", qualified(n), show::text(v))))
     }
 }
 
@@ -143,20 +144,20 @@ fn parse_parameter(ctx: Ctx, p: Node) -> Result<Parameter, SspError> {
                     s.parse::<f64>()
                         .ok()
                         .filter(|x| x.is_finite())
-                        .ok_or_else(|| bad(&format!("value \"{s}\" is not a finite number")))?,
+                        .ok_or_else(|| bad(&format!("value \"{}\" is not a finite number", show::text(s))))?,
                 )
             }
             "Integer" | "Int32" | "Int8" | "UInt8" | "Int16" | "UInt16" => {
                 let s = scalar(ctx, t)?;
                 let x = s
                     .parse::<i64>()
-                    .map_err(|_| bad(&format!("value \"{s}\" is not an integer")))?;
+                    .map_err(|_| bad(&format!("value \"{}\" is not an integer", show::text(s))))?;
                 Value::Integer(x)
             }
             "Boolean" => match scalar(ctx, t)? {
                 "true" | "1" => Value::Boolean(true),
                 "false" | "0" => Value::Boolean(false),
-                s => return Err(bad(&format!("value \"{s}\" is not true or false"))),
+                s => return Err(bad(&format!("value \"{}\" is not true or false", show::text(s)))),
             },
             "String" => {
                 if elements(t).next().is_some() {

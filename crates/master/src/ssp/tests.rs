@@ -569,3 +569,59 @@ fn broken_archives_are_refused() {
     )]);
     assert!(e.contains("XML syntax error") || e.contains("DTD"), "{e}");
 }
+
+/// `import(path)` on another thread, its message; a call that blocks (on a FIFO) fails the
+/// test instead of hanging it.
+#[cfg(unix)]
+fn import_message_within_seconds(path: &Path) -> String {
+    let path = path.to_path_buf();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(
+            import(&path, &ImportOptions::default())
+                .map(|_| ())
+                .map_err(|e| e.to_string()),
+        );
+    });
+    match rx.recv_timeout(std::time::Duration::from_secs(20)) {
+        Ok(r) => r.expect_err("imported although it should not"),
+        Err(_) => panic!("import blocks"),
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn a_fifo_or_folder_is_refused_as_not_a_regular_file() {
+    let d = tempfile::tempdir().unwrap();
+    let mkfifo = |p: &Path| {
+        let made = std::process::Command::new("mkfifo").arg(p).status();
+        assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+    };
+    for name in ["fifo.ssd", "fifo.ssp"] {
+        let p = d.path().join(name);
+        mkfifo(&p);
+        let e = import_message_within_seconds(&p);
+        assert!(
+            e.contains(name) && e.contains("not a regular file") && !e.contains("no such file"),
+            "{e}"
+        );
+    }
+    let folder = d.path().join("folder.ssd");
+    std::fs::create_dir(&folder).unwrap();
+    let e = import_message_within_seconds(&folder);
+    assert!(e.contains("not a regular file"), "{e}");
+    // a parameter set next to a bare .ssd that is a FIFO
+    std::fs::create_dir(d.path().join("resources")).unwrap();
+    std::fs::write(d.path().join("resources/ms.fmu"), fmu_bytes()).unwrap();
+    mkfifo(&d.path().join("a_params.ssv"));
+    let ssd = d.path().join("SystemStructure.ssd");
+    std::fs::write(&ssd, format!("{HEAD}{OSP_SSD}")).unwrap();
+    let e = import_message_within_seconds(&ssd);
+    assert!(
+        e.contains("a_params.ssv") && e.contains("not a regular file"),
+        "{e}"
+    );
+    // a missing one is still named as missing
+    let e = import_message_within_seconds(&d.path().join("none.ssd"));
+    assert!(e.contains("No such file"), "{e}");
+}

@@ -5,6 +5,7 @@
 use roxmltree::{Document, Node};
 
 use super::SspError;
+use crate::show;
 
 pub(super) const NS_SSD: &str = "http://ssp-standard.org/SSP1/SystemStructureDescription";
 pub(super) const NS_SSC: &str = "http://ssp-standard.org/SSP1/SystemStructureCommon";
@@ -105,7 +106,11 @@ impl Ctx<'_> {
                 .ok_or_else(|| {
                     self.err(
                         n,
-                        format!("<{} {attr}=\"{v}\">: not a finite number", qualified(n)),
+                        format!(
+                            "<{} {attr}=\"{}\">: not a finite number",
+                            qualified(n),
+                            show::text(v)
+                        ),
                     )
                 }),
         }
@@ -117,7 +122,11 @@ impl Ctx<'_> {
             Some(v) => v.trim().parse::<i64>().map(Some).map_err(|_| {
                 self.err(
                     n,
-                    format!("<{} {attr}=\"{v}\">: not an integer", qualified(n)),
+                    format!(
+                        "<{} {attr}=\"{}\">: not an integer",
+                        qualified(n),
+                        show::text(v)
+                    ),
                 )
             }),
         }
@@ -130,7 +139,11 @@ impl Ctx<'_> {
             Some("false") | Some("0") => Ok(Some(false)),
             Some(v) => Err(self.err(
                 n,
-                format!("<{} {attr}=\"{v}\">: not true or false", qualified(n)),
+                format!(
+                    "<{} {attr}=\"{}\">: not true or false",
+                    qualified(n),
+                    show::text(v)
+                ),
             )),
         }
     }
@@ -143,7 +156,11 @@ pub(super) fn scalar<'a>(ctx: Ctx, n: Node<'a, '_>) -> Result<&'a str, SspError>
     if v.split_whitespace().count() > 1 {
         return Err(ctx.unsupported(
             n,
-            format!("array value \"{v}\" of <{}> (scalars only)", qualified(n)),
+            format!(
+                "array value \"{}\" of <{}> (scalars only)",
+                show::text(v),
+                qualified(n)
+            ),
         ));
     }
     Ok(v.trim())

@@ -35,6 +35,7 @@ use serde_json::Value;
 use crate::coupling::{Algorithm, RunOptions, SimError, SimOutput};
 use crate::fmu::{FmuArchive, FmuError};
 use crate::model_description::{ModelDescription, VarType, Variable};
+use crate::show::text;
 use crate::slave::ScalarType;
 
 fn default_alg() -> Algorithm {
@@ -230,7 +231,8 @@ pub fn json_value_for(
             .map(|i| f64::from(i.value))
             .ok_or_else(|| {
                 format!(
-                    "'{name}' is no item of this enumeration; items: {}",
+                    "'{}' is no item of this enumeration; items: {}",
+                    text(name),
                     item_names()
                 )
             }),
@@ -251,7 +253,14 @@ pub fn json_value_for(
             };
             Ok(k as f64)
         }
-        (t, v) => Err(format!("a {t} variable cannot take the value {v}")),
+        (t, Value::String(s)) => Err(format!(
+            "a {t} variable cannot take the value {:?}",
+            text(s)
+        )),
+        (t, v) => Err(format!(
+            "a {t} variable cannot take the value {}",
+            text(&v.to_string())
+        )),
     }
 }
 
@@ -370,7 +379,7 @@ impl LoadedSystem {
             return Err(self.invalid(
                 field,
                 s,
-                format!("'{s}' is not of the form 'instance.variable'"),
+                format!("'{}' is not of the form 'instance.variable'", text(s)),
             ));
         };
         let Some(i) = self.instance_index(inst) else {
@@ -386,7 +395,7 @@ impl LoadedSystem {
                 .map(|n| format!(" (did you mean '{n}'?)"))
                 .next()
                 .unwrap_or_else(|| format!(" (instances: {})", names.join(", ")));
-            return Err(self.invalid(field, s, format!("unknown instance '{inst}'{hint}")));
+            return Err(self.invalid(field, s, format!("unknown instance '{}'{hint}", text(inst))));
         };
         let md = models[i];
         match md.variable(var) {
@@ -400,7 +409,8 @@ impl LoadedSystem {
                     field,
                     s,
                     format!(
-                        "unknown variable '{s}' in instance '{inst}' (model '{}'){hint}",
+                        "unknown variable '{}' in instance '{inst}' (model '{}'){hint}",
+                        text(s),
                         md.model_name
                     ),
                 ))

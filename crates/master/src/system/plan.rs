@@ -10,6 +10,7 @@ use crate::coupling::{
     topological_order, Algorithm, ColumnInfo, CouplingPlan, PlanConnection, PlanInstance, Recorded,
 };
 use crate::model_description::{Causality, ModelDescription};
+use crate::show::{num, text};
 use crate::slave::VarRef;
 
 impl LoadedSystem {
@@ -31,7 +32,7 @@ impl LoadedSystem {
             return Err(self.invalid(
                 "step",
                 "step",
-                format!("must be a positive number, got {}", d.step),
+                format!("must be a positive number, got {}", num(d.step)),
             ));
         }
         self.check_stop_time(d.stop_time)?;
@@ -45,7 +46,7 @@ impl LoadedSystem {
                     &inst.name,
                     format!(
                         "'{}' is not a valid instance name (non-empty, no '.')",
-                        inst.name
+                        text(&inst.name)
                     ),
                 ));
             }
@@ -53,7 +54,7 @@ impl LoadedSystem {
                 return Err(self.invalid(
                     f,
                     &inst.name,
-                    format!("instance name '{}' is used twice", inst.name),
+                    format!("instance name '{}' is used twice", text(&inst.name)),
                 ));
             }
             if inst.step_multiple == 0 {
@@ -199,14 +200,14 @@ impl LoadedSystem {
                         return Err(self.invalid(
                             format!("order[{k}]"),
                             n,
-                            format!("unknown instance '{n}'"),
+                            format!("unknown instance '{}'", text(n)),
                         ));
                     };
                     if order.contains(&i) {
                         return Err(self.invalid(
                             format!("order[{k}]"),
                             n,
-                            format!("instance '{n}' appears twice"),
+                            format!("instance '{}' appears twice", text(n)),
                         ));
                     }
                     order.push(i);
@@ -333,8 +334,9 @@ impl LoadedSystem {
                 "stop_time",
                 "stop_time",
                 format!(
-                    "must be greater than start_time ({}), got {stop_time}",
-                    d.start_time
+                    "must be greater than start_time ({}), got {}",
+                    num(d.start_time),
+                    num(stop_time)
                 ),
             ));
         }
@@ -350,8 +352,9 @@ impl LoadedSystem {
                 "step",
                 "step",
                 format!(
-                    "stop_time - start_time = {span} s is not an integer multiple of step = {} s",
-                    d.step
+                    "stop_time - start_time = {} s is not an integer multiple of step = {} s",
+                    num(span),
+                    num(d.step)
                 ),
             ));
         }
@@ -372,7 +375,7 @@ pub(super) fn start_value(
     strings: &mut Vec<String>,
     invalid: &Invalid,
 ) -> Result<(VarRef, f64), SystemError> {
-    let field = format!("instances[{i}].parameters.{name}");
+    let field = format!("instances[{i}].parameters.{}", text(name));
     let Some((_, v)) = md.variable(name) else {
         let hint = md
             .suggest(name)
@@ -382,7 +385,8 @@ pub(super) fn start_value(
             field,
             name,
             format!(
-                "unknown variable '{name}' in model '{}'{hint}",
+                "unknown variable '{}' in model '{}'{hint}",
+                text(name),
                 md.model_name
             ),
         ));

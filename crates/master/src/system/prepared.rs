@@ -11,6 +11,7 @@ use super::plan::start_value;
 use super::{split_ref, LoadedSystem, RunError, SystemError};
 use crate::coupling::{simulate, CouplingPlan, RunOptions, SimOutput};
 use crate::fmu::{FmuSlave, PreparedFmu};
+use crate::show::text;
 use crate::slave::{Slave, VarRef};
 
 /// What one run of a [`PreparedSystem`] changes: validated, typed start values (replacing the
@@ -114,7 +115,7 @@ impl PreparedSystem {
                 return Err(invalid(
                     key.clone(),
                     key,
-                    format!("'{key}' is not of the form 'instance.variable'"),
+                    format!("'{}' is not of the form 'instance.variable'", text(key)),
                 ));
             };
             let instances = &self.system.desc.instances;
@@ -122,7 +123,7 @@ impl PreparedSystem {
                 return Err(invalid(
                     key.clone(),
                     key,
-                    format!("unknown instance '{inst}'"),
+                    format!("unknown instance '{}'", text(inst)),
                 ));
             };
             let (v, x) = start_value(i, self.fmus[i].model(), var, value, &mut strings, &invalid)?;

@@ -10,6 +10,7 @@ use super::{InstanceSpec, LoadedSystem, SystemDescription, SystemError};
 use crate::coupling::Algorithm;
 use crate::fmu::FmuArchive;
 use crate::model_description::{Causality, ModelDescription};
+use crate::show::text;
 
 /// What a single-FMU run changes from the FMU's own defaults.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -105,7 +106,7 @@ impl LoadedSystem {
             let Some((k, v)) = s.split_once('=') else {
                 return Err(invalid(
                     "--set",
-                    format!("'{s}' is not of the form NAME=VALUE"),
+                    format!("'{}' is not of the form NAME=VALUE", text(s)),
                 ));
             };
             parameters.insert(k.trim().to_string(), parse_set_value(v.trim()));

@@ -140,7 +140,11 @@ pub fn characterise_actuator(
         .iter()
         .find(|a| !(a.is_finite() && **a > 0.0))
     {
-        return Err(option_err("amplitude/alpha", bad, "must be finite and > 0"));
+        return Err(option_err(
+            "amplitude/alpha",
+            master::show::num(bad),
+            "must be finite and > 0",
+        ));
     }
     let freqs = log_space(opts.band_hz.0, opts.band_hz.1, opts.points);
     let models = [ActuatorModel::FullOrder, ActuatorModel::ReducedOrder];

@@ -120,7 +120,11 @@ impl ResultsTable {
                     bad_file(
                         path,
                         no,
-                        format!("'{f}' in column '{}' is not a number", names[k]),
+                        format!(
+                            "'{}' in column '{}' is not a number",
+                            master::show::text(f),
+                            master::show::text(&names[k])
+                        ),
                     )
                 })?;
                 if !v.is_finite() {
@@ -524,7 +528,7 @@ pub fn assess_table(
     if !(speed_kmh.is_finite() && speed_kmh > 0.0) {
         return Err(AnalysisError::Option {
             option: "--speed",
-            value: speed_kmh.to_string(),
+            value: master::show::num(speed_kmh).to_string(),
             reason: "must be a speed > 0 km/h".into(),
         });
     }

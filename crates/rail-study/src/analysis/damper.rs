@@ -79,7 +79,11 @@ pub(super) fn check_band(
     if !(band.0.is_finite() && band.1.is_finite() && band.0 > 0.0 && band.1 > band.0) {
         return Err(option_err(
             option,
-            format!("{}..{}", band.0, band.1),
+            format!(
+                "{}..{}",
+                master::show::num(band.0),
+                master::show::num(band.1)
+            ),
             "needs 0 < low < high",
         ));
     }

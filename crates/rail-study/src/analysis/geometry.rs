@@ -68,7 +68,12 @@ impl ProfileSource {
 /// Parses a rail inclination: `1:40`, `1/40`, a decimal tangent (`0.025`) or `0`.
 pub fn parse_inclination(s: &str) -> Result<f64, String> {
     let t = s.trim();
-    let bad = || format!("'{s}' is not an inclination (use 1:40, 1:20, 0 or a tangent like 0.025)");
+    let bad = || {
+        format!(
+            "'{}' is not an inclination (use 1:40, 1:20, 0 or a tangent like 0.025)",
+            master::show::text(s)
+        )
+    };
     let v = if let Some((a, b)) = t.split_once([':', '/']) {
         let a: f64 = a.trim().parse().map_err(|_| bad())?;
         let b: f64 = b.trim().parse().map_err(|_| bad())?;
@@ -230,7 +235,7 @@ pub fn setup_of(inputs: &GeometryInputs) -> Result<ContactSetup, AnalysisError> 
 pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
     let bad = |option: &'static str, v: f64, reason: &str| AnalysisError::Option {
         option,
-        value: v.to_string(),
+        value: master::show::num(v).to_string(),
         reason: reason.to_string(),
     };
     if !(inputs.step_m.is_finite() && inputs.step_m > 0.0) {

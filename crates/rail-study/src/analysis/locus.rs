@@ -129,7 +129,10 @@ pub fn parse_damper(s: &str) -> Result<DamperSpec, String> {
         };
         match body.parse::<f64>() {
             Ok(v) if v.is_finite() && v >= 0.0 => Ok(v * scale),
-            _ => Err(format!("'{t}' is not a non-negative number")),
+            _ => Err(format!(
+                "'{}' is not a non-negative number",
+                master::show::text(t)
+            )),
         }
     };
     let parts: Vec<&str> = s.trim().split(':').collect();
@@ -138,7 +141,7 @@ pub fn parse_damper(s: &str) -> Result<DamperSpec, String> {
     let plain = |t: &str| -> Result<f64, String> {
         t.trim()
             .parse::<f64>()
-            .map_err(|_| format!("'{}' is not a number", t.trim()))
+            .map_err(|_| format!("'{}' is not a number", master::show::text(t.trim())))
     };
     match parts.as_slice() {
         ["passive"] => Ok(DamperSpec::Passive),
@@ -164,7 +167,7 @@ pub fn parse_damper(s: &str) -> Result<DamperSpec, String> {
                 freq,
             )?))
         }
-        _ => Err(format!("'{s}': {usage}")),
+        _ => Err(format!("'{}': {usage}", master::show::text(s))),
     }
 }
 
@@ -228,7 +231,7 @@ impl DamperSpec {
 pub fn speed_grid_kmh(from: f64, to: f64, step: f64) -> Result<Vec<f64>, AnalysisError> {
     let bad = |option: &'static str, v: f64, reason: &str| AnalysisError::Option {
         option,
-        value: v.to_string(),
+        value: master::show::num(v).to_string(),
         reason: reason.to_string(),
     };
     let max = CRITICAL_SEARCH_MPS.1 * 3.6;

@@ -49,7 +49,7 @@ pub enum AnalysisError {
     /// A results table or signal that cannot be assessed (message names file, line, column).
     #[error("{0}")]
     Input(String),
-    #[error("invalid option {option} = {value}: {reason}")]
+    #[error("invalid option {option} = {}: {reason}", master::show::text(.value))]
     Option {
         option: &'static str,
         value: String,

@@ -8,12 +8,14 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use crate::study::report::output_files;
 use crate::study::{
     run_study, write_outputs, Sources, StudyError, StudyOptions, StudySettings, Timing, TrackLevel,
     VehicleModel,
 };
 use master::cli::{CommandError, Context};
 use master::results::ResultsFormat;
+use master::show;
 
 /// Run the stability study and write REPORT.md, plots and CSVs.
 #[derive(Debug, clap::Args)]
@@ -27,7 +29,8 @@ pub struct Args {
     /// Folder with the FMUs (RailVehicle.fmu, Bogie2Dof.fmu, SemiActiveDamper.fmu, ...).
     #[arg(long)]
     pub fmus: Option<PathBuf>,
-    /// Output folder.
+    /// Output folder. An earlier study's report, figures and tables in it are removed when
+    /// the study starts (the user's other files stay).
     #[arg(long, default_value = "results")]
     pub out: PathBuf,
     /// Reduced study for CI: 1 seed, shorter runs, fewer speeds, coarser bisection.
@@ -94,10 +97,11 @@ fn parse_speed(text: &str) -> Result<f64, String> {
     let v: f64 = text
         .trim()
         .parse()
-        .map_err(|_| format!("'{text}' is not a speed in km/h"))?;
+        .map_err(|_| format!("'{}' is not a speed in km/h", show::text(text)))?;
     if !SPEED_RANGE_KMH.contains(&v) {
         return Err(format!(
-            "{v} km/h: speeds must lie between {} and {} km/h",
+            "{} km/h: speeds must lie between {} and {} km/h",
+            show::num(v),
             SPEED_RANGE_KMH.start(),
             SPEED_RANGE_KMH.end()
         ));
@@ -118,16 +122,20 @@ fn parse_speeds(text: &str) -> Result<SpeedList, String> {
             let step: f64 = step
                 .trim()
                 .parse()
-                .map_err(|_| format!("'{step}' is not a speed step in km/h"))?;
+                .map_err(|_| format!("'{}' is not a speed step in km/h", show::text(step)))?;
             if !(step.is_finite() && step >= 0.1) || to < from {
                 return Err(format!(
-                    "{text}: FROM:TO:STEP needs FROM <= TO and a step of at least 0.1 km/h"
+                    "{}: FROM:TO:STEP needs FROM <= TO and a step of at least 0.1 km/h",
+                    show::text(text)
                 ));
             }
             // slack for rounding only: TO is in when the step divides the range, never past it
             let n = ((to - from) / step + 1e-9).floor();
             if n >= MAX_SPEEDS as f64 {
-                return Err(format!("{text}: more than {MAX_SPEEDS} speeds"));
+                return Err(format!(
+                    "{}: more than {MAX_SPEEDS} speeds",
+                    show::text(text)
+                ));
             }
             (0..=n as usize)
                 .map(|k| to_tenth(from + k as f64 * step))
@@ -138,7 +146,12 @@ fn parse_speeds(text: &str) -> Result<SpeedList, String> {
             .split(',')
             .map(|v| parse_speed(v).map(to_tenth))
             .collect::<Result<Vec<_>, _>>()?,
-        _ => return Err(format!("'{text}': FROM:TO:STEP or a list V,V,...")),
+        _ => {
+            return Err(format!(
+                "'{}': FROM:TO:STEP or a list V,V,...",
+                show::text(text)
+            ))
+        }
     };
     speeds.sort_by(f64::total_cmp);
     speeds.dedup();
@@ -180,7 +193,8 @@ fn chosen_configurations(
 ) -> Result<Vec<&'static str>, CommandError> {
     if let Some(bad) = ids.iter().find(|id| !available.contains(&id.trim())) {
         return Err(CommandError::Failed(format!(
-            "--configurations: '{bad}' is not a configuration of this vehicle (one of {})",
+            "--configurations: '{}' is not a configuration of this vehicle (one of {})",
+            show::text(bad),
             available.join(", ")
         )));
     }
@@ -199,7 +213,12 @@ fn parse_seeds(text: &str) -> Result<SeedList, String> {
             .parse()
             .ok()
             .filter(|&s| s <= MAX_SEED)
-            .ok_or_else(|| format!("'{part}' is not a track seed (0 to {MAX_SEED})"))?;
+            .ok_or_else(|| {
+                format!(
+                    "'{}' is not a track seed (0 to {MAX_SEED})",
+                    show::text(part)
+                )
+            })?;
         if !seeds.contains(&seed) {
             seeds.push(seed);
         }
@@ -251,7 +270,8 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     if let Some(v) = args.cv_speed {
         if !SPEED_RANGE_KMH.contains(&v) {
             return Err(CommandError::Failed(format!(
-                "--cv-speed {v}: the speed of the c_v runs must lie between {} and {} km/h",
+                "--cv-speed {}: the speed of the c_v runs must lie between {} and {} km/h",
+                show::num(v),
                 SPEED_RANGE_KMH.start(),
                 SPEED_RANGE_KMH.end()
             )));
@@ -285,19 +305,10 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         settings.planned_runs(),
         args.out.display()
     );
-    // An interrupted or failed study must not leave the previous report looking current: it
-    // is removed before the first run and written again only when every output is ready.
-    for old in ["REPORT.md", "study.json"] {
-        match std::fs::remove_file(args.out.join(old)) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(CommandError::Failed(format!(
-                    "cannot remove the previous '{}': {e}",
-                    args.out.join(old).display()
-                )))
-            }
-            _ => {}
-        }
-    }
+    // An interrupted or failed study must not leave the previous study's results looking
+    // current: its report, figures and tables are removed before the first run and written
+    // again only when every output is ready.
+    remove_earlier_outputs(&args.out)?;
     // bisection rounds of an earlier study beyond this one's would be left beside its runs
     remove_batches(&args.out.join("runs"), "bisect-")?;
     let results = run_study(&settings, &opts)?;
@@ -322,6 +333,30 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         timing.sim_per_wall(&results),
         args.out.join("REPORT.md").display()
     );
+    Ok(())
+}
+
+/// Removes the files an earlier study wrote into `out` ([`output_files`]: report, figures,
+/// tables): regular files (and symbolic links) of these names only; a user's other files, and
+/// a folder or FIFO of such a name, stay.
+fn remove_earlier_outputs(out: &std::path::Path) -> Result<(), CommandError> {
+    for name in output_files() {
+        let path = out.join(name);
+        let ours = std::fs::symlink_metadata(&path)
+            .is_ok_and(|m| m.file_type().is_file() || m.file_type().is_symlink());
+        if !ours {
+            continue;
+        }
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(CommandError::Failed(format!(
+                    "cannot remove the previous '{}': {e}",
+                    path.display()
+                )))
+            }
+            _ => {}
+        }
+    }
     Ok(())
 }
 
@@ -427,6 +462,47 @@ mod tests {
             e.contains("at 51.4 km/h") && e.contains("is 51.5 km/h"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn an_earlier_studys_outputs_are_removed_and_nothing_else() {
+        let d = tempfile::tempdir().unwrap();
+        let out = d.path();
+        let earlier = [
+            "REPORT.md",
+            "study.json",
+            "rms_vs_speed.svg",
+            "rms_vs_speed.csv",
+            "history_carbody.svg",
+            "cv_sensitivity.csv",
+        ];
+        for f in earlier {
+            std::fs::write(out.join(f), "an earlier study's").unwrap();
+        }
+        let users = [
+            "notes.svg",
+            "my_table.csv",
+            "cv_sensitivity.svg",
+            "REPORT.txt",
+        ];
+        for f in users {
+            std::fs::write(out.join(f), "the user's").unwrap();
+        }
+        std::fs::create_dir(out.join("perturbation.svg")).unwrap();
+        remove_earlier_outputs(out).unwrap();
+        for f in earlier {
+            assert!(!out.join(f).exists(), "{f} is left");
+        }
+        for f in users {
+            assert_eq!(
+                std::fs::read_to_string(out.join(f)).unwrap(),
+                "the user's",
+                "{f}"
+            );
+        }
+        assert!(out.join("perturbation.svg").is_dir());
+        // no folder yet: nothing to remove
+        remove_earlier_outputs(&out.join("none")).unwrap();
     }
 
     #[test]

@@ -105,7 +105,7 @@ pub fn fleet(
     if inputs.amplitude_max_m < FIGURE_AMPLITUDE_M - 1e-12 {
         return Err(AnalysisError::Option {
             option: "--amplitude-max",
-            value: (inputs.amplitude_max_m * 1e3).to_string(),
+            value: master::show::num(inputs.amplitude_max_m * 1e3).to_string(),
             reason: "must be at least 3 mm for the fleet table (its figure is at 3 mm)".into(),
         });
     }

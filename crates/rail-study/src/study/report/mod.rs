@@ -131,6 +131,43 @@ fn fmt_opt(v: Option<f64>, scale: f64, prec: usize) -> String {
     v.map_or("failed".to_string(), |x| format!("{:.*}", prec, x * scale))
 }
 
+/// The figures a study may write into its output folder, each as `<stem>.svg` with its data
+/// in `<stem>.csv` (which of them depends on the vehicle and on the runs that succeeded).
+pub const FIGURE_STEMS: [&str; 17] = [
+    "rms_vs_speed",
+    "carbody_vs_speed",
+    "comfort_vs_speed",
+    "history_displacement",
+    "history_acceleration",
+    "history_force",
+    "history_command",
+    "history_carbody",
+    "full_active_force",
+    "perturbation",
+    "mppt_command_closed_start",
+    "mppt_command_open_start",
+    "slow_valve_displacement",
+    "slow_valve_opening",
+    "skyhook_valve_zoom",
+    "cv_acceleration",
+    "cv_force",
+];
+
+/// The names of every file [`write_outputs`] may write into a study's output folder: the
+/// figures and their CSVs, the c_v table, `study.json` and `REPORT.md`.
+pub fn output_files() -> Vec<String> {
+    let mut files: Vec<String> = FIGURE_STEMS
+        .iter()
+        .flat_map(|stem| [format!("{stem}.svg"), format!("{stem}.csv")])
+        .collect();
+    files.extend(
+        ["cv_sensitivity.csv", "study.json", "REPORT.md"]
+            .iter()
+            .map(|f| f.to_string()),
+    );
+    files
+}
+
 /// Writes every output file and REPORT.md into `out`; returns the report text.
 pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<String, StudyError> {
     std::fs::create_dir_all(out).map_err(|source| master::output::OutputError::Io {

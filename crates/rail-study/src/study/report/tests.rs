@@ -215,6 +215,18 @@ fn outputs_are_written_even_without_time_histories() {
 }
 
 #[test]
+fn every_file_the_outputs_write_is_one_a_new_study_removes_first() {
+    let names = output_files();
+    for vehicle in [VehicleModel::Bogie2Dof, VehicleModel::Coach] {
+        let (d, _) = outputs_of(&results_on(vehicle));
+        for e in std::fs::read_dir(d.path()).unwrap() {
+            let name = e.unwrap().file_name().to_string_lossy().to_string();
+            assert!(names.contains(&name), "{vehicle:?}: {name} is not listed");
+        }
+    }
+}
+
+#[test]
 fn the_coach_report_has_the_car_body_beside_the_en14363_verdict() {
     let r = results_on(VehicleModel::Coach);
     assert_eq!(comfort_speeds(&r), [280.0, 290.0]);
