@@ -84,6 +84,7 @@ pub fn table_from_columns(
         columns,
         sampling: None,
         described: full_rate,
+        text_columns: Vec::new(),
     };
     if full_rate {
         table.sampling = Some(Sampling::full_rate(

@@ -118,3 +118,18 @@ def test_messages_name_the_python_arguments_not_the_command_options(hunting, tmp
     assert "--" not in str(e.value)
     a = railfmu.assess_stability(path, SIGNALS, 320.0, skip_s=5.0, accept_narrow_band=True)
     assert len(a.notes) == 1 and "accept_narrow_band=True" in a.notes[0] and "--" not in a.notes[0]
+
+
+def test_a_file_with_text_columns_is_assessed_on_its_numeric_signals(dist, hunting, tmp_path):
+    # the passive run again, recording an Enumeration and a String beside the accelerations
+    desc = passive(dist, 12.0)
+    desc["record"] = list(desc["record"]) + ["bogie.contact.model", "bogie.contact.table"]
+    res = railfmu.System.from_dict(desc).run({"bogie.vehicle.speed": 320.0 / 3.6})
+    path = tmp_path / "typed.csv"
+    res.to_csv(path)
+    assert "bogie.contact.model (item)" in path.read_text().splitlines()[0]
+    a = railfmu.assess_stability(hunting, SIGNALS, 320.0, skip_s=5.0)
+    f = railfmu.assess_stability(path, SIGNALS, 320.0, skip_s=5.0)
+    assert f.max_rms == pytest.approx(a.max_rms, rel=1e-12)
+    with pytest.raises(railfmu.AssessmentError, match=r"column 'bogie.contact.table' is not a number.*is not numeric"):
+        railfmu.assess_stability(path, ["bogie.contact.table"], 320.0, skip_s=5.0)

@@ -772,6 +772,49 @@ fn assess_reports_the_en14363_verdict_and_refuses_bad_input() {
         r.stdout
     );
     check_files(&out, &["assess.csv", "assess.svg", "assess_summary.csv"]);
+    let max_rms = number_after(&r.stdout, "max rms");
+    // the same record with the text columns a recorded Enumeration and String give
+    let with_text = dir.path().join("with_text.csv");
+    let mut lines = text.lines();
+    let mut text2 = format!(
+        "{},contact.model,contact.model (item),contact.table\n",
+        lines.next().unwrap()
+    );
+    for line in lines {
+        text2.push_str(&format!("{line},1,nonlinear,AA\n"));
+    }
+    std::fs::write(&with_text, text2).unwrap();
+    let with_text_s = with_text.to_str().unwrap();
+    let text_out = dir.path().join("t");
+    let r = master(&[
+        "assess",
+        with_text_s,
+        "--signal",
+        "front",
+        "--speed",
+        "300",
+        "--out",
+        text_out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    assert_eq!(number_after(&r.stdout, "max rms"), max_rms, "{}", r.stdout);
+    let r = master(&[
+        "assess",
+        with_text_s,
+        "--signal",
+        "contact.table",
+        "--speed",
+        "300",
+        "--out",
+        text_out.to_str().unwrap(),
+    ]);
+    assert!(
+        !r.ok
+            && r.stderr
+                .contains("'AA' in column 'contact.table' is not a number"),
+        "{}",
+        r.stderr
+    );
     let r = master(&[
         "assess",
         csv_s,

@@ -49,6 +49,17 @@ pub struct ResultsTable {
     pub sampling: Option<Sampling>,
     /// Whether the file has our metadata.
     pub described: bool,
+    /// Columns left out because they hold text (a recorded String, an Enumeration's item
+    /// name, a host's label): their names and why, so that asking for one says so.
+    pub text_columns: Vec<TextColumn>,
+}
+
+/// A column of a results file that holds text, not numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TextColumn {
+    pub name: String,
+    /// Where and why, e.g. `results.csv:12: 'AA' is not a number`.
+    pub reason: String,
 }
 
 fn bad_file(path: &Path, line: usize, reason: String) -> AnalysisError {
@@ -106,6 +117,8 @@ impl ResultsTable {
             ));
         }
         let mut columns = vec![Vec::new(); names.len()];
+        // the first field of a column that is not a number makes it a text column
+        let mut text: Vec<Option<(usize, String)>> = vec![None; names.len()];
         for (no, line) in lines {
             let fields = split_fields(line, sep);
             if fields.len() != names.len() {
@@ -116,33 +129,70 @@ impl ResultsTable {
                 ));
             }
             for (k, f) in fields.iter().enumerate() {
-                let v: f64 = f.parse().map_err(|_| {
-                    bad_file(
-                        path,
-                        no,
-                        format!(
-                            "'{}' in column '{}' is not a number",
-                            master::show::text(f),
-                            master::show::text(&names[k])
-                        ),
-                    )
-                })?;
-                if !v.is_finite() {
-                    return Err(bad_file(
-                        path,
-                        no,
-                        format!("{v} in column '{}' is not finite", names[k]),
-                    ));
+                if text[k].is_some() {
+                    continue;
                 }
-                columns[k].push(v);
+                match f.parse::<f64>() {
+                    Ok(v) if v.is_finite() => columns[k].push(v),
+                    Ok(v) => {
+                        return Err(bad_file(
+                            path,
+                            no,
+                            format!(
+                                "{v} in column '{}' is not finite",
+                                master::show::text(&names[k])
+                            ),
+                        ))
+                    }
+                    Err(_) => {
+                        text[k] = Some((no, f.clone()));
+                        columns[k] = Vec::new();
+                    }
+                }
             }
+        }
+        let not_a_number = |no: usize, field: &str, name: &str| {
+            bad_file(
+                path,
+                no,
+                format!(
+                    "'{}' in column '{}' is not a number",
+                    master::show::text(field),
+                    master::show::text(name)
+                ),
+            )
+        };
+        if let Some((no, field)) = &text[0] {
+            return Err(not_a_number(*no, field, &names[0]));
+        }
+        // text columns are left out, as a Parquet file's texts are
+        let (mut kept_names, mut kept, mut text_columns) = (Vec::new(), Vec::new(), Vec::new());
+        for ((name, values), text) in names.into_iter().zip(columns).zip(text) {
+            match text {
+                None => {
+                    kept_names.push(name);
+                    kept.push(values);
+                }
+                Some((no, field)) => {
+                    let reason = not_a_number(no, &field, &name).to_string();
+                    text_columns.push(TextColumn { name, reason });
+                }
+            }
+        }
+        if kept_names.len() < 2 {
+            let reason = text_columns.first().map_or("", |c| c.reason.as_str());
+            return Err(AnalysisError::Input(format!(
+                "{}: no numeric signal beside the time column ({reason})",
+                path.display()
+            )));
         }
         Ok(ResultsTable {
             path: path.to_path_buf(),
-            names,
-            columns,
+            names: kept_names,
+            columns: kept,
             sampling: None,
             described: false,
+            text_columns,
         })
     }
 
@@ -168,12 +218,19 @@ impl ResultsTable {
             read_parquet(path).map_err(|e| AnalysisError::Input(e.to_string()))?;
         let mut names = Vec::new();
         let mut values = Vec::new();
+        let mut text_columns = Vec::new();
         for (name, data) in columns {
-            if let ColumnData::Numbers(x) = data {
-                if let Some(x) = x.into_iter().collect::<Option<Vec<f64>>>() {
-                    names.push(name);
-                    values.push(x);
+            match data {
+                ColumnData::Numbers(x) => {
+                    if let Some(x) = x.into_iter().collect::<Option<Vec<f64>>>() {
+                        names.push(name);
+                        values.push(x);
+                    }
                 }
+                _ => text_columns.push(TextColumn {
+                    reason: format!("{}: column '{name}' holds text", path.display()),
+                    name,
+                }),
             }
         }
         if names.len() < 2 {
@@ -198,6 +255,7 @@ impl ResultsTable {
             columns: values,
             described: meta.is_some(),
             sampling: meta.and_then(|m| m.sampling),
+            text_columns,
         })
     }
 
@@ -209,6 +267,16 @@ impl ResultsTable {
         match hits.as_slice() {
             [i] => Ok(*i),
             [] => {
+                let text = self
+                    .text_columns
+                    .iter()
+                    .find(|c| c.name == name || split_unit(&c.name).0 == name);
+                if let Some(c) = text {
+                    return Err(AnalysisError::Input(format!(
+                        "{}: signal '{name}' is not numeric",
+                        c.reason
+                    )));
+                }
                 let list: Vec<&str> = self.names[1..].iter().map(|n| split_unit(n).0).collect();
                 Err(AnalysisError::Input(format!(
                     "{}: no signal '{name}'; the signals are: {}",
@@ -702,6 +770,25 @@ mod tests {
             e.to_string().contains("bad.csv:3") && e.to_string().contains("'x'"),
             "{e}"
         );
+        let e = ResultsTable::parse("time,a\nx,1\n", p).unwrap_err();
+        assert!(
+            e.to_string().contains("bad.csv:2: 'x' in column 'time'"),
+            "{e}"
+        );
+        // a text column (a recorded String, an Enumeration's item) is left out; asking for it
+        // says why
+        let csv = "time,model,model (item),a,label\n0,1,nonlinear,2,AA\n0.1,1,nonlinear,3,\n";
+        let t = ResultsTable::parse(csv, p).unwrap();
+        assert_eq!(t.names, vec!["time", "model", "a"]);
+        assert_eq!(t.columns[2], vec![2.0, 3.0]);
+        let e = t.find("model (item)").unwrap_err().to_string();
+        assert!(
+            e.contains("bad.csv:2: 'nonlinear' in column 'model (item)' is not a number"),
+            "{e}"
+        );
+        assert!(e.ends_with("signal 'model (item)' is not numeric"), "{e}");
+        let e = t.find("label").unwrap_err().to_string();
+        assert!(e.contains("bad.csv:2: 'AA'"), "{e}");
         let e = ResultsTable::parse("time,a\n0,1,2\n", p).unwrap_err();
         assert!(e.to_string().contains("bad.csv:2"), "{e}");
         let e = ResultsTable::parse("time,a\n0,NaN\n", p).unwrap_err();
