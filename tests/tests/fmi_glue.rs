@@ -451,3 +451,16 @@ fn a_communication_point_off_by_more_than_a_billionth_of_the_step_is_refused() {
     assert_eq!(inst.do_step(1.0e-3, 500.0), OK);
     assert_eq!(inst.do_step(end * (1.0 + 4.0 * f64::EPSILON), 1.0e-3), OK);
 }
+
+#[test]
+fn the_shortest_sub_step_parameters_allow_still_takes_a_one_second_step() {
+    // at 0.02 m/s the creep damping sets a sub-step of about 0.77 µs: 1.3 million sub-steps
+    // in one 1 s step, a valid run (a bound of a million sub-steps refused it as corrupted)
+    let f = TestFmu::open_dist("Bogie2Dof").unwrap();
+    let inst = f.instantiate("slow").unwrap();
+    assert_eq!(inst.setup(0.0, None), OK);
+    assert_eq!(inst.enter_init(), OK);
+    assert_eq!(inst.set_real("vehicle.speed", 0.02), OK);
+    assert_eq!(inst.exit_init(), OK);
+    assert_eq!(inst.do_step(0.0, 1.0), OK, "{:?}", inst.messages());
+}

@@ -33,7 +33,7 @@ fn rk4_step(
 ) -> Result<(f64, f64), StepError> {
     if h > MAX_STEP_S {
         return Err(StepError::Discard(format!(
-            "communication step {h:e} s is longer than {MAX_STEP_S} s: take several shorter steps"
+            "communication step {h:?} s is longer than {MAX_STEP_S} s: take several shorter steps"
         )));
     }
     let n = (h / MAX_SUBSTEP_S).ceil().max(1.0);

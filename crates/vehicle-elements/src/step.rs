@@ -12,8 +12,8 @@ pub const MAX_STEP_S: f64 = 1.0;
 pub const MAX_HOST_STEP_S: f64 = 1000.0;
 
 /// The most internal sub-steps one physics step of at most [`MAX_STEP_S`] takes: a 1 s step
-/// at the smallest sub-step any model's parameters allow (1 µs).
-pub const MAX_SUBSTEPS: usize = 1_000_000;
+/// at the smallest sub-step a model builds ([`crate::MIN_SUBSTEP_S`], 0.1 µs).
+pub const MAX_SUBSTEPS: usize = 10_000_000;
 
 /// A step refused before it starts; the model is unchanged.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -34,16 +34,17 @@ pub enum InputError {
     },
     /// A host step longer than [`MAX_HOST_STEP_S`].
     #[error(
-        "communication step {h:e} s is longer than {MAX_HOST_STEP_S} s: take several shorter steps"
+        "communication step {h:?} s is longer than {MAX_HOST_STEP_S} s: take several shorter steps"
     )]
     StepTooLong {
         /// Step \[s\].
         h: f64,
     },
     /// The internal sub-step does not divide the step into at most [`MAX_SUBSTEPS`] parts (only
-    /// a corrupted state has such a sub-step; the parameters' ranges exclude it).
+    /// a corrupted state has such a sub-step: a model refuses parameters that need a sub-step
+    /// below [`crate::MIN_SUBSTEP_S`]).
     #[error(
-        "internal sub-step {substep_s:e} s would split the step of {h:e} s into more than \
+        "internal sub-step {substep_s:?} s would split the step of {h:?} s into more than \
          {MAX_SUBSTEPS} parts"
     )]
     TooManySubsteps {
@@ -131,6 +132,7 @@ impl FieldError for InputError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::MIN_SUBSTEP_S;
 
     #[test]
     fn a_long_host_step_is_split_and_committed_only_whole() {
@@ -158,7 +160,10 @@ mod tests {
         // a sub-step dividing the step up to rounding gives no extra sliver
         assert_eq!(substep_count(1e-3, 1e-3 / 3.0), Ok(3));
         assert_eq!(substep_count(1e-3, 1.0), Ok(1));
-        assert_eq!(substep_count(1.0, 1e-6), Ok(MAX_SUBSTEPS));
+        // the shortest sub-step a model builds fits a 1 s step, the bound is no tighter
+        assert_eq!(substep_count(1.0, 1e-6), Ok(1_000_000));
+        assert_eq!(substep_count(MAX_STEP_S, MIN_SUBSTEP_S), Ok(MAX_SUBSTEPS));
+        assert!(substep_count(MAX_STEP_S, 0.99 * MIN_SUBSTEP_S).is_err());
         // what only a corrupted state holds: refused, never a loop of 1e297 sub-steps
         for substep_s in [1e-300, 0.0, -1e-3, f64::NAN] {
             assert!(
