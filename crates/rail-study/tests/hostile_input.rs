@@ -884,12 +884,36 @@ fn a_failed_study_leaves_no_result_of_an_earlier_one() {
         case.write(&format!("out/{f}"), "an earlier study's");
     }
     case.write("out/notes.svg", "the user's");
-    // the study starts, then finds no FMU
+    // a mistyped FMU folder is refused before anything is touched
     let err = case.fails(
         &["study", "--quick", "--fmus", "no-fmus", "--out", "out"],
         &[],
     );
     assert!(err.contains("not found"), "{err}");
+    for f in earlier {
+        assert_eq!(
+            std::fs::read_to_string(case.path(&format!("out/{f}"))).unwrap(),
+            "an earlier study's"
+        );
+    }
+    // the study starts, then finds the FMUs broken: nothing of the earlier study is left
+    for fmu in [
+        "RailVehicle",
+        "Bogie2Dof",
+        "PassiveYawDamper",
+        "SemiActiveDamper",
+        "FullActiveActuator",
+        "MpptController",
+        "SkyHookController",
+        "IdealDamperForceController",
+    ] {
+        case.write(&format!("no-fmus/{fmu}.fmu"), "not a zip archive");
+    }
+    let err = case.fails(
+        &["study", "--quick", "--fmus", "no-fmus", "--out", "out"],
+        &[],
+    );
+    assert!(!err.contains("not found"), "{err}");
     for f in earlier {
         assert!(!case.path(&format!("out/{f}")).exists(), "{f} is left");
     }

@@ -9,6 +9,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use crate::study::report::output_files;
+use crate::study::run::{check_fmus, configurations_used};
 use crate::study::{
     run_study, write_outputs, Sources, StudyError, StudyOptions, StudySettings, Timing, TrackLevel,
     VehicleModel,
@@ -305,6 +306,12 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         settings.planned_runs(),
         args.out.display()
     );
+    // A mistyped FMU folder is refused before anything of an earlier study is touched.
+    check_fmus(
+        &opts.sources,
+        args.vehicle,
+        &configurations_used(&settings)?,
+    )?;
     // An interrupted or failed study must not leave the previous study's results looking
     // current: its report, figures and tables are removed before the first run and written
     // again only when every output is ready.
