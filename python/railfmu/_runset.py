@@ -109,6 +109,9 @@ class RunSet:
         # this set's runs only: nothing of the user's is replaced by a run folder, and an
         # earlier set's other runs are removed (the kept ones are in this set)
         _railfmu.prepare_run_folder(os.fspath(out), self._jobs_json)
+        # the earlier set's report goes with its runs: a set that fails before its first run
+        # (an unreadable FMU) leaves no report of runs that are no longer there
+        remove_sweep_report(out)
         reports: List[Optional[str]] = [None] * len(self)
         if resume:
             # decided over every job before the kept runs, as a fresh run set decides it
@@ -136,7 +139,6 @@ class RunSet:
                     if client is None:
                         system = _railfmu.PreparedSystem.from_json(self._base_json, "", self._label)
                         threads = threads or os.cpu_count() or 1
-                        remove_sweep_report(out)
                         local_runs = True
                         new = system.run_jobs(jobs, os.fspath(out), threads, on_done, format)
                     else:

@@ -258,3 +258,17 @@ def test_the_parameters_of_a_run_set_carry_their_units(dist, master_cmd, tmp_pat
     assert table.attrs["units"]["bogie.vehicle.speed"] is None
     with pytest.raises(railfmu.FmuError, match="nowhere"):
         railfmu.read_results(moved).parameter_units
+
+
+def test_a_set_that_fails_before_its_first_run_leaves_no_earlier_report(dist, tmp_path):
+    out = tmp_path / "out"
+    railfmu.RunSet.from_dict(speed_set(dist, [50.0, 60.0], stop_time=0.1)).run(out, threads=1)
+    assert len(json.loads((out / "sweep.json").read_text())) == 2
+    fmus = tmp_path / "fmus"
+    shutil.copytree(dist, fmus)
+    rs = railfmu.RunSet.from_dict(speed_set(fmus, [55.0, 65.0, 75.0], stop_time=0.1))
+    (fmus / "Bogie2Dof.fmu").write_bytes(b"not a zip archive")
+    with pytest.raises(railfmu.Error):
+        rs.run(out, threads=1)
+    # the earlier report would list runs of other parameters as this folder's
+    assert not (out / "sweep.json").exists()
