@@ -122,7 +122,9 @@ pub fn table_from_file(path: &Path) -> Result<ResultsTable, String> {
 /// `railfmu.assess_stability` (the computation's own messages name the command's options or
 /// its internal parameters, e.g. the wheel load in N).
 fn check_options(o: &AssessOptions, quantity: Quantity) -> Result<(), String> {
-    let bad = |name: &str, value: f64, reason: &str| Err(format!("{name} = {value}: {reason}"));
+    let bad = |name: &str, value: f64, reason: &str| {
+        Err(format!("{name} = {}: {reason}", master::show::num(value)))
+    };
     if o.signals.is_empty() {
         return Err("signals: none given (name at least one column)".into());
     }

@@ -215,6 +215,14 @@ pub fn sliding_rms_distance(
         "window length must be > 0",
     )?;
     check("step_m", step_m, step_m > 0.0, "window step must be > 0")?;
+    // a window step shorter than a sample would start window after window at the same sample
+    // (at 1e308 km/h: without end, until memory runs out)
+    check(
+        "speed_mps",
+        speed_mps,
+        step_m / speed_mps * fs >= 1.0,
+        "the window step must last at least one sample at this speed",
+    )?;
     check_finite(x)?;
     let win = (window_m / speed_mps * fs).round() as usize;
     let win = win.max(1);
@@ -352,6 +360,12 @@ mod tests {
         ));
         let e = sliding_rms_distance(&x, fs, 0.0, 100.0, 10.0).unwrap_err();
         assert!(e.to_string().contains("speed_mps"));
+        // the 10 m step lasts one sample at 1000 m/s and 100 Hz; faster, less than one
+        assert!(sliding_rms_distance(&x, fs, 1000.0, 100.0, 10.0).is_ok());
+        for v in [1001.0, 1e308] {
+            let e = sliding_rms_distance(&x, fs, v, 100.0, 10.0).unwrap_err();
+            assert!(e.to_string().contains("at least one sample"), "{e}");
+        }
         let mut bad = x.clone();
         bad[7] = f64::NAN;
         assert_eq!(

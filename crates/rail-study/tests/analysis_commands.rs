@@ -854,6 +854,18 @@ fn assess_reports_the_en14363_verdict_and_refuses_bad_input() {
         none_s,
     ]);
     assert!(!r.ok && r.stderr.contains("wrong unit"), "{}", r.stderr);
+    // a speed at which the 10 m window step lasts less than a sample: refused (it started
+    // windows at the same sample until memory ran out and the process aborted)
+    let r = master(&[
+        "assess", csv_s, "--signal", "front", "--speed", "1e308", "--out", none_s,
+    ]);
+    assert!(
+        !r.ok
+            && r.stderr
+                .contains("the window step must last at least one sample"),
+        "{}",
+        r.stderr
+    );
     let bad = dir.path().join("bad.csv");
     std::fs::write(&bad, "time,a\n0,1\n0.1,2\n0.3,3\n0.4,x\n").unwrap();
     let r = master(&[

@@ -605,10 +605,12 @@ pub fn assess_table(
     let assessed_m = settings.assessed_m(duration, speed_kmh);
     if assessed_m < settings.window_m {
         return Err(AnalysisError::Input(format!(
-            "{}: {duration:.2} s at {speed_kmh} km/h minus {} s skipped covers {assessed_m:.0} m, \
-             less than one {} m window",
+            "{}: {duration:.2} s at {} km/h minus {} s skipped covers {} m, less than one {} m \
+             window",
             table.path.display(),
-            settings.skip_s,
+            master::show::num(speed_kmh),
+            master::show::num(settings.skip_s),
+            master::show::num(assessed_m.max(0.0).round()),
             settings.window_m
         )));
     }
