@@ -205,48 +205,6 @@ pub fn collapse(table: &Table, columns: &[ColumnMetadata]) -> Result<SimOutput, 
     })
 }
 
-/// Splits one CSV line into fields (RFC 4180 quoting: `"a,b"`, `""` inside quotes).
-pub fn split_csv_line(line: &str) -> Result<Vec<String>, String> {
-    let mut fields = Vec::new();
-    let mut field = String::new();
-    let mut chars = line.chars().peekable();
-    let mut quoted = false;
-    let mut at_start = true;
-    while let Some(c) = chars.next() {
-        match (quoted, c) {
-            (false, '"') if at_start => {
-                quoted = true;
-                at_start = false;
-            }
-            (false, '"') => return Err("a quote inside an unquoted field".into()),
-            (true, '"') => {
-                if chars.peek() == Some(&'"') {
-                    chars.next();
-                    field.push('"');
-                } else {
-                    quoted = false;
-                    if !matches!(chars.peek(), None | Some(',')) {
-                        return Err("text after a closing quote".into());
-                    }
-                }
-            }
-            (false, ',') => {
-                fields.push(std::mem::take(&mut field));
-                at_start = true;
-            }
-            (_, c) => {
-                field.push(c);
-                at_start = false;
-            }
-        }
-    }
-    if quoted {
-        return Err("unterminated quoted field".into());
-    }
-    fields.push(field);
-    Ok(fields)
-}
-
 /// Splits a column label `name [unit]` into its name and unit (`None` when it has none).
 pub fn split_label(label: &str) -> (&str, Option<&str>) {
     match label.strip_suffix(']').and_then(|l| l.rsplit_once(" [")) {
@@ -259,11 +217,13 @@ pub fn split_label(label: &str) -> (&str, Option<&str>) {
 /// metadata, empty when it has none) tells which columns hold texts; every other field is a
 /// number.
 pub fn parse_csv(text: &str, file: &str, columns: &[ColumnMetadata]) -> Result<Table, String> {
-    let mut lines = text.lines();
-    let head = lines
+    // records, not lines: a quoted String may hold a line break
+    let records = master::csv_records::records(text, false).map_err(|e| format!("{file}: {e}"))?;
+    let mut records = records.into_iter();
+    let header = records
         .next()
-        .ok_or_else(|| format!("{file}: empty file (no header line)"))?;
-    let header = split_csv_line(head).map_err(|e| format!("{file}: line 1: {e}"))?;
+        .ok_or_else(|| format!("{file}: empty file (no header line)"))?
+        .texts();
     let time = header.first().map_or("", String::as_str);
     let is_text = match described_header(time, columns) {
         (described, text) if !columns.is_empty() && described == header => text,
@@ -275,25 +235,18 @@ pub fn parse_csv(text: &str, file: &str, columns: &[ColumnMetadata]) -> Result<T
         .map(|c| (c, Vec::new()))
         .collect();
     let mut data = Vec::new();
-    for (i, line) in lines.enumerate() {
-        let n = i + 2;
-        if line.is_empty() {
-            continue;
-        }
-        let fields = if line.contains('"') {
-            split_csv_line(line).map_err(|e| format!("{file}: line {n}: {e}"))?
-        } else {
-            line.split(',').map(str::to_string).collect()
-        };
-        if fields.len() != header.len() {
+    for record in records {
+        let n = record.line;
+        if record.fields.len() != header.len() {
             return Err(format!(
                 "{file}: line {n} has {} values but the header has {} columns",
-                fields.len(),
+                record.fields.len(),
                 header.len()
             ));
         }
         let mut t = texts.iter_mut();
-        for (k, field) in fields.into_iter().enumerate() {
+        for (k, field) in record.fields.into_iter().enumerate() {
+            let field = field.text;
             if is_text[k] {
                 data.push(f64::NAN);
                 if let Some((_, col)) = t.next() {
@@ -303,8 +256,9 @@ pub fn parse_csv(text: &str, file: &str, columns: &[ColumnMetadata]) -> Result<T
             }
             let x: f64 = field.trim().parse().map_err(|_| {
                 format!(
-                    "{file}: line {n}, column '{}': '{field}' is not a number",
-                    header[k]
+                    "{file}: line {n}, column '{}': '{}' is not a number",
+                    master::show::text(&header[k]),
+                    master::show::text(&field)
                 )
             })?;
             data.push(x);
@@ -432,7 +386,7 @@ mod tests {
                     col(l, t, items)
                 })
                 .collect(),
-            strings: vec!["Set me!".into(), "say \"hi\"".into()],
+            strings: vec!["Set me!".into(), "say \"hi\",\nthen bye".into()],
             decimation: None,
         }
     }
@@ -466,7 +420,10 @@ mod tests {
             t.texts,
             vec![
                 (5, vec!["Option, 2".to_string(), "Option 1".to_string()]),
-                (6, vec!["Set me!".to_string(), "say \"hi\"".to_string()]),
+                (
+                    6,
+                    vec!["Set me!".to_string(), "say \"hi\",\nthen bye".to_string()]
+                ),
             ]
         );
         // and back: the output the master's writers take

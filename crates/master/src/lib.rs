@@ -28,6 +28,7 @@
 
 pub mod cli;
 pub mod coupling;
+pub mod csv_records;
 pub mod decimation;
 pub mod fmu;
 pub mod input;

@@ -103,12 +103,43 @@ impl ResultsTable {
         } else {
             None
         };
-        // names may contain commas inside quotes (our writer quotes them)
-        let names = if sep == Some(',') && header.contains('"') {
-            parse_quoted_header(header)
+        // (line, fields, whether each was quoted): a comma-separated file by records (RFC
+        // 4180: our writer quotes names with commas and every String value, which may hold a
+        // line break), a host's semicolon- or space-separated export by lines
+        let mut records: Vec<(usize, Vec<String>, Vec<bool>)> = if sep == Some(',') {
+            master::csv_records::records(text, true)
+                .map_err(|e| bad_file(path, e.line, e.reason.into()))?
+                .into_iter()
+                .map(|r| {
+                    let quoted = r.fields.iter().map(|f| f.quoted).collect();
+                    let fields = r
+                        .fields
+                        .into_iter()
+                        .map(|f| {
+                            if f.quoted {
+                                f.text
+                            } else {
+                                f.text.trim().to_string()
+                            }
+                        })
+                        .collect();
+                    (r.line, fields, quoted)
+                })
+                .collect()
         } else {
-            split_fields(header, sep)
+            std::iter::once((1, header))
+                .chain(lines)
+                .map(|(no, line)| {
+                    let fields = split_fields(line, sep);
+                    let quoted = vec![false; fields.len()];
+                    (no, fields, quoted)
+                })
+                .collect()
         };
+        if records.is_empty() {
+            return Err(bad_file(path, 1, "no header line".into()));
+        }
+        let names = records.remove(0).1;
         if names.len() < 2 {
             return Err(bad_file(
                 path,
@@ -117,10 +148,10 @@ impl ResultsTable {
             ));
         }
         let mut columns = vec![Vec::new(); names.len()];
-        // the first field of a column that is not a number makes it a text column
+        // the first field of a column that is quoted (a String), not a number or not finite
+        // makes it a column that is left out
         let mut text: Vec<Option<(usize, String)>> = vec![None; names.len()];
-        for (no, line) in lines {
-            let fields = split_fields(line, sep);
+        for (no, fields, quoted) in records {
             if fields.len() != names.len() {
                 return Err(bad_file(
                     path,
@@ -133,37 +164,30 @@ impl ResultsTable {
                     continue;
                 }
                 match f.parse::<f64>() {
-                    Ok(v) if v.is_finite() => columns[k].push(v),
-                    Ok(v) => {
-                        return Err(bad_file(
-                            path,
-                            no,
-                            format!(
-                                "{v} in column '{}' is not finite",
-                                master::show::text(&names[k])
-                            ),
-                        ))
+                    Ok(v) if v.is_finite() && !quoted[k] => columns[k].push(v),
+                    Ok(v) if !quoted[k] => {
+                        let reason = format!(
+                            "{} in column '{}' is not finite",
+                            master::show::num(v),
+                            master::show::text(&names[k])
+                        );
+                        text[k] = Some((no, reason));
+                        columns[k] = Vec::new();
                     }
-                    Err(_) => {
-                        text[k] = Some((no, f.clone()));
+                    _ => {
+                        let reason = format!(
+                            "'{}' in column '{}' is not a number",
+                            master::show::text(f),
+                            master::show::text(&names[k])
+                        );
+                        text[k] = Some((no, reason));
                         columns[k] = Vec::new();
                     }
                 }
             }
         }
-        let not_a_number = |no: usize, field: &str, name: &str| {
-            bad_file(
-                path,
-                no,
-                format!(
-                    "'{}' in column '{}' is not a number",
-                    master::show::text(field),
-                    master::show::text(name)
-                ),
-            )
-        };
-        if let Some((no, field)) = &text[0] {
-            return Err(not_a_number(*no, field, &names[0]));
+        if let Some((no, reason)) = &text[0] {
+            return Err(bad_file(path, *no, reason.clone()));
         }
         // text columns are left out, as a Parquet file's texts are
         let (mut kept_names, mut kept, mut text_columns) = (Vec::new(), Vec::new(), Vec::new());
@@ -173,8 +197,8 @@ impl ResultsTable {
                     kept_names.push(name);
                     kept.push(values);
                 }
-                Some((no, field)) => {
-                    let reason = not_a_number(no, &field, &name).to_string();
+                Some((no, reason)) => {
+                    let reason = bad_file(path, no, reason).to_string();
                     text_columns.push(TextColumn { name, reason });
                 }
             }
@@ -321,27 +345,6 @@ impl ResultsTable {
         }
         Ok(1.0 / dt)
     }
-}
-
-/// Header fields split on commas outside double quotes.
-fn parse_quoted_header(line: &str) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut cur = String::new();
-    let mut quoted = false;
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match c {
-            '"' if quoted && chars.peek() == Some(&'"') => {
-                cur.push('"');
-                chars.next();
-            }
-            '"' => quoted = !quoted,
-            ',' if !quoted => out.push(std::mem::take(&mut cur).trim().to_string()),
-            _ => cur.push(c),
-        }
-    }
-    out.push(cur.trim().to_string());
-    out
 }
 
 /// The assessment of each selected signal and the overall verdict.
@@ -791,6 +794,27 @@ mod tests {
         assert!(e.ends_with("signal 'model (item)' is not numeric"), "{e}");
         let e = t.find("label").unwrap_err().to_string();
         assert!(e.contains("bad.csv:2: 'AA'"), "{e}");
+        // a String is quoted by our writer: text whatever it holds (a number, NaN, a line
+        // break); a column with a value that is not finite is left out, named when asked for
+        let csv =
+            "time,s,t,u,a,b\n0,\"12\",\"NaN\",\"two\nlines\",2,inf\n0.1,\"13\",\"x\",\"y\",3,1\n";
+        let t = ResultsTable::parse(csv, p).unwrap();
+        assert_eq!(t.names, vec!["time", "a"]);
+        assert_eq!(t.columns[1], vec![2.0, 3.0]);
+        let e = t.find("b").unwrap_err().to_string();
+        assert!(
+            e.contains("bad.csv:2: inf in column 'b' is not finite"),
+            "{e}"
+        );
+        let e = t.find("s").unwrap_err().to_string();
+        assert!(e.contains("'12' in column 's' is not a number"), "{e}");
+        // a quoted field left open is named at the line its record starts on
+        let e = ResultsTable::parse("time,a\n0,1\n0.1,\"2\n", p).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("bad.csv:3: unterminated quoted field"),
+            "{e}"
+        );
         let e = ResultsTable::parse("time,a\n0,1,2\n", p).unwrap_err();
         assert!(e.to_string().contains("bad.csv:2"), "{e}");
         let e = ResultsTable::parse("time,a\n0,NaN\n", p).unwrap_err();
