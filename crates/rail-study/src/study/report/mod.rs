@@ -131,26 +131,48 @@ fn fmt_opt(v: Option<f64>, scale: f64, prec: usize) -> String {
     v.map_or("failed".to_string(), |x| format!("{:.*}", prec, x * scale))
 }
 
+/// The stem of each figure (`<stem>.svg`, its data `<stem>.csv`): the write sites name them
+/// here, so that [`FIGURE_STEMS`] (what a new study removes first) lists every one.
+pub mod stem {
+    pub const RMS_VS_SPEED: &str = "rms_vs_speed";
+    pub const CARBODY_VS_SPEED: &str = "carbody_vs_speed";
+    pub const COMFORT_VS_SPEED: &str = "comfort_vs_speed";
+    pub const HISTORY_DISPLACEMENT: &str = "history_displacement";
+    pub const HISTORY_ACCELERATION: &str = "history_acceleration";
+    pub const HISTORY_FORCE: &str = "history_force";
+    pub const HISTORY_COMMAND: &str = "history_command";
+    pub const HISTORY_CARBODY: &str = "history_carbody";
+    pub const FULL_ACTIVE_FORCE: &str = "full_active_force";
+    pub const PERTURBATION: &str = "perturbation";
+    pub const MPPT_COMMAND_CLOSED_START: &str = "mppt_command_closed_start";
+    pub const MPPT_COMMAND_OPEN_START: &str = "mppt_command_open_start";
+    pub const SLOW_VALVE_DISPLACEMENT: &str = "slow_valve_displacement";
+    pub const SLOW_VALVE_OPENING: &str = "slow_valve_opening";
+    pub const SKYHOOK_VALVE_ZOOM: &str = "skyhook_valve_zoom";
+    pub const CV_ACCELERATION: &str = "cv_acceleration";
+    pub const CV_FORCE: &str = "cv_force";
+}
+
 /// The figures a study may write into its output folder, each as `<stem>.svg` with its data
 /// in `<stem>.csv` (which of them depends on the vehicle and on the runs that succeeded).
 pub const FIGURE_STEMS: [&str; 17] = [
-    "rms_vs_speed",
-    "carbody_vs_speed",
-    "comfort_vs_speed",
-    "history_displacement",
-    "history_acceleration",
-    "history_force",
-    "history_command",
-    "history_carbody",
-    "full_active_force",
-    "perturbation",
-    "mppt_command_closed_start",
-    "mppt_command_open_start",
-    "slow_valve_displacement",
-    "slow_valve_opening",
-    "skyhook_valve_zoom",
-    "cv_acceleration",
-    "cv_force",
+    stem::RMS_VS_SPEED,
+    stem::CARBODY_VS_SPEED,
+    stem::COMFORT_VS_SPEED,
+    stem::HISTORY_DISPLACEMENT,
+    stem::HISTORY_ACCELERATION,
+    stem::HISTORY_FORCE,
+    stem::HISTORY_COMMAND,
+    stem::HISTORY_CARBODY,
+    stem::FULL_ACTIVE_FORCE,
+    stem::PERTURBATION,
+    stem::MPPT_COMMAND_CLOSED_START,
+    stem::MPPT_COMMAND_OPEN_START,
+    stem::SLOW_VALVE_DISPLACEMENT,
+    stem::SLOW_VALVE_OPENING,
+    stem::SKYHOOK_VALVE_ZOOM,
+    stem::CV_ACCELERATION,
+    stem::CV_FORCE,
 ];
 
 /// The names of every file [`write_outputs`] may write into a study's output folder: the
@@ -275,7 +297,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     if !r.configs.is_empty() {
         chart.write_lines(&out.join("rms_vs_speed.svg"))?;
         figures.push((
-            "rms_vs_speed".into(),
+            stem::RMS_VS_SPEED.into(),
             "rms vs speed, a panel per control family with the passive damper in grey, a_lim dashed (Figs. 4.13, 4.23, 4.24)",
         ));
     }
@@ -296,11 +318,11 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         carbody_chart.write_lines(&out.join("carbody_vs_speed.svg"))?;
         comfort_chart.write_lines(&out.join("comfort_vs_speed.svg"))?;
         figures.push((
-            "carbody_vs_speed".into(),
+            stem::CARBODY_VS_SPEED.into(),
             "car-body floor lateral acceleration rms vs speed, max over seeds",
         ));
         figures.push((
-            "comfort_vs_speed".into(),
+            stem::COMFORT_VS_SPEED.into(),
             "EN 12299 lateral comfort N_y vs speed, max over seeds",
         ));
     }
@@ -342,14 +364,14 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         r.settings.stored_rate_hz
     );
     let mut histories = vec![
-        ("history_displacement", "leading wheelset lateral displacement relative to the track", "displacement [mm]", ws_y, 1e3, &hist_runs, "wheelset displacement, passive / MPPT2 / sky-hook / full-active (Figs. 4.18, 4.21, 4.25)"),
-        ("history_acceleration", acc_what, "acceleration [m/s^2]", acc, 1.0, &hist_runs, "EN 14363 acceleration (Figs. 4.18, 4.21, 4.26)"),
-        ("history_force", damper_what, "force [kN]", force.as_str(), 1e-3, &semi_runs, "damper force (Figs. 4.18, 4.21)"),
-        ("history_command", command_what.as_str(), "command [V]", command.as_str(), 1.0, &semi_runs, "valve command MPPT2 vs sky-hook (Figs. 4.18, 4.21)"),
+        (stem::HISTORY_DISPLACEMENT, "leading wheelset lateral displacement relative to the track", "displacement [mm]", ws_y, 1e3, &hist_runs, "wheelset displacement, passive / MPPT2 / sky-hook / full-active (Figs. 4.18, 4.21, 4.25)"),
+        (stem::HISTORY_ACCELERATION, acc_what, "acceleration [m/s^2]", acc, 1.0, &hist_runs, "EN 14363 acceleration (Figs. 4.18, 4.21, 4.26)"),
+        (stem::HISTORY_FORCE, damper_what, "force [kN]", force.as_str(), 1e-3, &semi_runs, "damper force (Figs. 4.18, 4.21)"),
+        (stem::HISTORY_COMMAND, command_what.as_str(), "command [V]", command.as_str(), 1.0, &semi_runs, "valve command MPPT2 vs sky-hook (Figs. 4.18, 4.21)"),
     ];
     if coach {
         histories.push((
-            "history_carbody",
+            stem::HISTORY_CARBODY,
             "car-body floor lateral acceleration at mid-length",
             "acceleration [m/s^2]",
             carbody_mid.as_str(),
@@ -389,7 +411,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         .with_series("reference c_v v", zoom(&fr))
         .write_lines(&out.join("full_active_force.svg"))?;
         figures.push((
-            "full_active_force".into(),
+            stem::FULL_ACTIVE_FORCE.into(),
             "full-active force vs IDF reference (Fig. 4.27)",
         ));
     }
@@ -414,7 +436,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             .one_panel_per_series()
             .write_lines(&out.join("perturbation.svg"))?;
         figures.push((
-            "perturbation".into(),
+            stem::PERTURBATION.into(),
             if coach {
                 "initial-perturbation runs, passive coach, 240/280/300 km/h (Figs. 4.4-4.6, R16)"
             } else {
@@ -433,7 +455,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     if let Some(s) = history_chart(
         r,
         out,
-        "mppt_command_closed_start",
+        stem::MPPT_COMMAND_CLOSED_START,
         &format!("MPPT valve command from a closed valve at {v_low:.0} km/h"),
         "command [V]",
         &low_runs,
@@ -457,7 +479,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     if let Some(s) = history_chart(
         r,
         out,
-        "mppt_command_open_start",
+        stem::MPPT_COMMAND_OPEN_START,
         &format!(
             "MPPT valve command from {:.0} V, slow valve, {v_hil:.0} km/h",
             r.settings.hil_initial_command_v
@@ -475,7 +497,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     if let Some(s) = history_chart(
         r,
         out,
-        "slow_valve_displacement",
+        stem::SLOW_VALVE_DISPLACEMENT,
         &format!(
             "slow valve at {v_hil:.0} km/h: leading wheelset displacement relative to the track"
         ),
@@ -492,7 +514,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     if let Some(s) = history_chart(
         r,
         out,
-        "slow_valve_opening",
+        stem::SLOW_VALVE_OPENING,
         &format!("slow valve at {v_hil:.0} km/h: actual valve opening (first damper)"),
         "opening [-]",
         &hil_runs,
@@ -532,7 +554,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         .with_series("slow valve: actual opening", zoom(&open))
         .write_lines(&out.join("skyhook_valve_zoom.svg"))?;
         figures.push((
-            "skyhook_valve_zoom".into(),
+            stem::SKYHOOK_VALVE_ZOOM.into(),
             "on/off sky-hook: the slow valve cannot follow the switching command (Fig. 5.25, R12)",
         ));
     }
@@ -609,7 +631,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     };
     let (acceleration, peak, reference) = (ours(1), ours(2), ours(4));
     if acceleration.len() >= 2 {
-        columns_csv("cv_acceleration", &[0, 1, 7])?;
+        columns_csv(stem::CV_ACCELERATION, &[0, 1, 7])?;
         Chart::new(
             "full-active c_v sensitivity: EN 14363 rms acceleration (Table 4-3)",
             "c_v [kNs/m]",
@@ -623,12 +645,12 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         )
         .write_lines(&out.join("cv_acceleration.svg"))?;
         figures.push((
-            "cv_acceleration".into(),
+            stem::CV_ACCELERATION.into(),
             "full-active: rms acceleration vs c_v, ours and the seed's (Table 4-3, R14)",
         ));
     }
     if peak.len() >= 2 {
-        columns_csv("cv_force", &[0, 2, 4, 8])?;
+        columns_csv(stem::CV_FORCE, &[0, 2, 4, 8])?;
         let bound = ActuatorBound::of_default_actuator();
         let mut chart = Chart::new(
             "full-active c_v sensitivity: peak actuator force (Table 4-3)",
@@ -656,7 +678,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             )
             .write_lines(&out.join("cv_force.svg"))?;
         figures.push((
-            "cv_force".into(),
+            stem::CV_FORCE.into(),
             "full-active: peak force vs c_v against the actuator's force bound, ours and the seed's (Table 4-3, R14)",
         ));
     }
