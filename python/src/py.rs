@@ -26,7 +26,7 @@ use master::runset::{
     execute_with, format_by_size, run_job, Job, ResultsOptions, RunReport, RunSet, SweepError,
 };
 use master::slave::ScalarType;
-use master::system::{split_ref, LoadedSystem, PreparedSystem, RunError, SystemError};
+use master::system::{LoadedSystem, PreparedSystem, RunError, SystemError};
 
 use crate::assess::{self, AssessOptions};
 use crate::{error_message, f64_bytes, f64_from_bytes, results, runs};
@@ -279,12 +279,8 @@ impl PySystem {
     ) -> PyResult<Value> {
         let mut desc = self.prepared.system().resolved();
         for (key, value) in params {
-            let spec = split_ref(key).and_then(|(inst, var)| {
-                Some((desc.instances.iter_mut().find(|i| i.name == inst)?, var))
-            });
-            if let Some((spec, var)) = spec {
-                spec.parameters.insert(var.to_string(), value.clone());
-            }
+            // every key named a variable of the system that ran
+            let _ = desc.set_start_value(key, value.clone());
         }
         if let Some(t) = stop_time {
             desc.stop_time = t;

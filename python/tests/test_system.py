@@ -36,13 +36,20 @@ def test_a_run_from_python_equals_the_command_line_bit_for_bit(passive_file, mas
     assert np.max(np.abs(res["bogie.wheelset_front.lateral_displacement_relative"])) > 1e-6
 
 
-def test_start_values_from_python_equal_a_description_holding_them(dist, master_cmd, tmp_path):
+def cli_run_and_base(dist, master_cmd, tmp_path):
+    """`master run` of the passive system at 55 m/s, track seed 7, 0.5 s into cli.csv; and the
+    description of the unchanged system (2 s) for Python to change the same way."""
     changed = tmp_path / "changed.json"
     changed.write_text(json.dumps(passive(dist, 0.5, **{"vehicle.speed": 55.0, "track.seed": 7})))
     cli_csv = tmp_path / "cli.csv"
     assert run_master(master_cmd, "run", changed, "-o", cli_csv).returncode == 0
     base = tmp_path / "base.json"
     base.write_text(json.dumps(passive(dist, 2.0)))
+    return cli_csv, base
+
+
+def test_start_values_from_python_equal_a_description_holding_them(dist, master_cmd, tmp_path):
+    cli_csv, base = cli_run_and_base(dist, master_cmd, tmp_path)
     sys = railfmu.System.load(base)
     sys.set_parameter("bogie.vehicle.speed", np.float64(55.0))  # NumPy scalars are accepted
     sys.set_parameters({"bogie.track.seed": np.int64(7)})
@@ -283,12 +290,7 @@ def test_an_fmu_given_as_a_description_is_refused_saying_how_to_describe_a_syste
 
 
 def test_to_csv_writes_the_metadata_file_the_command_line_writes(dist, master_cmd, tmp_path):
-    changed = tmp_path / "changed.json"
-    changed.write_text(json.dumps(passive(dist, 0.5, **{"vehicle.speed": 55.0, "track.seed": 7})))
-    cli_csv = tmp_path / "cli.csv"
-    assert run_master(master_cmd, "run", changed, "-o", cli_csv).returncode == 0
-    base = tmp_path / "base.json"
-    base.write_text(json.dumps(passive(dist, 2.0)))
+    cli_csv, base = cli_run_and_base(dist, master_cmd, tmp_path)
     res = railfmu.System.load(base).run({"bogie.vehicle.speed": 55.0, "bogie.track.seed": 7}, stop_time=0.5)
     py_csv = tmp_path / "py.csv"
     res.to_csv(py_csv)

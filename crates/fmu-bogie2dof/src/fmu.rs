@@ -110,6 +110,8 @@ const FT_ACC: &[&str] = &[
 const FT_TRACK: &[&str] = &["track.lateral_alignment"];
 
 impl FmuModel for Bogie2Dof {
+    const MAX_COMMUNICATION_STEP_S: f64 = vehicle_elements::MAX_HOST_STEP_S;
+
     const INFO: ModelInfo = ModelInfo {
         name: "Bogie2Dof",
         description: "High-speed bogie hunting model (seed 5.3): 2-dof (lateral + yaw) with \

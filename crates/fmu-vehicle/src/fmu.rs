@@ -95,6 +95,8 @@ const FT_DAMPERS: &[&str] = &[
 const FT_TRACK: &[&str] = &["track.lateral_alignment"];
 
 impl FmuModel for RailVehicle {
+    const MAX_COMMUNICATION_STEP_S: f64 = vehicle_elements::MAX_HOST_STEP_S;
+
     const INFO: ModelInfo = ModelInfo {
         name: "RailVehicle",
         description: "Lateral dynamics of a bogie coach on straight track (car body, two bogie \

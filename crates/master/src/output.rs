@@ -50,6 +50,20 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
     }
 }
 
+/// Removes `path` if it is a regular file or a symbolic link (an earlier result of that name);
+/// a folder, FIFO or device of that name is left alone, and no file is no error.
+pub fn remove_stale_file(path: &Path) -> std::io::Result<()> {
+    let removable = std::fs::symlink_metadata(path)
+        .is_ok_and(|m| m.file_type().is_file() || m.file_type().is_symlink());
+    if !removable {
+        return Ok(());
+    }
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
+        _ => Ok(()),
+    }
+}
+
 /// Writes `path` atomically: `fill` writes the content into a buffered temporary file in the
 /// same folder, which is flushed, fsync'ed and renamed onto `path` only if `fill` succeeded.
 /// On any error the temporary file is removed and `path` is left untouched. A `path` that

@@ -224,20 +224,8 @@ pub fn remove_results(path: &Path, format: ResultsFormat) -> Result<(), OutputEr
         files.push(csv_metadata_path(path));
     }
     for file in files {
-        let removable = std::fs::symlink_metadata(&file)
-            .is_ok_and(|m| m.file_type().is_file() || m.file_type().is_symlink());
-        if !removable {
-            continue;
-        }
-        match std::fs::remove_file(&file) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(OutputError::Io {
-                    path: file,
-                    source: e,
-                })
-            }
-            _ => {}
-        }
+        crate::output::remove_stale_file(&file)
+            .map_err(|source| OutputError::Io { path: file, source })?;
     }
     Ok(())
 }

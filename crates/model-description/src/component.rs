@@ -149,6 +149,8 @@ pub struct Component {
     stop_time: Option<f64>,
     last_successful_time: f64,
     outputs_dirty: bool,
+    /// [`crate::FmuModel::MAX_COMMUNICATION_STEP_S`] of the model.
+    max_step_s: f64,
     diag: Diagnostics,
     /// Strings returned by fmi2GetString stay valid until the next call on this instance.
     pub(crate) string_buffer: Vec<CString>,
@@ -181,8 +183,10 @@ impl Component {
             .filter(|(m, _)| m.var_type == VarType::Real)
             .map(|(_, r)| *r)
             .collect();
+        let max_step_s = model.max_communication_step_s();
         Component {
             model,
+            max_step_s,
             index,
             rules,
             real_rules,
@@ -757,6 +761,9 @@ impl Component {
         // Step from our own time to the host's target, so drift never accumulates.
         let effective = target - self.time;
         if effective > 0.0 {
+            if effective > self.max_step_s {
+                return self.step_too_long(effective);
+            }
             if let Err(e) = self.model.do_step(self.time, effective, &mut self.diag) {
                 return self.step_failed(e, effective);
             }
@@ -766,6 +773,17 @@ impl Component {
         // a model whose step computed its outputs needs no second computation before a read
         self.outputs_dirty = !(effective > 0.0 && self.model.step_computes_outputs());
         self.flush_diagnostics()
+    }
+
+    /// A step longer than the model takes at once: discarded before the model sees it.
+    #[cold]
+    #[inline(never)]
+    fn step_too_long(&mut self, effective: f64) -> Status {
+        let reason = format!(
+            "communication step {effective:?} s is longer than {} s: take several shorter steps",
+            self.max_step_s
+        );
+        self.step_failed(StepError::Discard(reason), effective)
     }
 
     /// fmi2DoStep refused before stepping: the first failed check, named.

@@ -31,6 +31,8 @@ pub trait ErasedModel: Send {
     fn update_outputs(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError>;
     fn do_step(&mut self, time: f64, step: f64, diag: &mut Diagnostics) -> Result<(), StepError>;
     fn step_computes_outputs(&self) -> bool;
+    /// [`FmuModel::MAX_COMMUNICATION_STEP_S`].
+    fn max_communication_step_s(&self) -> f64;
     fn snapshot(&self) -> Box<dyn Any + Send>;
     /// Restore from a snapshot taken from an instance of the same model.
     fn restore(&mut self, snapshot: &(dyn Any + Send)) -> bool;
@@ -213,6 +215,10 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
 
     fn step_computes_outputs(&self) -> bool {
         self.model.step_computes_outputs()
+    }
+
+    fn max_communication_step_s(&self) -> f64 {
+        M::MAX_COMMUNICATION_STEP_S
     }
 
     fn snapshot(&self) -> Box<dyn Any + Send> {

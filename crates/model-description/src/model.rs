@@ -92,6 +92,12 @@ impl Diagnostics {
 pub trait FmuModel: Clone + Send + Serialize + DeserializeOwned + 'static {
     const INFO: ModelInfo;
 
+    /// The longest communication step one fmi2DoStep takes \[s\]: the glue discards a longer
+    /// one (fmi2Discard, "take several shorter steps") before the model sees it, so that a
+    /// model whose cost grows with the step does not keep a host waiting for minutes (or, at
+    /// 1e300 s, for ever). Default: no limit.
+    const MAX_COMMUNICATION_STEP_S: f64 = f64::INFINITY;
+
     /// The variables, in declaration order (this order sets value references and indices).
     fn variables() -> Vec<Variable<Self>>;
 

@@ -5,7 +5,7 @@
 use model_description::{field_error, FieldError, FmuModel, ModelError, StepError};
 use serde::{Deserialize, Serialize};
 
-use crate::step::{host_step, InputError, MAX_HOST_STEP_S};
+use crate::step::{host_step, InputError};
 
 /// A rail-vehicle model's physics as its FMU shell drives it.
 pub trait ShellPhysics: Clone + Sized {
@@ -173,8 +173,7 @@ impl<P: ShellPhysics> Shell<P> {
     }
 
     /// One host step of `step_s` of FMU model `M` (see [`host_step`]). A diverged state or an
-    /// unusable step size (as one longer than [`MAX_HOST_STEP_S`]) may be avoided with a smaller
-    /// step (fmi2Discard); a non-finite input
+    /// unusable step size may be avoided with a smaller step (fmi2Discard); a non-finite input
     /// (named) or any other failure cannot (fmi2Error). The physics is unchanged after either.
     pub fn do_step<M: FmuModel>(&mut self, step_s: f64) -> Result<(), StepError> {
         let Some(p) = &mut self.physics else {
@@ -182,17 +181,10 @@ impl<P: ShellPhysics> Shell<P> {
                 "the physics is built in fmi2ExitInitializationMode; no step before it".into(),
             )));
         };
-        if step_s > MAX_HOST_STEP_S {
-            return Err(StepError::Discard(
-                InputError::StepTooLong { h: step_s }.to_string(),
-            ));
-        }
         let inputs = &self.inputs;
         let map = |e: P::StepError| match P::input_error(&e) {
             _ if P::diverged(&e) => StepError::Discard(e.to_string()),
-            Some(InputError::InvalidStep { .. } | InputError::StepTooLong { .. }) => {
-                StepError::Discard(e.to_string())
-            }
+            Some(InputError::InvalidStep { .. }) => StepError::Discard(e.to_string()),
             Some(InputError::TooManySubsteps { .. }) => StepError::Error(ModelError::Other(
                 format!("{e} (the internal sub-step comes from a corrupted FMU state)"),
             )),

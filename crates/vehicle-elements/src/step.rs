@@ -7,8 +7,9 @@ use model_description::FieldError;
 /// split, see [`host_step`]).
 pub const MAX_STEP_S: f64 = 1.0;
 
-/// The longest communication step a model accepts in one call \[s\]: longer ones are refused
-/// (fmi2Discard) rather than computed for minutes while the host waits.
+/// The longest communication step the rail-vehicle FMUs take in one call \[s\]
+/// (`FmuModel::MAX_COMMUNICATION_STEP_S`): longer ones are discarded by the FMI glue rather
+/// than computed for minutes while the host waits.
 pub const MAX_HOST_STEP_S: f64 = 1000.0;
 
 /// The most internal sub-steps one physics step of at most [`MAX_STEP_S`] takes: a 1 s step
@@ -29,14 +30,6 @@ pub enum InputError {
     /// Step size not usable.
     #[error("invalid communication step {h} s (must be finite, > 0 and <= 1 s)")]
     InvalidStep {
-        /// Step \[s\].
-        h: f64,
-    },
-    /// A host step longer than [`MAX_HOST_STEP_S`].
-    #[error(
-        "communication step {h:?} s is longer than {MAX_HOST_STEP_S} s: take several shorter steps"
-    )]
-    StepTooLong {
         /// Step \[s\].
         h: f64,
     },
@@ -115,9 +108,7 @@ impl FieldError for InputError {
     fn field(&self) -> Option<&str> {
         match self {
             InputError::NonFiniteInput { name, .. } => Some(name),
-            InputError::InvalidStep { .. }
-            | InputError::StepTooLong { .. }
-            | InputError::TooManySubsteps { .. } => None,
+            InputError::InvalidStep { .. } | InputError::TooManySubsteps { .. } => None,
         }
     }
 

@@ -29,7 +29,7 @@ use serde_json::Value;
 use crate::coupling::Summary;
 use crate::output::OutputError;
 use crate::show::text;
-use crate::system::{split_ref, LoadedSystem, SystemDescription, SystemError};
+use crate::system::{LoadedSystem, StartValueError, SystemDescription, SystemError};
 
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -275,22 +275,17 @@ impl RunSet {
         for (n, (name, params, field)) in sets.into_iter().enumerate() {
             let mut sys = resolved.clone();
             for (key, value) in &params {
-                let f = format!("{field}.{}", text(key));
-                let Some((inst, var)) = split_ref(key) else {
-                    return Err(invalid(
-                        file,
-                        f,
-                        format!("'{}' is not of the form 'instance.variable'", text(key)),
-                    ));
+                let reason = match sys.set_start_value(key, value.clone()) {
+                    Ok(()) => continue,
+                    Err(StartValueError::NotAReference) => {
+                        format!("'{}' is not of the form 'instance.variable'", text(key))
+                    }
+                    Err(StartValueError::UnknownInstance) => {
+                        let inst = key.split_once('.').map_or(key.as_str(), |(i, _)| i);
+                        format!("unknown instance '{}'", text(inst))
+                    }
                 };
-                let Some(spec) = sys.instances.iter_mut().find(|i| i.name == inst) else {
-                    return Err(invalid(
-                        file,
-                        f,
-                        format!("unknown instance '{}'", text(inst)),
-                    ));
-                };
-                spec.parameters.insert(var.to_string(), value.clone());
+                return Err(invalid(file, format!("{field}.{}", text(key)), reason));
             }
             let given = name.unwrap_or_else(|| format!("run-{n:03}"));
             let name = run_folder_name(&given).map_err(|r| invalid(file, field.clone(), r))?;

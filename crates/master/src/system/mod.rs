@@ -72,6 +72,30 @@ pub struct SystemDescription {
     pub max_step_halvings: u32,
 }
 
+/// Why [`SystemDescription::set_start_value`] cannot set a value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StartValueError {
+    /// The key is not of the form `instance.variable`.
+    NotAReference,
+    /// No instance of that name.
+    UnknownInstance,
+}
+
+impl SystemDescription {
+    /// Sets the start value of `key` (`instance.variable`) in the description (its
+    /// parameters; the variable itself is checked when the system is loaded).
+    pub fn set_start_value(&mut self, key: &str, value: Value) -> Result<(), StartValueError> {
+        let (inst, var) = split_ref(key).ok_or(StartValueError::NotAReference)?;
+        let spec = self
+            .instances
+            .iter_mut()
+            .find(|i| i.name == inst)
+            .ok_or(StartValueError::UnknownInstance)?;
+        spec.parameters.insert(var.to_string(), value);
+        Ok(())
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InstanceSpec {

@@ -106,7 +106,7 @@ impl ResultsTable {
         // (line, fields, whether each was quoted): a comma-separated file by records (RFC
         // 4180: our writer quotes names with commas and every String value, which may hold a
         // line break), a host's semicolon- or space-separated export by lines
-        let mut records: Vec<(usize, Vec<String>, Vec<bool>)> = if sep == Some(',') {
+        let records: Vec<(usize, Vec<String>, Vec<bool>)> = if sep == Some(',') {
             master::csv_records::records(text, true)
                 .map_err(|e| bad_file(path, e.line, e.reason.into()))?
                 .into_iter()
@@ -136,10 +136,10 @@ impl ResultsTable {
                 })
                 .collect()
         };
-        if records.is_empty() {
+        let mut records = records.into_iter();
+        let Some((_, names, _)) = records.next() else {
             return Err(bad_file(path, 1, "no header line".into()));
-        }
-        let names = records.remove(0).1;
+        };
         if names.len() < 2 {
             return Err(bad_file(
                 path,
@@ -163,27 +163,17 @@ impl ResultsTable {
                 if text[k].is_some() {
                     continue;
                 }
-                match f.parse::<f64>() {
-                    Ok(v) if v.is_finite() && !quoted[k] => columns[k].push(v),
-                    Ok(v) if !quoted[k] => {
-                        let reason = format!(
-                            "{} in column '{}' is not finite",
-                            master::show::num(v),
-                            master::show::text(&names[k])
-                        );
-                        text[k] = Some((no, reason));
-                        columns[k] = Vec::new();
+                let (value, is) = match f.parse::<f64>() {
+                    Ok(v) if v.is_finite() && !quoted[k] => {
+                        columns[k].push(v);
+                        continue;
                     }
-                    _ => {
-                        let reason = format!(
-                            "'{}' in column '{}' is not a number",
-                            master::show::text(f),
-                            master::show::text(&names[k])
-                        );
-                        text[k] = Some((no, reason));
-                        columns[k] = Vec::new();
-                    }
-                }
+                    Ok(v) if !quoted[k] => (master::show::num(v).to_string(), "not finite"),
+                    _ => (format!("'{}'", master::show::text(f)), "not a number"),
+                };
+                let column = master::show::text(&names[k]);
+                text[k] = Some((no, format!("{value} in column '{column}' is {is}")));
+                columns[k] = Vec::new();
             }
         }
         if let Some((no, reason)) = &text[0] {

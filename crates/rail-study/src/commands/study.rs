@@ -349,20 +349,12 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
 fn remove_earlier_outputs(out: &std::path::Path) -> Result<(), CommandError> {
     for name in output_files() {
         let path = out.join(name);
-        let ours = std::fs::symlink_metadata(&path)
-            .is_ok_and(|m| m.file_type().is_file() || m.file_type().is_symlink());
-        if !ours {
-            continue;
-        }
-        match std::fs::remove_file(&path) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(CommandError::Failed(format!(
-                    "cannot remove the previous '{}': {e}",
-                    path.display()
-                )))
-            }
-            _ => {}
-        }
+        master::output::remove_stale_file(&path).map_err(|e| {
+            CommandError::Failed(format!(
+                "cannot remove the previous '{}': {e}",
+                path.display()
+            ))
+        })?;
     }
     Ok(())
 }
