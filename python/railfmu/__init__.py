@@ -19,6 +19,7 @@ from ._railfmu import AssessmentError, Error, FmuError, OutputError, SimulationE
 from ._results import Results, RunSetResults, read_results, split_label
 from ._runset import RunSet, run_set
 from ._system import System
+from .dask import SchedulerLostError
 
 __all__ = [
     "AssessmentError",
@@ -27,6 +28,7 @@ __all__ = [
     "OutputError",
     "Results",
     "RunSet",
+    "SchedulerLostError",
     "RunSetResults",
     "SignalAssessment",
     "SimulationError",

@@ -31,7 +31,10 @@ removed and needed again is written again. Nothing else in the folder is touched
 A worker prepares a system (unpacks and loads its FMUs) once and keeps it for the later tasks of
 the same run set. A simulation that fails is the run's result (its error is kept in its
 ``summary.json``), not a task failure; a task whose worker dies is run again by Dask
-(``retries``, and Dask's own rescheduling of a lost worker's tasks).
+(``retries``, and Dask's own rescheduling of a lost worker's tasks). A client that loses its
+scheduler cannot get the other results: the set stops as an interrupted one does (the runs not
+finished are written as cancelled) and raises :class:`SchedulerLostError`; ``resume=True`` on a
+working cluster completes it.
 """
 
 from __future__ import annotations
@@ -49,6 +52,14 @@ from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from . import _railfmu
+
+
+
+class SchedulerLostError(_railfmu.Error, ConnectionError):
+    """The Dask client lost its scheduler during a run set: the runs that had not finished are
+    written as cancelled (the set's folder and sweep.json list every run) and ``resume=True``
+    on a working cluster runs them."""
+
 
 _PREPARED: Dict[str, "_railfmu.PreparedSystem"] = {}
 _PREPARED_LOCK = threading.Lock()
@@ -270,6 +281,13 @@ def run_jobs_on_cluster(
                 report = writer.write(job_json, r["header"], r["data"], r["summary_json"], r["columns_json"], r["error"])
                 error = r["error"]
             except Exception as e:  # the task failed: the run's error, the set goes on
+                if _scheduler_lost(client, e):
+                    finished = sum(r is not None for r in reports)
+                    raise SchedulerLostError(
+                        f"the Dask client lost its scheduler after {finished} of the {len(jobs_json)} "
+                        "runs submitted; the others are cancelled: run the set again with resume=True on a "
+                        "working cluster"
+                    ) from e
                 error = f"run '{name}' failed on the cluster: {type(e).__name__}: {e}"
                 report = writer.write(job_json, error=error)
             reports[i] = report
@@ -287,6 +305,19 @@ def run_jobs_on_cluster(
     else:
         _cancel(futures)
     return [r for r in reports if r is not None]
+
+
+def _scheduler_lost(client: Any, e: BaseException) -> bool:
+    """Whether a task's exception says that the client has lost its scheduler (every pending
+    future is cancelled then: no result of this set can arrive any more), not that the run
+    failed."""
+    from distributed.comm import CommClosedError
+
+    # the futures cancelled for it, or a result fetched over the closed connection
+    if getattr(e, "reason", None) == "scheduler-connection-lost" or isinstance(e, CommClosedError):
+        return True
+    # reconnecting, or closed meanwhile
+    return getattr(client, "status", "running") != "running"
 
 
 def _cancel(futures: Any) -> None:

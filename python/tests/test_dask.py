@@ -222,6 +222,68 @@ def test_an_interrupted_set_leaves_a_whole_folder_that_a_resumed_set_completes(d
     assert [r["name"] for r in json.loads((out / "sweep.json").read_text()) if r["ok"]] == rs.names
 
 
+def test_a_client_that_loses_its_scheduler_stops_the_set_as_an_interrupted_one(dist, client, tmp_path):
+    """A scheduler of its own (the module's LocalCluster runs its scheduler in this process),
+    killed once the first run has arrived: the set raises SchedulerLostError, the runs not
+    finished are cancelled, not failed, and the module's cluster completes the set."""
+    rs = eight_runs(dist, stop_time=1.0)
+    local = rs.run(tmp_path / "local", threads=2)
+    assert local.ok
+    addr_file = tmp_path / "scheduler.json"
+    quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    scheduler = subprocess.Popen(
+        [sys.executable, "-m", "distributed.cli.dask_scheduler", "--scheduler-file", str(addr_file), "--port", "0", "--no-dashboard"],
+        **quiet,
+    )
+    worker = None
+    own = None
+    try:
+        deadline = time.monotonic() + 60
+        while not addr_file.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        worker = subprocess.Popen(
+            [sys.executable, "-m", "distributed.cli.dask_worker", "--scheduler-file", str(addr_file), "--nthreads", "1", "--no-dashboard"],
+            **quiet,
+        )
+        own = distributed.Client(scheduler_file=str(addr_file), timeout=60)
+        own.wait_for_workers(1, timeout=60)
+        arrived = []
+
+        def kill_scheduler(done, total, name, error):
+            if name:
+                arrived.append((name, error))
+                if scheduler.poll() is None:
+                    scheduler.kill()
+
+        out = tmp_path / "dask"
+        with pytest.raises(railfmu.SchedulerLostError) as lost:
+            rs.run(out, client=own, progress=kill_scheduler)
+        assert isinstance(lost.value, ConnectionError) and isinstance(lost.value, railfmu.Error)
+        # a run or two may arrive before the scheduler is gone
+        assert 1 <= len(arrived) < 8 and all(error is None for _, error in arrived)
+        assert f"lost its scheduler after {len(arrived)} of the 8 runs submitted" in str(lost.value)
+    finally:
+        scheduler.kill()
+        if worker is not None:
+            worker.kill()
+        if own is not None:
+            own.close(timeout=5)
+    # the runs that arrived are whole; every other run is cancelled, none reported as failed
+    sweep = json.loads((out / "sweep.json").read_text())
+    assert [r["name"] for r in sweep] == rs.names
+    finished = [r["name"] for r in sweep if r["ok"]]
+    assert sorted(finished) == sorted(name for name, _ in arrived)
+    for r in sweep:
+        if not r["ok"]:
+            assert r["error"].startswith("cancelled: the run set stopped before this run finished (SchedulerLostError: ")
+    assert csv_bytes(out) == {n: b for n, b in csv_bytes(tmp_path / "local").items() if n in finished}
+    # resumed on a working cluster: only the cancelled runs run
+    ran = []
+    again = rs.run(out, client=client, resume=True, progress=lambda d, t, n, e: ran.append(n))
+    assert sorted(n for n in ran if n) == sorted(set(rs.names) - set(finished))
+    assert again.ok and csv_bytes(out) == csv_bytes(tmp_path / "local")
+
+
 def test_the_command_line_runs_a_set_on_the_cluster(dist, client, master_cmd, tmp_path):
     set_file = tmp_path / "set.json"
     set_file.write_text(json.dumps(speed_set(dist, [50.0, 70.0], stop_time=0.2)))
