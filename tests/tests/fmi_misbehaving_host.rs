@@ -106,12 +106,13 @@ fn deserialise(inst: &Instance, bytes: &[c_char], size: usize) -> ffi::fmi2Statu
     s
 }
 
+/// `bytes` with the f64 at `at` replaced, sealed again with a matching checksum (a forged
+/// state: the state's own checks decide, not the checksum).
 fn with_f64_at(bytes: &[c_char], at: usize, x: f64) -> Vec<c_char> {
-    let mut b = bytes.to_vec();
-    for (k, byte) in x.to_le_bytes().iter().enumerate() {
-        b[at + k] = *byte as c_char;
-    }
-    b
+    let mut b: Vec<u8> = bytes.iter().map(|&c| c as u8).collect();
+    b[at..at + 8].copy_from_slice(&x.to_le_bytes());
+    model_description::testing::reseal_state(&mut b);
+    b.into_iter().map(|c| c as c_char).collect()
 }
 
 #[test]
@@ -131,15 +132,24 @@ fn tampered_fmu_states_are_refused() {
         .any(|m| m.contains("are not exactly one serialised state")));
     // Too short.
     assert_eq!(deserialise(&inst, &bytes, n - 1), ERROR);
+    // One byte of the model altered (the last 4 bytes are the checksum): refused as a whole.
+    let mut flipped = bytes.clone();
+    flipped[n - 12] ^= 1;
+    assert_eq!(deserialise(&inst, &flipped, n), ERROR);
+    assert!(inst
+        .messages()
+        .iter()
+        .any(|m| m.contains("their checksum does not match")));
     // A non-finite time (the header's time follows the 4-byte magic).
     for bad in [f64::NAN, f64::INFINITY] {
         assert_eq!(deserialise(&inst, &with_f64_at(&bytes, 4, bad), n), ERROR);
     }
     assert!(inst.messages().iter().any(|m| m.contains("invalid time")));
-    // A non-finite value in the model: the last 8 bytes are MassSpring's velocity.
+    // A non-finite value in the model: the 8 bytes before the checksum are MassSpring's
+    // velocity.
     for bad in [f64::NAN, f64::NEG_INFINITY] {
         assert_eq!(
-            deserialise(&inst, &with_f64_at(&bytes, n - 8, bad), n),
+            deserialise(&inst, &with_f64_at(&bytes, n - 12, bad), n),
             ERROR
         );
     }
@@ -240,4 +250,30 @@ fn contact_table_files_that_are_no_regular_files_are_refused_without_reading_the
     std::fs::copy(shipped, &good).unwrap();
     let (status, msgs) = init_bogie_with_table(good.to_str().unwrap());
     assert!(status == OK || status == WARNING, "{msgs:?}");
+}
+
+#[test]
+fn a_state_of_another_model_in_the_same_binary_is_not_freed_as_ours() {
+    let f = mass_spring();
+    // the binary carries both example models: one instance of each from the same library
+    let guid = TestFmu::open_dist("SpringDamperMass").unwrap().guid;
+    let mass = f.instantiate("mass").unwrap();
+    let other = f.instantiate_with_guid("other", &guid).unwrap();
+    assert_eq!(mass.initialize(0.0), OK);
+    assert_eq!(other.initialize(0.0), OK);
+    let mut state: ffi::fmi2FMUstate = std::ptr::null_mut();
+    // SAFETY: plain FMI calls on live instances; the state stays owned by `other`.
+    unsafe {
+        assert_eq!(other.b().fmi2GetFMUstate(other.component, &mut state), OK);
+        assert_eq!(mass.b().fmi2FreeFMUstate(mass.component, &mut state), ERROR);
+        assert!(!state.is_null(), "the refused state was released");
+        assert!(mass
+            .messages()
+            .iter()
+            .any(|m| m.contains("belongs to another model")));
+        // still whole: its own model restores and frees it
+        assert_eq!(other.b().fmi2SetFMUstate(other.component, state), OK);
+        assert_eq!(other.b().fmi2FreeFMUstate(other.component, &mut state), OK);
+    }
+    assert!(state.is_null());
 }

@@ -3,9 +3,10 @@
 //! functions here. One binary may carry several models; `fmi2Instantiate` picks the model by
 //! GUID, so the same library is shipped in each model's FMU under its modelIdentifier.
 //!
-//! Every function catches panics (none crosses the C boundary), checks its pointers, and
-//! reports failures through the host's logger with the message passed as a `%s` argument and
-//! every '#' doubled (FMI 2.0 reserves '#' for variable references in log messages).
+//! Every function catches panics (none crosses the C boundary; the panic's message goes to
+//! the host's logger, not to the host process's stderr), checks its pointers, and reports
+//! failures through the host's logger with the message passed as a `%s` argument and every
+//! '#' doubled (FMI 2.0 reserves '#' for variable references in log messages).
 
 #![allow(clippy::missing_safety_doc)]
 
@@ -161,8 +162,9 @@ impl LogSink for HostLogger {
 /// The heap object behind an fmi2Component.
 pub struct CComponent {
     component: Component,
-    /// Cached bytes of the last serialised state (size query, then serialise).
-    serialized: Option<(usize, Vec<u8>)>,
+    /// Cached bytes of the last serialised state (size query, then serialise), by the
+    /// state's [`Snapshot::id`].
+    serialized: Option<(u64, Vec<u8>)>,
     /// Booleans converted from/to fmi2Boolean, kept so that the get/set path allocates only
     /// when a call passes more values than any before.
     booleans: Vec<bool>,
@@ -236,6 +238,7 @@ pub unsafe fn instantiate(
     _visible: fmi2Boolean,
     logging_on: fmi2Boolean,
 ) -> fmi2Component {
+    install_panic_hook();
     let result = catch_unwind(AssertUnwindSafe(|| {
         let fail = |msg: &str| {
             early_log(functions, instance_name, &format!("fmi2Instantiate: {msg}"));
@@ -296,6 +299,42 @@ pub unsafe fn instantiate(
     result.unwrap_or(std::ptr::null_mut())
 }
 
+thread_local! {
+    /// Set while this thread runs an `fmi2*` call on a component ([`with`]).
+    static IN_FMI_CALL: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Installs (once) a panic hook that stays silent for a panic inside an `fmi2*` call, which
+/// [`with`] reports through the host's logger, and leaves every other panic to the hook
+/// before it (this library's own copy of the standard library has its own hook).
+fn install_panic_hook() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !IN_FMI_CALL.with(std::cell::Cell::get) {
+                previous(info);
+            }
+        }));
+    });
+}
+
+/// The text of a caught panic's payload (`panic!` with a message gives a `&str` or a
+/// `String`).
+fn panic_text(payload: &(dyn std::any::Any + Send)) -> &str {
+    payload
+        .downcast_ref::<&str>()
+        .copied()
+        .or_else(|| payload.downcast_ref::<String>().map(String::as_str))
+        .unwrap_or("no message")
+        // the first line, at most 300 characters (a panic message may hold a backtrace or data)
+        .lines()
+        .next()
+        .map_or("", |l| {
+            l.char_indices().nth(300).map_or(l, |(i, _)| &l[..i])
+        })
+}
+
 pub unsafe fn free_instance(c: fmi2Component) {
     if c.is_null() {
         return;
@@ -318,15 +357,19 @@ pub unsafe fn with(
     }
     let cc = &mut *(c as *mut CComponent);
     cc.component.trace(call);
-    match catch_unwind(AssertUnwindSafe(|| f(&mut *cc))) {
+    let outer = IN_FMI_CALL.with(|f| f.replace(true));
+    let result = catch_unwind(AssertUnwindSafe(|| f(&mut *cc)));
+    IN_FMI_CALL.with(|f| f.set(outer));
+    match result {
         Ok(s) => to_c(s),
-        Err(_) => {
+        Err(payload) => {
             let cc = &mut *(c as *mut CComponent);
             let _ = catch_unwind(AssertUnwindSafe(|| {
                 cc.component.enter_error_state();
                 cc.component.error(&format!(
-                    "{call}: internal error (panic caught at the C boundary); the instance is \
-                     in the Error state (fmi2Reset, or fmi2SetFMUstate of a saved state)"
+                    "{call}: internal error (panic caught at the C boundary: {}); the instance \
+                     is in the Error state (fmi2Reset, or fmi2SetFMUstate of a saved state)",
+                    panic_text(payload.as_ref())
                 ));
             }));
             FMI2_ERROR
@@ -617,14 +660,7 @@ pub unsafe fn get_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2S
                 Err(s) => s,
             }
         } else {
-            // bytes serialised from this state before are out of date now
-            if cc
-                .serialized
-                .as_ref()
-                .is_some_and(|(p, _)| *p == (*state) as usize)
-            {
-                cc.serialized = None;
-            }
+            // bytes serialised from this state before are out of date now: its id changes
             let snapshot = &mut *((*state) as *mut Snapshot);
             cc.component.update_fmu_state(snapshot)
         }
@@ -647,10 +683,14 @@ pub unsafe fn free_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2
         }
         if !(*state).is_null() {
             let ptr = (*state) as *mut Snapshot;
+            let own = cc.component.check_own_fmu_state(&*ptr);
+            if own != Status::Ok {
+                return own;
+            }
             if cc
                 .serialized
                 .as_ref()
-                .is_some_and(|(p, _)| *p == ptr as usize)
+                .is_some_and(|(id, _)| *id == (*ptr).id())
             {
                 cc.serialized = None;
             }
@@ -662,7 +702,7 @@ pub unsafe fn free_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2
 }
 
 unsafe fn serialized_bytes(cc: &mut CComponent, state: fmi2FMUstate) -> Result<&[u8], Status> {
-    let key = state as usize;
+    let key = (*(state as *const Snapshot)).id();
     let cached = cc.serialized.as_ref().is_some_and(|(p, _)| *p == key);
     if !cached {
         let bytes = cc
@@ -744,8 +784,6 @@ pub unsafe fn deserialize_fmu_state(
         };
         match cc.component.deserialize_fmu_state(bytes) {
             Ok(snapshot) => {
-                // the new state may get the address of one whose bytes are cached
-                cc.serialized = None;
                 if !(*state).is_null() {
                     drop(Box::from_raw((*state) as *mut Snapshot));
                 }
@@ -791,6 +829,9 @@ pub unsafe fn get_real_status(
         if value.is_null() {
             return null_arg(cc, "fmi2GetRealStatus");
         }
+        if let Err(s) = cc.component.check_status_query("fmi2GetRealStatus") {
+            return s;
+        }
         if kind == ffi::fmi2StatusKind_fmi2LastSuccessfulTime {
             *value = cc.component.last_successful_time();
             Status::Ok
@@ -809,6 +850,9 @@ pub unsafe fn get_boolean_status(
     with(c, "fmi2GetBooleanStatus", |cc| {
         if value.is_null() {
             return null_arg(cc, "fmi2GetBooleanStatus");
+        }
+        if let Err(s) = cc.component.check_status_query("fmi2GetBooleanStatus") {
+            return s;
         }
         if kind == ffi::fmi2StatusKind_fmi2Terminated {
             // The models never ask to end the simulation early.

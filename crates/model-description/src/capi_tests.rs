@@ -205,6 +205,16 @@ fn a_deserialised_state_with_a_parameter_out_of_its_range_is_refused() {
         for (bad, shown) in [(-5.0_f64, "-5.0"), (1e300, "1e300")] {
             let mut altered = bytes.clone();
             altered[at..at + 8].copy_from_slice(&bad.to_le_bytes());
+            // as altered: its checksum no longer matches
+            assert_eq!(deserialise(&altered), FMI2_ERROR);
+            assert!(log
+                .take()
+                .iter()
+                .any(|(_, _, m)| m.contains("their checksum does not match")));
+            // forged with a matching checksum: the value's own check names it
+            let n = altered.len() - 4;
+            altered.truncate(n);
+            crate::component::seal(&mut altered);
             assert_eq!(deserialise(&altered), FMI2_ERROR);
             let expected = format!("'gain' = {shown} is outside its range");
             assert!(
@@ -216,5 +226,141 @@ fn a_deserialised_state_with_a_parameter_out_of_its_range_is_refused() {
         assert_eq!(do_step(c, 0.0, 0.1), FMI2_OK);
         assert_eq!(free_fmu_state(c, &mut state), FMI2_OK);
         free_instance(c);
+    }
+}
+
+#[test]
+fn a_panic_is_reported_with_its_message() {
+    let (c, log) = fragile();
+    let u = [value_reference::<Fragile>("u").unwrap()];
+    unsafe {
+        start_at(c, 0.0);
+        assert_eq!(set_real(c, u.as_ptr(), 1, [-1.0].as_ptr()), FMI2_OK);
+        assert_eq!(do_step(c, 0.0, 0.1), FMI2_ERROR);
+        free_instance(c);
+    }
+    let messages: Vec<String> = log.take().into_iter().map(|(_, _, m)| m).collect();
+    assert!(
+        messages
+            .iter()
+            .any(|m| m.contains("panic caught at the C boundary: index out of bounds")),
+        "{messages:?}"
+    );
+}
+
+#[test]
+fn a_step_below_the_time_resolution_is_refused_not_taken_as_done() {
+    let (c, log) = fragile();
+    let u = [value_reference::<Fragile>("u").unwrap()];
+    let x = [value_reference::<Fragile>("x").unwrap()];
+    unsafe {
+        start_at(c, 1e15);
+        assert_eq!(set_real(c, u.as_ptr(), 1, [1.0].as_ptr()), FMI2_OK);
+        // 1e15 + 1e-3 == 1e15: the step would not advance time
+        assert_eq!(do_step(c, 1e15, 1e-3), FMI2_ERROR);
+        let messages: Vec<String> = log.take().into_iter().map(|(_, _, m)| m).collect();
+        assert!(
+            messages
+                .iter()
+                .any(|m| m.contains("is below the time resolution at t = 1000000000000000.0 s")),
+            "{messages:?}"
+        );
+        let mut t = f64::NAN;
+        assert_eq!(
+            get_real_status(c, ffi::fmi2StatusKind_fmi2LastSuccessfulTime, &mut t),
+            FMI2_OK
+        );
+        assert_eq!(t, 1e15);
+        free_instance(c);
+    }
+    // a step that advances time at that point is taken (an ulp of 1e15 is 0.125)
+    let (c, _log) = fragile();
+    unsafe {
+        start_at(c, 1e15);
+        assert_eq!(set_real(c, u.as_ptr(), 1, [1.0].as_ptr()), FMI2_OK);
+        assert_eq!(do_step(c, 1e15, 0.125), FMI2_OK);
+        let mut value = [f64::NAN];
+        assert_eq!(get_real(c, x.as_ptr(), 1, value.as_mut_ptr()), FMI2_OK);
+        assert_eq!(value, [1.0]);
+        // a zero step stays allowed
+        assert_eq!(do_step(c, 1e15 + 0.125, 0.0), FMI2_OK);
+        free_instance(c);
+    }
+}
+
+#[test]
+fn status_queries_are_refused_before_the_first_step_as_the_state_machine_says() {
+    let (c, _log) = fragile();
+    unsafe {
+        let query = |c| {
+            let mut t = f64::NAN;
+            let mut b: fmi2Boolean = 7;
+            (
+                get_real_status(c, ffi::fmi2StatusKind_fmi2LastSuccessfulTime, &mut t),
+                get_boolean_status(c, ffi::fmi2StatusKind_fmi2Terminated, &mut b),
+            )
+        };
+        // instantiated, initialisation mode: refused
+        assert_eq!(query(c), (FMI2_ERROR, FMI2_ERROR));
+        assert_eq!(setup_experiment(c, 0, 0.0, 0.0, 0, 0.0), FMI2_OK);
+        assert_eq!(enter_initialization_mode(c), FMI2_OK);
+        assert_eq!(query(c), (FMI2_ERROR, FMI2_ERROR));
+        assert_eq!(exit_initialization_mode(c), FMI2_OK);
+        // step mode and terminated: answered
+        assert_eq!(query(c), (FMI2_OK, FMI2_OK));
+        assert_eq!(terminate(c), FMI2_OK);
+        assert_eq!(query(c), (FMI2_OK, FMI2_OK));
+        free_instance(c);
+    }
+}
+
+#[test]
+fn a_read_with_an_unknown_value_reference_leaves_the_hosts_array_untouched() {
+    let (c, _log) = fragile();
+    let x = value_reference::<Fragile>("x").unwrap();
+    unsafe {
+        start_at(c, 0.0);
+        let vrs = [x, 99];
+        let mut values = [-7.0, -7.0];
+        assert_eq!(
+            get_real(c, vrs.as_ptr(), 2, values.as_mut_ptr()),
+            FMI2_ERROR
+        );
+        assert_eq!(values, [-7.0, -7.0]);
+        free_instance(c);
+    }
+}
+
+#[test]
+fn serialised_bytes_are_those_of_the_state_asked_for_even_at_a_freed_states_address() {
+    let (c, _log) = fragile();
+    let (other, _other_log) = fragile();
+    let u = [value_reference::<Fragile>("u").unwrap()];
+    unsafe {
+        start_at(c, 0.0);
+        start_at(other, 0.0);
+        let mut first: fmi2FMUstate = std::ptr::null_mut();
+        assert_eq!(get_fmu_state(c, &mut first), FMI2_OK);
+        let mut size = 0usize;
+        // c keeps the bytes of `first` for the serialisation that usually follows
+        assert_eq!(serialized_fmu_state_size(c, first, &mut size), FMI2_OK);
+        let at_start = serialise(other, first);
+        // freed through the other instance: c does not see it
+        assert_eq!(free_fmu_state(other, &mut first), FMI2_OK);
+        assert_eq!(set_real(c, u.as_ptr(), 1, [1.0].as_ptr()), FMI2_OK);
+        assert_eq!(do_step(c, 0.0, 0.1), FMI2_OK);
+        // a new state of the same size, most likely at the freed one's address
+        let mut second: fmi2FMUstate = std::ptr::null_mut();
+        assert_eq!(get_fmu_state(c, &mut second), FMI2_OK);
+        let mut bytes = vec![0u8; size];
+        assert_eq!(
+            serialize_fmu_state(c, second, bytes.as_mut_ptr().cast(), size),
+            FMI2_OK
+        );
+        assert_ne!(bytes, at_start, "the bytes of the freed state");
+        assert_eq!(bytes, serialise(other, second));
+        assert_eq!(free_fmu_state(c, &mut second), FMI2_OK);
+        free_instance(c);
+        free_instance(other);
     }
 }

@@ -63,6 +63,9 @@ impl LogSink for CollectLog {
 
 /// A saved FMU state (fmi2FMUstate points to one of these).
 pub struct Snapshot {
+    /// Unique per content (a new one at each fmi2GetFMUstate that writes it): what the C API's
+    /// cache of serialised bytes is keyed by, not the address a freed state's successor may get.
+    id: u64,
     model: Box<dyn Any + Send>,
     time: f64,
     state: FmiState,
@@ -81,6 +84,19 @@ struct SnapshotHeader {
 }
 
 const MAGIC: [u8; 4] = *b"RFM2";
+
+/// A new [`Snapshot::id`].
+fn next_snapshot_id() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+impl Snapshot {
+    /// See [`Snapshot::id`](Snapshot).
+    pub fn id(&self) -> u64 {
+        self.id
+    }
+}
 
 /// What decides whether a value may be set, per variable (FMI 2.0 rules for co-simulation),
 /// computed once per instance so that the checks of every fmi2Set* call are a lookup and a few
@@ -495,6 +511,12 @@ impl Component {
         if status > Status::Warning {
             return status;
         }
+        // every value reference first: a refused call leaves the host's array as it was
+        for vr in vrs {
+            if let Err(s) = self.resolve("fmi2GetInteger", VarType::Integer, *vr) {
+                return s;
+            }
+        }
         for (vr, out) in vrs.iter().zip(values.iter_mut()) {
             let i = match self.resolve("fmi2GetInteger", VarType::Integer, *vr) {
                 Ok(i) => i,
@@ -753,6 +775,8 @@ impl Component {
             && step.is_finite()
             && step >= 0.0
             && target.is_finite()
+            // a positive step below the time resolution at `current` would not advance time
+            && (target > current || step == 0.0)
             && (current - self.time).abs() <= tol
             && self.stop_time.is_none_or(|stop| target <= stop + tol);
         if !valid {
@@ -799,6 +823,13 @@ impl Component {
             let msg = format!("{CALL}: invalid communication point {current:?} or step {step:?}");
             return self.error(&msg);
         }
+        if step > 0.0 && current + step == current {
+            let msg = format!(
+                "{CALL}: step {step:?} s is below the time resolution at t = {current:?} s \
+                 (t + h == t): it would not advance time"
+            );
+            return self.error(&msg);
+        }
         let tol = self.time_tolerance(step);
         if (current - self.time).abs() > tol {
             let msg = format!(
@@ -843,6 +874,15 @@ impl Component {
         }
     }
 
+    /// fmi2GetXXXStatus is allowed after the first step only: step complete, step failed or
+    /// terminated (FMI 2.0 co-simulation state machine, 4.2.4; the Reference FMUs' mask).
+    pub fn check_status_query(&mut self, call: &str) -> Result<(), Status> {
+        match self.state {
+            FmiState::StepComplete | FmiState::StepFailed | FmiState::Terminated => Ok(()),
+            _ => Err(self.wrong_state(call)),
+        }
+    }
+
     pub fn last_successful_time(&self) -> f64 {
         self.last_successful_time
     }
@@ -860,6 +900,7 @@ impl Component {
             return Err(self.wrong_state("fmi2GetFMUstate"));
         }
         Ok(Box::new(Snapshot {
+            id: next_snapshot_id(),
             model: self.model.snapshot(),
             time: self.time,
             state: self.state,
@@ -876,11 +917,22 @@ impl Component {
         if !self.model.update_snapshot(snapshot.model.as_mut()) {
             return self.error("fmi2GetFMUstate: the given FMU state belongs to another model");
         }
+        snapshot.id = next_snapshot_id();
         snapshot.time = self.time;
         snapshot.state = self.state;
         snapshot.start_time = self.start_time;
         snapshot.stop_time = self.stop_time;
         Status::Ok
+    }
+
+    /// fmi2FreeFMUstate: a state of this model (a state of another model in the same binary
+    /// is refused, not freed as if it were one of ours).
+    pub fn check_own_fmu_state(&mut self, snapshot: &Snapshot) -> Status {
+        if self.model.owns(snapshot.model.as_ref()) {
+            Status::Ok
+        } else {
+            self.error("fmi2FreeFMUstate: the given FMU state belongs to another model")
+        }
     }
 
     pub fn set_fmu_state(&mut self, snapshot: &Snapshot) -> Status {
@@ -908,11 +960,24 @@ impl Component {
             stop_time: snapshot.stop_time,
             model,
         };
-        bincode::serialize(&header).map_err(|e| self.error(&format!("fmi2SerializeFMUstate: {e}")))
+        let mut bytes = bincode::serialize(&header)
+            .map_err(|e| self.error(&format!("fmi2SerializeFMUstate: {e}")))?;
+        seal(&mut bytes);
+        Ok(bytes)
     }
 
     pub fn deserialize_fmu_state(&mut self, bytes: &[u8]) -> Result<Box<Snapshot>, Status> {
         const CALL: &str = "fmi2DeSerializeFMUstate";
+        // bytes altered, cut or extended since this FMU wrote them are refused whole here;
+        // the checks below name what is wrong in a state that is sealed but still invalid
+        let Some(bytes) = unseal(bytes) else {
+            let msg = format!(
+                "{CALL}: {} bytes are not exactly one serialised state of this FMU: their \
+                 checksum does not match (altered, truncated or extended since it wrote them)",
+                bytes.len()
+            );
+            return Err(self.error(&msg));
+        };
         let header: SnapshotHeader = match strict_bincode(bytes) {
             Ok(h) => h,
             Err(e) => {
@@ -943,6 +1008,7 @@ impl Component {
             Err(reason) => return Err(self.error(&format!("{CALL}: {reason}"))),
         };
         Ok(Box::new(Snapshot {
+            id: next_snapshot_id(),
             model,
             time: header.time,
             state: header.state,
@@ -950,6 +1016,18 @@ impl Component {
             stop_time: header.stop_time,
         }))
     }
+}
+
+/// Appends the CRC-32 of a serialised state's bytes (little-endian), which [`unseal`] checks.
+pub(crate) fn seal(bytes: &mut Vec<u8>) {
+    let sum = crc32fast::hash(bytes);
+    bytes.extend_from_slice(&sum.to_le_bytes());
+}
+
+/// The bytes before the checksum [`seal`] appended, if it matches.
+pub(crate) fn unseal(bytes: &[u8]) -> Option<&[u8]> {
+    let (body, sum) = bytes.split_at_checked(bytes.len().checked_sub(4)?)?;
+    (crc32fast::hash(body).to_le_bytes() == sum).then_some(body)
 }
 
 /// Decode bincode bytes (the legacy fixed-integer format `bincode::serialize` writes) strictly:

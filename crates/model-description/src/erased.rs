@@ -15,8 +15,7 @@ pub trait ErasedModel: Send {
     fn get_boolean(&self, index: usize) -> Option<bool>;
     fn get_string(&self, index: usize) -> Option<String>;
     /// Reads the Reals with value references `vrs` into `out` (as many): one call for a whole
-    /// fmi2GetReal. `Err(vr)`: the first value reference that is no Real (values before it
-    /// are written).
+    /// fmi2GetReal. `Err(vr)`: the first value reference that is no Real (nothing is written).
     fn get_reals(&self, vrs: &[u32], out: &mut [f64]) -> Result<(), u32>;
     /// Returns false if the variable has no setter of that type.
     fn set_integer(&mut self, index: usize, value: i32) -> bool;
@@ -34,6 +33,8 @@ pub trait ErasedModel: Send {
     /// [`FmuModel::MAX_COMMUNICATION_STEP_S`].
     fn max_communication_step_s(&self) -> f64;
     fn snapshot(&self) -> Box<dyn Any + Send>;
+    /// Whether `snapshot` is a snapshot of this model.
+    fn owns(&self, snapshot: &(dyn Any + Send)) -> bool;
     /// Restore from a snapshot taken from an instance of the same model.
     fn restore(&mut self, snapshot: &(dyn Any + Send)) -> bool;
     /// Overwrite an existing snapshot in place (fmi2GetFMUstate with a non-null state).
@@ -146,6 +147,10 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
     }
 
     fn get_reals(&self, vrs: &[u32], out: &mut [f64]) -> Result<(), u32> {
+        // every value reference first: a refused call leaves the host's array as it was
+        if let Some(&vr) = vrs.iter().find(|&&vr| vr as usize >= self.real_get.len()) {
+            return Err(vr);
+        }
         for (&vr, x) in vrs.iter().zip(out) {
             let get = self.real_get.get(vr as usize).ok_or(vr)?;
             *x = get(&self.model);
@@ -223,6 +228,10 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
 
     fn snapshot(&self) -> Box<dyn Any + Send> {
         Box::new(self.model.clone())
+    }
+
+    fn owns(&self, snapshot: &(dyn Any + Send)) -> bool {
+        snapshot.is::<M>()
     }
 
     fn restore(&mut self, snapshot: &(dyn Any + Send)) -> bool {
