@@ -299,20 +299,23 @@ pub unsafe fn instantiate(
     result.unwrap_or(std::ptr::null_mut())
 }
 
-thread_local! {
-    /// Set while this thread runs an `fmi2*` call on a component ([`with`]).
-    static IN_FMI_CALL: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
+/// How many `fmi2*` calls on components are running ([`with`]), in any thread. In an FMU's
+/// binary every panic is inside one (its standard library is its own, and no thread of its own
+/// runs), so the hook below is silent exactly for the panics [`with`] reports; where the glue is
+/// linked into a Rust program calling the C API in-process (its tests), a panic of another
+/// thread during such a call is silent too. A counter, not a thread-local flag: a shared
+/// library reaches a thread-local through `__tls_get_addr` on every call.
+static CALLS_RUNNING: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 /// Installs (once) a panic hook that stays silent for a panic inside an `fmi2*` call, which
 /// [`with`] reports through the host's logger, and leaves every other panic to the hook
-/// before it (this library's own copy of the standard library has its own hook).
+/// before it (see [`CALLS_RUNNING`]).
 fn install_panic_hook() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         let previous = std::panic::take_hook();
         std::panic::set_hook(Box::new(move |info| {
-            if !IN_FMI_CALL.with(std::cell::Cell::get) {
+            if CALLS_RUNNING.load(std::sync::atomic::Ordering::Relaxed) == 0 {
                 previous(info);
             }
         }));
@@ -357,9 +360,9 @@ pub unsafe fn with(
     }
     let cc = &mut *(c as *mut CComponent);
     cc.component.trace(call);
-    let outer = IN_FMI_CALL.with(|f| f.replace(true));
+    CALLS_RUNNING.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let result = catch_unwind(AssertUnwindSafe(|| f(&mut *cc)));
-    IN_FMI_CALL.with(|f| f.set(outer));
+    CALLS_RUNNING.fetch_sub(1, std::sync::atomic::Ordering::Relaxed);
     match result {
         Ok(s) => to_c(s),
         Err(payload) => {
