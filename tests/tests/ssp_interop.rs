@@ -227,6 +227,8 @@ impl HostRun {
 }
 
 /// tests/ssp/run_host.py `host` on `ssp` over [`STOP_TIME_S`], its values of `vars` to `csv`.
+/// The host's temporary files (Ecos unpacks the archive into `ecos_ssp_*` and keeps it) go to
+/// the folder of `csv`, a test's temporary folder, so nothing outlives the test.
 fn run_host(
     py: &Path,
     host: &str,
@@ -237,6 +239,7 @@ fn run_host(
     vars: &[String],
 ) -> std::process::Output {
     Command::new(py)
+        .env("TMPDIR", csv.parent().unwrap())
         .arg(workspace_root().join("tests/ssp/run_host.py"))
         .arg(host)
         .arg(ssp)

@@ -100,10 +100,13 @@ pub(crate) fn python() -> Option<PathBuf> {
 }
 
 /// Runs the repository's Python `script` (relative path) with the venv's Python and `args`:
-/// its standard output, or why it did not run.
+/// its standard output, or why it did not run. Its temporary files (a peer host's unpacked
+/// archives) go to a folder removed afterwards.
 pub(crate) fn python_script(script: &str, args: &[&std::ffi::OsStr]) -> Result<String, String> {
     let py = python().ok_or("no Python with the hosts (set RAIL_PYTHON or create .venv)")?;
+    let tmp = tempfile::tempdir().map_err(|e| e.to_string())?;
     let out = Command::new(&py)
+        .env("TMPDIR", tmp.path())
         .arg(repo().join(script))
         .args(args)
         .output()
