@@ -104,9 +104,10 @@ fn run_err(e: &RunError) -> PyErr {
 fn sweep_err(e: &SweepError) -> PyErr {
     match e {
         SweepError::System(s) => system_err(s),
-        SweepError::Output(_) | SweepError::Dir { .. } | SweepError::NotARunFolder { .. } => {
-            OutputError::new_err(error_message(e))
-        }
+        SweepError::Output(_)
+        | SweepError::Dir { .. }
+        | SweepError::NotARunFolder { .. }
+        | SweepError::NotATablesFolder { .. } => OutputError::new_err(error_message(e)),
         SweepError::Pool { .. } => Error::new_err(error_message(e)),
     }
 }

@@ -119,7 +119,10 @@ fn described_header(time: &str, columns: &[ColumnMetadata]) -> (Vec<String>, Vec
 /// columns are left out (the writers derive them from the values); a String's texts become
 /// indices into `strings`.
 pub fn collapse(table: &Table, columns: &[ColumnMetadata]) -> Result<SimOutput, String> {
-    let n = table.header.len().max(1);
+    if table.header.is_empty() {
+        return Err("a results table needs a time column (the header is empty)".into());
+    }
+    let n = table.header.len();
     if !table.data.len().is_multiple_of(n) {
         return Err(format!(
             "{} values do not fill rows of {n} columns",
@@ -280,7 +283,13 @@ pub fn read_results(path: &Path) -> Result<(Table, Option<ResultsMetadata>), Str
         return Ok((expand(&out), Some(meta)));
     }
     let meta = read_metadata(path).map_err(|e| e.to_string())?;
-    let text = std::fs::read_to_string(path)
+    // a regular file only: a FIFO would block the caller (and Ctrl-C) for ever, /dev/zero
+    // would fill the memory
+    let text = master::input::open_regular_file(path)
+        .and_then(|mut f| {
+            let mut text = String::new();
+            std::io::Read::read_to_string(&mut f, &mut text).map(|_| text)
+        })
         .map_err(|e| format!("cannot read '{}': {e}", path.display()))?;
     let columns = meta.as_ref().map_or(&[][..], |m| &m.columns[..]);
     let table = parse_csv(&text, &path.display().to_string(), columns)?;
@@ -314,6 +323,22 @@ mod tests {
         let got: Vec<u64> = t.data.iter().map(|x| x.to_bits()).collect();
         // NaN has one canonical bit pattern in Rust's formatting and parsing
         assert_eq!(got, want);
+    }
+
+    #[test]
+    fn a_fifo_or_a_device_is_refused_without_reading_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("r.csv");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        // (a read would block: nobody writes to the FIFO)
+        for path in [fifo.as_path(), Path::new("/dev/zero")] {
+            let e = read_results(path).unwrap_err();
+            assert!(e.contains("not a regular file"), "{e}");
+        }
     }
 
     #[test]

@@ -4,6 +4,7 @@ progress, the GIL released during runs, errors as exceptions with the master's m
 from __future__ import annotations
 
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -311,6 +312,30 @@ def test_to_csv_writes_the_metadata_file_the_command_line_writes(dist, master_cm
     back.to_csv(tmp_path / "again.csv")
     assert (tmp_path / "again.csv").read_bytes() == py_csv.read_bytes()
     assert (tmp_path / "again.meta.json").read_bytes() == (tmp_path / "py.meta.json").read_bytes()
+
+
+def test_results_files_that_cannot_be_written_or_read_fail_whole(dist, master_cmd, tmp_path):
+    cli_csv, base = cli_run_and_base(dist, master_cmd, tmp_path)
+    res = railfmu.read_results(cli_csv)
+    # a folder where the metadata goes: refused before the CSV is written
+    (tmp_path / "new.meta.json").mkdir()
+    with pytest.raises(railfmu.OutputError, match="is not a file"):
+        res.to_csv(tmp_path / "new.csv")
+    assert not (tmp_path / "new.csv").exists()
+    # an existing pair is replaced as a pair
+    res.to_csv(tmp_path / "z.csv")
+    short = railfmu.Results(res.header, res.values[:10])
+    short.to_csv(tmp_path / "z.csv")
+    assert len(railfmu.read_results(tmp_path / "z.csv")) == 10
+    # an empty table is refused as one, not as a panic of the writer
+    with pytest.raises(railfmu.OutputError, match="needs a time column"):
+        railfmu.Results([], np.zeros((0, 0))).to_csv(tmp_path / "empty.csv")
+    assert not (tmp_path / "empty.csv").exists()
+    # a FIFO is refused without reading it (a read would block: nobody writes to it)
+    fifo = tmp_path / "fifo.csv"
+    os.mkfifo(fifo)
+    with pytest.raises(railfmu.OutputError, match="not a regular file"):
+        railfmu.Results.read_csv(fifo)
 
 
 def test_an_ssps_step_stop_time_and_algorithm_are_set_as_the_command_line_sets_them(passive_file, master_cmd, tmp_path):

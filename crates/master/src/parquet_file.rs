@@ -295,6 +295,28 @@ where
         .collect())
 }
 
+/// Whether `path` is a run's table of a run set written by the master: a regular file (not a
+/// link) whose footer holds our metadata naming a run. Only the footer is read.
+pub fn is_run_table(path: &Path) -> bool {
+    if !path.symlink_metadata().is_ok_and(|m| m.is_file()) {
+        return false;
+    }
+    let Ok(file) = crate::input::open_regular_file(path) else {
+        return false;
+    };
+    let Ok(reader) = SerializedFileReader::new(file) else {
+        return false;
+    };
+    let meta = reader
+        .metadata()
+        .file_metadata()
+        .key_value_metadata()
+        .and_then(|kv| kv.iter().find(|k| k.key == PARQUET_METADATA_KEY))
+        .and_then(|k| k.value.as_deref())
+        .and_then(|json| serde_json::from_str::<ResultsMetadata>(json).ok());
+    meta.is_some_and(|m| m.run.is_some())
+}
+
 /// Reads every column of a Parquet file.
 pub fn read_parquet(path: &Path) -> Result<ParquetTable, ReadError> {
     let invalid = |reason: String| ReadError::Invalid {

@@ -206,8 +206,32 @@ pub fn write_results(
     let meta = ResultsMetadata::of(out, ctx);
     match format {
         ResultsFormat::Csv => {
+            let meta_path = csv_metadata_path(path);
+            // refused before anything is written: a folder (or FIFO) where the metadata goes
+            if meta_path
+                .symlink_metadata()
+                .is_ok_and(|m| !m.is_file() && !m.file_type().is_symlink())
+            {
+                return Err(OutputError::Io {
+                    path: meta_path,
+                    source: std::io::Error::new(
+                        std::io::ErrorKind::InvalidInput,
+                        "exists and is not a file, so the results' metadata cannot go there",
+                    ),
+                });
+            }
+            // the earlier metadata goes first, so that a CSV never sits beside the metadata
+            // of another run; a CSV whose metadata cannot be written is removed again
+            crate::output::remove_stale_file(&meta_path).map_err(|source| OutputError::Io {
+                path: meta_path.clone(),
+                source,
+            })?;
             write_results_csv(path, out)?;
-            write_json_atomic(&csv_metadata_path(path), &meta)
+            if let Err(e) = write_json_atomic(&meta_path, &meta) {
+                let _ = crate::output::remove_stale_file(path);
+                return Err(e);
+            }
+            Ok(())
         }
         ResultsFormat::Parquet => {
             crate::parquet_file::write_results_parquet(path, out, &meta, &ctx.constants())

@@ -242,10 +242,17 @@ pub fn check_run_folders(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> 
 /// Readies `outdir` for a run set whose whole set of runs (kept ones included) is `jobs`:
 /// refuses, before anything is removed, a run whose folder would replace what is not a run
 /// folder ([`check_run_folders`]); then removes the runs of an earlier set that are not among
-/// `jobs` (their run folders and `results/<run>.parquet`), so that the folder, and the
+/// `jobs` (their run folders and their tables `results/<run>.parquet`, told from a user's
+/// Parquet file by the metadata in the footer), so that the folder, and the
 /// results folder read as one table, hold this set's runs only. Nothing else is touched.
 pub fn prepare_run_folder(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> {
     check_run_folders(jobs, outdir)?;
+    // the tables are written into <outdir>/results: a link there would put them (and this
+    // function's removals) outside the output folder
+    let tables = outdir.join(PARQUET_FOLDER);
+    if tables.symlink_metadata().is_ok_and(|m| !m.is_dir()) {
+        return Err(SweepError::NotATablesFolder { path: tables });
+    }
     let keep: std::collections::HashSet<&str> = jobs.iter().map(|j| j.name.as_str()).collect();
     let remove_err = |path: PathBuf| move |source| SweepError::Dir { path, source };
     if let Ok(entries) = std::fs::read_dir(outdir) {
@@ -263,10 +270,13 @@ pub fn prepare_run_folder(jobs: &[Job], outdir: &Path) -> Result<(), SweepError>
     if let Ok(entries) = std::fs::read_dir(outdir.join(PARQUET_FOLDER)) {
         for e in entries.flatten() {
             let path = e.path();
-            let is_table = path.extension().is_some_and(|x| x == "parquet")
-                && e.file_type().is_ok_and(|t| t.is_file());
             let run = path.file_stem().map(|s| s.to_string_lossy().to_string());
-            if is_table && run.is_some_and(|r| !keep.contains(r.as_str())) {
+            // a table of an earlier set's run (our metadata in its footer), not any Parquet
+            // file of the user's that happens to sit there
+            if path.extension().is_some_and(|x| x == "parquet")
+                && run.is_some_and(|r| !keep.contains(r.as_str()))
+                && crate::parquet_file::is_run_table(&path)
+            {
                 std::fs::remove_file(&path).map_err(remove_err(path.clone()))?;
             }
         }

@@ -92,6 +92,11 @@ pub enum SweepError {
          replace; choose another output folder or rename the run"
     )]
     NotARunFolder { path: PathBuf, run: String },
+    #[error(
+        "'{path}' is not a folder (a link or a file), and a run set writes its Parquet tables \
+         there; choose another output folder or move it"
+    )]
+    NotATablesFolder { path: PathBuf },
 }
 
 fn invalid(file: &str, field: String, reason: String) -> SystemError {

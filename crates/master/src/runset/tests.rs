@@ -164,6 +164,44 @@ fn parquet_results_of_a_set_share_one_folder_and_a_failed_rerun_leaves_none() {
     assert!(run_folder_name("Results").is_err());
 }
 
+#[test]
+fn a_new_set_removes_an_earlier_sets_tables_only_not_a_users_parquet_files() {
+    let three = jobs(r#"{"product": {"ms.k": [50, 100, 200]}}"#).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path();
+    assert_eq!(resume(&three, out, ResultsFormat::Parquet).len(), 3);
+    let table = out.join(PARQUET_FOLDER);
+    // a user's files beside the tables: a Parquet file of another program (here: a table of
+    // ours stripped of its metadata would do as well; any bytes are not ours) and another file
+    std::fs::write(table.join("measured_track.parquet"), b"PAR1 not ours PAR1").unwrap();
+    std::fs::write(table.join("notes.txt"), b"kept").unwrap();
+    // a set of two: the third run's table goes, the user's files stay
+    let two = jobs(r#"{"product": {"ms.k": [50, 100]}}"#).unwrap();
+    prepare_run_folder(&two, out).unwrap();
+    let mut left: Vec<String> = std::fs::read_dir(&table)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(
+        left,
+        [
+            "measured_track.parquet",
+            "notes.txt",
+            "run-000.parquet",
+            "run-001.parquet"
+        ]
+    );
+    // a results folder that is a link is refused before anything is removed
+    let elsewhere = tempfile::tempdir().unwrap();
+    std::fs::write(elsewhere.path().join("run-009.parquet"), b"x").unwrap();
+    let other = tempfile::tempdir().unwrap();
+    std::os::unix::fs::symlink(elsewhere.path(), other.path().join(PARQUET_FOLDER)).unwrap();
+    let e = prepare_run_folder(&two, other.path()).unwrap_err();
+    assert!(matches!(e, SweepError::NotATablesFolder { .. }), "{e}");
+    assert!(elsewhere.path().join("run-009.parquet").exists());
+}
+
 /// Resumes a run set as `master sweep --resume` does: keeps the runs complete in `format`,
 /// runs the others; returns the names run.
 fn resume(j: &[Job], outdir: &Path, format: ResultsFormat) -> Vec<String> {
