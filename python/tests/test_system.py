@@ -130,6 +130,11 @@ def test_bad_input_raises_with_the_masters_message_and_changes_nothing(passive_f
         sys.run({"bogie.vehicle.speed": float("nan")})
     with pytest.raises(TypeError, match=r"not list"):
         sys.run({"bogie.vehicle.speed": [1.0]})
+    # outside the range the model description declares: refused here, not in every run
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"250 is above its maximum 200 \(declared by model 'Bogie2Dof' for 'vehicle.speed'\)"):
+        sys.set_parameter("bogie.vehicle.speed", 250.0)
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"-1 is below its minimum 0"):
+        sys.run({"bogie.track.seed": -1})
     with pytest.raises(railfmu.SystemDescriptionError, match=r"stop_time"):
         sys.stop_time = -1.0
     assert sys.parameters == {} and sys.stop_time == 1.0

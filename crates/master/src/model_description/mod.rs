@@ -182,6 +182,11 @@ pub struct Variable {
     pub description: Option<String>,
     /// `declaredType` of the type element, if any (an Enumeration's items are its type's).
     pub declared_type: Option<String>,
+    /// A Real's or Integer's declared `min` and `max` (its own, else its declared type's); a
+    /// start value outside them is refused before a run (the FMU would refuse it at
+    /// fmi2SetXXX, in every run).
+    pub min: Option<f64>,
+    pub max: Option<f64>,
 }
 
 /// One `<Item>` of an Enumeration type.

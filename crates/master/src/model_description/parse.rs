@@ -149,6 +149,8 @@ struct PendingVar {
     unit: Option<String>,
     declared_type: Option<String>,
     start: Option<String>,
+    min: Option<f64>,
+    max: Option<f64>,
 }
 
 impl ModelDescription {
@@ -168,8 +170,11 @@ impl ModelDescription {
             outputs: Vec::new(),
             enumerations: Default::default(),
         };
-        // SimpleType name -> unit
+        // SimpleType name -> unit, and a Real's or Integer's (min, max)
         let mut type_units: HashMap<String, Option<String>> = HashMap::new();
+        let mut type_ranges: HashMap<String, (Option<f64>, Option<f64>)> = HashMap::new();
+        // a bound that is not a number is not enforced here (the FMU has the last word)
+        let bound = |e: &Elem, key: &str| e.get(key).and_then(|x| x.trim().parse::<f64>().ok());
         let mut current_type: Option<String> = None;
         let mut pending: Vec<PendingVar> = Vec::new();
         let mut output_lines: Vec<usize> = Vec::new();
@@ -269,6 +274,14 @@ impl ModelDescription {
                             ("SimpleType", "Real") => {
                                 if let Some(t) = &current_type {
                                     type_units.insert(t.clone(), e.get("unit").map(String::from));
+                                    type_ranges
+                                        .insert(t.clone(), (bound(&e, "min"), bound(&e, "max")));
+                                }
+                            }
+                            ("SimpleType", "Integer") => {
+                                if let Some(t) = &current_type {
+                                    type_ranges
+                                        .insert(t.clone(), (bound(&e, "min"), bound(&e, "max")));
                                 }
                             }
                             ("SimpleType", "Enumeration") => {
@@ -338,6 +351,10 @@ impl ModelDescription {
                                     v.unit = e.get("unit").map(String::from);
                                     v.declared_type = e.get("declaredType").map(String::from);
                                     v.start = e.get("start").map(String::from);
+                                    if matches!(t, VarType::Real | VarType::Integer) {
+                                        v.min = bound(&e, "min");
+                                        v.max = bound(&e, "max");
+                                    }
                                 }
                             }
                             ("Outputs", "Unknown") => {
@@ -428,6 +445,13 @@ impl ModelDescription {
                     .clone(),
                 (None, None) => None,
             };
+            let (type_min, type_max) = p
+                .declared_type
+                .as_ref()
+                .and_then(|d| type_ranges.get(d))
+                .copied()
+                .unwrap_or_default();
+            let (min, max) = (p.min.or(type_min), p.max.or(type_max));
             if !seen.insert(p.name.clone()) {
                 return Err(ModelDescriptionError::DuplicateName { name: p.name });
             }
@@ -462,6 +486,8 @@ impl ModelDescription {
                 start: p.start,
                 description: p.description,
                 declared_type: p.declared_type,
+                min,
+                max,
             });
         }
         let views: Vec<rules::AliasView> = md

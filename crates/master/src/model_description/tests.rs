@@ -337,3 +337,29 @@ fn stray_ampersands_and_line_numbers_stay_linear() {
         .to_string();
     assert!(e.contains("line 5013"), "{e}");
 }
+
+#[test]
+fn ranges_come_from_the_variable_else_from_its_declared_type() {
+    let xml = MASS_SPRING
+        .replace(
+            r#"<Real quantity="Length" unit="m"/>"#,
+            r#"<Real quantity="Length" unit="m" min="-1" max="1"/>"#,
+        )
+        .replace(
+            r#"<Real start="100" unit="N/m"/>"#,
+            r#"<Real start="100" unit="N/m" min="0"/>"#,
+        )
+        .replace(
+            r#"<Real declaredType="Position" start="0.1"/>"#,
+            r#"<Real declaredType="Position" start="0.1" max="0.5"/>"#,
+        );
+    let md = ModelDescription::parse(&xml).unwrap();
+    let range = |n: &str| {
+        let v = md.variable(n).unwrap().1;
+        (v.min, v.max)
+    };
+    assert_eq!(range("k"), (Some(0.0), None));
+    // the type's min, the variable's own max
+    assert_eq!(range("position"), (Some(-1.0), Some(0.5)));
+    assert_eq!(range("m"), (None, None));
+}

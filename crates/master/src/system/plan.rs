@@ -9,7 +9,7 @@ use super::{json_value_for, type_of, LoadedSystem, SystemError};
 use crate::coupling::{
     topological_order, Algorithm, ColumnInfo, CouplingPlan, PlanConnection, PlanInstance, Recorded,
 };
-use crate::model_description::{Causality, ModelDescription};
+use crate::model_description::{Causality, ModelDescription, VarType};
 use crate::show::{num, text};
 use crate::slave::VarRef;
 
@@ -403,6 +403,23 @@ pub(super) fn start_value(
     }
     let ty = type_of(v.var_type);
     let x = json_value_for(md, v, value, strings).map_err(|r| invalid(field.clone(), name, r))?;
+    if matches!(v.var_type, VarType::Real | VarType::Integer) {
+        // the FMU refuses such a value at fmi2SetXXX, in every run: said here, before one
+        let outside = match (v.min, v.max) {
+            (Some(lo), _) if x < lo => Some(format!("below its minimum {}", num(lo))),
+            (_, Some(hi)) if x > hi => Some(format!("above its maximum {}", num(hi))),
+            _ => None,
+        };
+        if let Some(why) = outside {
+            let reason = format!(
+                "{} is {why} (declared by model '{}' for '{}')",
+                num(x),
+                md.model_name,
+                text(name)
+            );
+            return Err(invalid(field, name, reason));
+        }
+    }
     Ok((
         VarRef {
             vr: v.value_reference,
