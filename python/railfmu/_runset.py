@@ -102,6 +102,13 @@ class RunSet:
         if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1):
             raise ValueError(f"threads must be a whole number >= 1 (or None: all cores), got {threads!r}")
         out = Path(output_dir)
+        system = None
+        if client is None:
+            # the FMUs loaded and every run's start values checked (names, types, declared
+            # ranges) before anything is written or removed: a misspelt variable is refused
+            # here, not failed run by run
+            system = _railfmu.PreparedSystem.from_json(self._base_json, "", self._label)
+            system.check_jobs(self._jobs_json)
         try:
             out.mkdir(parents=True, exist_ok=True)
         except OSError as e:
@@ -136,8 +143,7 @@ class RunSet:
                 new: List[Optional[str]] = [None] * len(jobs)
                 local_runs = False
                 try:
-                    if client is None:
-                        system = _railfmu.PreparedSystem.from_json(self._base_json, "", self._label)
+                    if system is not None:
                         threads = threads or os.cpu_count() or 1
                         local_runs = True
                         new = system.run_jobs(jobs, os.fspath(out), threads, on_done, format)

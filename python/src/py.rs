@@ -485,6 +485,14 @@ impl PySystem {
         }
     }
 
+    /// Checks every job's start values and stop time against the FMUs (names, types,
+    /// declared ranges), as each run would: a run set with a misspelt variable is refused
+    /// before anything runs or is removed.
+    fn check_jobs(&self, jobs_json: Vec<String>) -> PyResult<()> {
+        let jobs = parse_jobs(&jobs_json)?;
+        master::runset::check_jobs(&self.prepared, &jobs).map_err(|e| system_err(&e))
+    }
+
     /// Runs jobs of this system's run set on `threads` threads, writing `<outdir>/<run>/` per
     /// job and `<outdir>/sweep.json` (the master's run-set folder), the results in `format`
     /// ("csv" or "parquet"; None: by size, as `master sweep`); `on_done(name, error)` is

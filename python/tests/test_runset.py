@@ -53,16 +53,31 @@ def test_a_local_run_set_equals_master_sweep(dist, master_cmd, tmp_path):
 
 def test_a_failed_run_is_kept_and_the_others_go_on(dist, tmp_path):
     rs = speed_set(dist, [60.0], stop_time=0.2)
-    rs["runs"] = [{"name": "typo", "parameters": {"bogie.vehicle.sped": 70.0}}, {"name": "slow", "parameters": {"bogie.vehicle.speed": 40.0}}]
+    # a value within the declared range that only the FMU refuses (speed > 0): that run fails
+    rs["runs"] = [{"name": "standstill", "parameters": {"bogie.vehicle.speed": 0.0}}, {"name": "slow", "parameters": {"bogie.vehicle.speed": 40.0}}]
     res = railfmu.run_set(rs, tmp_path / "out", threads=2)
     assert not res.ok
     assert set(res) == {"run-000", "slow"}
-    assert "unknown variable 'vehicle.sped'" in res.failed["typo"]
+    assert "'vehicle.speed': must be > 0" in res.failed["standstill"]
     with pytest.raises(KeyError, match="failed"):
-        res["typo"]
+        res["standstill"]
     sweep = json.loads((tmp_path / "out" / "sweep.json").read_text())
-    assert [r["name"] for r in sweep] == ["run-000", "typo", "slow"]
-    assert not (tmp_path / "out" / "typo" / "results.csv").exists()
+    assert [r["name"] for r in sweep] == ["run-000", "standstill", "slow"]
+    assert not (tmp_path / "out" / "standstill" / "results.csv").exists()
+
+
+def test_a_misspelt_variable_refuses_the_set_before_it_touches_the_folder(dist, tmp_path):
+    out = tmp_path / "out"
+    railfmu.RunSet.from_dict(speed_set(dist, [50.0, 60.0], stop_time=0.1)).run(out, threads=1)
+    before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    rs = speed_set(dist, [60.0], stop_time=0.1)
+    rs["runs"] = [{"name": "typo", "parameters": {"bogie.vehicle.sped": 70.0}}]
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"run 'typo'.*unknown variable 'vehicle.sped'.*did you mean 'vehicle.speed'"):
+        railfmu.run_set(rs, out, threads=2)
+    rs["runs"] = [{"name": "fast", "parameters": {"bogie.vehicle.speed": 250.0}}]
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"run 'fast'.*above its maximum 200"):
+        railfmu.run_set(rs, out, threads=2)
+    assert {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
 
 
 def test_a_resumed_set_skips_finished_runs(dist, tmp_path):
@@ -147,8 +162,8 @@ def test_bad_run_set_options_raise_python_errors(dist, tmp_path):
         railfmu.run_set(rs, a_file / "out")
     # a set in which no run succeeds warns, naming the first failure
     bad = speed_set(dist, [50.0, 60.0], stop_time=0.2)
-    bad["product"] = {"bogie.vehicle.sped": [50.0, 60.0]}
-    with pytest.warns(RuntimeWarning, match=r"no run of the set succeeded \(2 failed\).*vehicle.sped"):
+    bad["product"] = {"bogie.vehicle.speed": [0.0, 0.0]}
+    with pytest.warns(RuntimeWarning, match=r"no run of the set succeeded \(2 failed\).*'vehicle.speed': must be > 0"):
         res = railfmu.run_set(bad, tmp_path / "bad")
     assert len(res) == 0 and set(res.failed) == {"run-000", "run-001"}
 
@@ -260,7 +275,7 @@ def test_the_parameters_of_a_run_set_carry_their_units(dist, master_cmd, tmp_pat
         railfmu.read_results(moved).parameter_units
 
 
-def test_a_set_that_fails_before_its_first_run_leaves_no_earlier_report(dist, tmp_path):
+def test_a_set_that_fails_before_its_first_run_leaves_the_earlier_set_whole(dist, tmp_path):
     out = tmp_path / "out"
     railfmu.RunSet.from_dict(speed_set(dist, [50.0, 60.0], stop_time=0.1)).run(out, threads=1)
     assert len(json.loads((out / "sweep.json").read_text())) == 2
@@ -268,7 +283,8 @@ def test_a_set_that_fails_before_its_first_run_leaves_no_earlier_report(dist, tm
     shutil.copytree(dist, fmus)
     rs = railfmu.RunSet.from_dict(speed_set(fmus, [55.0, 65.0, 75.0], stop_time=0.1))
     (fmus / "Bogie2Dof.fmu").write_bytes(b"not a zip archive")
+    before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
     with pytest.raises(railfmu.Error):
         rs.run(out, threads=1)
-    # the earlier report would list runs of other parameters as this folder's
-    assert not (out / "sweep.json").exists()
+    # refused before the folder is touched: the earlier set stays whole, its report with it
+    assert {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()} == before

@@ -34,7 +34,7 @@ fn sweep_runs_in_parallel_and_keeps_failures() {
     std::fs::write(
         dir.path().join("set.json"),
         r#"{"base": "system.json", "product": {"ms.stiffness": [50.0, 100.0, 200.0]},
-            "runs": [{"name": "bad", "parameters": {"ms.mass": -1.0}}]}"#,
+            "runs": [{"name": "bad", "parameters": {"ms.initial_position": 1e308}}]}"#,
     )
     .unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_master"))
@@ -67,18 +67,46 @@ fn sweep_runs_in_parallel_and_keeps_failures() {
         finals.push(csv.lines().last().unwrap().to_string());
     }
     assert!(finals[0] != finals[1] && finals[1] != finals[2]);
-    // a negative mass must be rejected by the FMU: reported, the others kept, exit code 1
+    // a run the FMU fails (a spring force that overflows): reported, the others kept, exit
+    // code 1
     assert_eq!(runs[3]["ok"], serde_json::json!(false), "{}", runs[3]);
     assert!(
         runs[3]["error"]
             .as_str()
             .unwrap()
-            .contains("start value 'mass' = -1"),
+            .contains("'coupling_force' is -inf"),
         "{}",
         runs[3]
     );
     assert!(!dir.path().join("out/bad/results.csv").exists());
     assert_eq!(out.status.code(), Some(1));
+    // a start value outside the model's declared range is refused before anything runs or
+    // is written: the earlier set's folder stays as it was
+    std::fs::write(
+        dir.path().join("set.json"),
+        r#"{"base": "system.json", "runs": [{"name": "light", "parameters": {"ms.mass": -1.0}}]}"#,
+    )
+    .unwrap();
+    let before = std::fs::read(dir.path().join("out/sweep.json")).unwrap();
+    let refused = Command::new(env!("CARGO_BIN_EXE_master"))
+        .args(["--quiet", "sweep"])
+        .arg(dir.path().join("set.json"))
+        .arg("-o")
+        .arg(dir.path().join("out"))
+        .output()
+        .unwrap();
+    assert_eq!(refused.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains("run 'light'") && stderr.contains("-1 is below its minimum 1e-9"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("out/sweep.json")).unwrap(),
+        before
+    );
+    assert!(dir.path().join("out/run-000/results.csv").is_file());
+    assert!(!dir.path().join("out/light").exists());
 }
 
 #[test]

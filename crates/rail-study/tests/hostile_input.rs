@@ -225,7 +225,7 @@ fn rerun_replaces_the_run_folder_and_a_failed_sweep_reports_failure() {
     // the same run now fails: its folder holds the new description and summary only
     c.write(
         "set.json",
-        r#"{"base": "system.json", "runs": [{"name": "a", "parameters": {"h.y": 2}}]}"#,
+        r#"{"base": "system.json", "runs": [{"name": "a", "parameters": {"h.gain": 13}}]}"#,
     );
     let e = c.fails(&["sweep", "set.json", "-o", "out"], &[]);
     assert!(e.contains("1 run(s) failed: a"), "{e}");
@@ -238,7 +238,7 @@ fn rerun_replaces_the_run_folder_and_a_failed_sweep_reports_failure() {
     let summary = std::fs::read_to_string(c.path("out/a/summary.json")).unwrap();
     assert!(summary.contains("\"ok\": false"), "{summary}");
     let sweep = std::fs::read_to_string(c.path("out/sweep.json")).unwrap();
-    assert!(sweep.contains("cannot be given a start value"), "{sweep}");
+    assert!(sweep.contains("start value 'gain' = 13"), "{sweep}");
     // no hidden partial folders left
     let hidden: Vec<_> = std::fs::read_dir(c.path("out"))
         .unwrap()

@@ -7,8 +7,8 @@ use super::{CommandError, Context};
 use crate::output::write_json_atomic;
 use crate::results::ResultsFormat;
 use crate::runset::{
-    completed, execute_with as run_all, format_by_description, prepare_run_folder, run_job, Job,
-    ResultsOptions, RunReport, RunSet,
+    check_jobs, completed, execute_with as run_all, format_by_description, prepare_run_folder,
+    run_job, Job, ResultsOptions, RunReport, RunSet,
 };
 use crate::system::PreparedSystem;
 
@@ -68,12 +68,19 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         .filter(|(_, k)| k.is_none())
         .map(|(j, _)| j.clone())
         .collect();
+    // the FMUs loaded and every run's start values checked before anything is removed
+    let system = if !todo.is_empty() || !args.resume {
+        let system = PreparedSystem::prepare(&base)?;
+        check_jobs(&system, &todo)?;
+        Some(system)
+    } else {
+        None
+    };
     // the runs of this set only: nothing of the user's is replaced by a run folder, and
     // runs of an earlier set into this folder are removed (the kept ones are in this set)
     prepare_run_folder(&jobs, &args.output)?;
     let mut fresh = Vec::new();
-    if !todo.is_empty() || !args.resume {
-        let system = PreparedSystem::prepare(&base)?;
+    if let Some(system) = system {
         let threads = args
             .jobs
             .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));

@@ -17,6 +17,17 @@ use crate::system::{LoadedSystem, PreparedSystem, SystemDescription, SystemError
 /// Runs one job of `system`'s run set (a job from [`RunSet::expand`](super::RunSet::expand) of that system: the same
 /// instances, FMUs and timing; only start values and the stop time differ) on the prepared
 /// FMUs: validates its start values, simulates, returns the output.
+/// The start values and stop time of every job, checked against the prepared system's FMUs
+/// as each run would check them (variable names, types, declared ranges): a run set with a
+/// misspelt variable is refused before anything runs or is removed, not failed run by run.
+pub fn check_jobs(system: &PreparedSystem, jobs: &[Job]) -> Result<(), SystemError> {
+    for job in jobs {
+        let run = format!("run '{}'", job.name);
+        system.changes(&job.parameters, Some(job.system.stop_time), &run)?;
+    }
+    Ok(())
+}
+
 pub fn run_job(
     system: &PreparedSystem,
     job: &Job,
