@@ -15,6 +15,30 @@ from ._progress import bar
 from ._results import RunSetResults
 
 PathLike = Union[str, "os.PathLike[str]"]
+
+
+@contextlib.contextmanager
+def _folder_lock(folder: Path):
+    """An exclusive ``flock`` on the run-set folder itself while a set writes into it (no file
+    is created), the lock ``master sweep`` takes: a second set into the same folder, from
+    Python or the command line, is refused instead of mixing its runs with this one's."""
+    try:
+        import fcntl
+    except ImportError:  # not on Windows: no lock there
+        yield
+        return
+    fd = os.open(folder, os.O_RDONLY)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise _railfmu.OutputError(
+                f"another run set is writing into '{folder}' (a `master sweep` or a Python run set): "
+                "wait for it or choose another output folder"
+            ) from None
+        yield
+    finally:
+        os.close(fd)
 DoneCallback = Callable[[int, int, str, Optional[str]], Any]
 
 
@@ -113,83 +137,86 @@ class RunSet:
             out.mkdir(parents=True, exist_ok=True)
         except OSError as e:
             raise _railfmu.OutputError(f"cannot create the output folder '{out}': {e}") from e
-        # this set's runs only: nothing of the user's is replaced by a run folder, and an
-        # earlier set's other runs are removed (the kept ones are in this set)
-        _railfmu.prepare_run_folder(os.fspath(out), self._jobs_json)
-        # the earlier set's report goes with its runs: a set that fails before its first run
-        # (an unreadable FMU) leaves no report of runs that are no longer there
-        remove_sweep_report(out)
-        reports: List[Optional[str]] = [None] * len(self)
-        if resume:
-            # decided over every job before the kept runs, as a fresh run set decides it
-            if format is None:
-                format = self._format_by_size(client, ship_fmus, retries)
-            for i, j in enumerate(self._jobs_json):
-                reports[i] = _railfmu.completed_report(os.fspath(out), j, format)
-        todo = [i for i, r in enumerate(reports) if r is None]
-        total, done = len(self), len(self) - len(todo)
-        with bar(progress, "runs") as cb:
-            if cb is not None and done:
-                cb(done, total, "", None)
+        # one set at a time in a folder (the lock `master sweep` takes too): a second one
+        # would mix its runs into this one's
+        with _folder_lock(out):
+            # this set's runs only: nothing of the user's is replaced by a run folder, and an
+            # earlier set's other runs are removed (the kept ones are in this set)
+            _railfmu.prepare_run_folder(os.fspath(out), self._jobs_json)
+            # the earlier set's report goes with its runs: a set that fails before its first run
+            # (an unreadable FMU) leaves no report of runs that are no longer there
+            remove_sweep_report(out)
+            reports: List[Optional[str]] = [None] * len(self)
+            if resume:
+                # decided over every job before the kept runs, as a fresh run set decides it
+                if format is None:
+                    format = self._format_by_size(client, ship_fmus, retries)
+                for i, j in enumerate(self._jobs_json):
+                    reports[i] = _railfmu.completed_report(os.fspath(out), j, format)
+            todo = [i for i, r in enumerate(reports) if r is None]
+            total, done = len(self), len(self) - len(todo)
+            with bar(progress, "runs") as cb:
+                if cb is not None and done:
+                    cb(done, total, "", None)
 
-            def on_done(name: str, error: Optional[str]) -> None:
-                nonlocal done
-                done += 1
-                if cb is not None:
-                    cb(done, total, name, error)
+                def on_done(name: str, error: Optional[str]) -> None:
+                    nonlocal done
+                    done += 1
+                    if cb is not None:
+                        cb(done, total, name, error)
 
-            if todo:
-                jobs = [self._jobs_json[i] for i in todo]
-                new: List[Optional[str]] = [None] * len(jobs)
-                local_runs = False
-                try:
-                    if system is not None:
-                        threads = threads or os.cpu_count() or 1
-                        local_runs = True
-                        new = system.run_jobs(jobs, os.fspath(out), threads, on_done, format)
-                    else:
-                        from .dask import run_jobs_on_cluster
+                if todo:
+                    jobs = [self._jobs_json[i] for i in todo]
+                    new: List[Optional[str]] = [None] * len(jobs)
+                    local_runs = False
+                    try:
+                        if system is not None:
+                            threads = threads or os.cpu_count() or 1
+                            local_runs = True
+                            new = system.run_jobs(jobs, os.fspath(out), threads, on_done, format)
+                        else:
+                            from .dask import run_jobs_on_cluster
 
-                        run_jobs_on_cluster(
-                            client,
-                            self._base_json,
-                            self._label,
-                            jobs,
-                            out,
-                            on_done,
-                            ship_fmus=ship_fmus,
-                            retries=retries,
-                            format=format,
-                            reports=new,
-                        )
-                except BaseException:
-                    # stopped part way (Ctrl-C, an exception of `progress`, ...): the runners
-                    # end every started set with a folder per run, finished or cancelled, as
-                    # `master sweep` does; sweep.json lists them all, the kept ones too, so
-                    # that the folder is whole and `resume=True` carries on from it
-                    if local_runs:
-                        new = _reports_of_stopped_set(out, jobs)
-                    if all(r is not None for r in new):
-                        for i, r in zip(todo, new):
-                            reports[i] = r
-                        with contextlib.suppress(Exception):  # the set's own exception is raised
-                            _railfmu.write_sweep(os.fspath(out), [r for r in reports if r is not None])
-                    raise
-                for i, r in zip(todo, new):
-                    reports[i] = r
-        final = [r for r in reports if r is not None]
-        _railfmu.write_sweep(os.fspath(out), final)
-        results = RunSetResults(out, [json.loads(r) for r in final])
-        if results.reports and all(not r.get("ok") for r in results.reports):
-            # as `master sweep` exits with status 1: a set with no result is not quietly empty
-            first = results.reports[0]
-            warnings.warn(
-                f"no run of the set succeeded ({len(results.reports)} failed); the first, "
-                f"'{first.get('name')}': {first.get('error')}",
-                RuntimeWarning,
-                stacklevel=2,
-            )
-        return results
+                            run_jobs_on_cluster(
+                                client,
+                                self._base_json,
+                                self._label,
+                                jobs,
+                                out,
+                                on_done,
+                                ship_fmus=ship_fmus,
+                                retries=retries,
+                                format=format,
+                                reports=new,
+                            )
+                    except BaseException:
+                        # stopped part way (Ctrl-C, an exception of `progress`, ...): the runners
+                        # end every started set with a folder per run, finished or cancelled, as
+                        # `master sweep` does; sweep.json lists them all, the kept ones too, so
+                        # that the folder is whole and `resume=True` carries on from it
+                        if local_runs:
+                            new = _reports_of_stopped_set(out, jobs)
+                        if all(r is not None for r in new):
+                            for i, r in zip(todo, new):
+                                reports[i] = r
+                            with contextlib.suppress(Exception):  # the set's own exception is raised
+                                _railfmu.write_sweep(os.fspath(out), [r for r in reports if r is not None])
+                        raise
+                    for i, r in zip(todo, new):
+                        reports[i] = r
+            final = [r for r in reports if r is not None]
+            _railfmu.write_sweep(os.fspath(out), final)
+            results = RunSetResults(out, [json.loads(r) for r in final])
+            if results.reports and all(not r.get("ok") for r in results.reports):
+                # as `master sweep` exits with status 1: a set with no result is not quietly empty
+                first = results.reports[0]
+                warnings.warn(
+                    f"no run of the set succeeded ({len(results.reports)} failed); the first, "
+                    f"'{first.get('name')}': {first.get('error')}",
+                    RuntimeWarning,
+                    stacklevel=2,
+                )
+            return results
 
     def _format_by_size(self, client: Any, ship_fmus: bool, retries: int) -> str:
         """The results format a fresh run of every job chooses by size ("csv" or "parquet")."""

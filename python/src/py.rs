@@ -107,7 +107,8 @@ fn sweep_err(e: &SweepError) -> PyErr {
         SweepError::Output(_)
         | SweepError::Dir { .. }
         | SweepError::NotARunFolder { .. }
-        | SweepError::NotATablesFolder { .. } => OutputError::new_err(error_message(e)),
+        | SweepError::NotATablesFolder { .. }
+        | SweepError::FolderInUse { .. } => OutputError::new_err(error_message(e)),
         SweepError::Pool { .. } => Error::new_err(error_message(e)),
     }
 }

@@ -5,6 +5,7 @@ back."""
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -288,3 +289,27 @@ def test_a_set_that_fails_before_its_first_run_leaves_the_earlier_set_whole(dist
         rs.run(out, threads=1)
     # refused before the folder is touched: the earlier set stays whole, its report with it
     assert {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
+
+
+def test_a_second_set_into_a_folder_in_use_is_refused(dist, master_cmd, tmp_path):
+    import fcntl
+
+    out = tmp_path / "out"
+    railfmu.RunSet.from_dict(speed_set(dist, [50.0, 60.0], stop_time=0.1)).run(out, threads=1)
+    before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    # the lock a set writing into the folder holds (an flock on the folder itself)
+    fd = os.open(out, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        with pytest.raises(railfmu.OutputError, match="another run set is writing into"):
+            railfmu.RunSet.from_dict(speed_set(dist, [70.0], stop_time=0.1)).run(out, threads=1)
+        set_file = tmp_path / "set.json"
+        set_file.write_text(json.dumps(speed_set(dist, [70.0], stop_time=0.1)))
+        r = run_master(master_cmd, "sweep", set_file, "-o", out)
+        assert r.returncode == 1 and "another run set is writing into" in r.stderr, r.stderr
+        assert {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
+    finally:
+        os.close(fd)
+    # released: the next set runs
+    assert railfmu.RunSet.from_dict(speed_set(dist, [70.0], stop_time=0.1)).run(out, threads=1).ok
+    assert not [p for p in out.iterdir() if p.name.startswith(".")]

@@ -250,6 +250,29 @@ pub fn check_run_folders(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> 
     Ok(())
 }
 
+/// Held while a run set writes into its output folder: an exclusive `flock` on the folder
+/// itself (no file is created in it), released when dropped or when the process ends. Python
+/// run sets take the same lock (`fcntl.flock`), so two sets, from the command line or from
+/// Python, never mix their runs in one folder.
+pub struct OutputFolderLock {
+    _folder: std::fs::File,
+}
+
+/// Takes the [`OutputFolderLock`] of `outdir` (an existing folder), or says that another set
+/// holds it.
+pub fn lock_output_folder(outdir: &Path) -> Result<OutputFolderLock, SweepError> {
+    let folder = std::fs::File::open(outdir).map_err(|source| SweepError::Dir {
+        path: outdir.to_path_buf(),
+        source,
+    })?;
+    if !crate::fmu::extract::try_lock(&folder) {
+        return Err(SweepError::FolderInUse {
+            path: outdir.to_path_buf(),
+        });
+    }
+    Ok(OutputFolderLock { _folder: folder })
+}
+
 /// Readies `outdir` for a run set whose whole set of runs (kept ones included) is `jobs`:
 /// refuses, before anything is removed, a run whose folder would replace what is not a run
 /// folder ([`check_run_folders`]); then removes the runs of an earlier set that are not among

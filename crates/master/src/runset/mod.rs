@@ -97,6 +97,11 @@ pub enum SweepError {
          there; choose another output folder or move it"
     )]
     NotATablesFolder { path: PathBuf },
+    #[error(
+        "another run set is writing into '{path}' (a `master sweep` or a Python run set): wait \
+         for it or choose another output folder"
+    )]
+    FolderInUse { path: PathBuf },
 }
 
 fn invalid(file: &str, field: String, reason: String) -> SystemError {
