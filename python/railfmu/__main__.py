@@ -20,7 +20,10 @@ def _sweep(args: argparse.Namespace) -> int:
     if args.dask_scheduler:
         from distributed import Client
 
-        client = Client(args.dask_scheduler)
+        try:
+            client = Client(args.dask_scheduler)
+        except (OSError, TimeoutError, ValueError) as e:
+            raise Error(f"cannot reach the Dask scheduler '{args.dask_scheduler}': {e}") from None
     try:
         res = rs.run(
             args.output,
@@ -48,13 +51,21 @@ def _sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _positive(text: str) -> int:
+    """A whole number >= 1 (argparse reports a ValueError as an invalid value)."""
+    n = int(text)
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"must be 1 or more, got {text}")
+    return n
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     p = argparse.ArgumentParser(prog="railfmu", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
     s = sub.add_parser("sweep", help="run a run set (parameter variations) into a run-set folder")
     s.add_argument("runset", help="run-set description (JSON)")
     s.add_argument("-o", "--output", default="sweep-out", help="output folder (default: sweep-out)")
-    s.add_argument("-j", "--jobs", type=int, default=None, help="local threads (default: all cores)")
+    s.add_argument("-j", "--jobs", type=_positive, default=None, help="local threads (default: all cores)")
     s.add_argument("--dask-scheduler", metavar="ADDRESS", help="run on this Dask scheduler (e.g. tcp://host:8786)")
     s.add_argument(
         "--resume",

@@ -409,3 +409,15 @@ def test_the_fmu_cache_of_the_workers_stays_bounded(monkeypatch, tmp_path):
     assert entries() == {third.name, second.name, path.parent.name} | {f.name for f in in_use}
     assert mine.is_dir() and (root / "note.txt").read_text() == "kept"
     assert not [p for p in root.iterdir() if p.name.startswith(".")]
+
+
+def test_the_command_line_reports_an_unreachable_scheduler_and_bad_options_as_errors(dist, tmp_path):
+    set_file = tmp_path / "set.json"
+    set_file.write_text(json.dumps(speed_set(dist, [50.0], stop_time=0.1)))
+    cmd = [sys.executable, "-m", "railfmu", "sweep", str(set_file), "-o", str(tmp_path / "out"), "-q"]
+    env = dict(os.environ, DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT="1s")
+    r = subprocess.run(cmd + ["--dask-scheduler", "tcp://127.0.0.1:9"], capture_output=True, text=True, env=env, check=False)
+    assert r.returncode == 1 and r.stderr.startswith("error: cannot reach the Dask scheduler 'tcp://127.0.0.1:9'"), r.stderr
+    assert "Traceback" not in r.stderr
+    r = subprocess.run(cmd + ["-j", "0"], capture_output=True, text=True, check=False)
+    assert r.returncode == 2 and "must be 1 or more, got 0" in r.stderr and "Traceback" not in r.stderr
