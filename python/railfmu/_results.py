@@ -170,6 +170,9 @@ class Results:
         (``results.csv`` -> ``results.meta.json``: each column's type, unit and FMU variable,
         the sampling, the summary and the system as run), which :func:`read_results` and
         ``master assess`` read."""
+        if Path(path).suffix.lower() == ".parquet":
+            # CSV text under a Parquet name is a file nothing reads back
+            raise _railfmu.OutputError(f"to_csv writes CSV: '{path}' names a Parquet file; give a .csv name")
         texts = [(self.names.index(n), list(t)) for n, t in self.texts.items()]
         meta = json.dumps(self.metadata) if self.metadata is not None else None
         data = np.ascontiguousarray(self.values, dtype=np.float64).tobytes()

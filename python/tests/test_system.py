@@ -336,6 +336,10 @@ def test_results_files_that_cannot_be_written_or_read_fail_whole(dist, master_cm
     with pytest.raises(railfmu.OutputError, match="needs a time column"):
         railfmu.Results([], np.zeros((0, 0))).to_csv(tmp_path / "empty.csv")
     assert not (tmp_path / "empty.csv").exists()
+    # CSV text under a Parquet name would not read back
+    with pytest.raises(railfmu.OutputError, match="names a Parquet file"):
+        res.to_csv(tmp_path / "r.parquet")
+    assert not (tmp_path / "r.parquet").exists()
     # a FIFO is refused without reading it (a read would block: nobody writes to it)
     fifo = tmp_path / "fifo.csv"
     os.mkfifo(fifo)
