@@ -76,6 +76,11 @@ impl StabilitySettings {
 pub enum AssessError {
     #[error(transparent)]
     Signal(#[from] SignalError),
+    #[error(
+        "the band-passed signal is not finite (its largest sample, {largest}, overflows the \
+         filter's sums): no verdict; remove or clip that sample"
+    )]
+    Overflow { largest: String },
 }
 
 /// Result of one rms assessment.
@@ -137,6 +142,14 @@ pub fn assess_rms(
     let pad = (8.0 * fs / (hi - lo)).ceil() as usize;
     let y = bp.filtfilt(x, pad);
     let rms = sliding_rms_distance(&y, fs, speed_mps, s.window_m, s.step_m)?;
+    // a huge sample (1e160 and up) overflows the filter or the squares: NaN or inf rms, which
+    // a max over the windows would drop, giving "stable"
+    if y.iter().any(|v| !v.is_finite()) || rms.iter().any(|r| !r.1.is_finite()) {
+        let largest = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        return Err(AssessError::Overflow {
+            largest: master::show::num(largest).to_string(),
+        });
+    }
     let max_rms = rms.iter().map(|r| r.1).fold(0.0, f64::max);
     Ok(Assessment {
         dominant_frequency_hz: f0,
@@ -200,6 +213,24 @@ mod tests {
         (0..(secs * fs) as usize)
             .map(|i| a * (2.0 * PI * f * i as f64 / fs).sin())
             .collect()
+    }
+
+    #[test]
+    fn a_huge_sample_never_gives_a_stable_verdict() {
+        let mut x = sine(10.0, 6.0, 1000.0, 20.0);
+        let s = StabilitySettings::default();
+        let unstable = assess_rms(&x, 1000.0, 300.0 / 3.6, 5.39, &s).unwrap();
+        assert!(!unstable.stable);
+        // never "stable": a spike the window sums carry is assessed (its windows far above
+        // the limit); one that overflows the filter gives no verdict
+        for spikes in [&[1e160][..], &[1e308], &[1e308, 1e308, -1e308, 1e308]] {
+            x[5500..5500 + spikes.len()].copy_from_slice(spikes);
+            match assess_rms(&x, 1000.0, 300.0 / 3.6, 5.39, &s) {
+                Ok(a) => assert!(!a.stable && a.max_rms > 1e150, "{spikes:?}: {}", a.max_rms),
+                // no verdict, with the reason (an overflow, or no spectral peak left)
+                Err(e) => assert!(!e.to_string().is_empty()),
+            }
+        }
     }
 
     #[test]

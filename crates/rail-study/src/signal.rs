@@ -233,17 +233,10 @@ pub fn sliding_rms_distance(
             what: "one rms window",
         });
     }
-    // prefix sums of squares (compensated) so every window costs O(1)
-    let mut pre = Vec::with_capacity(x.len() + 1);
-    pre.push(0.0);
-    let (mut sum, mut comp) = (0.0f64, 0.0f64);
-    for v in x {
-        let y = v * v - comp;
-        let t = sum + y;
-        comp = (t - sum) - y;
-        sum = t;
-        pre.push(sum);
-    }
+    // each window summed on its own (a window step of 10 m in 100 m windows counts each
+    // sample about 10 times): a prefix sum would carry one huge sample's square into every
+    // later window and lose them to cancellation; the squares are scaled by the window's
+    // largest magnitude, so a sample up to 1e308 neither overflows nor swamps the sum
     let mut out = Vec::new();
     let mut k = 0usize;
     loop {
@@ -253,8 +246,15 @@ pub fn sliding_rms_distance(
         if i1 > x.len() {
             break;
         }
-        let ms = ((pre[i1] - pre[i0]) / win as f64).max(0.0);
-        out.push((start_m + window_m / 2.0, ms.sqrt()));
+        let w = &x[i0..i1];
+        let scale = w.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let rms = if scale > 0.0 {
+            let ms = w.iter().map(|v| (v / scale) * (v / scale)).sum::<f64>() / win as f64;
+            scale * ms.sqrt()
+        } else {
+            0.0
+        };
+        out.push((start_m + window_m / 2.0, rms));
         k += 1;
     }
     Ok(out)
