@@ -157,3 +157,24 @@ fn inspect_reports_platforms_and_the_glibc_a_binary_needs() {
     // the packaged binaries meet the baseline: no warning
     assert!(!text.contains("warning:"), "{text}");
 }
+
+#[test]
+fn a_sweep_does_not_write_its_report_over_its_own_run_set() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("system.json"), system_json(0.1)).unwrap();
+    let set = r#"{"base": "system.json", "product": {"ms.stiffness": [50.0, 100.0]}}"#;
+    std::fs::write(dir.path().join("sweep.json"), set).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .current_dir(dir.path())
+        .args(["--quiet", "sweep", "sweep.json", "-o", "."])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("same file as the input"), "{stderr}");
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("sweep.json")).unwrap(),
+        set
+    );
+    assert!(!dir.path().join("run-000").exists());
+}

@@ -48,6 +48,16 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         return on_dask(args, address, ctx);
     }
     let (base, jobs) = RunSet::load(&args.runset)?;
+    // the report the set writes must not replace the run-set file or its base system (a
+    // run set named sweep.json swept into its own folder), nor one of the FMUs
+    let mut inputs = vec![args.runset.clone(), PathBuf::from(&base.file)];
+    inputs.extend(
+        base.desc
+            .instances
+            .iter()
+            .map(|i| base.base_dir.join(&i.fmu)),
+    );
+    crate::output::check_outputs_apart(&inputs, &[args.output.join("sweep.json")])?;
     // decided before the kept runs, over every job, so a resumed sweep writes the format a
     // fresh one would and keeps only runs complete in it
     let format = match args.format {
