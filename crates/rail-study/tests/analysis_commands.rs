@@ -73,6 +73,37 @@ fn number_after(stdout: &str, prefix: &str) -> f64 {
 }
 
 #[test]
+fn characterise_refuses_counts_and_frequencies_that_would_not_end() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("ch");
+    for (option, value, why) in [
+        ("--damper-freqs", "10000000000", "from 2 to 10000"),
+        (
+            "--actuator-freqs",
+            "18446744073709551615",
+            "from 2 to 10000",
+        ),
+        ("--damper-f-min", "1e-300", "outside 0.001 to 1e5 Hz"),
+        ("--actuator-f-max", "1e10", "outside 0.001 to 1e5 Hz"),
+    ] {
+        let r = master(&[
+            "characterise",
+            option,
+            value,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(
+            !r.ok && r.stderr.contains(why),
+            "{option} {value}: {}",
+            r.stderr
+        );
+        assert!(!r.stderr.contains("panicked"), "{}", r.stderr);
+    }
+    assert!(!out.exists());
+}
+
+#[test]
 fn characterise_damper_writes_loops_frfs_and_r1_table() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("ch");

@@ -39,24 +39,49 @@ pub struct Args {
     /// Output folder (created if needed; files are written only once everything is computed).
     #[arg(long, value_name = "DIR", default_value = "results/characterise")]
     pub out: PathBuf,
-    /// Number of log-spaced frequencies of the damper FRF.
-    #[arg(long, default_value_t = 25)]
+    /// Number of log-spaced frequencies of the damper FRF (2 to 10000).
+    #[arg(long, default_value_t = 25, value_parser = frf_points)]
     pub damper_freqs: usize,
-    /// Lowest damper FRF frequency [Hz].
-    #[arg(long, default_value_t = 0.5)]
+    /// Lowest damper FRF frequency [Hz] (at least 0.001 Hz: each frequency is simulated over
+    /// whole periods).
+    #[arg(long, default_value_t = 0.5, value_parser = frequency_hz)]
     pub damper_f_min: f64,
-    /// Highest damper FRF frequency [Hz].
-    #[arg(long, default_value_t = 20.0)]
+    /// Highest damper FRF frequency [Hz] (at most 1e5 Hz).
+    #[arg(long, default_value_t = 20.0, value_parser = frequency_hz)]
     pub damper_f_max: f64,
-    /// Number of log-spaced frequencies of the actuator FRF.
-    #[arg(long, default_value_t = 30)]
+    /// Number of log-spaced frequencies of the actuator FRF (2 to 10000).
+    #[arg(long, default_value_t = 30, value_parser = frf_points)]
     pub actuator_freqs: usize,
-    /// Lowest actuator FRF frequency [Hz].
-    #[arg(long, default_value_t = 1.0)]
+    /// Lowest actuator FRF frequency [Hz] (at least 0.001 Hz).
+    #[arg(long, default_value_t = 1.0, value_parser = frequency_hz)]
     pub actuator_f_min: f64,
-    /// Highest actuator FRF frequency [Hz].
-    #[arg(long, default_value_t = 320.0)]
+    /// Highest actuator FRF frequency [Hz] (at most 1e5 Hz).
+    #[arg(long, default_value_t = 320.0, value_parser = frequency_hz)]
     pub actuator_f_max: f64,
+}
+
+/// A number of FRF frequencies: 2 to 10000 (each is a simulation of its own).
+fn frf_points(text: &str) -> Result<usize, String> {
+    match text.trim().parse::<usize>() {
+        Ok(n) if (2..=10_000).contains(&n) => Ok(n),
+        _ => Err(format!("'{text}' is not a whole number from 2 to 10000")),
+    }
+}
+
+/// An FRF frequency: 0.001 to 1e5 Hz. Each frequency is simulated over whole periods, so a
+/// frequency of 1e-300 Hz would run for ever and 1e10 would take billions of steps.
+fn frequency_hz(text: &str) -> Result<f64, String> {
+    let f: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number"))?;
+    if !(1e-3..=1e5).contains(&f) {
+        return Err(format!(
+            "{} Hz is outside 0.001 to 1e5 Hz",
+            master::show::num(f)
+        ));
+    }
+    Ok(f)
 }
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
