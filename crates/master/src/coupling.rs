@@ -45,8 +45,8 @@ mod exchange;
 mod plan;
 
 pub use plan::{
-    check_plan, topological_order, Algorithm, ColumnInfo, CouplingPlan, PlanConnection,
-    PlanInstance, Recorded, RunLimits, SimError, SimOutput, Summary, Terminated,
+    check_plan, step_below_resolution, topological_order, Algorithm, ColumnInfo, CouplingPlan,
+    PlanConnection, PlanInstance, Recorded, RunLimits, SimError, SimOutput, Summary, Terminated,
     MAX_RECORDED_VALUES_VAR, MAX_STEPS_VAR,
 };
 

@@ -244,6 +244,23 @@ pub enum SimError {
 
 /// Environment variable raising [`RunLimits::max_steps`].
 pub const MAX_STEPS_VAR: &str = "MASTER_MAX_STEPS";
+
+/// Why `step` is too short for the times it steps through, if it is: near the largest time
+/// of the run a step of `step` would not advance time (1e16 + 1e-3 == 1e16) or would be off
+/// by half of it, so communication points would repeat or jump.
+pub fn step_below_resolution(start: f64, stop: f64, step: f64) -> Option<String> {
+    let largest = start.abs().max(stop.abs());
+    let advance = (largest + step) - largest;
+    (advance < 0.5 * step || advance > 1.5 * step).then(|| {
+        format!(
+            "step {} s is below the time resolution at t = {} s (a step there advances time by \
+             {} s): shift the start time towards 0",
+            num(step),
+            num(largest),
+            num(advance)
+        )
+    })
+}
 /// Environment variable raising [`RunLimits::max_recorded_values`].
 pub const MAX_RECORDED_VALUES_VAR: &str = "MASTER_MAX_RECORDED_VALUES";
 
@@ -383,6 +400,9 @@ pub fn check_plan(plan: &CouplingPlan, n_slaves: usize) -> Result<u64, SimError>
             num(plan.stop_time),
             num(plan.start_time)
         ));
+    }
+    if let Some(why) = step_below_resolution(plan.start_time, plan.stop_time, plan.step) {
+        return bad(why);
     }
     let span = plan.stop_time - plan.start_time;
     let limits = RunLimits::from_env().map_err(SimError::Plan)?;

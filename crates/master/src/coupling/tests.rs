@@ -1112,3 +1112,22 @@ fn a_recorded_connected_output_is_not_read_again_while_its_slave_is_unchanged() 
         }
     }
 }
+
+#[test]
+fn a_step_below_the_time_resolution_of_the_run_is_refused() {
+    use super::step_below_resolution;
+    // 1e16 + 1e-3 == 1e16: points would repeat
+    let why = step_below_resolution(1e16, 1e16 + 2.0, 1e-3).unwrap();
+    assert!(why.contains("advances time by 0 s"), "{why}");
+    // a Unix-time start with 1 ms steps still advances by 1 ms (to 2e-4 of it)
+    assert!(step_below_resolution(1.7e9, 1.7e9 + 10.0, 1e-3).is_none());
+    assert!(step_below_resolution(0.0, 10.0, 1e-3).is_none());
+    assert!(step_below_resolution(-5.0, 0.0, 1e-9).is_none());
+    let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.01);
+    plan.start_time = 1e16;
+    plan.stop_time = 1e16 + 2.0;
+    let mut a = Mock::new("ms", MassSpring::new(1.0, 1.0, 1.0, 0.0));
+    let mut b = Mock::new("sdm", SpringDamperMass::new(1.0, 1.0, 1.0));
+    let e = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("below the time resolution"), "{e}");
+}

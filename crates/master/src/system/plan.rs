@@ -340,6 +340,9 @@ impl LoadedSystem {
                 ),
             ));
         }
+        if let Some(why) = crate::coupling::step_below_resolution(d.start_time, stop_time, d.step) {
+            return Err(self.invalid("step", "step", why));
+        }
         let span = stop_time - d.start_time;
         let limits =
             crate::coupling::RunLimits::from_env().map_err(|r| self.invalid("step", "step", r))?;
