@@ -401,12 +401,12 @@ pub fn check_plan(plan: &CouplingPlan, n_slaves: usize) -> Result<u64, SimError>
             num(plan.start_time)
         ));
     }
-    if let Some(why) = step_below_resolution(plan.start_time, plan.stop_time, plan.step) {
-        return bad(why);
-    }
     let span = plan.stop_time - plan.start_time;
     let limits = RunLimits::from_env().map_err(SimError::Plan)?;
     limits.steps(span, plan.step).map_err(SimError::Plan)?;
+    if let Some(why) = step_below_resolution(plan.start_time, plan.stop_time, plan.step) {
+        return bad(why);
+    }
     let n = (span / plan.step).round();
     if n < 1.0 || (n * plan.step - span).abs() > 1e-9 * span.max(plan.step) {
         return bad(format!(

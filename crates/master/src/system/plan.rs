@@ -340,15 +340,15 @@ impl LoadedSystem {
                 ),
             ));
         }
-        if let Some(why) = crate::coupling::step_below_resolution(d.start_time, stop_time, d.step) {
-            return Err(self.invalid("step", "step", why));
-        }
         let span = stop_time - d.start_time;
         let limits =
             crate::coupling::RunLimits::from_env().map_err(|r| self.invalid("step", "step", r))?;
         limits
             .steps(span, d.step)
             .map_err(|r| self.invalid("step", "step", r))?;
+        if let Some(why) = crate::coupling::step_below_resolution(d.start_time, stop_time, d.step) {
+            return Err(self.invalid("step", "step", why));
+        }
         let n = (span / d.step).round();
         if (n * d.step - span).abs() > 1e-9 * span.max(d.step) {
             return Err(self.invalid(
