@@ -152,8 +152,7 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
             return Err(vr);
         }
         for (&vr, x) in vrs.iter().zip(out) {
-            let get = self.real_get.get(vr as usize).ok_or(vr)?;
-            *x = get(&self.model);
+            *x = self.real_get[vr as usize](&self.model);
         }
         Ok(())
     }

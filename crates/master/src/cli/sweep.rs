@@ -8,7 +8,7 @@ use crate::output::write_json_atomic;
 use crate::results::ResultsFormat;
 use crate::runset::{
     check_jobs, completed, execute_with as run_all, format_by_description, lock_output_folder,
-    prepare_run_folder, run_job, Job, ResultsOptions, RunReport, RunSet, SweepError,
+    prepare_run_folder, run_job, Job, ResultsOptions, RunReport, RunSet,
 };
 use crate::system::PreparedSystem;
 
@@ -87,10 +87,6 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         None
     };
     // one set at a time in a folder: a second one would mix its runs into this one's
-    std::fs::create_dir_all(&args.output).map_err(|source| SweepError::Dir {
-        path: args.output.clone(),
-        source,
-    })?;
     let _lock = lock_output_folder(&args.output)?;
     // the runs of this set only: nothing of the user's is replaced by a run folder, and
     // runs of an earlier set into this folder are removed (the kept ones are in this set)

@@ -245,6 +245,9 @@ pub enum SimError {
 /// Environment variable raising [`RunLimits::max_steps`].
 pub const MAX_STEPS_VAR: &str = "MASTER_MAX_STEPS";
 
+/// Environment variable raising [`RunLimits::max_recorded_values`].
+pub const MAX_RECORDED_VALUES_VAR: &str = "MASTER_MAX_RECORDED_VALUES";
+
 /// Why `step` is too short for the times it steps through, if it is: near the largest time
 /// of the run a step of `step` would not advance time (1e16 + 1e-3 == 1e16) or would be off
 /// by half of it, so communication points would repeat or jump.
@@ -261,8 +264,6 @@ pub fn step_below_resolution(start: f64, stop: f64, step: f64) -> Option<String>
         )
     })
 }
-/// Environment variable raising [`RunLimits::max_recorded_values`].
-pub const MAX_RECORDED_VALUES_VAR: &str = "MASTER_MAX_RECORDED_VALUES";
 
 /// How large one run may be, checked before any FMU is called: a stop time of 1e9 s at a 1 s
 /// step, or a step of 1e-300 s, is refused up front instead of running for days or running out

@@ -14,9 +14,6 @@ use crate::output::write_json_atomic;
 use crate::results::{constant_kinds, write_results, ConstantKind, ResultsFormat, RunContext};
 use crate::system::{LoadedSystem, PreparedSystem, SystemDescription, SystemError};
 
-/// Runs one job of `system`'s run set (a job from [`RunSet::expand`](super::RunSet::expand) of that system: the same
-/// instances, FMUs and timing; only start values and the stop time differ) on the prepared
-/// FMUs: validates its start values, simulates, returns the output.
 /// The start values and stop time of every job, checked against the prepared system's FMUs
 /// as each run would check them (variable names, types, declared ranges): a run set with a
 /// misspelt variable is refused before anything runs or is removed, not failed run by run.
@@ -28,6 +25,9 @@ pub fn check_jobs(system: &PreparedSystem, jobs: &[Job]) -> Result<(), SystemErr
     Ok(())
 }
 
+/// Runs one job of `system`'s run set (a job from [`RunSet::expand`](super::RunSet::expand) of that system: the same
+/// instances, FMUs and timing; only start values and the stop time differ) on the prepared
+/// FMUs: validates its start values, simulates, returns the output.
 pub fn run_job(
     system: &PreparedSystem,
     job: &Job,
@@ -258,13 +258,15 @@ pub struct OutputFolderLock {
     _folder: std::fs::File,
 }
 
-/// Takes the [`OutputFolderLock`] of `outdir` (an existing folder), or says that another set
+/// Takes the [`OutputFolderLock`] of `outdir` (created if needed), or says that another set
 /// holds it.
 pub fn lock_output_folder(outdir: &Path) -> Result<OutputFolderLock, SweepError> {
-    let folder = std::fs::File::open(outdir).map_err(|source| SweepError::Dir {
+    let dir_err = |source| SweepError::Dir {
         path: outdir.to_path_buf(),
         source,
-    })?;
+    };
+    std::fs::create_dir_all(outdir).map_err(dir_err)?;
+    let folder = std::fs::File::open(outdir).map_err(dir_err)?;
     if !crate::fmu::extract::try_lock(&folder) {
         return Err(SweepError::FolderInUse {
             path: outdir.to_path_buf(),

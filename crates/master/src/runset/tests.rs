@@ -178,13 +178,8 @@ fn a_new_set_removes_an_earlier_sets_tables_only_not_a_users_parquet_files() {
     // a set of two: the third run's table goes, the user's files stay
     let two = jobs(r#"{"product": {"ms.k": [50, 100]}}"#).unwrap();
     prepare_run_folder(&two, out).unwrap();
-    let mut left: Vec<String> = std::fs::read_dir(&table)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    left.sort();
     assert_eq!(
-        left,
+        files_under(&table),
         [
             "measured_track.parquet",
             "notes.txt",
