@@ -33,8 +33,8 @@ def _folder_lock(folder: Path):
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             raise _railfmu.OutputError(
-                f"another run set is writing into '{folder}' (a `master sweep` or a Python run set): "
-                "wait for it or choose another output folder"
+                f"another run set or study is writing into '{folder}' (a `master sweep`, "
+                "`master study` or a Python run set): wait for it or choose another output folder"
             ) from None
         yield
     finally:

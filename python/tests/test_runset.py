@@ -301,12 +301,12 @@ def test_a_second_set_into_a_folder_in_use_is_refused(dist, master_cmd, tmp_path
     fd = os.open(out, os.O_RDONLY)
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        with pytest.raises(railfmu.OutputError, match="another run set is writing into"):
+        with pytest.raises(railfmu.OutputError, match="another run set or study is writing into"):
             railfmu.RunSet.from_dict(speed_set(dist, [70.0], stop_time=0.1)).run(out, threads=1)
         set_file = tmp_path / "set.json"
         set_file.write_text(json.dumps(speed_set(dist, [70.0], stop_time=0.1)))
         r = run_master(master_cmd, "sweep", set_file, "-o", out)
-        assert r.returncode == 1 and "another run set is writing into" in r.stderr, r.stderr
+        assert r.returncode == 1 and "another run set or study is writing into" in r.stderr, r.stderr
         assert {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
     finally:
         os.close(fd)

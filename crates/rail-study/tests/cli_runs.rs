@@ -178,3 +178,95 @@ fn a_sweep_does_not_write_its_report_over_its_own_run_set() {
     );
     assert!(!dir.path().join("run-000").exists());
 }
+
+/// `master study` checks its system descriptions before it touches the output folder, holds
+/// the folder while it runs, and an interrupted study leaves no earlier result looking
+/// current (the user's own files stay).
+#[test]
+fn a_study_checks_its_systems_first_and_holds_its_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("REPORT.md"), "the earlier report").unwrap();
+    std::fs::write(out.join("notes.txt"), "the user's").unwrap();
+    let systems = dir.path().join("systems");
+    std::fs::create_dir_all(&systems).unwrap();
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../systems");
+    for e in std::fs::read_dir(&shipped).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), systems.join(e.file_name())).unwrap();
+    }
+    let mppt2 = std::fs::read_to_string(systems.join("mppt2.json")).unwrap();
+    let study = |extra: &[&str]| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_master"));
+        cmd.args(["--quiet", "study", "--quick", "--fmus"])
+            .arg(dist())
+            .arg("--out")
+            .arg(&out)
+            .args(extra)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped());
+        cmd
+    };
+    let bogie_with_systems = [
+        "--vehicle",
+        "bogie2dof",
+        "--systems",
+        systems.to_str().unwrap(),
+    ];
+    // a description that does not parse, one whose bogie instance has another name than the
+    // study's start values use, one that is missing
+    for (text, expected) in [
+        ("{ not json".to_string(), "mppt2.json: line 1"),
+        (
+            mppt2
+                .replace("\"bogie\"", "\"train\"")
+                .replace("\"bogie.", "\"train."),
+            "unknown instance 'bogie'",
+        ),
+    ] {
+        std::fs::write(systems.join("mppt2.json"), text).unwrap();
+        let r = study(&bogie_with_systems).output().unwrap();
+        let stderr = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(1), "{stderr}");
+        assert!(stderr.contains(expected), "{stderr}");
+        assert_eq!(
+            std::fs::read_to_string(out.join("REPORT.md")).unwrap(),
+            "the earlier report"
+        );
+        assert!(!out.join("runs").exists(), "{stderr}");
+    }
+    std::fs::remove_file(systems.join("mppt2.json")).unwrap();
+    let r = study(&bogie_with_systems).output().unwrap();
+    assert_eq!(r.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("mppt2.json"));
+    assert!(out.join("REPORT.md").exists());
+
+    // the coach's study runs long enough to be met by a second one and interrupted
+    let first = study(&[]).spawn().unwrap();
+    let started = std::time::Instant::now();
+    while !out.join("runs/main").exists() {
+        assert!(
+            started.elapsed().as_secs() < 120,
+            "the study did not start its runs"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let second = study(&[]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&second.stderr);
+    assert_eq!(second.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("is writing into"), "{stderr}");
+    let st = Command::new("kill")
+        .args(["-INT", &first.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let r = first.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(130), "{stderr}");
+    assert!(!out.join("REPORT.md").exists(), "{stderr}");
+    assert_eq!(
+        std::fs::read_to_string(out.join("notes.txt")).unwrap(),
+        "the user's"
+    );
+}

@@ -98,8 +98,8 @@ pub enum SweepError {
     )]
     NotATablesFolder { path: PathBuf },
     #[error(
-        "another run set is writing into '{path}' (a `master sweep` or a Python run set): wait \
-         for it or choose another output folder"
+        "another run set or study is writing into '{path}' (a `master sweep`, `master study` or a \
+         Python run set): wait for it or choose another output folder"
     )]
     FolderInUse { path: PathBuf },
 }

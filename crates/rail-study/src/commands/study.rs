@@ -11,8 +11,8 @@ use std::time::Instant;
 use crate::study::report::output_files;
 use crate::study::run::{check_fmus, configurations_used};
 use crate::study::{
-    run_study, write_outputs, Sources, StudyError, StudyOptions, StudySettings, Timing, TrackLevel,
-    VehicleModel,
+    run_study_checked, write_outputs, Sources, StudyError, StudyOptions, StudySettings, Timing,
+    TrackLevel, VehicleModel,
 };
 use master::cli::{CommandError, Context};
 use master::results::ResultsFormat;
@@ -312,13 +312,18 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         args.vehicle,
         &configurations_used(&settings)?,
     )?;
-    // An interrupted or failed study must not leave the previous study's results looking
-    // current: its report, figures and tables are removed before the first run and written
-    // again only when every output is ready.
-    remove_earlier_outputs(&args.out)?;
-    // bisection rounds of an earlier study beyond this one's would be left beside its runs
-    remove_batches(&args.out.join("runs"), "bisect-")?;
-    let results = run_study(&settings, &opts)?;
+    // A study that cannot run (a system description that does not parse or names an unknown
+    // variable) fails before the folder is touched. Then the folder is locked against a
+    // second study or run set writing into it, and an interrupted or failed study must not
+    // leave the previous study's results looking current: its report, figures and tables
+    // are removed before the first run and written again only when every output is ready.
+    let mut lock = None;
+    let results = run_study_checked(&settings, &opts, || {
+        lock = Some(master::runset::lock_output_folder(&args.out)?);
+        remove_earlier_outputs(&args.out)?;
+        // bisection rounds of an earlier study beyond this one's would be left beside its runs
+        remove_batches(&args.out.join("runs"), "bisect-")
+    })?;
     let timing = Timing {
         wall_s: start.elapsed().as_secs_f64(),
         threads,
@@ -346,11 +351,11 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
 /// Removes the files an earlier study wrote into `out` ([`output_files`]: report, figures,
 /// tables): regular files (and symbolic links) of these names only; a user's other files, and
 /// a folder or FIFO of such a name, stay.
-fn remove_earlier_outputs(out: &std::path::Path) -> Result<(), CommandError> {
+fn remove_earlier_outputs(out: &std::path::Path) -> Result<(), StudyError> {
     for name in output_files() {
         let path = out.join(name);
         master::output::remove_stale_file(&path).map_err(|e| {
-            CommandError::Failed(format!(
+            StudyError::Folder(format!(
                 "cannot remove the previous '{}': {e}",
                 path.display()
             ))
@@ -361,7 +366,7 @@ fn remove_earlier_outputs(out: &std::path::Path) -> Result<(), CommandError> {
 
 /// Removes the batch folders `<runs>/<prefix>*` an earlier study wrote (each holds its
 /// `sweep.json` or run folders; anything else is left alone).
-fn remove_batches(runs: &std::path::Path, prefix: &str) -> Result<(), CommandError> {
+fn remove_batches(runs: &std::path::Path, prefix: &str) -> Result<(), StudyError> {
     let Ok(entries) = std::fs::read_dir(runs) else {
         return Ok(());
     };
@@ -372,7 +377,7 @@ fn remove_batches(runs: &std::path::Path, prefix: &str) -> Result<(), CommandErr
             && path.join("sweep.json").is_file();
         if ours {
             std::fs::remove_dir_all(&path).map_err(|err| {
-                CommandError::Failed(format!(
+                StudyError::Folder(format!(
                     "cannot remove the earlier study's '{}': {err}",
                     path.display()
                 ))

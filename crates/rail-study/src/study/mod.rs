@@ -29,6 +29,6 @@ pub use config::Sources;
 pub use configurations::{Configuration, CONFIGURATIONS};
 pub use critical::Critical;
 pub use report::{write_outputs, Timing};
-pub use run::{run_study, StudyError, StudyOptions, StudyResults};
+pub use run::{run_study, run_study_checked, StudyError, StudyOptions, StudyResults};
 pub use settings::{StudySettings, TrackLevel};
 pub use vehicle::VehicleModel;

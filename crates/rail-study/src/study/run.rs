@@ -47,6 +47,8 @@ pub enum StudyError {
     Output(#[from] master::output::OutputError),
     #[error(transparent)]
     Plot(#[from] crate::plot::PlotError),
+    #[error("{0}")]
+    Folder(String),
     #[error("cancelled")]
     Cancelled,
 }
@@ -226,6 +228,21 @@ impl Executor<'_> {
             let system = self.opts.sources.system(self.settings.vehicle, c)?;
             self.prepared
                 .insert(c.id, PreparedSystem::prepare(&system)?);
+        }
+        Ok(())
+    }
+
+    /// Prepares the systems of `planned` and checks each run's start values against them.
+    fn check(&mut self, planned: &[Planned]) -> Result<(), StudyError> {
+        for p in planned {
+            self.prepare(p.request.config)?;
+            let Some(system) = self.prepared.get(p.request.config.id) else {
+                return Err(StudyError::UnknownConfiguration(p.request.config.id.into()));
+            };
+            let mut request = p.request.clone();
+            request.track_level = self.settings.track_level;
+            let job = request.job(system.system())?;
+            master::runset::check_jobs(system, std::slice::from_ref(&job))?;
         }
         Ok(())
     }
@@ -519,6 +536,18 @@ pub fn run_study(
     settings: &StudySettings,
     opts: &StudyOptions<'_>,
 ) -> Result<StudyResults, StudyError> {
+    run_study_checked(settings, opts, || Ok(()))
+}
+
+/// [`run_study`], calling `before_first_run` once every configuration's system is prepared
+/// (FMUs loaded, connections checked) and every run of the first batch has its start values
+/// checked against the models: a study that cannot run fails before the caller touches its
+/// output folder.
+pub fn run_study_checked(
+    settings: &StudySettings,
+    opts: &StudyOptions<'_>,
+    before_first_run: impl FnOnce() -> Result<(), StudyError>,
+) -> Result<StudyResults, StudyError> {
     let configs: Vec<&'static Configuration> = settings
         .configurations
         .iter()
@@ -644,6 +673,8 @@ pub fn run_study(
             keep: true,
         });
     }
+    ex.check(&planned)?;
+    before_first_run()?;
     ex.run_batch("main", planned)?;
 
     let limit = acceleration_limit(BOGIE_MASS_T);
