@@ -66,6 +66,12 @@ pub enum EigenError {
         /// Speed [m/s].
         speed_mps: f64,
     },
+    /// The eigenvalue iteration did not converge.
+    #[error("the eigenvalues of the state matrix at {speed_mps} m/s did not converge")]
+    NoEigenvalues {
+        /// Speed [m/s].
+        speed_mps: f64,
+    },
 }
 
 /// The least damped oscillatory mode (hunting).
@@ -121,25 +127,22 @@ pub struct CriticalSpeed {
 }
 
 fn check_damper(rep: &DamperRepresentation) -> Result<(), EigenError> {
-    let ok = |v: f64| v.is_finite() && v >= 0.0;
+    use vehicle_elements::damper::{check_damping, check_stiffness};
     match rep {
-        DamperRepresentation::Linear(d) => match *d {
-            LinearDamper::None => Ok(()),
-            LinearDamper::Viscous { c } if ok(c) => Ok(()),
-            LinearDamper::KelvinVoigt { k, c } if ok(k) && ok(c) => Ok(()),
-            LinearDamper::Maxwell { k, c } if ok(k) && k > 0.0 && ok(c) && c > 0.0 => Ok(()),
-            _ => Err(EigenError::Damper(format!(
-                "negative, zero or NaN value in {d:?}"
-            ))),
-        },
+        DamperRepresentation::Linear(d) => d.check().map_err(EigenError::Damper),
         DamperRepresentation::FrequencyDependent(t) => {
             if t.is_empty() {
                 return Err(EigenError::Damper("empty frequency table".into()));
             }
             for (i, pt) in t.iter().enumerate() {
-                if !(ok(pt.freq_hz) && ok(pt.k_n_per_m) && ok(pt.c_ns_per_m)) {
+                if !(pt.freq_hz.is_finite() && pt.freq_hz >= 0.0) {
                     return Err(EigenError::Damper(format!("table row {i}: negative/NaN")));
                 }
+                check_stiffness(&format!("table row {i}: stiffness"), pt.k_n_per_m, true)
+                    .and_then(|()| {
+                        check_damping(&format!("table row {i}: damping"), pt.c_ns_per_m, true)
+                    })
+                    .map_err(EigenError::Damper)?;
                 if i > 0 && pt.freq_hz <= t[i - 1].freq_hz {
                     return Err(EigenError::Damper("table not sorted by frequency".into()));
                 }
@@ -239,9 +242,10 @@ fn resolve(rep: &DamperRepresentation, freq_hz: f64) -> Resolved {
     }
 }
 
-fn analyse_resolved(p: &Params, v: f64, d: Resolved) -> EigenResult {
+fn analyse_resolved(p: &Params, v: f64, d: Resolved) -> Result<EigenResult, EigenError> {
     let a = state_matrix_resolved(p, v, d);
-    let ev = a.complex_eigenvalues();
+    let ev = vehicle_elements::eigenvalues::eigenvalues(&a)
+        .ok_or(EigenError::NoEigenvalues { speed_mps: v })?;
     let mut list: Vec<(f64, f64)> = ev.iter().map(|l| (l.re, l.im)).collect();
     list.sort_by(|x, y| y.0.total_cmp(&x.0));
     let max_re = list.first().map(|x| x.0).unwrap_or(f64::NEG_INFINITY);
@@ -253,13 +257,13 @@ fn analyse_resolved(p: &Params, v: f64, d: Resolved) -> EigenResult {
     let damper_k_c = match d {
         Resolved::Kv { k, c } | Resolved::Maxwell { k, c } => (k, c),
     };
-    EigenResult {
+    Ok(EigenResult {
         speed_mps: v,
         eigenvalues: list,
         max_re,
         hunting,
         damper_k_c,
-    }
+    })
 }
 
 /// Frequency-dependent Kelvin-Voigt damper given as a function f_hz -> (k, c): iterates
@@ -275,10 +279,10 @@ pub fn analyse_with_fn(
     let mut f = 3.5; // start at a typical hunting frequency [Hz]
     for _ in 0..100 {
         let (k, c) = damper(f);
-        if !(k.is_finite() && c.is_finite() && k >= 0.0 && c >= 0.0) {
-            return Err(EigenError::Damper(format!("k={k}, c={c} at {f} Hz")));
-        }
-        let r = analyse_resolved(p, speed_mps, Resolved::Kv { k, c });
+        LinearDamper::KelvinVoigt { k, c }
+            .check()
+            .map_err(|e| EigenError::Damper(format!("at {f} Hz: {e}")))?;
+        let r = analyse_resolved(p, speed_mps, Resolved::Kv { k, c })?;
         let Some(h) = r.hunting else {
             return Ok(r);
         };
@@ -305,7 +309,7 @@ pub fn analyse(
         DamperRepresentation::FrequencyDependent(t) => {
             analyse_with_fn(p, speed_mps, &|f| interpolate_table(t, f))
         }
-        _ => Ok(analyse_resolved(p, speed_mps, resolve(rep, 0.0))),
+        _ => analyse_resolved(p, speed_mps, resolve(rep, 0.0)),
     }
 }
 
@@ -433,7 +437,7 @@ mod tests {
         let m = analyse(
             &p,
             70.0,
-            &DamperRepresentation::Linear(LinearDamper::Maxwell { k: 1e11, c: 1.2e5 }),
+            &DamperRepresentation::Linear(LinearDamper::Maxwell { k: 1e10, c: 1.2e5 }),
         )
         .unwrap();
         let (hv, hm) = (v.hunting.unwrap(), m.hunting.unwrap());

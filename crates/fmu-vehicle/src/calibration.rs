@@ -38,16 +38,16 @@
 //! re-found for 285 km/h with the passive damper where [1, 100] allows it; then the linear
 //! critical speed, km/h, with a closed valve as a Maxwell element of 16.9 MN/m in series with
 //! 330 kNs/m and with ideal 210 kNs/m dampers; target shape: closed 350-385, ideal below 380):
-//! * calibrated coach: passive 285.0, closed 695.9, ideal 335.9; ideal dampers of 60 / 104 /
+//! * calibrated coach: passive 285.0, closed 695.8, ideal 335.9; ideal dampers of 60 / 104 /
 //!   150 / 210 / 330 kNs/m: 244.0 / 267.7 / 295.3 / 335.9 / 434.1. The closed valve's series
 //!   spring counts as much as its damping: 330 kNs/m behind 2 / 5 / 10 / 16.9 MN/m gives
-//!   292.3 / 447.2 / > 900 / 695.9, and the passive damper behind a 5 / 10 MN/m mounting
+//!   292.3 / 447.2 / > 900 / 695.8, and the passive damper behind a 5 / 10 MN/m mounting
 //!   309.6 / 306.4. Four yaw dampers of 16.9 MN/m at 1.35 m put 2 k b^2 = 61.6 MN m/rad of yaw
 //!   stiffness between each frame and the car body (the air springs: about 0.3 MN m/rad): the
 //!   elastic yaw coupling to the car body is a strong stabiliser of bogie hunting.
 //! * split of the primary factor (longitudinal x lateral, no re-calibration): every split with
 //!   passive 280-290 km/h keeps the closed valve at 662-711 and the ideal damper at 318-350
-//!   (kx x2 ky x10: 287.3 / 710.7 / 349.8; x3.15 x3.15: 285.0 / 695.9 / 335.9; x5 x2: 285.1 /
+//!   (kx x2 ky x10: 287.3 / 710.8 / 349.8; x3.15 x3.15: 285.0 / 695.8 / 335.9; x5 x2: 285.1 /
 //!   690.3 / 328.2; x10 x2: 279.6 / 662.3 / 318.2).
 //! * equivalent conicity 0.20 / 0.30 (re-calibrated where possible): 0.20 cannot reach 285
 //!   (325.5 at factor 100), 0.30 at factor 1.54: closed > 900. 0.35: 238.1 already at 3.15.

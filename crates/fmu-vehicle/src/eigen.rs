@@ -73,16 +73,21 @@ pub enum EigenError {
         /// Lower end [m/s].
         lo_mps: f64,
     },
+    /// The eigenvalue iteration did not converge.
+    #[error("the eigenvalues of the state matrix at {speed_mps} m/s did not converge")]
+    NoEigenvalues {
+        /// Speed [m/s].
+        speed_mps: f64,
+    },
 }
 
 fn resolve(d: &YawDamperModel) -> Result<Resolved, EigenError> {
-    let ok = |v: f64| v.is_finite() && v >= 0.0;
-    let bad = || EigenError::Damper(format!("negative, zero or non-finite value in {d:?}"));
-    let mount = match d.mounting_stiffness_n_per_m {
-        None => None,
-        Some(k) if k.is_finite() && k > 0.0 => Some(k),
-        Some(_) => return Err(bad()),
-    };
+    d.representation.check().map_err(EigenError::Damper)?;
+    let mount = d.mounting_stiffness_n_per_m;
+    if let Some(km) = mount {
+        vehicle_elements::damper::check_stiffness("mounting stiffness", km, false)
+            .map_err(EigenError::Damper)?;
+    }
     let series = |k: f64, km: Option<f64>| match km {
         Some(km) => k * km / (k + km),
         None => k,
@@ -94,11 +99,11 @@ fn resolve(d: &YawDamperModel) -> Result<Resolved, EigenError> {
     };
     Ok(match d.representation {
         DamperRepresentation::None => Resolved::Parallel { k: 0.0, c: 0.0 },
-        DamperRepresentation::Viscous { c } if ok(c) => match mount {
+        DamperRepresentation::Viscous { c } => match mount {
             Some(km) if c > 0.0 => maxwell(km, c),
             _ => Resolved::Parallel { k: 0.0, c },
         },
-        DamperRepresentation::KelvinVoigt { k, c } if ok(k) && ok(c) => match mount {
+        DamperRepresentation::KelvinVoigt { k, c } => match mount {
             None => Resolved::Parallel { k, c },
             Some(km) if c == 0.0 => Resolved::Parallel {
                 k: series(k, Some(km)),
@@ -111,10 +116,7 @@ fn resolve(d: &YawDamperModel) -> Result<Resolved, EigenError> {
                 a_f: (km + k) / c,
             },
         },
-        DamperRepresentation::Maxwell { k, c } if ok(k) && k > 0.0 && ok(c) && c > 0.0 => {
-            maxwell(series(k, mount), c)
-        }
-        _ => return Err(bad()),
+        DamperRepresentation::Maxwell { k, c } => maxwell(series(k, mount), c),
     })
 }
 
@@ -333,9 +335,13 @@ fn mode(p: &VehicleParams, a: &DMatrix<f64>, l: Complex<f64>) -> Mode {
 /// Below this imaginary part an eigenvalue counts as real [rad/s].
 const OSCILLATORY_MIN_IM: f64 = 1e-3;
 
-fn analyse_validated(p: &VehicleParams, v: f64, d: Resolved) -> EigenResult {
+fn eigenvalues_at(a: &DMatrix<f64>, speed_mps: f64) -> Result<Vec<Complex<f64>>, EigenError> {
+    vehicle_elements::eigenvalues::eigenvalues(a).ok_or(EigenError::NoEigenvalues { speed_mps })
+}
+
+fn analyse_validated(p: &VehicleParams, v: f64, d: Resolved) -> Result<EigenResult, EigenError> {
     let a = build(p, v, d);
-    let ev = a.complex_eigenvalues();
+    let ev = eigenvalues_at(&a, v)?;
     let mut list: Vec<(f64, f64)> = ev.iter().map(|l| (l.re, l.im)).collect();
     list.sort_by(|x, y| y.0.total_cmp(&x.0));
     let max_re = list.first().map_or(f64::NEG_INFINITY, |x| x.0);
@@ -344,13 +350,13 @@ fn analyse_validated(p: &VehicleParams, v: f64, d: Resolved) -> EigenResult {
     let least_damped = osc()
         .max_by(|x, y| (x.re / x.norm()).total_cmp(&(y.re / y.norm())))
         .copied();
-    EigenResult {
+    Ok(EigenResult {
         speed_mps: v,
         eigenvalues: list,
         max_re,
         least_stable: least_stable.map(|l| mode(p, &a, l)),
         least_damped: least_damped.map(|l| mode(p, &a, l)),
-    }
+    })
 }
 
 /// Eigenvalues and modes at one speed.
@@ -362,7 +368,7 @@ pub fn analyse(
     let mut q = p.clone();
     q.speed_mps = speed_mps;
     q.validate()?;
-    Ok(analyse_validated(&q, speed_mps, resolve(damper)?))
+    analyse_validated(&q, speed_mps, resolve(damper)?)
 }
 
 /// Root locus: eigenvalues and modes over the given speeds (the `master root-locus` data).
@@ -375,12 +381,11 @@ pub fn root_locus(
 }
 
 /// Largest real part of all eigenvalues at one speed (no modes: for the bisection).
-fn max_re(p: &VehicleParams, v: f64, d: Resolved) -> f64 {
-    build(p, v, d)
-        .complex_eigenvalues()
+fn max_re(p: &VehicleParams, v: f64, d: Resolved) -> Result<f64, EigenError> {
+    Ok(eigenvalues_at(&build(p, v, d), v)?
         .iter()
         .map(|l| l.re)
-        .fold(f64::NEG_INFINITY, f64::max)
+        .fold(f64::NEG_INFINITY, f64::max))
 }
 
 /// Linear critical speed: the first speed in [lo, hi] where the largest real part of all
@@ -401,7 +406,7 @@ pub fn critical_speed(
         let mut q = p.clone();
         q.speed_mps = v;
         q.validate()?;
-        let r = max_re(&q, v, d);
+        let r = max_re(&q, v, d)?;
         Ok((q, r))
     };
     let b = match first_unstable_speed(lo_mps, hi_mps, 1.0, 1e-6, |v| {
@@ -412,7 +417,7 @@ pub fn critical_speed(
         Crossing::None => return Err(no),
     };
     let (q, _) = at(b)?;
-    let r = analyse_validated(&q, b, d);
+    let r = analyse_validated(&q, b, d)?;
     let mode = r.least_stable.ok_or(no)?;
     Ok(CriticalSpeed {
         speed_mps: b,
@@ -492,6 +497,13 @@ mod tests {
             YawDamperModel {
                 representation: DamperRepresentation::Viscous { c: 1.0 },
                 mounting_stiffness_n_per_m: Some(f64::NAN),
+            },
+            // beyond any installation: the eigenvalues would not be trusted
+            YawDamperModel::rigid(DamperRepresentation::Viscous { c: 1e20 }),
+            YawDamperModel::rigid(DamperRepresentation::KelvinVoigt { k: 1e11, c: 0.0 }),
+            YawDamperModel {
+                representation: DamperRepresentation::Viscous { c: 1e5 },
+                mounting_stiffness_n_per_m: Some(1e305),
             },
         ] {
             assert!(matches!(analyse(&p, 60.0, &d), Err(EigenError::Damper(_))));

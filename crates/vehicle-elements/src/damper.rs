@@ -35,7 +35,73 @@ pub enum LinearDamper {
     },
 }
 
+/// Stiffness a linear damper (its spring, or the mounting it sits on) may have, when it has
+/// one [N/m]: 1 kN/m is nothing beside the coach's suspension, 10 GN/m is a thousand times a
+/// published damper mounting (10 MN/m) and stiffer than the steel around it. Beyond these
+/// bounds the eigen-analysis' state matrix spans too many orders of magnitude for its
+/// eigenvalues to be trusted (a dashpot of 1e20 N s/m made the coach unstable at 18 km/h).
+pub const STIFFNESS_RANGE_N_PER_M: std::ops::RangeInclusive<f64> = 1e3..=1e10;
+/// Damping a linear damper may have, when it has any [N s/m]: 1 N s/m is nothing, 100 MN s/m
+/// three hundred times a closed semi-active valve (about 330 kN s/m).
+pub const DAMPING_RANGE_NS_PER_M: std::ops::RangeInclusive<f64> = 1.0..=1e8;
+
+/// Checks a stiffness \[N/m\]: zero where `zero_allowed`, else within
+/// [`STIFFNESS_RANGE_N_PER_M`]; the message names `what`.
+pub fn check_stiffness(what: &str, k: f64, zero_allowed: bool) -> Result<(), String> {
+    check_in(what, k, zero_allowed, &STIFFNESS_RANGE_N_PER_M, "N/m")
+}
+
+/// Checks a damping \[N s/m\]: zero where `zero_allowed`, else within
+/// [`DAMPING_RANGE_NS_PER_M`]; the message names `what`.
+pub fn check_damping(what: &str, c: f64, zero_allowed: bool) -> Result<(), String> {
+    check_in(what, c, zero_allowed, &DAMPING_RANGE_NS_PER_M, "N s/m")
+}
+
+fn check_in(
+    what: &str,
+    v: f64,
+    zero_allowed: bool,
+    range: &std::ops::RangeInclusive<f64>,
+    unit: &str,
+) -> Result<(), String> {
+    if (zero_allowed && v == 0.0) || range.contains(&v) {
+        return Ok(());
+    }
+    let short = |x: f64| {
+        if (1e-3..1e4).contains(&x.abs()) {
+            format!("{x}")
+        } else {
+            format!("{x:e}")
+        }
+    };
+    Err(format!(
+        "{what} {} {unit} is outside {} .. {} {unit}{}",
+        short(v),
+        short(*range.start()),
+        short(*range.end()),
+        if zero_allowed { " (or 0)" } else { "" }
+    ))
+}
+
 impl LinearDamper {
+    /// Checks the law's values against [`STIFFNESS_RANGE_N_PER_M`] and
+    /// [`DAMPING_RANGE_NS_PER_M`] (a viscous or Kelvin-Voigt damper may have zero of either,
+    /// a Maxwell element needs both).
+    pub fn check(&self) -> Result<(), String> {
+        match *self {
+            LinearDamper::None => Ok(()),
+            LinearDamper::Viscous { c } => check_damping("damping", c, true),
+            LinearDamper::KelvinVoigt { k, c } => {
+                check_stiffness("stiffness", k, true)?;
+                check_damping("damping", c, true)
+            }
+            LinearDamper::Maxwell { k, c } => {
+                check_stiffness("series stiffness", k, false)?;
+                check_damping("damping", c, false)
+            }
+        }
+    }
+
     /// Force of one damper held over the next step of length `h_s`, from its elongation
     /// \[m\] and elongation velocity [m/s] at the start of the step; `state_n` is the
     /// Maxwell element's force \[N\], advanced to the end of the step.

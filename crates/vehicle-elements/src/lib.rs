@@ -14,6 +14,8 @@
 //!   when a parameter set needs a shorter one;
 //! * [`stability`]: the search for a linear critical speed (scan, then bisection) that both
 //!   eigen-analyses run;
+//! * [`eigenvalues`]: the eigenvalues of a state matrix, balanced and with a bounded
+//!   iteration, for both eigen-analyses;
 //! * [`damper`]: the linear yaw damper law (none, viscous, Kelvin-Voigt, Maxwell) that the
 //!   closed-loop runs evaluate beside a model, co-simulation style, and the coach's
 //!   eigen-analysis takes; the loop itself.
@@ -21,6 +23,7 @@
 //! Wheel/rail contact and the track generator are physics of contact and live in `wheel-rail`.
 
 pub mod damper;
+pub mod eigenvalues;
 pub mod params;
 pub mod resources;
 pub mod shell;

@@ -267,7 +267,7 @@ pub struct LocusResults {
 }
 
 fn bogie_err(e: EigenError) -> AnalysisError {
-    AnalysisError::Bogie(e.to_string())
+    AnalysisError::LinearModel(format!("2-dof bogie: {e}"))
 }
 
 /// Eigenvalues over the speed grid and the linear critical speed. `params` is usually

@@ -44,8 +44,9 @@ pub enum AnalysisError {
     Conicity(#[from] wheel_rail::ConicityError),
     #[error("contact geometry: {0}")]
     Geometry(String),
-    #[error("bogie model: {0}")]
-    Bogie(String),
+    /// An error of a linear model's eigen-analysis (the message starts with the model).
+    #[error("linear model of the {0}")]
+    LinearModel(String),
     /// A results table or signal that cannot be assessed (message names file, line, column).
     #[error("{0}")]
     Input(String),

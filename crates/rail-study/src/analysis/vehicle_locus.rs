@@ -49,7 +49,7 @@ pub struct VehicleLocus {
 }
 
 fn vehicle_err(e: EigenError) -> AnalysisError {
-    AnalysisError::Bogie(format!("coach: {e}"))
+    AnalysisError::LinearModel(format!("coach: {e}"))
 }
 
 /// Eigenvalues over the speed grid and the linear critical speed.

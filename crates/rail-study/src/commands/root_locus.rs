@@ -38,11 +38,13 @@ pub struct Args {
     /// 120k = 120e3), `none`, or `semi-active:OPENING:STROKE[:FREQ]`: the hydraulic
     /// semi-active damper model with its valve fixed at OPENING (0 closed .. 1), linearised by
     /// its first harmonic at stroke amplitude STROKE [m] and FREQ [Hz, default 4], e.g.
-    /// `semi-active:0:3e-3:5.5` (a closed valve at +-3 mm, 5.5 Hz).
+    /// `semi-active:0:3e-3:5.5` (a closed valve at +-3 mm, 5.5 Hz). A stiffness lies within
+    /// 1 kN/m .. 10 GN/m, a damping within 1 N s/m .. 100 MN s/m (or either is 0 where the law
+    /// allows): beyond them the eigenvalues cannot be trusted.
     #[arg(long, default_value = "passive", value_parser = parse_damper)]
     pub damper: DamperSpec,
-    /// Mounting (series) stiffness of each yaw damper's installation [N/m], coach only
-    /// [default: rigid].
+    /// Mounting (series) stiffness of each yaw damper's installation [N/m], 1 kN/m .. 10 GN/m,
+    /// coach only [default: rigid].
     #[arg(long, value_name = "N_PER_M")]
     pub mounting_stiffness: Option<f64>,
     /// Equivalent conicity of the linear model [default: the calibrated value].
