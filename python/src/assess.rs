@@ -141,8 +141,15 @@ fn check_options(o: &AssessOptions, quantity: Quantity) -> Result<(), String> {
         Quantity::Acceleration if !(o.bogie_mass_t > 0.0 && o.bogie_mass_t < 60.0) => {
             bad("bogie_mass_t", o.bogie_mass_t, "must be in (0, 60) t")
         }
-        Quantity::GuidingForce if o.wheel_load_kn.is_nan() || o.wheel_load_kn <= 0.0 => {
-            bad("wheel_load_kn", o.wheel_load_kn, "must be a load > 0 kN")
+        Quantity::GuidingForce
+            if !rail_study::en14363::STATIC_WHEEL_LOAD_RANGE_N
+                .contains(&(o.wheel_load_kn * 1e3)) =>
+        {
+            bad(
+                "wheel_load_kn",
+                o.wheel_load_kn,
+                "must be a static wheel load within 1 .. 300 kN",
+            )
         }
         _ => Ok(()),
     }
@@ -293,10 +300,13 @@ mod tests {
             ("bogie_mass_t = 70: must be in (0, 60) t", |o| {
                 o.bogie_mass_t = 70.0
             }),
-            ("wheel_load_kn = -5: must be a load > 0 kN", |o| {
-                o.quantity = "guiding_force".into();
-                o.wheel_load_kn = -5.0;
-            }),
+            (
+                "wheel_load_kn = -5: must be a static wheel load within 1 .. 300 kN",
+                |o| {
+                    o.quantity = "guiding_force".into();
+                    o.wheel_load_kn = -5.0;
+                },
+            ),
             ("speed_kmh = NaN", |o| o.speed_kmh = f64::NAN),
         ];
         for (want, change) in cases {

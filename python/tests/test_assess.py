@@ -96,7 +96,10 @@ def test_messages_name_the_python_arguments_not_the_command_options(hunting, tmp
         ({"skip_s": -1.0}, "skip_s = -1: must be >= 0 s"),
         ({"f0_hz": -2.0}, "f0_hz = -2: must be a frequency > 0 Hz"),
         ({"bogie_mass_t": 80.0}, r"bogie_mass_t = 80: must be in \(0, 60\) t"),
-        ({"quantity": "guiding_force", "wheel_load_kn": -5.0}, "wheel_load_kn = -5: must be a load > 0 kN"),
+        ({"quantity": "guiding_force", "wheel_load_kn": -5.0},
+         "wheel_load_kn = -5: must be a static wheel load within 1 .. 300 kN"),
+        ({"quantity": "guiding_force", "wheel_load_kn": 1e300},
+         "wheel_load_kn = 1e300: must be a static wheel load within 1 .. 300 kN"),
         # huge values: refused in short form (1e308 made windows without end until memory ran out)
         ({"speed_kmh": 1e308}, "the window step must last at least one sample at this speed"),
         ({"skip_s": 1e308}, "at 320 km/h minus 1e308 s skipped covers 0 m, less than one 100 m window"),

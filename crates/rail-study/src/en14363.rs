@@ -24,6 +24,10 @@ pub fn acceleration_limit(bogie_mass_t: f64) -> f64 {
     (12.0 - bogie_mass_t / 5.0) / 2.0
 }
 
+/// Static wheel loads the guiding-force criterion takes \[N\]: 300 kN is a wheel under an
+/// axle load of 60 t, twice the heaviest freight axle.
+pub const STATIC_WHEEL_LOAD_RANGE_N: std::ops::RangeInclusive<f64> = 1e3..=3e5;
+
 /// EN 14363 limit of the rms of the sum of guiding forces \[kN\] for a static wheel load \[kN\]:
 /// (10 + 2 Q0/3)/2.
 pub fn guiding_force_limit_kn(static_wheel_load_kn: f64) -> f64 {
@@ -179,8 +183,8 @@ pub fn assess_guiding_forces(
     param(
         "static_wheel_load_n",
         static_wheel_load_n,
-        static_wheel_load_n > 0.0,
-        "must be > 0",
+        STATIC_WHEEL_LOAD_RANGE_N.contains(&static_wheel_load_n),
+        "a static wheel load must lie within 1 .. 300 kN",
     )?;
     let kn: Vec<f64> = sum_y_n.iter().map(|v| v / 1000.0).collect();
     assess_rms(

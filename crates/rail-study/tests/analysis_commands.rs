@@ -935,6 +935,68 @@ fn assess_reports_the_en14363_verdict_and_refuses_bad_input() {
         "{}",
         r.stderr
     );
+    // a wheel load no wheel carries: refused
+    let forces = dir.path().join("forces.csv");
+    std::fs::write(
+        &forces,
+        text.replace("front [m/s2],rear [m/s2]", "force [kN],other [kN]"),
+    )
+    .unwrap();
+    let r = master(&[
+        "assess",
+        forces.to_str().unwrap(),
+        "--signal",
+        "force",
+        "--quantity",
+        "guiding-force",
+        "--wheel-load",
+        "1e300",
+        "--speed",
+        "300",
+        "--out",
+        none_s,
+    ]);
+    assert!(
+        !r.ok
+            && r.stderr
+                .contains("a static wheel load must lie within 1 .. 300 kN"),
+        "{}",
+        r.stderr
+    );
+    // one sample of 1e308: unstable, and the numbers in short form, not 300 digits
+    let spike = dir.path().join("spike.csv");
+    let spiked: String = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 3000 {
+                let t = l.split(',').next().unwrap();
+                format!("{t},1e308,0\n")
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    std::fs::write(&spike, spiked).unwrap();
+    let spike_out = dir.path().join("spike");
+    let r = master(&[
+        "assess",
+        spike.to_str().unwrap(),
+        "--signal",
+        "front",
+        "--speed",
+        "300",
+        "--out",
+        spike_out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let verdict = r.stdout.lines().find(|l| l.starts_with("verdict")).unwrap();
+    assert!(
+        verdict.starts_with("verdict: unstable (max rms ")
+            && verdict.contains("e30")
+            && verdict.len() < 80,
+        "{verdict}"
+    );
     let bad = dir.path().join("bad.csv");
     std::fs::write(&bad, "time,a\n0,1\n0.1,2\n0.3,3\n0.4,x\n").unwrap();
     let r = master(&[

@@ -399,17 +399,17 @@ impl AssessReport {
     pub fn summary(&self) -> String {
         let u = self.unit();
         let mut s = format!(
-            "EN 14363 rms criterion at {:.1} km/h, limit {:.3} {u}\n",
+            "EN 14363 rms criterion at {:.1} km/h, limit {} {u}\n",
             self.speed_kmh,
-            self.limit()
+            fixed(self.limit(), 3)
         );
         for (name, a) in &self.signals {
             s.push_str(&format!(
-                "  {name}: dominant {:.2} Hz, band {:.2}-{:.2} Hz, max rms {:.3} {u} over {} windows: {}\n",
+                "  {name}: dominant {:.2} Hz, band {:.2}-{:.2} Hz, max rms {} {u} over {} windows: {}\n",
                 a.dominant_frequency_hz,
                 a.band_hz.0,
                 a.band_hz.1,
-                a.max_rms,
+                fixed(a.max_rms, 3),
                 a.rms.len(),
                 if a.stable { "within the limit" } else { "LIMIT EXCEEDED" }
             ));
@@ -418,10 +418,10 @@ impl AssessReport {
             s.push_str(&format!("note: {note}\n"));
         }
         s.push_str(&format!(
-            "verdict: {} (max rms {:.3} {u}, {:.0} % of the limit)\n",
+            "verdict: {} (max rms {} {u}, {} % of the limit)\n",
             if self.stable() { "stable" } else { "unstable" },
-            self.max_rms(),
-            100.0 * self.max_rms() / self.limit()
+            fixed(self.max_rms(), 3),
+            fixed(100.0 * self.max_rms() / self.limit(), 0)
         ));
         s
     }
@@ -633,6 +633,16 @@ pub fn assess_table(
         signals: out,
         unitless,
     })
+}
+
+/// `x` with `decimals` decimals, or in scientific notation once it has more than nine digits
+/// before the point (a signal of 1e308 would otherwise print 300 of them).
+fn fixed(x: f64, decimals: usize) -> String {
+    if x.abs() < 1e9 || !x.is_finite() {
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.decimals$e}")
+    }
 }
 
 #[cfg(test)]
