@@ -46,7 +46,11 @@ def _sweep(args: argparse.Namespace) -> int:
     ok = sum(1 for r in res.reports if r["ok"])
     print(f"{ok} of {len(res.reports)} runs ok; see {res.folder / 'sweep.json'}")
     if res.failed:
-        print(f"error: {len(res.failed)} run(s) failed: {', '.join(res.failed)}", file=sys.stderr)
+        # the first ten names: a set of 100 000 failed runs must not print them all on one line
+        names = ", ".join(res.failed[:10])
+        if len(res.failed) > 10:
+            names += f" and {len(res.failed) - 10} more (see sweep.json)"
+        print(f"error: {len(res.failed)} run(s) failed: {names}", file=sys.stderr)
         return 1
     return 0
 
@@ -91,7 +95,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         print(f"error: {e}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
+        print("interrupted: sweep.json lists every run; --resume runs the others", file=sys.stderr)
         return 130
 
 

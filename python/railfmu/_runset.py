@@ -119,9 +119,11 @@ class RunSet:
         * ``progress``: True for a bar, or ``f(done, total, run_name, error_or_None)``.
 
         A set stopped part way (Ctrl-C, an exception of ``progress``) ends as ``master sweep``
-        ends it, then raises: each run not finished is written as a cancelled (failed) run and
-        ``sweep.json`` lists every run, so the folder is whole and ``resume=True`` runs only
-        what is missing.
+        ends it, then raises: no further run starts, a run stopped at a communication point
+        is written as a cancelled (failed) run, a run not started (locally) or not finished
+        (on Dask) has no folder (an earlier set's folder of its name is removed), and
+        ``sweep.json`` lists every run with its outcome, so ``resume=True`` runs only what is
+        missing. A set of 100 000 runs stops at once.
         """
         if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1):
             raise ValueError(f"threads must be a whole number >= 1 (or None: all cores), got {threads!r}")
@@ -191,9 +193,9 @@ class RunSet:
                             )
                     except BaseException:
                         # stopped part way (Ctrl-C, an exception of `progress`, ...): the runners
-                        # end every started set with a folder per run, finished or cancelled, as
-                        # `master sweep` does; sweep.json lists them all, the kept ones too, so
-                        # that the folder is whole and `resume=True` carries on from it
+                        # end every started set with a report per run (finished, cancelled or
+                        # not started), as `master sweep` does; sweep.json lists them all, the
+                        # kept ones too, so that `resume=True` carries on from it
                         if local_runs:
                             new = _reports_of_stopped_set(out, jobs)
                         if all(r is not None for r in new):
@@ -241,8 +243,8 @@ def remove_sweep_report(out: Path) -> None:
 
 def _reports_of_stopped_set(out: Path, jobs_json: List[str]) -> List[Optional[str]]:
     """The reports (JSON) of the local runs of ``jobs_json`` that were stopped part way, as
-    their runner wrote them in ``<out>/sweep.json`` before it raised (every run: finished or
-    cancelled); None for each when it wrote none."""
+    their runner wrote them in ``<out>/sweep.json`` before it raised (every run: finished,
+    cancelled or not started); None for each when it wrote none."""
     names = [json.loads(j)["name"] for j in jobs_json]
     try:
         written = json.loads((out / "sweep.json").read_text(encoding="utf-8"))

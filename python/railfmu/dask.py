@@ -33,7 +33,7 @@ the same run set. A simulation that fails is the run's result (its error is kept
 ``summary.json``), not a task failure; a task whose worker dies is run again by Dask
 (``retries``, and Dask's own rescheduling of a lost worker's tasks). A client that loses its
 scheduler cannot get the other results: the set stops as an interrupted one does (the runs not
-finished are written as cancelled) and raises :class:`SchedulerLostError`; ``resume=True`` on a
+finished are listed as cancelled in sweep.json, without a folder) and raises :class:`SchedulerLostError`; ``resume=True`` on a
 working cluster completes it.
 """
 
@@ -57,8 +57,8 @@ from . import _railfmu
 
 class SchedulerLostError(_railfmu.Error, ConnectionError):
     """The Dask client lost its scheduler during a run set: the runs that had not finished are
-    written as cancelled (the set's folder and sweep.json list every run) and ``resume=True``
-    on a working cluster runs them."""
+    listed as cancelled in sweep.json (which lists every run), without a folder, and
+    ``resume=True`` on a working cluster runs them."""
 
 
 _PREPARED: Dict[str, "_railfmu.PreparedSystem"] = {}
@@ -249,9 +249,9 @@ def run_jobs_on_cluster(
 
     ``reports``, when given, is a list of one entry per job that receives each report as its
     run's folder is written. A set stopped part way (Ctrl-C, an exception of ``on_done``, a
-    client that fails) ends as a local run set does: the remaining tasks are cancelled, the
-    folder of each run not finished is written as a cancelled run, so that every job has its
-    folder and its report in ``reports``, and the exception is raised."""
+    client that fails) ends as a local run set does: the remaining tasks are cancelled, each
+    run not finished gets its report in ``reports`` as cancelled but no folder (an earlier
+    set's folder of its name is removed), and the exception is raised."""
     from distributed import as_completed
 
     from ._runset import remove_sweep_report
@@ -300,7 +300,7 @@ def run_jobs_on_cluster(
             error = f"cancelled: the run set stopped before this run finished ({type(stop).__name__}: {stop})"
         for i, job_json in enumerate(jobs_json):
             if reports[i] is None:
-                reports[i] = writer.write(job_json, error=error)
+                reports[i] = writer.not_finished(job_json, error)
         raise
     else:
         _cancel(futures)

@@ -525,13 +525,22 @@ impl PySystem {
             &cancel,
             move |tx| {
                 let tx = Mutex::new(tx.clone());
-                execute_with(jobs_ref, outdir_ref, threads, false, results_ref, |job| {
-                    let r = run_job(prepared, job, cancel_ref);
-                    if let Ok(tx) = tx.lock() {
-                        let _ = tx.send(Event::Done(job.name.clone(), r.as_ref().err().cloned()));
-                    }
-                    r
-                })
+                execute_with(
+                    jobs_ref,
+                    outdir_ref,
+                    threads,
+                    false,
+                    results_ref,
+                    Some(cancel_ref),
+                    |job| {
+                        let r = run_job(prepared, job, cancel_ref);
+                        if let Ok(tx) = tx.lock() {
+                            let _ =
+                                tx.send(Event::Done(job.name.clone(), r.as_ref().err().cloned()));
+                        }
+                        r
+                    },
+                )
             },
             |py, ev| match (&on_done, ev) {
                 (Some(cb), Event::Done(name, error)) => cb.call1(py, (name, error)).map(|_| ()),
@@ -753,6 +762,13 @@ impl PyRunWriter {
             _ => Err("internal: a run came back with neither results nor an error".to_string()),
         };
         report_json(&self.writer.write(&job, result))
+    }
+
+    /// The report (JSON) of a job whose set stopped before it finished: no folder is written
+    /// for it, an earlier set's folder and table of its name are removed.
+    fn not_finished(&self, job_json: &str, error: &str) -> PyResult<String> {
+        let job: Job = serde_json::from_str(job_json).map_err(|e| json_err("job", &e))?;
+        report_json(&self.writer.not_finished(&job, error))
     }
 }
 

@@ -65,6 +65,12 @@ pub struct RunSetWriter {
 }
 
 impl RunSetWriter {
+    /// The report of a run that did not finish because its set stopped: no folder, and an
+    /// earlier set's folder and table of its name removed (as `master sweep` does).
+    pub fn not_finished(&self, job: &Job, error: &str) -> RunReport {
+        master::runset::not_finished(job, &self.outdir, error)
+    }
+
     pub fn new(outdir: &Path, jobs: &[Job], format: ResultsFormat) -> Self {
         RunSetWriter {
             outdir: outdir.to_path_buf(),

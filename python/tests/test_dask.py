@@ -189,16 +189,17 @@ def test_an_interrupted_set_leaves_a_whole_folder_that_a_resumed_set_completes(d
         return progress
 
     def check(finished, cancelled):
-        # every run has its folder and its report: the finished ones as on the local threads,
-        # the others cancelled
+        # every run has its report: the finished ones with their folders as on the local
+        # threads, the others cancelled without a folder (the earlier set's one removed)
         sweep = json.loads((out / "sweep.json").read_text())
         assert [r["name"] for r in sweep] == rs.names
         assert {r["name"] for r in sweep if r["ok"]} == set(finished)
         for r in sweep:
-            assert json.loads((out / r["name"] / "summary.json").read_text()) == r
-            if not r["ok"]:
-                assert r["error"] == cancelled
-                assert not (out / r["name"] / "results.csv").exists()
+            if r["ok"]:
+                assert json.loads((out / r["name"] / "summary.json").read_text()) == r
+            else:
+                assert r["error"] == cancelled and r["results"] is None
+                assert not (out / r["name"]).exists()
         assert csv_bytes(out) == {n: b for n, b in csv_bytes(tmp_path / "local").items() if n in finished}
         assert not [p for p in out.iterdir() if p.name.startswith(".")]
 

@@ -115,9 +115,14 @@ def test_an_interrupted_resumed_set_lists_every_run(dist, tmp_path):
         sweep = json.loads((out / "sweep.json").read_text())
         assert [r["name"] for r in sweep] == rs.names
         for r in sweep:
-            assert json.loads((out / r["name"] / "summary.json").read_text()) == r
-            assert (out / r["name"] / "results.csv").is_file() == r["ok"]
-            assert r["ok"] or r["error"].startswith("cancelled")
+            if r["ok"] or r["error"].startswith("cancelled"):
+                # finished, or stopped at a communication point: its folder
+                assert json.loads((out / r["name"] / "summary.json").read_text()) == r
+                assert (out / r["name"] / "results.csv").is_file() == r["ok"]
+            else:
+                # not started: no folder
+                assert r["error"] == "not run: the run set was interrupted before this run started"
+                assert not (out / r["name"]).exists()
         return {r["name"] for r in sweep if r["ok"]}
 
     with pytest.raises(KeyboardInterrupt):

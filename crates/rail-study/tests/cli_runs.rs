@@ -270,3 +270,83 @@ fn a_study_checks_its_systems_first_and_holds_its_folder() {
         "the user's"
     );
 }
+
+/// Ctrl-C during a large sweep: no further run starts, so it ends at once; sweep.json lists
+/// every run (the ones not started without a folder), the message is one short line, and
+/// `--resume` runs the others.
+#[test]
+fn an_interrupted_sweep_stops_at_once_and_resumes() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("system.json"), system_json(2.0)).unwrap();
+    let stiffness: Vec<String> = (0..2000).map(|i| format!("{}", 100.0 + i as f64)).collect();
+    std::fs::write(
+        dir.path().join("set.json"),
+        format!(
+            r#"{{"base": "system.json", "product": {{"ms.stiffness": [{}]}}}}"#,
+            stiffness.join(",")
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let sweep = |resume: bool| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_master"));
+        cmd.args(["--quiet", "sweep"])
+            .arg(dir.path().join("set.json"))
+            .arg("-o")
+            .arg(&out)
+            .args(["--jobs", "2", "--format", "csv"])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped());
+        if resume {
+            cmd.arg("--resume");
+        }
+        cmd
+    };
+    let child = sweep(false).spawn().unwrap();
+    let started = std::time::Instant::now();
+    while !out.join("run-000/summary.json").exists() {
+        assert!(started.elapsed().as_secs() < 120, "no run finished");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let st = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let r = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(130), "{stderr}");
+    let last = stderr.lines().last().unwrap_or("");
+    assert!(
+        last.starts_with("error: interrupted: ")
+            && last.contains("not started")
+            && last.len() < 200,
+        "{stderr}"
+    );
+    let reports: Vec<serde_json::Value> =
+        serde_json::from_str(&std::fs::read_to_string(out.join("sweep.json")).unwrap()).unwrap();
+    assert_eq!(reports.len(), 2000);
+    let not_started: Vec<&str> = reports
+        .iter()
+        .filter(|r| {
+            r["error"]
+                == serde_json::json!("not run: the run set was interrupted before this run started")
+        })
+        .map(|r| r["name"].as_str().unwrap())
+        .collect();
+    // a 2 s run takes about 4 ms: far from all had started
+    assert!(
+        not_started.len() > 1000,
+        "{} not started",
+        not_started.len()
+    );
+    assert!(not_started.iter().all(|n| !out.join(n).exists()));
+    let r = sweep(true).output().unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let reports: Vec<serde_json::Value> =
+        serde_json::from_str(&std::fs::read_to_string(out.join("sweep.json")).unwrap()).unwrap();
+    assert!(reports.iter().all(|r| r["ok"] == serde_json::json!(true)));
+    assert!(not_started
+        .iter()
+        .all(|n| out.join(n).join("results.csv").is_file()));
+}

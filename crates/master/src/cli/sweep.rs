@@ -8,7 +8,7 @@ use crate::output::write_json_atomic;
 use crate::results::ResultsFormat;
 use crate::runset::{
     check_jobs, completed, execute_with as run_all, format_by_description, lock_output_folder,
-    prepare_run_folder, run_job, Job, ResultsOptions, RunReport, RunSet,
+    prepare_run_folder, run_job, Job, ResultsOptions, RunReport, RunSet, NOT_STARTED,
 };
 use crate::system::PreparedSystem;
 
@@ -107,6 +107,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             threads,
             ctx.progress,
             &results,
+            Some(cancel),
             |job| run_job(&system, job, cancel),
         )?;
     }
@@ -121,32 +122,60 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         let n_kept = reports.len() - todo.len();
         println!("{n_kept} complete run(s) kept, {} run", todo.len());
     }
+    let not_started = reports
+        .iter()
+        .filter(|r| r.error.as_deref() == Some(NOT_STARTED))
+        .count();
     let failed: Vec<&str> = reports
         .iter()
-        .filter(|r| !r.ok)
+        .filter(|r| !r.ok && r.error.as_deref() != Some(NOT_STARTED))
         .map(|r| r.name.as_str())
         .collect();
     for r in &reports {
         match (&r.summary, &r.error) {
             (Some(s), _) => println!("{}: ok, {s}", r.name),
-            (None, Some(e)) => println!("{}: FAILED: {e}", r.name),
+            (None, Some(e)) if e != NOT_STARTED => println!("{}: FAILED: {e}", r.name),
             _ => {}
         }
     }
+    let ok = reports.len() - failed.len() - not_started;
     println!(
-        "{} of {} runs ok; see {}",
-        reports.len() - failed.len(),
+        "{ok} of {} runs ok{}; see {}",
         reports.len(),
+        if not_started > 0 {
+            format!(", {not_started} not started")
+        } else {
+            String::new()
+        },
         args.output.join("sweep.json").display()
     );
+    if ctx.cancel.load(std::sync::atomic::Ordering::SeqCst) {
+        return Err(CommandError::Failed(format!(
+            "interrupted: {ok} of {} runs ok, {} failed or stopped, {not_started} not started; \
+             `master sweep --resume` runs the others",
+            reports.len(),
+            failed.len()
+        )));
+    }
     if failed.is_empty() {
         Ok(())
     } else {
         Err(CommandError::Failed(format!(
             "{} run(s) failed: {}",
             failed.len(),
-            failed.join(", ")
+            first_names(&failed, 10)
         )))
+    }
+}
+
+/// The first `n` of `names`, and how many more there are (a set of 100 000 failed runs must
+/// not print 100 000 names on one line).
+fn first_names(names: &[&str], n: usize) -> String {
+    let shown = names[..names.len().min(n)].join(", ");
+    if names.len() > n {
+        format!("{shown} and {} more (see sweep.json)", names.len() - n)
+    } else {
+        shown
     }
 }
 

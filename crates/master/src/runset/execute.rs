@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 use serde_json::Value;
@@ -149,17 +149,22 @@ where
         threads,
         show_progress,
         &ResultsOptions::default(),
+        None,
         runner,
     )
 }
 
-/// [`execute`] with results written as `results` says.
+/// [`execute`] with results written as `results` says. Once `cancel` is set no further run
+/// starts: each run not started is reported as [`NOT_STARTED`] without a folder (an earlier
+/// set's folder and table of its name are removed), so that an interrupted set of 100 000
+/// runs ends at once and `sweep.json` still lists every run.
 pub fn execute_with<F>(
     jobs: &[Job],
     outdir: &Path,
     threads: usize,
     show_progress: bool,
     results: &ResultsOptions,
+    cancel: Option<&AtomicBool>,
     runner: F,
 ) -> Result<Vec<RunReport>, SweepError>
 where
@@ -208,6 +213,9 @@ where
     let reports: Vec<RunReport> = pool.install(|| {
         jobs.par_iter()
             .map(|job| {
+                if cancel.is_some_and(|c| c.load(Ordering::SeqCst)) {
+                    return not_finished(job, outdir, NOT_STARTED);
+                }
                 let r = run_one_with(job, outdir, results, &kinds, &runner);
                 bar.inc(1);
                 if !r.ok {
@@ -224,6 +232,31 @@ where
     bar.finish_and_clear();
     write_json_atomic(&report_path, &reports)?;
     Ok(reports)
+}
+
+/// Error of a run that an interrupted run set did not start.
+pub const NOT_STARTED: &str = "not run: the run set was interrupted before this run started";
+
+/// The report of a run that did not finish because its set stopped (`error` says how): no
+/// folder is written for it, and an earlier set's run folder and Parquet table of its name
+/// are removed, so that nothing of an earlier run looks like this one's result.
+pub fn not_finished(job: &Job, outdir: &Path, error: &str) -> RunReport {
+    let dest = outdir.join(&job.name);
+    if is_run_folder(&dest) {
+        let _ = std::fs::remove_dir_all(&dest);
+    }
+    let table = results_path(outdir, &job.name, ResultsFormat::Parquet);
+    if crate::parquet_file::is_run_table(&table) {
+        let _ = std::fs::remove_file(&table);
+    }
+    RunReport {
+        name: job.name.clone(),
+        parameters: job.parameters.clone(),
+        ok: false,
+        error: Some(error.to_string()),
+        summary: None,
+        results: None,
+    }
 }
 
 /// Whether `dir` is a run folder written by a sweep (it holds the run's `system.json` or

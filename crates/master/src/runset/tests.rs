@@ -2,6 +2,7 @@ use super::*;
 use crate::coupling::tests::{two_mass_plan, MassSpring, Mock, SpringDamperMass};
 use crate::coupling::{simulate, Algorithm, RunOptions, SimOutput};
 use crate::results::ResultsFormat;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 const BASE: &str = r#"{
   "instances": [{"name": "ms", "fmu": "MassSpring.fmu"}, {"name": "sdm", "fmu": "SDM.fmu"}],
@@ -104,6 +105,62 @@ fn parallel_execution_keeps_every_result_and_reports_failures() {
     assert_eq!(sweep[2]["ok"], serde_json::json!(false));
 }
 
+/// An interrupted set starts no further run: the runs not started get a report (sweep.json
+/// lists every run) but no folder, and an earlier set's folder or table of their names is
+/// removed, not left looking like this set's result.
+#[test]
+fn an_interrupted_set_starts_no_further_run_and_leaves_no_earlier_result_under_its_names() {
+    let j = jobs(r#"{"product": {"ms.k": [50, 100, 200, 400, 800, 1600]}}"#).unwrap();
+    for format in [ResultsFormat::Csv, ResultsFormat::Parquet] {
+        let dir = tempfile::tempdir().unwrap();
+        let opts = ResultsOptions {
+            format,
+            ..ResultsOptions::default()
+        };
+        let run = |job: &Job| -> Result<SimOutput, String> {
+            let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.01);
+            plan.instances[0].parameters[1].1 = job.parameters["ms.k"].as_f64().unwrap();
+            let mut a = Mock::new("ms", MassSpring::new(1.0, 1.0, 1.0, 0.0));
+            let mut b = Mock::new("sdm", SpringDamperMass::new(1.0, 1.0, 1.0));
+            simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default())
+                .map_err(|e| e.to_string())
+        };
+        // an earlier, complete set of the same names
+        let earlier = execute_with(&j, dir.path(), 1, false, &opts, None, run).unwrap();
+        assert!(earlier.iter().all(|r| r.ok));
+        // this one is interrupted during its second run (one thread: runs in order)
+        let cancel = AtomicBool::new(false);
+        let started = std::sync::atomic::AtomicUsize::new(0);
+        let reports = execute_with(&j, dir.path(), 1, false, &opts, Some(&cancel), |job| {
+            if started.fetch_add(1, Ordering::SeqCst) == 1 {
+                cancel.store(true, Ordering::SeqCst);
+                return Err("cancelled at t = 0.004 s".into());
+            }
+            run(job)
+        })
+        .unwrap();
+        assert_eq!(started.load(Ordering::SeqCst), 2, "{format:?}");
+        assert!(reports[0].ok && !reports[1].ok);
+        let sweep: Vec<RunReport> =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join("sweep.json")).unwrap())
+                .unwrap();
+        assert_eq!(sweep.len(), j.len());
+        for (r, job) in reports.iter().zip(&j).skip(2) {
+            assert_eq!(r.error.as_deref(), Some(NOT_STARTED));
+            assert!(r.results.is_none() && r.summary.is_none());
+            assert!(
+                !dir.path().join(&job.name).exists(),
+                "{format:?} {}",
+                job.name
+            );
+            assert!(!results_path(dir.path(), &job.name, format).exists());
+            assert!(completed(dir.path(), job, format).is_none());
+        }
+        // the stopped run has its folder with its error, as any failed run
+        assert!(dir.path().join(&j[1].name).join("summary.json").is_file());
+    }
+}
+
 #[test]
 fn parquet_results_of_a_set_share_one_folder_and_a_failed_rerun_leaves_none() {
     let j = jobs(r#"{"product": {"ms.k": [50, 100, 200]}}"#).unwrap();
@@ -125,7 +182,7 @@ fn parquet_results_of_a_set_share_one_folder_and_a_failed_rerun_leaves_none() {
         format: ResultsFormat::Parquet,
         ..ResultsOptions::default()
     };
-    let reports = execute_with(&j, dir.path(), 2, false, &opts, runner(None)).unwrap();
+    let reports = execute_with(&j, dir.path(), 2, false, &opts, None, runner(None)).unwrap();
     assert!(reports.iter().all(|r| r.ok));
     let table = dir.path().join(PARQUET_FOLDER);
     let mut files: Vec<String> = std::fs::read_dir(&table)
@@ -157,7 +214,16 @@ fn parquet_results_of_a_set_share_one_folder_and_a_failed_rerun_leaves_none() {
         crate::parquet_file::ColumnData::Numbers(vec![Some(100.0); 51])
     );
     // a rerun in which run-001 fails leaves no stale results of it in the table
-    let reports = execute_with(&j, dir.path(), 2, false, &opts, runner(Some("run-001"))).unwrap();
+    let reports = execute_with(
+        &j,
+        dir.path(),
+        2,
+        false,
+        &opts,
+        None,
+        runner(Some("run-001")),
+    )
+    .unwrap();
     assert!(!reports[1].ok && reports[0].ok);
     assert!(!table.join("run-001.parquet").exists());
     assert!(table.join("run-002.parquet").exists());
@@ -209,7 +275,7 @@ fn resume(j: &[Job], outdir: &Path, format: ResultsFormat) -> Vec<String> {
         format,
         ..ResultsOptions::default()
     };
-    let reports = execute_with(&todo, outdir, 2, false, &opts, |job: &Job| {
+    let reports = execute_with(&todo, outdir, 2, false, &opts, None, |job: &Job| {
         let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.02);
         plan.instances[0].parameters[1].1 = job.parameters["ms.k"].as_f64().unwrap();
         let mut a = Mock::new("ms", MassSpring::new(1.0, 1.0, 1.0, 0.0));

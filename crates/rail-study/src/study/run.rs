@@ -334,6 +334,7 @@ impl Executor<'_> {
             self.opts.threads,
             self.opts.progress,
             &results,
+            Some(cancel),
             runner,
         )?;
         if cancel.load(Ordering::SeqCst) {
