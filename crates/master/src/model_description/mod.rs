@@ -44,6 +44,8 @@ pub enum ModelDescriptionError {
         count: usize,
         line: usize,
     },
+    #[error("ModelStructure/Outputs (line {line}): {reason}")]
+    OutputStructure { line: usize, reason: String },
     #[error("variable name '{name}' is used twice")]
     DuplicateName { name: String },
     #[error("variable '{name}' (line {line}): invalid name: {reason}")]

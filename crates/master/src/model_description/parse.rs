@@ -388,6 +388,35 @@ impl ModelDescription {
                                         Some(v)
                                     }
                                 };
+                                // FMI 2.0 (2.2.8): one kind per dependency, of the five
+                                // kinds; the kinds without the dependencies mean nothing
+                                if let Some(kinds) = e.get("dependenciesKind") {
+                                    let n = kinds.split_whitespace().count();
+                                    if let Some(k) = kinds.split_whitespace().find(|k| {
+                                        !["dependent", "constant", "fixed", "tunable", "discrete"]
+                                            .contains(k)
+                                    }) {
+                                        return Err(e.invalid(
+                                            "dependenciesKind",
+                                            kinds,
+                                            &format!("'{k}' is not one of dependent, constant, fixed, tunable, discrete"),
+                                        ));
+                                    }
+                                    if depends_on.as_ref().map(Vec::len) != Some(n) {
+                                        return Err(e.invalid(
+                                            "dependenciesKind",
+                                            kinds,
+                                            &format!(
+                                                "{n} kind(s) for {} dependencies",
+                                                depends_on
+                                                    .as_ref()
+                                                    .map_or("absent".to_string(), |d| d
+                                                        .len()
+                                                        .to_string())
+                                            ),
+                                        ));
+                                    }
+                                }
                                 md.outputs.push(OutputDependency {
                                     output: index - 1,
                                     depends_on,
@@ -452,6 +481,15 @@ impl ModelDescription {
                 .copied()
                 .unwrap_or_default();
             let (min, max) = (p.min.or(type_min), p.max.or(type_max));
+            if let (Some(lo), Some(hi)) = (min, max) {
+                if lo > hi {
+                    return Err(ModelDescriptionError::InvalidVariable {
+                        name: p.name.clone(),
+                        line: p.line,
+                        reason: format!("min {lo} is greater than max {hi}"),
+                    });
+                }
+            }
             if !seen.insert(p.name.clone()) {
                 return Err(ModelDescriptionError::DuplicateName { name: p.name });
             }
@@ -506,7 +544,7 @@ impl ModelDescription {
             .collect();
         rules::check_aliases(&views)?;
         let count = md.variables.len();
-        for (o, line) in md.outputs.iter().zip(output_lines) {
+        for (o, &line) in md.outputs.iter().zip(&output_lines) {
             let bad = std::iter::once(o.output)
                 .chain(o.depends_on.iter().flatten().copied())
                 .find(|&i| i >= count);
@@ -518,6 +556,66 @@ impl ModelDescription {
                 });
             }
         }
+        check_output_structure(&md, &output_lines, &lines_of_vars)?;
         Ok(md)
     }
+}
+
+/// FMI 2.0 (2.2.8): ModelStructure/Outputs lists every variable of causality output exactly
+/// once and nothing else, and an output depends only on knowns: inputs, states (locals) and
+/// the independent variable, not on a parameter, another output or itself. (The indices are
+/// checked to be in range before.)
+fn check_output_structure(
+    md: &ModelDescription,
+    lines: &[usize],
+    variable_lines: &[usize],
+) -> Result<(), ModelDescriptionError> {
+    let mut listed = vec![false; md.variables.len()];
+    for (o, &line) in md.outputs.iter().zip(lines) {
+        let fail = |reason: String| Err(ModelDescriptionError::OutputStructure { line, reason });
+        let v = &md.variables[o.output];
+        if v.causality != Causality::Output {
+            return fail(format!(
+                "index {} is '{}', whose causality is {}, not output",
+                o.output + 1,
+                v.name,
+                v.causality
+            ));
+        }
+        if std::mem::replace(&mut listed[o.output], true) {
+            return fail(format!("output '{}' is listed twice", v.name));
+        }
+        for &d in o.depends_on.iter().flatten() {
+            let known = &md.variables[d];
+            if !matches!(
+                known.causality,
+                Causality::Input | Causality::Local | Causality::Independent
+            ) {
+                let what = if d == o.output {
+                    "itself".to_string()
+                } else {
+                    format!(
+                        "'{}', a variable of causality {}",
+                        known.name, known.causality
+                    )
+                };
+                return fail(format!(
+                    "output '{}' depends on {what} (index {}); an output depends on inputs, \
+                     states and the independent variable only",
+                    v.name,
+                    d + 1
+                ));
+            }
+        }
+    }
+    for ((v, &l), &line) in md.variables.iter().zip(&listed).zip(variable_lines) {
+        if v.causality == Causality::Output && !l {
+            return Err(ModelDescriptionError::InvalidVariable {
+                name: v.name.clone(),
+                line,
+                reason: "an output not listed in ModelStructure/Outputs".into(),
+            });
+        }
+    }
+    Ok(())
 }

@@ -117,6 +117,84 @@ fn errors_name_line_and_attribute() {
     ));
 }
 
+/// FMI 2.0 (2.2.8) on ModelStructure/Outputs and declared ranges, as fmpy validate checks
+/// them: each was accepted before and is refused with the line and the cause.
+#[test]
+fn output_structure_and_ranges_follow_the_standard() {
+    let refused = |from: &str, to: &str| {
+        assert!(MASS_SPRING.contains(from), "{from}");
+        ModelDescription::parse(&MASS_SPRING.replace(from, to))
+            .unwrap_err()
+            .to_string()
+    };
+    let outputs = r#"<Unknown index="6" dependencies=""/>"#;
+    for (to, expected) in [
+        // a parameter listed as an output
+        (
+            r#"<Unknown index="6" dependencies=""/><Unknown index="2"/>"#,
+            "index 2 is 'k', whose causality is parameter, not output",
+        ),
+        // listed twice
+        (
+            r#"<Unknown index="6" dependencies=""/><Unknown index="6"/>"#,
+            "output 'velocity' is listed twice",
+        ),
+        // depending on itself, on a parameter
+        (
+            r#"<Unknown index="6" dependencies="6"/>"#,
+            "output 'velocity' depends on itself (index 6)",
+        ),
+        (
+            r#"<Unknown index="6" dependencies="1"/>"#,
+            "depends on 'm', a variable of causality parameter (index 1)",
+        ),
+        // kinds without dependencies, more kinds than dependencies, an unknown kind
+        (
+            r#"<Unknown index="6" dependenciesKind="dependent"/>"#,
+            "1 kind(s) for absent dependencies",
+        ),
+        (
+            r#"<Unknown index="6" dependencies="4" dependenciesKind="dependent fixed"/>"#,
+            "2 kind(s) for 1 dependencies",
+        ),
+        (
+            r#"<Unknown index="6" dependencies="4" dependenciesKind="linear"/>"#,
+            "'linear' is not one of dependent",
+        ),
+        // an output not listed
+        (
+            "",
+            "variable 'velocity' (line 15): an output not listed in ModelStructure/Outputs",
+        ),
+    ] {
+        let e = refused(outputs, to);
+        assert!(e.contains(expected), "{to}: {e}");
+    }
+    // an input, a state and kinds matching the dependencies are fine
+    let xml = MASS_SPRING.replace(
+        outputs,
+        r#"<Unknown index="6" dependencies="4 7" dependenciesKind="dependent fixed"/>"#,
+    );
+    ModelDescription::parse(&xml).unwrap();
+    // min above max, also through a declared type
+    let e = refused(
+        r#"<Real start="100" unit="N/m"/>"#,
+        r#"<Real start="100" unit="N/m" min="10" max="1"/>"#,
+    );
+    assert!(
+        e.contains("variable 'k' (line 11): min 10 is greater than max 1"),
+        "{e}"
+    );
+    let e = refused(
+        r#"<Real quantity="Length" unit="m"/>"#,
+        r#"<Real quantity="Length" unit="m" min="1" max="0"/>"#,
+    );
+    assert!(
+        e.contains("variable 'position' (line 14): min 1 is greater than max 0"),
+        "{e}"
+    );
+}
+
 #[test]
 fn suggestions() {
     let md = ModelDescription::parse(MASS_SPRING).unwrap();
@@ -137,7 +215,15 @@ fn with_m(attrs: &str, real: &str) -> String {
 #[test]
 fn fmi2_causality_variability_initial_table() {
     let ok = |attrs: &str, real: &str| {
-        ModelDescription::parse(&with_m(attrs, real)).map_err(|e| e.to_string())
+        let mut xml = with_m(attrs, real);
+        if attrs.contains("\"output\"") {
+            // an output is listed in ModelStructure/Outputs
+            xml = xml.replace(
+                "<Outputs>",
+                "<Outputs><Unknown index=\"1\" dependencies=\"\"/>",
+            );
+        }
+        ModelDescription::parse(&xml).map_err(|e| e.to_string())
     };
     // allowed, each with the start value its case needs or forbids
     for (attrs, real) in [
