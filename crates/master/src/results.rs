@@ -276,7 +276,12 @@ pub fn read_metadata(path: &Path) -> Result<Option<ResultsMetadata>, ReadError> 
         }
         _ => {
             let meta = csv_metadata_path(path);
-            if !meta.is_file() {
+            // no file of that name: a host's export without metadata; anything else of that
+            // name (a FIFO, a folder, a dangling link) is refused below, not taken as none
+            if meta
+                .symlink_metadata()
+                .is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound)
+            {
                 return Ok(None);
             }
             let text = crate::input::read_text_file(&meta, crate::input::MAX_TEXT_FILE_BYTES)
@@ -307,5 +312,27 @@ mod tests {
         }
         assert_eq!(ResultsFormat::from_name("CSV"), None);
         assert_eq!(ResultsFormat::from_name("pq"), None);
+    }
+
+    /// A CSV without metadata file has none; a metadata name taken by something other than a
+    /// file (a folder, a FIFO, a dangling link) is an error, not "no metadata" (which would
+    /// assess a signal without its recorded pass band).
+    #[test]
+    fn metadata_beside_a_csv_is_a_file_or_absent() {
+        let dir = tempfile::tempdir().unwrap();
+        let csv = dir.path().join("r.csv");
+        std::fs::write(&csv, "time [s],x\n0,1\n").unwrap();
+        assert!(super::read_metadata(&csv).unwrap().is_none());
+        let meta = dir.path().join("r.meta.json");
+        std::fs::create_dir(&meta).unwrap();
+        assert!(super::read_metadata(&csv).is_err());
+        std::fs::remove_dir(&meta).unwrap();
+        std::os::unix::fs::symlink(dir.path().join("gone"), &meta).unwrap();
+        assert!(super::read_metadata(&csv).is_err());
+        std::fs::remove_file(&meta).unwrap();
+        let status = std::process::Command::new("mkfifo").arg(&meta).status().unwrap();
+        assert!(status.success());
+        let e = super::read_metadata(&csv).unwrap_err().to_string();
+        assert!(e.contains("r.meta.json"), "{e}");
     }
 }
