@@ -121,14 +121,29 @@ class Results:
         return self.values[:, 0]
 
     def __len__(self) -> int:
+        """The number of rows (communication points), as ``len`` of a DataFrame."""
         return self.values.shape[0]
+
+    def __iter__(self) -> Iterator[str]:
+        """The column names, ``time`` first, as iterating a DataFrame gives its columns:
+        ``for name in results: results[name]``."""
+        return iter(self.names)
+
+    def keys(self) -> List[str]:
+        """The column names, ``time`` first."""
+        return list(self.names)
 
     def __contains__(self, name: object) -> bool:
         return name in self.units or name in self.header
 
     def __getitem__(self, name: str) -> np.ndarray:
         """A column by name (``bogie.x``) or by its header label (``bogie.x [m]``): numbers,
-        or the texts of a text column."""
+        or the texts of a text column. Rows are ``values[i]`` or ``to_pandas().iloc[i]``."""
+        if not isinstance(name, str):
+            raise TypeError(
+                f"a column is taken by its name (one of {', '.join(self.names[:4])}, ...), not by "
+                f"{type(name).__name__} {name!r}; rows: results.values[i] or results.to_pandas().iloc[i]"
+            )
         for i, (n, h) in enumerate(zip(self.names, self.header)):
             if name == n or name == h:
                 return self.texts[n] if n in self.texts else self.values[:, i]

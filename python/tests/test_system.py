@@ -79,6 +79,11 @@ def test_results_carry_units_into_pandas_and_numpy(passive_file):
     assert arr.dtype.names[0] == "time"
     assert arr.dtype["damper_left.damper.force"].metadata == {"unit": "N"}
     assert np.array_equal(arr["time"], res.time)
+    # a mapping of columns, as a DataFrame: iterating gives the names, len the rows
+    assert list(res) == res.names == res.keys() and len(res) == 201
+    assert all(np.array_equal(res[n], res.values[:, i]) for i, n in enumerate(res))
+    with pytest.raises(TypeError, match=r"rows: results.values\[i\]"):
+        res[0]
 
 
 def test_progress_and_the_gil_released_during_a_run(passive_file):
