@@ -173,9 +173,18 @@ def format_task(base_json: str, label: str, jobs_json: List[str]) -> str:
         return "csv"
 
 
-def run_task(base_json: str, label: str, job_json: str, fmus: Optional[Dict[str, Tuple[str, str, bytes]]] = None) -> Dict[str, Any]:
+def run_task(
+    base_json: str,
+    label: str,
+    job_json: str,
+    fmus: Optional[Dict[str, Tuple[str, str, bytes]]] = None,
+    stop_event: Optional[str] = None,
+) -> Dict[str, Any]:
     """The task a worker runs: one job of a run set. ``fmus`` maps each FMU path of the
-    description to (SHA-256, file name, bytes) when the FMUs are shipped. Returns the run's
+    description to (SHA-256, file name, bytes) when the FMUs are shipped. ``stop_event``: the
+    name of the set's ``distributed.Event``, which the client sets when the set stops (Ctrl-C):
+    a run still going then stops at its next communication point, instead of running to its end
+    for nobody (a cancelled future does not stop a task already running). Returns the run's
     ``header``, ``data`` (float64 bytes), ``summary_json`` and ``columns_json`` (the columns'
     units and FMU variables), or its ``error``."""
     if fmus:
@@ -184,8 +193,24 @@ def run_task(base_json: str, label: str, job_json: str, fmus: Optional[Dict[str,
         job = json.loads(job_json)
         job["system"] = _localise(job["system"], paths)
         job_json = json.dumps(job)
-    header, data, summary_json, columns_json, error = _prepared(base_json, label).run_job(job_json)
+    should_stop = _stop_check(stop_event) if stop_event is not None else None
+    header, data, summary_json, columns_json, error = _prepared(base_json, label).run_job(job_json, should_stop)
     return {"header": header, "data": data, "summary_json": summary_json, "columns_json": columns_json, "error": error}
+
+
+def _stop_check(name: str) -> Any:
+    """``f()`` -> whether the set's stop event is set (asked of the scheduler; the run polls it
+    about once a second, so a short run never asks)."""
+    from distributed import Event, get_client
+
+    state: Dict[str, Any] = {}
+
+    def stopped() -> bool:
+        if "event" not in state:
+            state["event"] = Event(name, client=get_client())
+        return bool(state["event"].is_set())
+
+    return stopped
 
 
 def _read_fmus(base_json: str) -> Dict[str, Tuple[str, str, bytes]]:
@@ -265,13 +290,22 @@ def run_jobs_on_cluster(
     # keys unique per submission: a key resubmitted while the scheduler still releases it from
     # an earlier set would be cancelled
     token = uuid.uuid4().hex[:16]
+    stop_event = f"railfmu-stop-{token}"
     futures = {}
     remove_sweep_report(Path(outdir))
     try:
         for i, job_json in enumerate(jobs_json):
             name = json.loads(job_json)["name"]
             fut = client.submit(
-                run_task, base_json, label, job_json, fmus_arg, key=f"railfmu-{name}-{token}", retries=retries, pure=False
+                run_task,
+                base_json,
+                label,
+                job_json,
+                fmus_arg,
+                stop_event,
+                key=f"railfmu-{name}-{token}",
+                retries=retries,
+                pure=False,
             )
             futures[fut] = (i, name, job_json)
         for fut in as_completed(list(futures)):
@@ -293,6 +327,8 @@ def run_jobs_on_cluster(
             reports[i] = report
             on_done(name, error)
     except BaseException as stop:
+        if not isinstance(stop, SchedulerLostError):
+            _stop_running_tasks(client, stop_event)
         _cancel(futures)
         if isinstance(stop, KeyboardInterrupt):
             error = "cancelled: the run set was interrupted before this run finished"
@@ -318,6 +354,18 @@ def _scheduler_lost(client: Any, e: BaseException) -> bool:
         return True
     # reconnecting, or closed meanwhile
     return getattr(client, "status", "running") != "running"
+
+
+def _stop_running_tasks(client: Any, name: str) -> None:
+    """Sets the set's stop event, which the runs still going poll (a cancelled future stops a
+    task only before it starts). Best effort: a client that cannot reach its scheduler has no
+    running tasks to stop."""
+    from distributed import Event
+
+    try:
+        Event(name, client=client).set()
+    except Exception:
+        pass
 
 
 def _cancel(futures: Any) -> None:

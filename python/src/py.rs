@@ -177,8 +177,25 @@ fn in_background<'s, T: Send>(
     py: Python<'_>,
     cancel: &'s AtomicBool,
     work: impl FnOnce(&Sender<Event>) -> T + Send + 's,
-    mut on_event: impl FnMut(Python<'_>, Event) -> PyResult<()>,
+    on_event: impl FnMut(Python<'_>, Event) -> PyResult<()>,
 ) -> PyResult<T> {
+    in_background_polling(py, cancel, work, on_event, None)
+}
+
+/// How often [`in_background_polling`] asks its `should_stop` (a Dask task asks its
+/// scheduler, one round trip per call).
+const STOP_POLL: Duration = Duration::from_secs(1);
+
+/// [`in_background`], also setting `cancel` once `should_stop()` (called every
+/// [`STOP_POLL`]) returns True; its exceptions are ignored.
+fn in_background_polling<'s, T: Send>(
+    py: Python<'_>,
+    cancel: &'s AtomicBool,
+    work: impl FnOnce(&Sender<Event>) -> T + Send + 's,
+    mut on_event: impl FnMut(Python<'_>, Event) -> PyResult<()>,
+    should_stop: Option<&Py<PyAny>>,
+) -> PyResult<T> {
+    let mut last_poll = std::time::Instant::now();
     let (tx, rx) = mpsc::channel::<Event>();
     let rx = Mutex::new(rx);
     std::thread::scope(|s| {
@@ -206,6 +223,13 @@ fn in_background<'s, T: Send>(
                 if let Err(e) = py.check_signals() {
                     cancel.store(true, Ordering::SeqCst);
                     failure = Some(e);
+                }
+            }
+            if let Some(f) = should_stop.filter(|_| last_poll.elapsed() >= STOP_POLL) {
+                last_poll = std::time::Instant::now();
+                let stop = f.call0(py).and_then(|r| r.is_truthy(py)).unwrap_or(false);
+                if stop {
+                    cancel.store(true, Ordering::SeqCst);
                 }
             }
         }
@@ -450,11 +474,17 @@ impl PySystem {
     /// Runs one job of this system's run set (JSON, as from `load_run_set`), as a run set's
     /// worker does; returns (header, data bytes, summary JSON, columns JSON, None) or (None,
     /// None, None, None, error): a failed simulation is the run's result, not an exception.
+    /// `should_stop()`, when given, is called about once a second while the run goes on; once
+    /// it returns True the run stops at its next communication point (a cancelled run, an
+    /// error). An exception of it is taken as False: a check that cannot be made stops
+    /// nothing.
     #[allow(clippy::type_complexity)]
+    #[pyo3(signature = (job_json, should_stop=None))]
     fn run_job<'py>(
         &self,
         py: Python<'py>,
         job_json: &str,
+        should_stop: Option<Py<PyAny>>,
     ) -> PyResult<(
         Option<Vec<String>>,
         Option<Bound<'py, PyBytes>>,
@@ -467,11 +497,12 @@ impl PySystem {
         let prepared = &self.prepared;
         let cancel_ref = &cancel;
         let job_ref = &job;
-        let out = in_background(
+        let out = in_background_polling(
             py,
             &cancel,
             move |_| run_job(prepared, job_ref, cancel_ref),
             |_, _| Ok(()),
+            should_stop.as_ref(),
         )?;
         match out {
             Ok(out) => {

@@ -12,7 +12,9 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
+import _thread
 from pathlib import Path
 
 import numpy as np
@@ -221,6 +223,35 @@ def test_an_interrupted_set_leaves_a_whole_folder_that_a_resumed_set_completes(d
     assert sorted(n for n in ran if n) == sorted(set(rs.names) - set(first + second))
     assert again.ok and csv_bytes(out) == csv_bytes(tmp_path / "local")
     assert [r["name"] for r in json.loads((out / "sweep.json").read_text()) if r["ok"]] == rs.names
+
+
+def test_an_interrupted_set_stops_the_runs_under_way_on_the_workers(dist, client, tmp_path):
+    """A cancelled future stops a task only before it starts: the runs already going on the
+    workers are stopped through the set's stop event (they ran to their end before, minutes for
+    long runs). Measured by the workers' CPU time once the set has raised."""
+    d = speed_set(dist, [60.0, 70.0], stop_time=6000.0)  # about 10 s of work each, uninterrupted
+    d["system"]["record"] = ["bogie.wheelset_front.lateral_displacement_relative"]
+    rs = railfmu.RunSet.from_dict(d)
+
+    def cpu_seconds():
+        return sum(client.run(time.process_time).values())
+
+    timer = threading.Timer(2.0, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            rs.run(tmp_path / "out", client=client)
+    finally:
+        timer.cancel()
+    sweep = json.loads((tmp_path / "out" / "sweep.json").read_text())
+    assert [r["ok"] for r in sweep] == [False, False]
+    # each run polls the event about once a second, then stops at its next step; without the
+    # event both workers stay busy for another 8 s
+    time.sleep(2.0)
+    before = cpu_seconds()
+    time.sleep(2.0)
+    busy = cpu_seconds() - before
+    assert busy < 1.0, f"the workers used {busy:.1f} s of CPU in 2 s, 2 s after the set stopped"
 
 
 def test_a_client_that_loses_its_scheduler_stops_the_set_as_an_interrupted_one(dist, client, tmp_path):

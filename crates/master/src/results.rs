@@ -330,7 +330,10 @@ mod tests {
         std::os::unix::fs::symlink(dir.path().join("gone"), &meta).unwrap();
         assert!(super::read_metadata(&csv).is_err());
         std::fs::remove_file(&meta).unwrap();
-        let status = std::process::Command::new("mkfifo").arg(&meta).status().unwrap();
+        let status = std::process::Command::new("mkfifo")
+            .arg(&meta)
+            .status()
+            .unwrap();
         assert!(status.success());
         let e = super::read_metadata(&csv).unwrap_err().to_string();
         assert!(e.contains("r.meta.json"), "{e}");
