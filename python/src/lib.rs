@@ -40,6 +40,21 @@ pub fn f64_bytes(data: &[f64]) -> Vec<u8> {
     data.iter().flat_map(|x| x.to_ne_bytes()).collect()
 }
 
+/// [`f64_bytes`] written straight into a Python `bytes` object (no intermediate copy: the
+/// results of a long run are held once in Rust and once in Python, not three times).
+#[cfg(feature = "python")]
+pub fn f64_pybytes<'py>(
+    py: pyo3::Python<'py>,
+    data: &[f64],
+) -> pyo3::PyResult<pyo3::Bound<'py, pyo3::types::PyBytes>> {
+    pyo3::types::PyBytes::new_with(py, data.len() * 8, |buf| {
+        for (chunk, x) in buf.chunks_exact_mut(8).zip(data) {
+            chunk.copy_from_slice(&x.to_ne_bytes());
+        }
+        Ok(())
+    })
+}
+
 /// The inverse of [`f64_bytes`]; `Err` when the length is not a multiple of 8.
 pub fn f64_from_bytes(bytes: &[u8]) -> Result<Vec<f64>, String> {
     if !bytes.len().is_multiple_of(8) {

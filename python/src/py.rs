@@ -29,7 +29,7 @@ use master::slave::ScalarType;
 use master::system::{LoadedSystem, PreparedSystem, RunError, SystemError};
 
 use crate::assess::{self, AssessOptions};
-use crate::{error_message, f64_bytes, f64_from_bytes, results, runs};
+use crate::{error_message, f64_from_bytes, f64_pybytes, results, runs};
 
 pyo3::create_exception!(
     _railfmu,
@@ -252,15 +252,16 @@ type Table<'py> = (
     String,
 );
 
-fn table<'py>(py: Python<'py>, out: &SimOutput, ctx: &RunContext) -> PyResult<Table<'py>> {
+fn table<'py>(py: Python<'py>, out: SimOutput, ctx: &RunContext) -> PyResult<Table<'py>> {
     let summary = serde_json::to_string(&out.summary)
         .map_err(|e| Error::new_err(format!("internal: summary: {e}")))?;
-    let meta = serde_json::to_string(&ResultsMetadata::of(out, ctx))
+    let meta = serde_json::to_string(&ResultsMetadata::of(&out, ctx))
         .map_err(|e| Error::new_err(format!("internal: metadata: {e}")))?;
-    let t = results::expand(out);
+    // the output is consumed: its values are held once here, then once in Python
+    let t = results::expand_owned(out);
     Ok((
         t.header,
-        PyBytes::new(py, &f64_bytes(&t.data)),
+        f64_pybytes(py, &t.data)?,
         t.texts,
         summary,
         meta,
@@ -468,7 +469,7 @@ impl PySystem {
             system: Some(self.run_description(&params, stop_time)?),
             ..RunContext::default()
         };
-        table(py, &out, &ctx)
+        table(py, out, &ctx)
     }
 
     /// Runs one job of this system's run set (JSON, as from `load_run_set`), as a run set's
@@ -510,7 +511,7 @@ impl PySystem {
                     .map_err(|e| Error::new_err(format!("internal: summary: {e}")))?;
                 let c = serde_json::to_string(&runs::ColumnsWire::of(&out))
                     .map_err(|e| Error::new_err(format!("internal: columns: {e}")))?;
-                let d = PyBytes::new(py, &f64_bytes(&out.data));
+                let d = f64_pybytes(py, &out.data)?;
                 Ok((Some(out.header), Some(d), Some(summary), Some(c), None))
             }
             Err(e) => Ok((None, None, None, None, Some(e))),
@@ -824,7 +825,7 @@ fn read_results<'py>(py: Python<'py>, path: PathBuf) -> PyResult<ReadTable<'py>>
         .map_err(|e| Error::new_err(format!("internal: metadata: {e}")))?;
     Ok((
         t.header,
-        PyBytes::new(py, &f64_bytes(&t.data)),
+        f64_pybytes(py, &t.data)?,
         t.texts,
         meta,
     ))

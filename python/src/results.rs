@@ -31,6 +31,28 @@ pub fn item_label(label: &str) -> String {
     format!("{label} (item)")
 }
 
+/// [`expand`], taking the output: a table of numbers only (no String or Enumeration column)
+/// keeps the output's values instead of copying them, so that a long run's results are held
+/// once, not twice, on their way to Python.
+pub fn expand_owned(out: SimOutput) -> Table {
+    let numbers_only = (0..out.header.len()).all(|c| {
+        !matches!(
+            out.column_info(c).scalar_type(),
+            ScalarType::String | ScalarType::Enumeration
+        )
+    });
+    if numbers_only {
+        let header = results_header(&out);
+        Table {
+            header,
+            data: out.data,
+            texts: Vec::new(),
+        }
+    } else {
+        expand(&out)
+    }
+}
+
 /// The table of a run's output with the columns the master's files have: a String column as
 /// its texts, an Enumeration as its integer followed by its item names.
 pub fn expand(out: &SimOutput) -> Table {
