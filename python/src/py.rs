@@ -259,13 +259,7 @@ fn table<'py>(py: Python<'py>, out: SimOutput, ctx: &RunContext) -> PyResult<Tab
         .map_err(|e| Error::new_err(format!("internal: metadata: {e}")))?;
     // the output is consumed: its values are held once here, then once in Python
     let t = results::expand_owned(out);
-    Ok((
-        t.header,
-        f64_pybytes(py, &t.data)?,
-        t.texts,
-        summary,
-        meta,
-    ))
+    Ok((t.header, f64_pybytes(py, &t.data)?, t.texts, summary, meta))
 }
 
 /// A system description with its FMUs opened, checked, unpacked and loaded once, and its
@@ -823,12 +817,7 @@ fn read_results<'py>(py: Python<'py>, path: PathBuf) -> PyResult<ReadTable<'py>>
         .map(|m| serde_json::to_string(&m))
         .transpose()
         .map_err(|e| Error::new_err(format!("internal: metadata: {e}")))?;
-    Ok((
-        t.header,
-        f64_pybytes(py, &t.data)?,
-        t.texts,
-        meta,
-    ))
+    Ok((t.header, f64_pybytes(py, &t.data)?, t.texts, meta))
 }
 
 /// Writes results as `master run` does, atomically: the CSV and its metadata file beside it

@@ -304,7 +304,7 @@ fn an_interrupted_sweep_stops_at_once_and_resumes() {
     };
     let child = sweep(false).spawn().unwrap();
     let started = std::time::Instant::now();
-    while !out.join("run-000/summary.json").exists() {
+    while !out.join("run-0000/summary.json").exists() {
         assert!(started.elapsed().as_secs() < 120, "no run finished");
         std::thread::sleep(std::time::Duration::from_millis(20));
     }

@@ -282,6 +282,8 @@ impl RunSet {
         // folder name (lower case: also distinct on case-insensitive file systems) -> run
         let mut folders: std::collections::HashMap<String, String> =
             std::collections::HashMap::new();
+        // run-000 .. run-999, run-0000 .. run-9999 for more: the names sort as the runs do
+        let width = sets.len().saturating_sub(1).to_string().len().max(3);
         for (n, (name, params, field)) in sets.into_iter().enumerate() {
             let mut sys = resolved.clone();
             for (key, value) in &params {
@@ -297,7 +299,7 @@ impl RunSet {
                 };
                 return Err(invalid(file, format!("{field}.{}", text(key)), reason));
             }
-            let given = name.unwrap_or_else(|| format!("run-{n:03}"));
+            let given = name.unwrap_or_else(|| format!("run-{n:0width$}"));
             let name = run_folder_name(&given).map_err(|r| invalid(file, field.clone(), r))?;
             if let Some(other) = folders.insert(name.to_ascii_lowercase(), given.clone()) {
                 let reason = if other == given {

@@ -33,6 +33,21 @@ fn product_and_list_expand() {
         ks,
         ["1true", "1false", "2true", "2false", "3true", "3false"]
     );
+    // more than 1000 runs: the names widen so that they sort as the runs do
+    let values: Vec<String> = (0..1001).map(|i| i.to_string()).collect();
+    let many = jobs(&format!(
+        r#"{{"product": {{"ms.k": [{}]}}}}"#,
+        values.join(",")
+    ))
+    .unwrap();
+    assert_eq!(
+        [
+            many[0].name.as_str(),
+            many[999].name.as_str(),
+            many[1000].name.as_str()
+        ],
+        ["run-0000", "run-0999", "run-1000"]
+    );
     assert_eq!(
         j[3].system.instances[0].parameters["k"],
         serde_json::json!(2)
