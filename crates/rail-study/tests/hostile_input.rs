@@ -462,6 +462,57 @@ fn archive_limits_and_unsafe_entries_are_refused_before_extraction() {
     assert!(c.extraction_folders().is_empty());
 }
 
+/// The FMUs inside an SSP unpack within the FMU limit, checked before a byte is written: a
+/// small archive wrote its declared gigabytes to the temporary folder and was refused only
+/// after (a limit of 4 GiB per entry, MASTER_FMU_MAX_UNPACKED_BYTES ignored).
+#[test]
+fn an_ssps_fmus_unpack_within_the_fmu_limit() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    let out = c.master(&["export-ssp", "system.json", "ok.ssp"], &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = c.master(&["run", "ok.ssp", "-o", "ok.csv"], &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // the same archive with its FMU replaced by 8 MB of zeros (a few kB compressed)
+    let mut src = zip::ZipArchive::new(std::fs::File::open(c.path("ok.ssp")).unwrap()).unwrap();
+    let mut entries: Vec<(String, Vec<u8>)> = Vec::new();
+    for i in 0..src.len() {
+        let mut e = src.by_index(i).unwrap();
+        let mut data = Vec::new();
+        std::io::Read::read_to_end(&mut e, &mut data).unwrap();
+        if e.name().ends_with(".fmu") {
+            data = vec![0u8; 8 << 20];
+        }
+        entries.push((e.name().to_string(), data));
+    }
+    let mut z = zip::ZipWriter::new(std::fs::File::create(c.path("bomb.ssp")).unwrap());
+    let o = zip::write::SimpleFileOptions::default();
+    for (name, data) in &entries {
+        z.start_file(name.as_str(), o).unwrap();
+        z.write_all(data).unwrap();
+    }
+    z.finish().unwrap();
+    assert!(std::fs::metadata(c.path("bomb.ssp")).unwrap().len() < 200_000);
+    let e = c.fails(
+        &["run", "bomb.ssp", "-o", "bomb.csv"],
+        &[("MASTER_FMU_MAX_UNPACKED_BYTES", "4000000")],
+    );
+    assert!(
+        e.contains("declares 8388608 bytes, more than the 4000000 bytes left")
+            && e.contains("MASTER_FMU_MAX_UNPACKED_BYTES"),
+        "{e}"
+    );
+    assert!(!c.path("bomb.csv").exists());
+}
+
 #[test]
 fn extraction_folders_of_a_killed_master_are_removed_by_the_next_one() {
     let c = Case::new();

@@ -9,13 +9,16 @@ use super::SspError;
 
 /// Largest .ssd/.ssv/.ssm read (a parameter set of a large model is a few MB).
 const MAX_XML_BYTES: u64 = 64 << 20;
-/// Largest FMU unpacked from a .ssp.
-const MAX_FMU_BYTES: u64 = 4 << 30;
 
 pub(super) enum Package {
     Zip {
         path: PathBuf,
         zip: Box<zip::ZipArchive<std::fs::File>>,
+        /// Bytes the FMUs unpacked from the archive may take together: the unpacked-size limit
+        /// of an FMU (`MASTER_FMU_MAX_UNPACKED_BYTES`), for the archive as a whole.
+        budget: u64,
+        /// The FMUs unpacked so far, by reference: components of one FMU share its file.
+        unpacked: Vec<(String, PathBuf)>,
     },
     Dir {
         ssd: PathBuf,
@@ -55,6 +58,8 @@ impl Package {
                 Ok(Package::Zip {
                     path: path.to_path_buf(),
                     zip: Box::new(zip),
+                    budget: limits.max_unpacked_bytes,
+                    unpacked: Vec::new(),
                 })
             }
             Some("ssd") => {
@@ -112,7 +117,7 @@ impl Package {
     /// Reads the XML file at the normalised reference `rel`.
     pub fn read_text(&mut self, rel: &str) -> Result<String, SspError> {
         match self {
-            Package::Zip { path, zip } => {
+            Package::Zip { path, zip, .. } => {
                 let label = format!("{}:{rel}", path.display());
                 let entry = zip.by_name(rel).map_err(|_| SspError::Read {
                     path: PathBuf::from(&label),
@@ -142,15 +147,36 @@ impl Package {
     }
 
     /// The FMU at reference `rel` as a file: unpacked into `dest` (a fresh folder) from a zip,
-    /// the file itself next to a bare .ssd.
+    /// once for all components that use it, the file itself next to a bare .ssd. The FMUs of
+    /// an archive unpack within one budget, checked against each entry's declared size before
+    /// a byte is written and against what it really gives (a small archive must not fill the
+    /// disk first and be refused after).
     pub fn fmu_file(&mut self, rel: &str, dest: &Path, index: usize) -> Result<PathBuf, SspError> {
         match self {
-            Package::Zip { path, zip } => {
+            Package::Zip {
+                path,
+                zip,
+                budget,
+                unpacked,
+            } => {
+                if let Some((_, done)) = unpacked.iter().find(|(r, _)| r == rel) {
+                    return Ok(done.clone());
+                }
                 let label = PathBuf::from(format!("{}:{rel}", path.display()));
+                let too_large = |what: String| SspError::Read {
+                    path: label.clone(),
+                    reason: format!(
+                        "{what}, more than the {budget} bytes left of the FMUs' limit \
+                         (MASTER_FMU_MAX_UNPACKED_BYTES)"
+                    ),
+                };
                 let mut entry = zip.by_name(rel).map_err(|_| SspError::Read {
                     path: label.clone(),
                     reason: "no such file in the archive".into(),
                 })?;
+                if entry.size() > *budget {
+                    return Err(too_large(format!("declares {} bytes", entry.size())));
+                }
                 let file_name = rel.rsplit('/').next().unwrap_or("component.fmu");
                 // one folder per component: two sources may share a file name
                 let dir = dest.join(index.to_string());
@@ -161,14 +187,22 @@ impl Package {
                 };
                 std::fs::create_dir_all(&dir).map_err(io)?;
                 let mut f = std::fs::File::create(&out).map_err(io)?;
-                let n =
-                    std::io::copy(&mut (&mut entry).take(MAX_FMU_BYTES + 1), &mut f).map_err(io)?;
-                if n > MAX_FMU_BYTES {
-                    return Err(SspError::Read {
-                        path: label,
-                        reason: format!("larger than {MAX_FMU_BYTES} bytes"),
-                    });
-                }
+                let copied = std::io::copy(&mut (&mut entry).take(*budget + 1), &mut f);
+                let n = match copied {
+                    Ok(n) if n <= *budget => n,
+                    Ok(n) => {
+                        drop(f);
+                        let _ = std::fs::remove_file(&out);
+                        return Err(too_large(format!("unpacks to more than {}", n - 1)));
+                    }
+                    Err(e) => {
+                        drop(f);
+                        let _ = std::fs::remove_file(&out);
+                        return Err(io(e));
+                    }
+                };
+                *budget -= n;
+                unpacked.push((rel.to_string(), out.clone()));
                 Ok(out)
             }
             // relative to the folder, which is the system's base folder
