@@ -15,10 +15,9 @@ pub(super) enum Package {
         path: PathBuf,
         zip: Box<zip::ZipArchive<std::fs::File>>,
         /// Bytes the FMUs unpacked from the archive may take together: the unpacked-size limit
-        /// of an FMU (`MASTER_FMU_MAX_UNPACKED_BYTES`), for the archive as a whole.
+        /// of an FMU (`MASTER_FMU_MAX_UNPACKED_BYTES`), for the archive as a whole (each
+        /// component's copy counts).
         budget: u64,
-        /// The FMUs unpacked so far, by reference: components of one FMU share its file.
-        unpacked: Vec<(String, PathBuf)>,
     },
     Dir {
         ssd: PathBuf,
@@ -59,7 +58,6 @@ impl Package {
                     path: path.to_path_buf(),
                     zip: Box::new(zip),
                     budget: limits.max_unpacked_bytes,
-                    unpacked: Vec::new(),
                 })
             }
             Some("ssd") => {
@@ -146,22 +144,15 @@ impl Package {
         }
     }
 
-    /// The FMU at reference `rel` as a file: unpacked into `dest` (a fresh folder) from a zip,
-    /// once for all components that use it, the file itself next to a bare .ssd. The FMUs of
-    /// an archive unpack within one budget, checked against each entry's declared size before
-    /// a byte is written and against what it really gives (a small archive must not fill the
+    /// The FMU at reference `rel` as a file: unpacked into `dest` (a fresh folder per
+    /// component, so that each instance has its own copy, as FMUs that can be instantiated only
+    /// once per process need) from a zip, the file itself next to a bare .ssd. The FMUs of an
+    /// archive unpack within one budget, checked against each entry's declared size before a
+    /// byte is written and against what it really gives (a small archive must not fill the
     /// disk first and be refused after).
     pub fn fmu_file(&mut self, rel: &str, dest: &Path, index: usize) -> Result<PathBuf, SspError> {
         match self {
-            Package::Zip {
-                path,
-                zip,
-                budget,
-                unpacked,
-            } => {
-                if let Some((_, done)) = unpacked.iter().find(|(r, _)| r == rel) {
-                    return Ok(done.clone());
-                }
+            Package::Zip { path, zip, budget } => {
                 let label = PathBuf::from(format!("{}:{rel}", path.display()));
                 let too_large = |what: String| SspError::Read {
                     path: label.clone(),
@@ -202,7 +193,6 @@ impl Package {
                     }
                 };
                 *budget -= n;
-                unpacked.push((rel.to_string(), out.clone()));
                 Ok(out)
             }
             // relative to the folder, which is the system's base folder
