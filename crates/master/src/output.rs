@@ -140,9 +140,20 @@ fn same_inode(_: &Path, _: &Path) -> bool {
 }
 
 /// Refuses to start a command whose output files would replace one of its inputs, or each
-/// other: each output is compared with every input and every other output (symbolic links
-/// resolved, hard links too). Called before anything is written.
+/// other, or that cannot be written as files: each output is compared with every input and
+/// every other output (symbolic links resolved, hard links too), and one that exists must be
+/// a file (or a link, which the write replaces), not a folder, FIFO or device. Called before
+/// anything is written, so that a command never writes some of its outputs and then fails on
+/// another.
 pub fn check_outputs_apart(inputs: &[PathBuf], outputs: &[PathBuf]) -> Result<(), OutputError> {
+    for out in outputs {
+        if let Ok(meta) = std::fs::symlink_metadata(out) {
+            let kind = meta.file_type();
+            if !(kind.is_file() || kind.is_symlink()) {
+                return Err(OutputError::NotAFile { path: out.clone() });
+            }
+        }
+    }
     let ids = |ps: &[PathBuf]| ps.iter().map(|p| identity(p)).collect::<Vec<_>>();
     let (input_ids, output_ids) = (ids(inputs), ids(outputs));
     for (k, (out, id)) in outputs.iter().zip(&output_ids).enumerate() {

@@ -462,6 +462,40 @@ fn archive_limits_and_unsafe_entries_are_refused_before_extraction() {
     assert!(c.extraction_folders().is_empty());
 }
 
+/// An instance name that is no safe archive member name (a space, `#`, `%`) is exported as a
+/// safe member: the SSP runs (it referred to `resources/h #1%.ssv`, which the import reads as
+/// a URI with a fragment); what SSP cannot hold is named.
+#[test]
+fn an_exported_ssp_runs_whatever_its_instance_names_and_says_what_it_drops() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    c.write(
+        "odd.json",
+        r#"{"instances": [{"name": "h #1%", "fmu": "Hostile.fmu", "parameters": {"gain": 2}}],
+            "stop_time": 0.01, "step": 0.001, "init_sweeps": 7}"#,
+    );
+    let out = c.master(&["export-ssp", "odd.json", "odd.ssp"], &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("no place for the master's init_sweeps (7)"),
+        "{stdout}"
+    );
+    let zip = zip::ZipArchive::new(std::fs::File::open(c.path("odd.ssp")).unwrap()).unwrap();
+    let names: Vec<&str> = zip.file_names().collect();
+    assert!(names.contains(&"resources/h__1_.ssv"), "{names:?}");
+    let out = c.master(&["run", "odd.ssp", "-o", "odd.csv"], &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// The FMUs inside an SSP unpack within the FMU limit, checked before a byte is written: a
 /// small archive wrote its declared gigabytes to the temporary folder and was refused only
 /// after (a limit of 4 GiB per entry, MASTER_FMU_MAX_UNPACKED_BYTES ignored).
@@ -855,9 +889,81 @@ fn outputs_never_replace_an_input_or_a_device() {
         .unwrap()
         .file_type()
         .is_fifo());
+    // a folder named as the summary: refused before the run, not after writing the results
+    std::fs::create_dir_all(c.path("summary-folder")).unwrap();
+    for args in [
+        &[
+            "run",
+            "system.json",
+            "-o",
+            "r.csv",
+            "--summary",
+            "summary-folder",
+        ][..],
+        &["run", "system.json", "--summary", "summary-folder"],
+    ] {
+        let e = c.fails(args, &[]);
+        assert!(
+            e.contains("'summary-folder'") && e.contains("not a regular file"),
+            "{e}"
+        );
+    }
+    // a file named for one format does not get the other's content; an SSP is a .ssp
+    let e = c.fails(
+        &["run", "system.json", "--format", "csv", "-o", "r.parquet"],
+        &[],
+    );
+    assert!(e.contains("--format csv writes csv: name it .csv"), "{e}");
+    let e = c.fails(&["export-ssp", "system.json", "system.ssp.json"], &[]);
+    assert!(e.contains("an SSP is written as a .ssp file"), "{e}");
     assert_eq!(std::fs::read(c.path("system.json")).unwrap(), system);
     assert_eq!(std::fs::read(c.path("Hostile.fmu")).unwrap(), fmu);
-    assert!(!c.path("r.csv").exists());
+    for f in [
+        "r.csv",
+        "r.meta.json",
+        "r.parquet",
+        "results.parquet",
+        "results.csv",
+        "system.ssp.json",
+    ] {
+        assert!(!c.path(f).exists(), "{f}");
+    }
+    // a command's files are all checked before the first is written: a folder in place of
+    // one of them leaves the others as they were (it rewrote some, then failed)
+    let geometry = |extra: &[&str]| {
+        let mut args = vec!["contact-geometry", "--out", "cg"];
+        args.extend_from_slice(extra);
+        c.master(&args, &[])
+    };
+    let out = geometry(&[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let names: Vec<std::path::PathBuf> = std::fs::read_dir(c.path("cg"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    let victim = names
+        .iter()
+        .find(|p| p.extension().is_some_and(|e| e == "csv"))
+        .unwrap();
+    std::fs::remove_file(victim).unwrap();
+    std::fs::create_dir(victim).unwrap();
+    let before: Vec<Vec<u8>> = names
+        .iter()
+        .filter(|p| *p != victim)
+        .map(|p| std::fs::read(p).unwrap())
+        .collect();
+    let e = c.fails(&["contact-geometry", "--out", "cg", "--gauge", "1440"], &[]);
+    assert!(e.contains("not a regular file"), "{e}");
+    let after: Vec<Vec<u8>> = names
+        .iter()
+        .filter(|p| *p != victim)
+        .map(|p| std::fs::read(p).unwrap())
+        .collect();
+    assert!(before == after, "files were rewritten before the refusal");
     // the assessment's files are not written over the table it reads
     let rows: String = (0..2001)
         .map(|k| {

@@ -23,8 +23,43 @@ pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
         .chain((0..sys.desc.instances.len()).map(|i| sys.fmu_path(i)))
         .collect();
     crate::output::check_outputs_apart(&inputs, std::slice::from_ref(&args.output))?;
+    // a zip under another name is read as that (a .json as text, "not valid UTF-8")
+    if !args
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ssp"))
+    {
+        return Err(CommandError::Failed(format!(
+            "'{}': an SSP is written as a .ssp file (a zip archive that hosts and `master run` \
+             recognise by that extension)",
+            args.output.display()
+        )));
+    }
     let summary = crate::ssp::export(&sys, &args.output)?;
     println!("{}: {summary}", args.output.display());
+    // what SSP has no place for: `master run` on the archive takes its defaults
+    let defaults: crate::system::SystemDescription =
+        serde_json::from_str(r#"{"instances": [], "stop_time": 1, "step": 1}"#)
+            .map_err(|e| CommandError::Failed(format!("internal: defaults: {e}")))?;
+    for (field, value, default) in [
+        (
+            "init_sweeps",
+            sys.desc.init_sweeps as u64,
+            defaults.init_sweeps as u64,
+        ),
+        (
+            "max_step_halvings",
+            u64::from(sys.desc.max_step_halvings),
+            u64::from(defaults.max_step_halvings),
+        ),
+    ] {
+        if value != default {
+            println!(
+                "note: SSP has no place for the master's {field} ({value}); `master run` on the \
+                 archive takes its default ({default})"
+            );
+        }
+    }
     if sys.desc.algorithm == Algorithm::GaussSeidel {
         println!(
             "note: SSP has no coupling algorithm; hosts reading it (libcosim, Ecos, fmpy) and `master run` on it exchange Jacobi-style (gauss-seidel with `master run --algorithm gauss-seidel`)"

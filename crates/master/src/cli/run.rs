@@ -150,11 +150,26 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     let chosen = args
         .format
         .or_else(|| args.output.as_deref().and_then(ResultsFormat::of_path));
-    if let Some(output) = &args.output {
-        check_outputs_apart(
+    match &args.output {
+        Some(output) => check_outputs_apart(
             &inputs,
             &written(output, chosen.unwrap_or(ResultsFormat::Parquet)),
-        )?;
+        )?,
+        None => check_outputs_apart(&inputs, &args.summary.iter().cloned().collect::<Vec<_>>())?,
+    }
+    // a file named for one format does not take the other's content
+    if let (Some(format), Some(output)) = (args.format, &args.output) {
+        if let Some(named) = ResultsFormat::of_path(output).filter(|&n| n != format) {
+            return Err(CommandError::Failed(format!(
+                "'{}' is named as a {} file but --format {} writes {}: name it .{} or leave \
+                 --format out",
+                output.display(),
+                named.extension(),
+                format.extension(),
+                format.extension(),
+                format.extension()
+            )));
+        }
     }
     let bar = if ctx.progress {
         indicatif::ProgressBar::new(0)

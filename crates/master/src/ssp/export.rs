@@ -133,12 +133,7 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
             resource_of.push(r.clone());
             continue;
         }
-        let stem = p
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .filter(|s| !s.is_empty())
-            .unwrap_or("component")
-            .to_string();
+        let stem = safe_member_stem(p.file_stem().and_then(|s| s.to_str()).unwrap_or(""));
         let mut name = format!("resources/{stem}.fmu");
         let mut k = 2;
         while used.contains(&name) {
@@ -249,7 +244,15 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
             let _ = writeln!(ssd, "        </ssd:Connectors>");
         }
         if !inst.parameters.is_empty() {
-            let member = format!("resources/{}.ssv", inst.name);
+            // the instance's name where it is a safe file name; `_2`, ... against clashes
+            let stem = safe_member_stem(&inst.name);
+            let mut member = format!("resources/{stem}.ssv");
+            let mut k = 2;
+            while used.contains(&member) {
+                member = format!("resources/{stem}_{k}.ssv");
+                k += 1;
+            }
+            used.insert(member.clone());
             let text = parameter_set(md, &extras[i], &inst.name, &inst.parameters)?;
             n_params += inst.parameters.len();
             let _ = writeln!(ssd, "        <ssd:ParameterBindings>");
@@ -462,4 +465,27 @@ fn parameter_set(
     }
     let _ = writeln!(s, "</ssv:ParameterSet>");
     Ok(s)
+}
+
+/// A name for an archive member made from `name`: letters, digits, `_` and `-` kept, anything
+/// else `_`, at most 64 characters ("component" when nothing is left). An SSD refers to members
+/// by URI: a space, `%`, `#` or `?` in a member name would have to be percent-encoded, a `/`
+/// would make a folder, and a long name is truncated by some unpacking hosts.
+fn safe_member_stem(name: &str) -> String {
+    let stem: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .take(64)
+        .collect();
+    if stem.trim_matches('_').is_empty() {
+        "component".to_string()
+    } else {
+        stem
+    }
 }

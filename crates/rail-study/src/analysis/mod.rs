@@ -173,6 +173,10 @@ impl Artefacts {
             path: dir.to_path_buf(),
             source,
         })?;
+        // every file checked before the first is written: a folder in place of one of them
+        // must not leave the others new and the rest from an earlier call
+        let paths: Vec<PathBuf> = self.files.iter().map(|(name, _)| dir.join(name)).collect();
+        master::output::check_outputs_apart(&[], &paths)?;
         let mut written = Vec::with_capacity(self.files.len());
         for (name, bytes) in &self.files {
             let path = dir.join(name);
