@@ -52,26 +52,54 @@ fn command_at_dead_zone_gives_no_motion() {
 #[test]
 fn r4_full_vs_reduced_frf() {
     let p = ActuatorParams::default();
-    let low = [1.0, 5.0, 20.0, 50.0, 80.0, 95.0]; // up to 597 rad/s
-    let high = [191.0, 250.0, 320.0]; // 1200-2010 rad/s
-    let mut freqs = low.to_vec();
-    freqs.extend_from_slice(&high);
-    let full = actuator_frf(&p, ActuatorModel::FullOrder, p.alpha_m, &freqs).unwrap();
-    let red = actuator_frf(&p, ActuatorModel::ReducedOrder, p.alpha_m, &freqs).unwrap();
+    // a dense grid up to 597 rad/s: a coarse one (1, 5, 20, 50, 80, 95 Hz) steps over the
+    // steep fall between 60 and 76 Hz, where the modulus drops two decades and the two models
+    // differ most
+    let n = 300;
+    let low: Vec<f64> = (0..n)
+        .map(|i| 10f64.powf((95f64).log10() * i as f64 / (n - 1) as f64))
+        .collect();
+    let full = actuator_frf(&p, ActuatorModel::FullOrder, p.alpha_m, &low).unwrap();
+    let red = actuator_frf(&p, ActuatorModel::ReducedOrder, p.alpha_m, &low).unwrap();
+    let reference = full[0].modulus_per_s;
+    let (mut worst_db, mut worst_above_db) = (0.0f64, 0.0f64);
+    for (f, r) in full.iter().zip(&red) {
+        let db = (20.0 * (f.modulus_per_s / r.modulus_per_s).log10()).abs();
+        worst_db = worst_db.max(db);
+        if f.modulus_per_s > 0.1 * reference {
+            worst_above_db = worst_above_db.max(db);
+        }
+    }
+    // where each falls below a tenth of the low-frequency modulus
+    let tenth = |pts: &[fmu_damper::characterise::ActuatorFrfPoint]| {
+        pts.iter()
+            .find(|x| x.modulus_per_s < 0.1 * reference)
+            .map(|x| x.freq_hz)
+            .unwrap()
+    };
+    let (f_full, f_red) = (tenth(&full), tenth(&red));
+    eprintln!(
+        "R4: {worst_db:.2} dB worst, {worst_above_db:.2} dB above a tenth; a tenth at {f_full:.2} / {f_red:.2} Hz"
+    );
+    // the seed's "close" on its Bode plot: within about 1 dB (0.97 here) wherever the response
+    // is above a tenth of its low-frequency value; in the steep fall the reduced model lies
+    // about 1.5 % higher in frequency, which gives up to 4 dB there
+    assert!(worst_above_db < 1.5, "{worst_above_db} dB");
+    assert!(worst_db < 4.0, "{worst_db} dB");
+    assert!(
+        (f_red / f_full - 1.0).abs() < 0.02,
+        "{f_full} vs {f_red} Hz"
+    );
+    // above the valve poles (1200-2010 rad/s) the two part
+    let high = [191.0, 250.0, 320.0];
+    let full = actuator_frf(&p, ActuatorModel::FullOrder, p.alpha_m, &high).unwrap();
+    let red = actuator_frf(&p, ActuatorModel::ReducedOrder, p.alpha_m, &high).unwrap();
     for (f, r) in full.iter().zip(&red) {
         let rel = (f.modulus_per_s - r.modulus_per_s).abs() / r.modulus_per_s;
-        eprintln!(
-            "{:7.1} rad/s: full {:9.3} reduced {:9.3} rel {:.3}",
-            f.omega_radps, f.modulus_per_s, r.modulus_per_s, rel
+        assert!(
+            rel > 0.25 && f.modulus_per_s < r.modulus_per_s,
+            "{f:?} vs {r:?}"
         );
-        if f.omega_radps < 600.0 {
-            assert!(rel < 0.10, "{f:?} vs {r:?}");
-        } else if f.omega_radps >= 1199.0 {
-            assert!(
-                rel > 0.25 && f.modulus_per_s < r.modulus_per_s,
-                "{f:?} vs {r:?}"
-            );
-        }
     }
 }
 

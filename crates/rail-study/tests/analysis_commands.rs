@@ -84,7 +84,9 @@ fn characterise_refuses_counts_and_frequencies_that_would_not_end() {
             "from 2 to 10000",
         ),
         ("--damper-f-min", "1e-300", "outside 0.001 to 1e5 Hz"),
-        ("--actuator-f-max", "1e10", "outside 0.001 to 1e5 Hz"),
+        ("--actuator-f-max", "1e10", "outside 0.01 to 1e5 Hz"),
+        // the full-order actuator at 0.001 Hz exceeded its internal step limit
+        ("--actuator-f-min", "0.001", "outside 0.01 to 1e5 Hz"),
     ] {
         let r = master(&[
             "characterise",
@@ -100,6 +102,24 @@ fn characterise_refuses_counts_and_frequencies_that_would_not_end() {
         );
         assert!(!r.stderr.contains("panicked"), "{}", r.stderr);
     }
+    // a reversed band names the options the user gave
+    let r = master(&[
+        "characterise",
+        "actuator",
+        "--actuator-f-min",
+        "50",
+        "--actuator-f-max",
+        "10",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !r.ok
+            && r.stderr
+                .contains("--actuator-f-min/--actuator-f-max = 50..10"),
+        "{}",
+        r.stderr
+    );
     assert!(!out.exists());
 }
 

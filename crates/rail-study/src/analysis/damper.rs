@@ -109,7 +109,11 @@ pub fn characterise_damper(
     cancel: &AtomicBool,
 ) -> Result<DamperResults, AnalysisError> {
     params.validate()?;
-    check_band("--damper-band", opts.frf_band_hz, opts.frf_points)?;
+    check_band(
+        "--damper-f-min/--damper-f-max",
+        opts.frf_band_hz,
+        opts.frf_points,
+    )?;
     let loop_grid: Vec<(f64, f64)> = opts
         .loop_openings
         .iter()
@@ -370,7 +374,10 @@ mod tests {
             ..DamperOptions::default()
         };
         let e = characterise_damper(&SemiActiveParams::default(), &opts, &cancel).unwrap_err();
-        assert!(e.to_string().contains("--damper-band"), "{e}");
+        assert!(
+            e.to_string().contains("--damper-f-min/--damper-f-max"),
+            "{e}"
+        );
     }
 
     #[test]
