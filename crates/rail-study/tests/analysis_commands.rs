@@ -471,6 +471,40 @@ fn contact_geometry_without_a_value_fails_and_writes_nothing() {
     assert!(r.ok, "{}", r.stderr);
     let csv = std::fs::read_to_string(out.join("conicity.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 23); // 1 to 6.5 mm every 0.25 mm
+                                             // an amplitude of a few table steps has no conicity worth the name (0.0001 mm gave
+                                             // tan(gamma_e) = 0 from Annex B beside 0.107 from the regression): refused
+    let none = d.path().join("none");
+    for a in ["0.0001", "0.4"] {
+        let r = master(&[
+            "contact-geometry",
+            "--amplitude-max",
+            a,
+            "--out",
+            none.to_str().unwrap(),
+        ]);
+        assert!(
+            !r.ok && r.stderr.contains("must be at least 0.5 mm"),
+            "{a}: {}",
+            r.stderr
+        );
+    }
+    // wheel (R, Rad) and rail (S, Schiene) profiles swapped: said so
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../wheel-rail/data");
+    let r = master(&[
+        "contact-geometry",
+        "--wheel",
+        data.join("SUIC519A.dat").to_str().unwrap(),
+        "--rail",
+        data.join("RUIC519A.dat").to_str().unwrap(),
+        "--out",
+        none.to_str().unwrap(),
+    ]);
+    assert!(
+        !r.ok && r.stderr.contains("no contact on either side") && r.stderr.contains("swapped"),
+        "{}",
+        r.stderr
+    );
+    assert!(!none.exists());
 }
 
 /// The flange two-point contact of E1 is located between the grid rows and flagged in the

@@ -73,9 +73,9 @@ pub enum ContactError {
         what: String,
     },
     /// The wheel and rail do not overlap laterally, or the rolled wheel is not single-valued.
-    #[error("no contact on the {side} side at y = {y_m} m: {reason}")]
+    #[error("no contact on {side} at y = {y_m} m: {reason}")]
     NoContact {
-        /// "left" or "right".
+        /// "the left side", "the right side" or "either side".
         side: &'static str,
         /// Lateral displacement.
         y_m: f64,
@@ -351,7 +351,10 @@ impl PreparedSide {
             buf.push((y + yh * cs - zh * sn, yh * sn + zh * cs - h, s));
         }
         let no_contact = |reason| ContactError::NoContact {
-            side: self.side.name(),
+            side: match self.side {
+                WheelSide::Left => "the left side",
+                WheelSide::Right => "the right side",
+            },
             y_m: y,
             reason,
         };

@@ -255,14 +255,20 @@ pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
             "must be > 0 mm",
         ));
     }
+    // an oscillation of a few table steps has no equivalent conicity worth the name: at
+    // 0.0001 mm Annex B gave tan(gamma_e) = 0 beside 0.107 from the other two methods
+    let lowest_m = (0.5e-3f64).max(10.0 * inputs.step_m);
     if !(inputs.amplitude_max_m.is_finite()
-        && inputs.amplitude_max_m > 0.0
+        && inputs.amplitude_max_m >= lowest_m
         && inputs.amplitude_max_m < inputs.y_max_m)
     {
         return Err(bad(
             "--amplitude-max",
             inputs.amplitude_max_m * 1e3,
-            "must be > 0 and below --y-max",
+            &format!(
+                "must be at least {} mm (0.5 mm and 10 table steps of --step) and below --y-max",
+                master::show::num(lowest_m * 1e3)
+            ),
         ));
     }
     Ok(())

@@ -191,9 +191,10 @@ pub fn compute_table(
     let first = solve_at(&p, ys[centre], 0.0)?;
     if first.beyond {
         return Err(ContactError::NoContact {
-            side: "either",
+            side: "either side",
             y_m: ys[centre],
-            reason: "the central row already lies beyond the flange limit",
+            reason: "the central row already lies beyond the flange limit (are the wheel \
+                     and rail profiles swapped?)",
         });
     }
     let mut rows: Vec<Option<ContactRow>> = vec![None; n];
