@@ -488,6 +488,23 @@ fn contact_geometry_without_a_value_fails_and_writes_nothing() {
             r.stderr
         );
     }
+    // the option to blame, numbers in short form (a gauge of 1e300 printed 300 digits)
+    for (args, message) in [
+        (
+            ["--step", "1e-5"],
+            "--step = 1e-5: with --y-max 10 mm gives 2000000 table rows",
+        ),
+        (["--gauge", "1e300"], "`rail_placement.gauge_m` = 1e297"),
+    ] {
+        let r = master(&[
+            "contact-geometry",
+            args[0],
+            args[1],
+            "--out",
+            none.to_str().unwrap(),
+        ]);
+        assert!(!r.ok && r.stderr.contains(message), "{}", r.stderr);
+    }
     // wheel (R, Rad) and rail (S, Schiene) profiles swapped: said so
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../wheel-rail/data");
     let r = master(&[

@@ -48,11 +48,21 @@ const ZONE_STEP_M: f64 = 0.01e-3;
 /// Largest half width of a contact zone, in grid steps (30 mm).
 const ZONE_MAX_STEPS: f64 = 3000.0;
 
+/// A number for a message: as written below 1e16 (and above 1e-4), in scientific notation
+/// beyond (a gauge of 1e300 m printed 300 digits).
+fn short(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e16).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// Errors of the contact geometry.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ContactError {
     /// A setup parameter is invalid.
-    #[error("invalid parameter `{name}` = {value}: {reason}")]
+    #[error("invalid parameter `{name}` = {}: {reason}", short(*.value))]
     Param {
         /// Parameter name.
         name: &'static str,

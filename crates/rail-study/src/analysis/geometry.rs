@@ -248,6 +248,19 @@ pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
             "must be at least 3 steps",
         ));
     }
+    // the table's rows, -y_max to y_max in steps (the contact search refuses more than 1e6)
+    let rows = 2.0 * inputs.y_max_m / inputs.step_m;
+    if rows > 1e6 {
+        return Err(bad(
+            "--step",
+            inputs.step_m * 1e3,
+            &format!(
+                "with --y-max {} mm gives {} table rows, more than 1 000 000",
+                master::show::num(inputs.y_max_m * 1e3),
+                master::show::num(rows.round())
+            ),
+        ));
+    }
     if !(inputs.conicity_step_m.is_finite() && inputs.conicity_step_m > 0.0) {
         return Err(bad(
             "conicity step",
