@@ -545,6 +545,14 @@ fn an_ssps_fmus_unpack_within_the_fmu_limit() {
         "{e}"
     );
     assert!(!c.path("bomb.csv").exists());
+    // within the limit, the zeros are no FMU: named as the archive's member, not as the
+    // temporary file they were unpacked to (gone when the message is read)
+    let e = c.fails(&["run", "bomb.ssp", "-o", "bomb.csv"], &[]);
+    assert!(
+        e.contains("bomb.ssp:resources/") && e.contains("is not a valid zip archive"),
+        "{e}"
+    );
+    assert!(!e.contains("/tmp/") && !e.contains("ssp-"), "{e}");
 }
 
 #[test]

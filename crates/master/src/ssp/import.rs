@@ -74,10 +74,14 @@ pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, S
             .map_err(|r| invalid(c.line, format!("component '{}': source {r}", c.name)))?;
         let dest = base_dir.clone();
         let file = pkg.fmu_file(&rel, &dest, i)?;
-        let archive = FmuArchive::open(&base_dir.join(&file)).map_err(|source| SspError::Fmu {
+        let unpacked = base_dir.join(&file);
+        let archive = FmuArchive::open(&unpacked).map_err(|source| SspError::Fmu {
             file: ssd_label.clone(),
             component: c.name.clone(),
-            source: Box::new(source),
+            message: source
+                .to_string()
+                .replace(&unpacked.display().to_string(), &pkg.file_label(&rel)),
+            fmu_error: Box::new(source),
         })?;
         models.push(archive.model);
         instances.push(InstanceSpec {

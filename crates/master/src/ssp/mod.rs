@@ -55,12 +55,15 @@ pub enum SspError {
     },
     #[error("{message}")]
     Parameter { message: String },
-    #[error("{file}: component '{component}': {source}")]
+    /// `message` is the FMU error's, the FMU named as the archive's member (not as the
+    /// temporary file it was unpacked to, which is gone when the message is read).
+    #[error("{file}: component '{component}': {message}")]
     Fmu {
         file: String,
         component: String,
-        #[source]
-        source: Box<FmuError>,
+        message: String,
+        /// The FMU error itself (not a `source`: its message names the temporary file).
+        fmu_error: Box<FmuError>,
     },
     #[error(transparent)]
     System(#[from] SystemError),
