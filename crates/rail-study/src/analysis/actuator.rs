@@ -68,7 +68,7 @@ pub struct R4Agreement {
 }
 
 /// Frequencies of the R4 comparison.
-const R4_POINTS: usize = 300;
+pub const R4_POINTS: usize = 300;
 
 fn r4_agreement(
     params: &ActuatorParams,
