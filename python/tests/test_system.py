@@ -329,7 +329,7 @@ def test_results_files_that_cannot_be_written_or_read_fail_whole(dist, master_cm
     res = railfmu.read_results(cli_csv)
     # a folder where the metadata goes: refused before the CSV is written
     (tmp_path / "new.meta.json").mkdir()
-    with pytest.raises(railfmu.OutputError, match="is not a file"):
+    with pytest.raises(railfmu.OutputError, match="new.meta.json': it exists and is not a regular file"):
         res.to_csv(tmp_path / "new.csv")
     assert not (tmp_path / "new.csv").exists()
     # an existing pair is replaced as a pair
