@@ -73,14 +73,7 @@ pub fn write_atomic<F>(path: &Path, fill: F) -> Result<(), OutputError>
 where
     F: FnOnce(&mut dyn Write) -> Result<(), OutputError>,
 {
-    if let Ok(meta) = std::fs::symlink_metadata(path) {
-        let kind = meta.file_type();
-        if !(kind.is_file() || kind.is_symlink()) {
-            return Err(OutputError::NotAFile {
-                path: path.to_path_buf(),
-            });
-        }
-    }
+    check_file_or_absent(path)?;
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -108,6 +101,19 @@ where
         source: e.error,
     })?;
     Ok(())
+}
+
+/// An output path that exists must be a regular file or a symbolic link (which the rename of
+/// an atomic write replaces), not a device such as /dev/null, a FIFO or a folder.
+fn check_file_or_absent(path: &Path) -> Result<(), OutputError> {
+    match std::fs::symlink_metadata(path) {
+        Ok(meta) if !(meta.file_type().is_file() || meta.file_type().is_symlink()) => {
+            Err(OutputError::NotAFile {
+                path: path.to_path_buf(),
+            })
+        }
+        _ => Ok(()),
+    }
 }
 
 /// What a path names, for telling whether two paths are the same file: the canonical path
@@ -147,12 +153,7 @@ fn same_inode(_: &Path, _: &Path) -> bool {
 /// another.
 pub fn check_outputs_apart(inputs: &[PathBuf], outputs: &[PathBuf]) -> Result<(), OutputError> {
     for out in outputs {
-        if let Ok(meta) = std::fs::symlink_metadata(out) {
-            let kind = meta.file_type();
-            if !(kind.is_file() || kind.is_symlink()) {
-                return Err(OutputError::NotAFile { path: out.clone() });
-            }
-        }
+        check_file_or_absent(out)?;
     }
     let ids = |ps: &[PathBuf]| ps.iter().map(|p| identity(p)).collect::<Vec<_>>();
     let (input_ids, output_ids) = (ids(inputs), ids(outputs));

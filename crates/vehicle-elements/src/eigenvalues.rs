@@ -185,8 +185,8 @@ mod tests {
 
     #[test]
     fn a_matrix_the_plain_iteration_stalls_on_is_reduced_or_refused() {
-        // nalgebra issue 611: the companion matrix of x^11 - 1.7748... loops for ever in the
-        // unbounded Schur iteration; here it returns, and any answer it gives is right
+        // the companion matrix of x^11 - 1.7748..., on which nalgebra's unbounded Schur
+        // iteration loops for ever; here it returns, and any answer it gives is right
         let n = 11;
         let mut a = DMatrix::zeros(n, n);
         a[(0, n - 1)] = 1.774_809_211_101_797_7;

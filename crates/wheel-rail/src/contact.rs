@@ -36,7 +36,7 @@ pub use setup::{
     ContactSetup, LateralReference, RadiusConvention, RailPlacement, WheelPlacement,
     CONTACT_ZONE_DEPTH_M,
 };
-pub use sweep::{compute_table, ContactJump, ContactTable};
+pub use sweep::{compute_table, ContactJump, ContactTable, MAX_TABLE_ROWS};
 
 /// Half width of the central difference used for the contact-angle slope [m].
 const SLOPE_HALF_WINDOW_M: f64 = 0.25e-3;

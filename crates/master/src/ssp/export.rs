@@ -133,14 +133,8 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
             resource_of.push(r.clone());
             continue;
         }
-        let stem = safe_member_stem(p.file_stem().and_then(|s| s.to_str()).unwrap_or(""));
-        let mut name = format!("resources/{stem}.fmu");
-        let mut k = 2;
-        while used.contains(&name) {
-            name = format!("resources/{stem}_{k}.fmu");
-            k += 1;
-        }
-        used.insert(name.clone());
+        let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or("");
+        let name = unique_member(&mut used, stem, "fmu");
         by_path.insert(key, name.clone());
         fmu_members.push((name.clone(), p));
         resource_of.push(name);
@@ -244,15 +238,7 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
             let _ = writeln!(ssd, "        </ssd:Connectors>");
         }
         if !inst.parameters.is_empty() {
-            // the instance's name where it is a safe file name; `_2`, ... against clashes
-            let stem = safe_member_stem(&inst.name);
-            let mut member = format!("resources/{stem}.ssv");
-            let mut k = 2;
-            while used.contains(&member) {
-                member = format!("resources/{stem}_{k}.ssv");
-                k += 1;
-            }
-            used.insert(member.clone());
+            let member = unique_member(&mut used, &inst.name, "ssv");
             let text = parameter_set(md, &extras[i], &inst.name, &inst.parameters)?;
             n_params += inst.parameters.len();
             let _ = writeln!(ssd, "        <ssd:ParameterBindings>");
@@ -465,6 +451,20 @@ fn parameter_set(
     }
     let _ = writeln!(s, "</ssv:ParameterSet>");
     Ok(s)
+}
+
+/// `resources/<stem>.<extension>` with the stem made safe from `name` ([`safe_member_stem`]),
+/// `_2`, `_3`, ... appended against a member already in `used`; recorded in `used`.
+fn unique_member(used: &mut BTreeSet<String>, name: &str, extension: &str) -> String {
+    let stem = safe_member_stem(name);
+    let mut member = format!("resources/{stem}.{extension}");
+    let mut k = 2;
+    while used.contains(&member) {
+        member = format!("resources/{stem}_{k}.{extension}");
+        k += 1;
+    }
+    used.insert(member.clone());
+    member
 }
 
 /// A name for an archive member made from `name`: letters, digits, `_` and `-` kept, anything

@@ -248,9 +248,10 @@ pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
             "must be at least 3 steps",
         ));
     }
-    // the table's rows, -y_max to y_max in steps (the contact search refuses more than 1e6)
+    // the table's rows, -y_max to y_max in steps (the contact search refuses more), refused
+    // here to name the options
     let rows = 2.0 * inputs.y_max_m / inputs.step_m;
-    if rows > 1e6 {
+    if rows > wheel_rail::contact::MAX_TABLE_ROWS as f64 {
         return Err(bad(
             "--step",
             inputs.step_m * 1e3,

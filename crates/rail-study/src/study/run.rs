@@ -232,17 +232,28 @@ impl Executor<'_> {
         Ok(())
     }
 
-    /// Prepares the systems of `planned` and checks each run's start values against them.
-    fn check(&mut self, planned: &[Planned]) -> Result<(), StudyError> {
+    /// The jobs of `planned`, in its order: each request given the study's track level, its
+    /// configuration's system prepared.
+    fn jobs_of(&mut self, planned: &mut [Planned]) -> Result<Vec<Job>, StudyError> {
+        let mut jobs = Vec::with_capacity(planned.len());
         for p in planned {
+            p.request.track_level = self.settings.track_level;
             self.prepare(p.request.config)?;
             let Some(system) = self.prepared.get(p.request.config.id) else {
                 return Err(StudyError::UnknownConfiguration(p.request.config.id.into()));
             };
-            let mut request = p.request.clone();
-            request.track_level = self.settings.track_level;
-            let job = request.job(system.system())?;
-            master::runset::check_jobs(system, std::slice::from_ref(&job))?;
+            jobs.push(p.request.job(system.system())?);
+        }
+        Ok(jobs)
+    }
+
+    /// Prepares the systems of `planned` and checks each run's start values against them.
+    fn check(&mut self, planned: &mut [Planned]) -> Result<(), StudyError> {
+        let jobs = self.jobs_of(planned)?;
+        for (p, job) in planned.iter().zip(&jobs) {
+            if let Some(system) = self.prepared.get(p.request.config.id) {
+                master::runset::check_jobs(system, std::slice::from_ref(job))?;
+            }
         }
         Ok(())
     }
@@ -252,14 +263,8 @@ impl Executor<'_> {
         if planned.is_empty() {
             return Ok(());
         }
-        for p in &mut planned {
-            p.request.track_level = self.settings.track_level;
-        }
-        for p in &planned {
-            self.prepare(p.request.config)?;
-        }
+        let mut jobs = self.jobs_of(&mut planned)?;
         let prepared = &self.prepared;
-        let mut jobs: Vec<Job> = Vec::with_capacity(planned.len());
         let mut specs: HashMap<String, (MetricSpec, bool, &PreparedSystem)> = HashMap::new();
         let mut results = ResultsOptions {
             format: self.settings.stored_format,
@@ -269,7 +274,6 @@ impl Executor<'_> {
             let Some(system) = prepared.get(p.request.config.id) else {
                 return Err(StudyError::UnknownConfiguration(p.request.config.id.into()));
             };
-            jobs.push(p.request.job(system.system())?);
             let r = &p.request;
             results.labels.insert(
                 r.name.clone(),
@@ -674,7 +678,7 @@ pub fn run_study_checked(
             keep: true,
         });
     }
-    ex.check(&planned)?;
+    ex.check(&mut planned)?;
     before_first_run()?;
     ex.run_batch("main", planned)?;
 

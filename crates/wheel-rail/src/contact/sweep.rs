@@ -10,6 +10,9 @@ use super::{prepare, solve_at, ContactError, ContactRow, ContactSetup, Prepared,
 use crate::contact::RadiusConvention;
 use crate::table::{write_csv, CsvNumbers, CsvRow, GeometryTable, TableError};
 
+/// Most rows a contact table may have (a point every 0.02 um over +-10 mm).
+pub const MAX_TABLE_ROWS: usize = 1_000_000;
+
 /// Two adjacent rows whose contact point on one wheel moves by more than this [m] ...
 const JUMP_CANDIDATE_M: f64 = 0.25e-3;
 /// ... and by more than this times its movement in either neighbouring step are searched for a
@@ -176,7 +179,7 @@ pub fn compute_table(
         return Err(bad("y_max_m", y_max_m, "must be finite and >= y_min_m"));
     }
     let nf = ((y_max_m - y_min_m) / step_m).round();
-    if nf > 1e6 {
+    if nf > MAX_TABLE_ROWS as f64 {
         return Err(bad("step_m", step_m, "gives more than 1e6 rows"));
     }
     let n = nf as usize + 1;
