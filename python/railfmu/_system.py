@@ -67,11 +67,10 @@ class System:
         An ``.fmu`` is not a system description (:class:`SystemDescriptionError`): describe
         a system of its instances with :meth:`from_dict`.
 
-        For an SSP, as ``master run --step --stop-time --algorithm``: ``step``, the
-        communication step [s] (default: the SSP's libcosim or OMSimulator annotation);
-        ``stop_time`` [s] (default: its DefaultExperiment's); ``algorithm``, the coupling
-        algorithm, ``"jacobi"`` (default) or ``"gauss-seidel"``. A JSON description sets
-        them itself: given with one, they raise :class:`SystemDescriptionError`."""
+        ``step``, the communication step [s]; ``stop_time`` [s]; ``algorithm``, the coupling
+        algorithm, ``"jacobi"`` or ``"gauss-seidel"``: each replaces the description's (as
+        ``master run --step --stop --algorithm``). An SSP's defaults: its libcosim or
+        OMSimulator step annotation, its DefaultExperiment's stop time, Jacobi."""
         return cls(
             _railfmu.PreparedSystem.load(
                 os.fspath(path),

@@ -315,9 +315,8 @@ impl PySystem {
 impl PySystem {
     /// Loads a system description and prepares it: JSON (FMU paths relative to its folder),
     /// or an SSP (`.ssp` archive, or a bare `.ssd` next to its FMUs) as `master run` reads it.
-    /// An SSP's communication step, stop time and coupling algorithm ("jacobi" or
-    /// "gauss-seidel") can be given (`master run --step --stop-time --algorithm`); a JSON
-    /// description sets them itself.
+    /// The communication step, stop time and coupling algorithm ("jacobi" or "gauss-seidel")
+    /// can be given, replacing the description's (`master run --step --stop --algorithm`).
     #[staticmethod]
     #[pyo3(signature = (path, step=None, stop_time=None, algorithm=None))]
     fn load(
@@ -340,26 +339,17 @@ impl PySystem {
             system._ssp = Some(imported);
             return Ok(system);
         }
-        let given: Vec<&str> = [
-            ("step", step.is_some()),
-            ("stop_time", stop_time.is_some()),
-            ("algorithm", algorithm.is_some()),
-        ]
-        .iter()
-        .filter(|(_, g)| *g)
-        .map(|(n, _)| *n)
-        .collect();
-        if !given.is_empty() {
-            return Err(SystemDescriptionError::new_err(format!(
-                "{}: {} of System.load apply to an SSP (.ssp, .ssd); a JSON system description \
-                 sets its own \"step\", \"stop_time\" and \"algorithm\" (System.from_dict \
-                 takes a changed description; System.stop_time changes the stop time of later \
-                 runs)",
-                path.display(),
-                given.join(", ")
-            )));
-        }
-        let system = LoadedSystem::load(&path).map_err(|e| system_err(&e))?;
+        let mut system = LoadedSystem::load(&path).map_err(|e| system_err(&e))?;
+        let overrides = master::system::SystemOverrides {
+            from: master::system::OverridesFrom::PythonLoad,
+            step,
+            stop_time,
+            algorithm,
+            ..Default::default()
+        };
+        system
+            .apply_overrides(&overrides)
+            .map_err(|e| system_err(&e))?;
         Self::prepare(py, system)
     }
 

@@ -388,9 +388,14 @@ def test_an_ssps_step_stop_time_and_algorithm_are_set_as_the_command_line_sets_t
         railfmu.System.load(ssd, stop_time=0.5)
     assert "--" not in str(e.value)
     assert len(railfmu.System.load(ssd, stop_time=0.5, step=0.002).run()) == 251
-    # a JSON description sets them itself; an unknown algorithm is refused by name
-    with pytest.raises(railfmu.SystemDescriptionError, match=r"step, algorithm of System.load apply to an SSP"):
-        railfmu.System.load(passive_file, step=0.002, algorithm="jacobi")
+    # a JSON description takes them too, in place of its own; a value that does not fit is
+    # named as System.load's, not as the file's
+    changed = railfmu.System.load(passive_file, step=0.002, stop_time=0.5, algorithm="jacobi")
+    assert (changed.description["step"], changed.description["algorithm"]) == (0.002, "jacobi")
+    assert len(changed.run()) == 251
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"with System.load's stop_time, step: step: .*not an integer multiple") as e:
+        railfmu.System.load(passive_file, step=0.003, stop_time=0.5)
+    assert "--" not in str(e.value) and " line " not in str(e.value)
     with pytest.raises(ValueError, match=r"algorithm 'seidel': expected 'jacobi' or 'gauss-seidel'"):
         railfmu.System.load(ssp, algorithm="seidel")
 

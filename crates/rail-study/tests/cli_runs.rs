@@ -137,6 +137,141 @@ fn ctrl_c_stops_cleanly_without_result_file() {
     assert!(!dir.path().join("r.csv").exists());
 }
 
+/// `master run SYSTEM.json` with `--stop --step --set --record`: the same results as the
+/// description edited to say so, bit for bit; a change that does not fit is named as the
+/// option's, without a line of the file, and writes nothing.
+#[test]
+fn run_changes_a_system_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("system.json"), system_json(0.5)).unwrap();
+    let edited = system_json(0.2)
+        .replace(
+            "\"step\": 0.001",
+            "\"step\": 0.002, \"record\": [\"ms.position\"]",
+        )
+        .replace(
+            "\"coupling_stiffness\": 200.0",
+            "\"coupling_stiffness\": 50.0",
+        );
+    assert_ne!(edited, system_json(0.2));
+    std::fs::write(d.join("edited.json"), edited).unwrap();
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_master"))
+            .args(["--quiet", "run"])
+            .args(args)
+            .current_dir(d)
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).to_string(),
+        )
+    };
+    let (code, stderr) = run(&["edited.json", "-o", "edited.csv"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    let changes = [
+        "--stop",
+        "0.2",
+        "--step",
+        "0.002",
+        "--set",
+        "sdm.coupling_stiffness=50",
+        "--record",
+        "ms.position",
+    ];
+    let mut args = vec!["system.json", "-o", "changed.csv"];
+    args.extend(changes);
+    let (code, stderr) = run(&args);
+    assert_eq!(code, Some(0), "{stderr}");
+    let changed = std::fs::read_to_string(d.join("changed.csv")).unwrap();
+    assert_eq!(changed.lines().next(), Some("time [s],ms.position [m]"));
+    assert_eq!(changed.lines().count(), 102, "0.2 s at 2 ms and the header");
+    assert_eq!(
+        changed,
+        std::fs::read_to_string(d.join("edited.csv")).unwrap()
+    );
+    // the start value made a difference
+    let (code, stderr) = run(&[
+        "system.json",
+        "-o",
+        "unset.csv",
+        "--stop",
+        "0.2",
+        "--step",
+        "0.002",
+        "--record",
+        "ms.position",
+    ]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert_ne!(
+        changed,
+        std::fs::read_to_string(d.join("unset.csv")).unwrap()
+    );
+    // the metadata holds the description that was run
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("changed.meta.json")).unwrap())
+            .unwrap();
+    let text = meta.to_string();
+    assert!(text.contains("\"coupling_stiffness\":50"), "{text}");
+    assert!(text.contains("\"stop_time\":0.2"), "{text}");
+    // --stop-time, as for an SSP, is the same option
+    let (code, stderr) = run(&["system.json", "-o", "alias.csv", "--stop-time", "0.1"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    let alias = std::fs::read_to_string(d.join("alias.csv")).unwrap();
+    assert_eq!(alias.lines().count(), 102, "0.1 s at 1 ms and the header");
+    // changes that do not fit: named as given, no output
+    for (args, expected) in [
+        (
+            vec!["--set", "nobody.mass=1"],
+            "system.json with --set: nobody.mass: no such instance (instances: sdm, ms)",
+        ),
+        (
+            vec!["--set", "mass"],
+            "mass: not of the form instance.variable=VALUE",
+        ),
+        (
+            vec!["--set", "ms.mass=-1"],
+            "system.json with --set: instances[1].parameters.mass: -1 is below its minimum",
+        ),
+        (
+            vec!["--stop", "0.2", "--step", "0.003"],
+            "system.json with --stop, --step: step: stop_time - start_time = 0.2 s is not an \
+             integer multiple of step = 0.003 s",
+        ),
+        (
+            vec!["--stop", "-1"],
+            "system.json with --stop: stop_time: must be greater than start_time (0), got -1",
+        ),
+        (
+            vec!["--record", "ms.nothing"],
+            "system.json with --record: record[0]: unknown variable 'ms.nothing'",
+        ),
+    ] {
+        let mut a = vec!["system.json", "-o", "bad.csv"];
+        a.extend(args.iter().copied());
+        let (code, stderr) = run(&a);
+        assert_eq!(code, Some(1), "{args:?}: {stderr}");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+        assert!(!stderr.contains(" line "), "{args:?}: {stderr}");
+        assert!(!d.join("bad.csv").exists(), "{args:?}");
+    }
+    // an FMU alone has no coupling to choose
+    let fmu = dist().join("MassSpring.fmu");
+    let (code, stderr) = run(&[
+        fmu.to_str().unwrap(),
+        "-o",
+        "bad.csv",
+        "--algorithm",
+        "jacobi",
+    ]);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("--algorithm: an FMU run alone has no coupling"),
+        "{stderr}"
+    );
+}
+
 /// `master inspect` reads the binaries without loading them: platform, format, architecture
 /// and the newest glibc a Linux binary needs against the portable baseline.
 #[test]

@@ -1,6 +1,6 @@
 //! `master run SYSTEM.json|SYSTEM.ssp|SYSTEM.ssd [-o results.csv] [--format csv|parquet]` or
-//! `master run MODEL.fmu [--stop ..] [--set ..]`: one co-simulation, results as CSV or
-//! Parquet.
+//! `master run MODEL.fmu`, each with `[--stop ..] [--set ..]` and the other changes of
+//! [`SystemOverrides`]: one co-simulation, results as CSV or Parquet.
 
 use std::path::PathBuf;
 
@@ -9,7 +9,7 @@ use crate::coupling::{Algorithm, RunOptions};
 use crate::output::{check_outputs_apart, write_json_atomic};
 use crate::results::{csv_metadata_path, remove_results, write_results, ResultsFormat, RunContext};
 use crate::ssp::{self, ImportOptions};
-use crate::system::{LoadedSystem, SingleFmuOptions};
+use crate::system::{LoadedSystem, OverridesFrom, SingleFmuOptions, SystemOverrides};
 
 /// Run one system description, or one FMU alone, and write the recorded variables as CSV or
 /// Parquet.
@@ -33,30 +33,35 @@ pub struct Args {
     /// Also write the run summary (steps, wall time, real-time ratio) as JSON.
     #[arg(long)]
     pub summary: Option<PathBuf>,
-    /// SSP or single FMU: communication step [s] (default: the SSP's libcosim or OMSimulator
-    /// annotation; the FMU's DefaultExperiment, else 1/500 to 1/1000 of the run as fmpy).
-    #[arg(long)]
+    /// Communication step [s]. Default: the description's; an SSP's libcosim or OMSimulator
+    /// annotation; an FMU alone, its DefaultExperiment's, else 1/500 to 1/1000 of the run as
+    /// fmpy.
+    #[arg(long, allow_negative_numbers = true)]
     pub step: Option<f64>,
-    /// SSP only: stop time [s] (default: the SSP's DefaultExperiment).
-    #[arg(long)]
-    pub stop_time: Option<f64>,
-    /// SSP only: coupling algorithm, jacobi (default) or gauss-seidel.
+    /// Start time [s]. Default: the description's; the SSP's or FMU's DefaultExperiment's,
+    /// else 0.
+    #[arg(long, allow_negative_numbers = true)]
+    pub start: Option<f64>,
+    /// Stop time [s]. Default: the description's; the SSP's or FMU's DefaultExperiment's
+    /// (an FMU without one: start + 1).
+    #[arg(long, visible_alias = "stop-time", allow_negative_numbers = true)]
+    pub stop: Option<f64>,
+    /// Coupling algorithm, jacobi or gauss-seidel. Default: the description's (gauss-seidel
+    /// unless it says), jacobi for an SSP. Not for an FMU alone.
     #[arg(long, value_parser = parse_algorithm)]
     pub algorithm: Option<Algorithm>,
-    /// Single FMU: start time [s] (default: its DefaultExperiment's, else 0).
-    #[arg(long)]
-    pub start: Option<f64>,
-    /// Single FMU: stop time [s] (default: its DefaultExperiment's, else start + 1).
-    #[arg(long)]
-    pub stop: Option<f64>,
-    /// Single FMU: start value of a parameter or input, NAME=VALUE (repeatable; numbers,
-    /// true/false, text for Strings, an item name or integer for Enumerations).
+    /// Start value of a parameter or input, NAME=VALUE (repeatable): NAME is
+    /// instance.variable in a system, the variable's name for an FMU alone; numbers,
+    /// true/false, text for Strings, an item name or integer for Enumerations. Replaces the
+    /// description's value.
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
-    /// Single FMU: variables to record (default: every output).
+    /// Variables to record, replacing the description's list (instance.variable in a system,
+    /// the variable's name for an FMU alone; default: the description's, every output of an
+    /// FMU alone).
     #[arg(long, num_args = 1.., value_name = "NAME")]
     pub record: Vec<String>,
-    /// Single FMU: switch the FMU's own logging on (loggingOn).
+    /// Switch the FMUs' own logging on (loggingOn), every instance of a system.
     #[arg(long)]
     pub fmu_logging: bool,
 }
@@ -78,12 +83,18 @@ impl Args {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("fmu"))
     }
-    fn single_only(&self) -> bool {
-        self.start.is_some()
-            || self.stop.is_some()
-            || !self.set.is_empty()
-            || !self.record.is_empty()
-            || self.fmu_logging
+    /// What a system (JSON or SSP) changes in its description.
+    fn overrides(&self) -> SystemOverrides {
+        SystemOverrides {
+            from: OverridesFrom::CommandLine,
+            start_time: self.start,
+            stop_time: self.stop,
+            step: self.step,
+            algorithm: self.algorithm,
+            set: self.set.clone(),
+            record: self.record.clone(),
+            logging: self.fmu_logging,
+        }
     }
 }
 
@@ -94,17 +105,11 @@ fn default_output(format: ResultsFormat) -> PathBuf {
 }
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
-    if !args.is_fmu() && args.single_only() {
-        return Err(CommandError::Failed(format!(
-            "{}: --start, --stop, --set, --record and --fmu-logging apply to an .fmu run alone",
-            args.system.display()
-        )));
-    }
     // an imported SSP's FMUs live in a temporary folder as long as `_imported` does
     let (sys, _imported) = if args.is_fmu() {
-        if args.stop_time.is_some() || args.algorithm.is_some() {
+        if args.algorithm.is_some() {
             return Err(CommandError::Failed(
-                "--stop-time and --algorithm apply to SSPs; an .fmu alone takes --stop".into(),
+                "--algorithm: an FMU run alone has no coupling".into(),
             ));
         }
         let opts = SingleFmuOptions {
@@ -119,18 +124,17 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     } else if ssp::is_ssp_path(&args.system) {
         let opts = ImportOptions {
             step: args.step,
-            stop_time: args.stop_time,
+            stop_time: args.stop,
             algorithm: args.algorithm,
         };
         let imported = ssp::import(&args.system, &opts)?;
-        (imported.system.clone(), Some(imported))
+        let mut sys = imported.system.clone();
+        sys.apply_overrides(&args.overrides())?;
+        (sys, Some(imported))
     } else {
-        if args.step.is_some() || args.stop_time.is_some() || args.algorithm.is_some() {
-            return Err(CommandError::Failed(
-                "--step, --stop-time and --algorithm apply to SSPs; a JSON system description sets them itself".into(),
-            ));
-        }
-        (LoadedSystem::load(&args.system)?, None)
+        let mut sys = LoadedSystem::load(&args.system)?;
+        sys.apply_overrides(&args.overrides())?;
+        (sys, None)
     };
     // the files it reads: the system file and every FMU (those of an archive are unpacked)
     let inputs: Vec<PathBuf> = std::iter::once(args.system.clone())

@@ -450,10 +450,12 @@ impl LoadedSystem {
     }
 }
 
+mod overrides;
 mod plan;
 mod prepared;
 mod single;
 
+pub use overrides::{OverridesFrom, SystemOverrides};
 pub use prepared::{PreparedSystem, RunChanges};
 pub use single::{default_timing, instance_name, parse_set_value, round_step, SingleFmuOptions};
 
