@@ -217,7 +217,7 @@ const E1_FILES: [&str; 6] = [
 fn contact_geometry_defaults_to_e1() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("cg");
-    let r = master(&["contact-geometry", "--out", out.to_str().unwrap()]);
+    let r = master(&["contact-geometry", "-o", out.to_str().unwrap()]);
     assert!(r.ok, "{}\n{}", r.stdout, r.stderr);
     check_files(&out, &E1_FILES);
     let table = std::fs::read_to_string(out.join("wheel_rail_table.csv")).unwrap();
@@ -530,7 +530,7 @@ fn contact_geometry_without_a_value_fails_and_writes_nothing() {
 fn contact_geometry_reports_two_point_contact() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("cg");
-    let r = master(&["contact-geometry", "--out", out.to_str().unwrap()]);
+    let r = master(&["contact-geometry", "--output", out.to_str().unwrap()]);
     assert!(r.ok, "{}", r.stderr);
     let y = number_after(&r.stdout, "two-point contact on the right wheel at y =");
     assert!(y > 6.3 && y < 6.8, "{y}");

@@ -67,7 +67,7 @@ pub struct GlobalArgs {
 /// The generic subcommands.
 #[derive(Debug, clap::Subcommand)]
 pub enum GenericCommand {
-    /// Run one system description and write results as CSV.
+    /// Run one system description (or one FMU alone) and write results as CSV or Parquet.
     Run(run::Args),
     /// Run parameter variations of a system in parallel.
     Sweep(sweep::Args),

@@ -54,7 +54,13 @@ pub struct Args {
     #[arg(long)]
     pub accept_narrow_band: bool,
     /// Output folder (created if needed; files are written only once everything is computed).
-    #[arg(long, value_name = "DIR", default_value = "results/assess")]
+    #[arg(
+        short = 'o',
+        long,
+        visible_alias = "output",
+        value_name = "DIR",
+        default_value = "results/assess"
+    )]
     pub out: PathBuf,
 }
 

@@ -37,7 +37,13 @@ pub struct Args {
     #[arg(value_enum, default_value_t = Target::All)]
     pub target: Target,
     /// Output folder (created if needed; files are written only once everything is computed).
-    #[arg(long, value_name = "DIR", default_value = "results/characterise")]
+    #[arg(
+        short = 'o',
+        long,
+        visible_alias = "output",
+        value_name = "DIR",
+        default_value = "results/characterise"
+    )]
     pub out: PathBuf,
     /// Number of log-spaced frequencies of the damper FRF (2 to 10000).
     #[arg(long, default_value_t = 25, value_parser = frf_points)]

@@ -82,7 +82,13 @@ pub struct Args {
     #[arg(long, value_name = "DIR", conflicts_with_all = ["wheel", "wheel_right"])]
     pub wheel_dir: Option<PathBuf>,
     /// Output folder (created if needed; files are written only once everything is computed).
-    #[arg(long, value_name = "DIR", default_value = "results/contact-geometry")]
+    #[arg(
+        short = 'o',
+        long,
+        visible_alias = "output",
+        value_name = "DIR",
+        default_value = "results/contact-geometry"
+    )]
     pub out: PathBuf,
 }
 

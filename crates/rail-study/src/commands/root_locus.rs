@@ -51,7 +51,13 @@ pub struct Args {
     #[arg(long)]
     pub conicity: Option<f64>,
     /// Output folder (created if needed; files are written only once everything is computed).
-    #[arg(long, value_name = "DIR", default_value = "results/root-locus")]
+    #[arg(
+        short = 'o',
+        long,
+        visible_alias = "output",
+        value_name = "DIR",
+        default_value = "results/root-locus"
+    )]
     pub out: PathBuf,
 }
 

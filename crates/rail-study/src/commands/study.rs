@@ -32,7 +32,13 @@ pub struct Args {
     pub fmus: Option<PathBuf>,
     /// Output folder. An earlier study's report, figures and tables in it are removed when
     /// the study starts (the user's other files stay).
-    #[arg(long, default_value = "results")]
+    #[arg(
+        short = 'o',
+        long,
+        visible_alias = "output",
+        value_name = "DIR",
+        default_value = "results"
+    )]
     pub out: PathBuf,
     /// Reduced study for CI: 1 seed, shorter runs, fewer speeds, coarser bisection.
     #[arg(long)]
