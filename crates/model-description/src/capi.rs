@@ -290,13 +290,28 @@ pub unsafe fn instantiate(
             instance_name: c_string_lossy(name),
         };
         let component = Component::new(model, ctx, Box::new(logger), logging_on != 0);
-        Box::into_raw(Box::new(CComponent {
+        let c = Box::into_raw(Box::new(CComponent {
             component,
             serialized: None,
             booleans: Vec::new(),
-        })) as fmi2Component
+        })) as fmi2Component;
+        live_instances().push(c as usize);
+        c
     }));
     result.unwrap_or(std::ptr::null_mut())
+}
+
+/// The instances this binary gave out and has not freed. Only fmi2Instantiate and
+/// fmi2FreeInstance look at it (a lock on every call would cost more than the call): a host
+/// that frees an instance twice, or frees a pointer that is not one of ours, has nothing freed
+/// instead of corrupting its heap. Any other call with a freed instance stays undefined.
+static LIVE_INSTANCES: std::sync::Mutex<Vec<usize>> = std::sync::Mutex::new(Vec::new());
+
+fn live_instances() -> std::sync::MutexGuard<'static, Vec<usize>> {
+    // a panic while the lock is held cannot leave the list half-changed (push and swap_remove)
+    LIVE_INSTANCES
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// How many `fmi2*` calls on components are running ([`with`]), in any thread. In an FMU's
@@ -341,6 +356,14 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> &str {
 pub unsafe fn free_instance(c: fmi2Component) {
     if c.is_null() {
         return;
+    }
+    {
+        let mut live = live_instances();
+        let Some(i) = live.iter().position(|&p| p == c as usize) else {
+            // freed already, or not ours: the host has no logger left to tell
+            return;
+        };
+        live.swap_remove(i);
     }
     let _ = catch_unwind(AssertUnwindSafe(|| {
         drop(Box::from_raw(c as *mut CComponent));

@@ -364,3 +364,25 @@ fn serialised_bytes_are_those_of_the_state_asked_for_even_at_a_freed_states_addr
         free_instance(other);
     }
 }
+
+#[test]
+fn an_instance_freed_twice_or_a_pointer_not_ours_is_not_freed_again() {
+    unsafe {
+        let (c, _log) = fragile();
+        let (other, _other_log) = fragile();
+        free_instance(c);
+        // without the list of live instances the second free corrupts the heap (glibc aborts)
+        free_instance(c);
+        let mut not_ours = [0u64; 8];
+        free_instance(not_ours.as_mut_ptr().cast());
+        assert_eq!(not_ours, [0u64; 8]);
+        // the other instance lives on
+        start_at(other, 0.0);
+        let u = [value_reference::<Fragile>("u").unwrap()];
+        assert_eq!(set_real(other, u.as_ptr(), 1, [1.0].as_ptr()), FMI2_OK);
+        assert_eq!(do_step(other, 0.0, 0.1), FMI2_OK);
+        free_instance(other);
+        free_instance(other);
+        assert!(!live_instances().contains(&(other as usize)));
+    }
+}
