@@ -214,7 +214,7 @@ fn a_deserialised_state_with_a_parameter_out_of_its_range_is_refused() {
             // forged with a matching checksum: the value's own check names it
             let n = altered.len() - 4;
             altered.truncate(n);
-            crate::component::seal(&mut altered);
+            crate::state_bytes::seal(&mut altered);
             assert_eq!(deserialise(&altered), FMI2_ERROR);
             let expected = format!("'gain' = {shown} is outside its range");
             assert!(

@@ -263,7 +263,7 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
     }
 
     fn deserialize(&self, bytes: &[u8]) -> Result<Box<dyn Any + Send>, String> {
-        let tagged: Tagged<M> = crate::component::strict_bincode(bytes)
+        let tagged: Tagged<M> = crate::state_bytes::strict_bincode(bytes)
             .map_err(|e| format!("not a serialised state of model {}: {e}", M::INFO.name))?;
         if tagged.model_name != M::INFO.name {
             return Err(format!(

@@ -27,6 +27,7 @@ pub mod files;
 pub mod finite;
 pub mod model;
 pub mod package;
+mod state_bytes;
 #[cfg(feature = "testing")]
 pub mod testing;
 pub mod timing;

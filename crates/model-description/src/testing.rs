@@ -96,5 +96,5 @@ pub fn allocations_during<T>(f: impl FnOnce() -> T) -> (usize, T) {
 pub fn reseal_state(bytes: &mut Vec<u8>) {
     let n = bytes.len().saturating_sub(4);
     bytes.truncate(n);
-    crate::component::seal(bytes);
+    crate::state_bytes::seal(bytes);
 }
