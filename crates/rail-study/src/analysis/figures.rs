@@ -4,6 +4,7 @@
 
 use std::ops::Range;
 
+use plotters::coord::combinators::{BindKeyPoints, LogCoord, WithKeyPoints};
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 
@@ -90,10 +91,63 @@ pub fn lines_svg(chart: &Chart, x: Scale, y: Scale) -> Result<String, PlotError>
     let yr = axis_range(y0, y1, y, true);
     let span = (xr.start, xr.end);
     match (x, y) {
-        (Scale::Log, Scale::Log) => render(chart, xr.log_scale(), yr.log_scale(), span, x, y),
-        (Scale::Log, Scale::Linear) => render(chart, xr.log_scale(), yr, span, x, y),
-        _ => render(chart, xr, yr.log_scale(), span, x, y),
+        (Scale::Log, Scale::Log) => render(chart, log_axis(xr), log_axis(yr), span, x, y),
+        (Scale::Log, Scale::Linear) => render(chart, log_axis(xr), yr, span, x, y),
+        _ => render(chart, xr, log_axis(yr), span, x, y),
     }
+}
+
+/// A logarithmic axis with the ticks of [`log_ticks`]: plotters' own put no tick below the
+/// range's first power of ten (a modulus from 0.25 to 15 had labels from 1 to 10 only) and
+/// about a hundred light lines within one decade.
+fn log_axis(r: Range<f64>) -> WithKeyPoints<LogCoord<f64>> {
+    let (bold, light) = log_ticks(r.start, r.end);
+    r.log_scale().with_key_points(bold).with_light_points(light)
+}
+
+/// Labelled ticks and light grid lines of a logarithmic axis over `lo..hi` (both > 0): grid
+/// lines at 1..9 times each power of ten; labels at 1, 2 and 5 times a power of ten over up to
+/// four decades, at the powers of ten over more (every second, third, ... beyond twelve), at
+/// every grid line when that gives fewer than three, and at the ends when not even two
+/// grid lines fall in the range.
+fn log_ticks(lo: f64, hi: f64) -> (Vec<f64>, Vec<f64>) {
+    if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+        return (Vec::new(), Vec::new());
+    }
+    let first = lo.log10().floor() as i32;
+    let last = hi.log10().ceil() as i32;
+    let in_range = |v: &f64| *v >= lo * (1.0 - 1e-9) && *v <= hi * (1.0 + 1e-9);
+    let multiples = |ms: &[f64], every: i32| -> Vec<f64> {
+        (first..=last)
+            .filter(|d| d.rem_euclid(every) == 0)
+            // m / 10^-d for a negative d: 0.3, where 3 x 0.1 gives 0.30000000000000004
+            .flat_map(|d| {
+                ms.iter().map(move |m| {
+                    if d >= 0 {
+                        m * 10f64.powi(d)
+                    } else {
+                        m / 10f64.powi(-d)
+                    }
+                })
+            })
+            .filter(in_range)
+            .collect()
+    };
+    let all = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0];
+    let light = multiples(&all, 1);
+    let decades = (hi / lo).log10();
+    let mut bold = if decades <= 4.0 {
+        multiples(&[1.0, 2.0, 5.0], 1)
+    } else {
+        multiples(&[1.0], (decades / 12.0).ceil().max(1.0) as i32)
+    };
+    if bold.len() < 3 {
+        bold = light.clone();
+    }
+    if bold.len() < 2 {
+        bold = vec![lo, hi];
+    }
+    (bold, light)
 }
 
 fn render<X, Y>(
@@ -264,6 +318,30 @@ impl ColourScatter {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn log_ticks_label_every_decade_part_of_the_range() {
+        // the damper modulus: 0.25 to 15 kN/mm
+        let (bold, light) = log_ticks(0.25, 15.0);
+        assert_eq!(bold, [0.5, 1.0, 2.0, 5.0, 10.0]);
+        assert_eq!(light.first(), Some(&0.3));
+        assert_eq!(light.last(), Some(&10.0));
+        assert_eq!(light.len(), 7 + 9 + 1);
+        // a frequency band of 0.5 to 20 Hz keeps 1-2-5
+        assert_eq!(log_ticks(0.5, 20.0).0, [0.5, 1.0, 2.0, 5.0, 10.0, 20.0]);
+        // six decades: the powers of ten
+        assert_eq!(
+            log_ticks(1e-3, 1e3).0,
+            [1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0, 1e3]
+        );
+        // thirty decades: every third
+        let wide = log_ticks(1e-15, 1e15).0;
+        assert_eq!(wide.len(), 11);
+        // a narrow range: every grid line, or its ends
+        assert_eq!(log_ticks(3.5, 8.5).0, [4.0, 5.0, 6.0, 7.0, 8.0]);
+        assert_eq!(log_ticks(3.1, 3.9).0, [3.1, 3.9]);
+        assert!(log_ticks(0.0, 1.0).0.is_empty());
+    }
 
     #[test]
     fn log_log_chart_skips_non_positive_points() {

@@ -280,6 +280,8 @@ where
         .configure_mesh()
         .x_desc(spec.labels.0)
         .y_desc(spec.labels.1)
+        .x_label_formatter(&|v| tick_label(*v))
+        .y_label_formatter(&|v| tick_label(*v))
         .draw()
         .map_err(|e| draw_err(title, &e))?;
     let entries = body(&mut chart)?;
@@ -382,4 +384,35 @@ where
         ))
         .map_err(|e| draw_err(title, &e))?;
     Ok(LegendEntry::new(label, Swatch::Dashed(RED.to_rgba())))
+}
+
+/// A tick value as a person writes it: 250 and 0.3, not 250.0 and 0.30000000000000004 (the
+/// value rounded to 9 significant digits, then printed in its shortest form; within 1e-4 and
+/// 1e6 in magnitude without an exponent).
+pub(crate) fn tick_label(v: f64) -> String {
+    let rounded: f64 = format!("{v:.8e}").parse().unwrap_or(v);
+    if rounded == 0.0 {
+        "0".to_string()
+    } else if (1e-4..1e6).contains(&rounded.abs()) {
+        format!("{rounded}")
+    } else {
+        format!("{rounded:e}")
+    }
+}
+
+#[cfg(test)]
+mod tick_tests {
+    use super::tick_label;
+
+    #[test]
+    fn ticks_print_as_written_by_hand() {
+        assert_eq!(tick_label(250.0), "250");
+        assert_eq!(tick_label(0.1 + 0.2), "0.3");
+        assert_eq!(tick_label(-2.5), "-2.5");
+        assert_eq!(tick_label(-0.0), "0");
+        assert_eq!(tick_label(1e-3), "0.001");
+        assert_eq!(tick_label(2e-6), "2e-6");
+        assert_eq!(tick_label(3.5e7), "3.5e7");
+        assert_eq!(tick_label(12.0), "12");
+    }
 }
