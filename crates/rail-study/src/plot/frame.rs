@@ -216,6 +216,41 @@ fn titled<'a>(
     Ok(rest)
 }
 
+/// Font size plotters gives an axis description by default (that of the tick labels) [px].
+const AXIS_DESC_FONT_PX: u32 = 12;
+
+/// Length of an axis description on the figure [px], estimated as for the legend.
+pub(super) fn axis_desc_px(text: &str) -> u32 {
+    let em = f64::from(AXIS_DESC_FONT_PX) / 1.24;
+    (text.chars().count() as f64 * 0.56 * em).ceil() as u32
+}
+
+/// Height of a panel's plotting area for a panel `panel_px` high: less its caption, the
+/// margins and the tick labels below it [px].
+pub(super) fn panel_plot_px(panel_px: u32) -> u32 {
+    panel_px.saturating_sub(2 * 12 + PANEL_FONT_PX + 10 + 45)
+}
+
+/// Writes `text` once, rotated, at the left edge of `area` and centred on its height: the y
+/// description of stacked panels, when it is longer than one panel is tall (each panel's own
+/// ran into its neighbours). Cut to the area's height.
+pub(super) fn draw_shared_y_desc(
+    area: &DrawingArea<SVGBackend<'_>, Shift>,
+    title: &str,
+    text: &str,
+) -> Result<(), PlotError> {
+    let (_, h) = area.dim_in_pixel();
+    let per_char = axis_desc_px("0000000000") as f64 / 10.0;
+    let text = cut(text, (f64::from(h.saturating_sub(20)) / per_char) as usize);
+    let style = ("sans-serif", AXIS_DESC_FONT_PX)
+        .into_font()
+        .transform(FontTransform::Rotate270)
+        .into_text_style(area)
+        .pos(Pos::new(HPos::Center, VPos::Top));
+    area.draw(&Text::new(text, (12, h as i32 / 2), style))
+        .map_err(|e| draw_err(title, &e))
+}
+
 /// A figure of `size` as an SVG string: white background, the title, then `draw` on the area
 /// below the title.
 pub(super) fn svg_figure(

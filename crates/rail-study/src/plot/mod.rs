@@ -17,12 +17,13 @@ use plotters::prelude::*;
 
 use master::output::{write_bytes_atomic, OutputError};
 
+use frame::{
+    axis_desc_px, cut, draw_frame, draw_shared_y_desc, panel_plot_px, svg_figure, title_height_px,
+    Frame, FrameSpec, MAX_PANEL_CHARS, PANEL_FONT_PX,
+};
 pub(crate) use frame::{
     colour, draw_err, draw_legend, draw_limit, draw_lines, legend_width, longest, render_svg,
     LegendEntry, Swatch,
-};
-use frame::{
-    cut, draw_frame, svg_figure, title_height_px, Frame, FrameSpec, MAX_PANEL_CHARS, PANEL_FONT_PX,
 };
 
 #[derive(Debug, thiserror::Error)]
@@ -248,6 +249,8 @@ impl Chart {
         let n = self.panels.len();
         let width = self.width + legend_px;
         let height = title_height_px(t, width) + self.panel_height * n as u32;
+        // a y description longer than one panel is tall is written once beside the stack
+        let shared_y = axis_desc_px(&self.y_label) > panel_plot_px(self.panel_height);
         svg_figure(t, (width, height), |panels| {
             for (p, area) in panels.split_evenly((n, 1)).iter().enumerate() {
                 let last = p + 1 == n;
@@ -256,12 +259,15 @@ impl Chart {
                     caption: Some((caption.as_str(), PANEL_FONT_PX)),
                     labels: (
                         if last { self.x_label.as_str() } else { "" },
-                        self.y_label.as_str(),
+                        if shared_y { "" } else { self.y_label.as_str() },
                     ),
                     legend_px,
                     legend: self.needs_legend(p),
                 };
                 draw_frame(area, t, &spec, (x0..x1, y0..y1), |c| body(p, c))?;
+            }
+            if shared_y {
+                draw_shared_y_desc(panels, t, &self.y_label)?;
             }
             Ok(())
         })

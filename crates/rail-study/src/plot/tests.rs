@@ -227,3 +227,27 @@ fn markers_put_a_dot_on_every_point() {
     assert_eq!(dots(&c.to_svg(false).unwrap()), 0);
     assert_eq!(dots(&c.with_markers().to_svg(false).unwrap()), 5);
 }
+
+#[test]
+fn a_y_description_longer_than_a_panel_is_written_once_beside_the_stack() {
+    let long = "leading wheelset lateral displacement relative to the track [mm]";
+    let line = vec![(0.0, 1.0), (1.0, -1.0), (2.0, 1.0)];
+    let c = Chart::new("perturbation", "time [s]", long)
+        .with_series("240 km/h", line.clone())
+        .with_series("280 km/h", line.clone())
+        .with_series("300 km/h", line.clone())
+        .one_panel_per_series();
+    let svg = c.to_svg(false).unwrap();
+    let all = texts(&svg);
+    assert_eq!(found(&all, long).len(), 1, "{all:?}");
+    // centred on the stack: between the first and the last panel's caption
+    let y = found(&all, long)[0].1;
+    assert!(found(&all, "240 km/h")[0].1 < y && y < found(&all, "300 km/h")[0].1);
+    // a short one stays in each panel
+    let c = Chart::new("history", "time [s]", "displacement [mm]")
+        .with_series("240 km/h", line.clone())
+        .with_series("280 km/h", line)
+        .one_panel_per_series();
+    let all = texts(&c.to_svg(false).unwrap());
+    assert_eq!(found(&all, "displacement [mm]").len(), 2);
+}
