@@ -203,7 +203,8 @@ pub fn csv_field(s: &str) -> String {
 }
 
 /// Writes a numeric CSV table atomically. Every row must have `header.len()` values.
-/// Numbers are written with Rust's shortest round-trip formatting (no precision loss).
+/// Numbers are written with Rust's shortest round-trip formatting (no precision loss), in
+/// exponential form outside 1e-4..1e16 in magnitude ([`crate::show::num`]).
 pub fn write_csv_atomic<'a, I>(path: &Path, header: &[String], rows: I) -> Result<(), OutputError>
 where
     I: IntoIterator<Item = &'a [f64]>,
@@ -226,7 +227,8 @@ where
                     w.write_all(b",").map_err(io_err(path))?;
                 }
                 first = false;
-                write!(w, "{v}").map_err(io_err(path))?;
+                // 1e-300 as such, not as 300 zeros and a 1; exact as before
+                write!(w, "{}", crate::show::num(*v)).map_err(io_err(path))?;
             }
             w.write_all(b"\n").map_err(io_err(path))?;
         }
@@ -295,10 +297,26 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("a.csv");
         let header = vec!["time [s]".to_string(), "x,y [m]".to_string()];
-        let rows = [vec![0.0, 1.5], vec![0.1, -2.25e-7]];
+        let tiny = 4.785669883657919e-300;
+        let rows = [
+            vec![0.0, 1.5],
+            vec![0.1, -2.25e-7],
+            vec![0.2, tiny],
+            vec![1e300, 0.001],
+        ];
         write_csv_atomic(&p, &header, rows.iter().map(|r| r.as_slice())).unwrap();
         let text = std::fs::read_to_string(&p).unwrap();
-        assert_eq!(text, "time [s],\"x,y [m]\"\n0,1.5\n0.1,-0.000000225\n");
+        assert_eq!(
+            text,
+            "time [s],\"x,y [m]\"\n0,1.5\n0.1,-2.25e-7\n0.2,4.785669883657919e-300\n1e300,0.001\n"
+        );
+        // every value reads back exactly
+        let back: Vec<f64> = text
+            .lines()
+            .skip(1)
+            .flat_map(|l| l.split(',').map(|v| v.parse::<f64>().unwrap()))
+            .collect();
+        assert_eq!(back, rows.concat());
         // only the result is left in the folder, no temporary file
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
