@@ -533,8 +533,10 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         series(r, &slow, &command, 0.1),
         series(r, &slow, &opening, 1.0),
     ) {
-        let t_end = cmd.last().map_or(0.0, |p| p.0);
-        let zoom = |s: &[(f64, f64)]| from_time(s, t_end - 1.0);
+        // the second where the command switches most: on the coach the sky-hook settles
+        // and its last second held only numerical noise (1e-20)
+        let t0 = busiest_second(&cmd);
+        let zoom = |s: &[(f64, f64)]| between(s, t0, t0 + 1.0);
         write_series_csv(
             &out.join("skyhook_valve_zoom.csv"),
             &[
@@ -544,7 +546,9 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         )?;
         Chart::new(
             &format!(
-                "on/off sky-hook, slow valve, {v_hil:.0} km/h: command and actual opening, last 1 s ({:.0} Hz samples)",
+                "on/off sky-hook, slow valve, {v_hil:.0} km/h: command and actual opening, \
+                 {t0:.0}-{:.0} s, the second where the command varies most ({:.0} Hz samples)",
+                t0 + 1.0,
                 r.settings.stored_rate_hz
             ),
             "time [s]",
@@ -691,6 +695,39 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
 /// The points of a time series from `t0` on (zoomed figures).
 fn from_time(s: &[(f64, f64)], t0: f64) -> Vec<(f64, f64)> {
     s.iter().filter(|p| p.0 >= t0).copied().collect()
+}
+
+/// The points of `s` from `t0` to `t1`, both included.
+fn between(s: &[(f64, f64)], t0: f64, t1: f64) -> Vec<(f64, f64)> {
+    s.iter()
+        .filter(|p| p.0 >= t0 && p.0 <= t1 + 1e-9)
+        .copied()
+        .collect()
+}
+
+/// Start of the whole second of `s` (from its first time on) where its values vary most
+/// (largest standard deviation); the last whole second when none varies.
+fn busiest_second(s: &[(f64, f64)]) -> f64 {
+    let (Some(first), Some(last)) = (s.first(), s.last()) else {
+        return 0.0;
+    };
+    let seconds = (last.0 - first.0).floor().max(1.0) as usize;
+    let spread = |t0: f64| {
+        let w = between(s, t0, t0 + 1.0);
+        let n = w.len().max(1) as f64;
+        let mean = w.iter().map(|p| p.1).sum::<f64>() / n;
+        w.iter().map(|p| (p.1 - mean).powi(2)).sum::<f64>() / n
+    };
+    let mut best = (last.0 - 1.0).max(first.0);
+    let mut most = spread(best);
+    for k in 0..seconds {
+        let t0 = first.0 + k as f64;
+        let v = spread(t0);
+        if v > most {
+            (best, most) = (t0, v);
+        }
+    }
+    best
 }
 
 mod markdown;

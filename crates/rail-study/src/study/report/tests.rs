@@ -355,3 +355,22 @@ fn force_bound_note_names_the_saturated_gains_from_the_runs() {
         "{text}"
     );
 }
+
+#[test]
+fn the_valve_zoom_takes_the_second_where_the_command_switches() {
+    // switching from 0 to 33 s, then settled (the coach's sky-hook on the slow valve)
+    let cmd: Vec<(f64, f64)> = (0..4000)
+        .map(|i| {
+            let t = i as f64 * 0.01;
+            let amplitude = if t < 33.0 { 1.0 + t / 100.0 } else { 1e-20 };
+            (t, amplitude * (t * 40.0).sin())
+        })
+        .collect();
+    assert_eq!(super::busiest_second(&cmd), 32.0);
+    // nothing varies: the last second
+    let flat: Vec<(f64, f64)> = (0..4001).map(|i| (i as f64 * 0.01, 0.0)).collect();
+    assert_eq!(super::busiest_second(&flat), 39.0);
+    let w = super::between(&flat, 39.0, 40.0);
+    assert_eq!((w.len(), w[0].0, w[100].0), (101, 39.0, 40.0));
+    assert_eq!(super::busiest_second(&[]), 0.0);
+}
