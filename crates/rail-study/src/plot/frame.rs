@@ -311,12 +311,13 @@ where
         .y_label_area_size(70)
         .build_cartesian_2d(xr, yr)
         .map_err(|e| draw_err(title, &e))?;
+    let (x_span, y_span) = (chart.x_range(), chart.y_range());
     chart
         .configure_mesh()
         .x_desc(spec.labels.0)
         .y_desc(spec.labels.1)
-        .x_label_formatter(&|v| tick_label(*v))
-        .y_label_formatter(&|v| tick_label(*v))
+        .x_label_formatter(&|v| tick_label(*v, &x_span))
+        .y_label_formatter(&|v| tick_label(*v, &y_span))
         .draw()
         .map_err(|e| draw_err(title, &e))?;
     let entries = body(&mut chart)?;
@@ -423,8 +424,14 @@ where
 
 /// A tick value as a person writes it: 250 and 0.3, not 250.0 and 0.30000000000000004 (the
 /// value rounded to 9 significant digits, then printed in its shortest form; within 1e-4 and
-/// 1e6 in magnitude without an exponent).
-pub(crate) fn tick_label(v: f64) -> String {
+/// 1e6 in magnitude without an exponent). On an axis `span` that holds 0, a tick within 1e-9 of
+/// the span's length of it is 0 (plotters gave 1.4e-17 for the 0 of a damping-ratio axis).
+pub(crate) fn tick_label(v: f64, span: &std::ops::Range<f64>) -> String {
+    let length = (span.end - span.start).abs();
+    let holds_zero = span.start.min(span.end) <= 0.0 && span.start.max(span.end) >= 0.0;
+    if holds_zero && v.abs() <= length * 1e-9 {
+        return "0".to_string();
+    }
     let rounded: f64 = format!("{v:.8e}").parse().unwrap_or(v);
     if rounded == 0.0 {
         "0".to_string()
@@ -441,13 +448,20 @@ mod tick_tests {
 
     #[test]
     fn ticks_print_as_written_by_hand() {
-        assert_eq!(tick_label(250.0), "250");
-        assert_eq!(tick_label(0.1 + 0.2), "0.3");
-        assert_eq!(tick_label(-2.5), "-2.5");
-        assert_eq!(tick_label(-0.0), "0");
-        assert_eq!(tick_label(1e-3), "0.001");
-        assert_eq!(tick_label(2e-6), "2e-6");
-        assert_eq!(tick_label(3.5e7), "3.5e7");
-        assert_eq!(tick_label(12.0), "12");
+        let t = |v: f64| tick_label(v, &(-100.0..1e8));
+        assert_eq!(t(250.0), "250");
+        assert_eq!(t(0.1 + 0.2), "0.3");
+        assert_eq!(t(-2.5), "-2.5");
+        assert_eq!(t(-0.0), "0");
+        assert_eq!(t(12.0), "12");
+        assert_eq!(t(3.5e7), "3.5e7");
+        // small values on an axis of their size, or one without 0 (a logarithmic one)
+        assert_eq!(tick_label(1e-3, &(-0.01..0.01)), "0.001");
+        assert_eq!(tick_label(2e-6, &(-1e-5..1e-5)), "2e-6");
+        assert_eq!(tick_label(1e-10, &(1e-11..10.0)), "1e-10");
+        // the zero of a damping-ratio axis, computed with a rounding error
+        let zero = 1.3877787807814457e-17;
+        assert_eq!(tick_label(zero, &(-0.11..0.17)), "0");
+        assert_eq!(tick_label(0.05, &(-0.11..0.17)), "0.05");
     }
 }
