@@ -441,7 +441,10 @@ impl AssessReport {
             }
             chart = chart.with_series(name, a.rms.clone());
         }
-        chart = chart.with_limit(self.limit(), "limit");
+        chart = chart.with_limit(
+            self.limit(),
+            &format!("limit {} {u}", fixed(self.limit(), 3)),
+        );
         if self.signals.len() > 2 {
             // several signals' rms along the track overlap into one band: a panel each
             chart = chart.one_panel_per_series();

@@ -155,22 +155,44 @@ impl Chart {
         refs.chain(own).collect()
     }
 
-    /// Whether panel `p` needs a legend: not when its caption names its only line.
+    /// The name of panel `p`'s only own line when its caption is that name (one panel per
+    /// series): the legend does not repeat it.
+    fn captioned_line(&self, p: usize) -> Option<&str> {
+        let caption = self.panels.get(p)?;
+        let mut own = self.series.iter().filter(|s| !s.reference && s.panel == p);
+        match (own.next(), own.next()) {
+            (Some(only), None) if &only.name == caption => Some(caption),
+            _ => None,
+        }
+    }
+
+    /// What panel `p`'s legend lists: its lines (but one its caption names) and the limit.
+    fn legend_names(&self, p: usize) -> Vec<&str> {
+        let captioned = self.captioned_line(p);
+        self.panel_series(p)
+            .into_iter()
+            .filter(|s| s.reference || captioned.is_none())
+            .map(|s| s.name.as_str())
+            .chain(self.limit.iter().map(|(_, l)| l.as_str()))
+            .collect()
+    }
+
+    /// Whether panel `p` needs a legend (a single frame always has one).
     fn needs_legend(&self, p: usize) -> bool {
-        let entries = self.panel_series(p).len() + usize::from(self.limit.is_some());
-        entries > 1 || self.panels.is_empty()
+        self.panels.is_empty() || !self.legend_names(p).is_empty()
     }
 
     /// The legend column's width, the same for every panel so that their plotting areas
     /// align: enough for the longest entry; none when no panel needs a legend.
     pub(crate) fn legend_px(&self) -> u32 {
-        if !(0..self.panels.len().max(1)).any(|p| self.needs_legend(p)) {
-            return 0;
+        if self.panels.is_empty() {
+            let names = self.series.iter().map(|s| s.name.as_str());
+            return legend_width(longest(
+                names.chain(self.limit.iter().map(|(_, l)| l.as_str())),
+            ));
         }
-        let names = self.series.iter().map(|s| s.name.as_str());
-        legend_width(longest(
-            names.chain(self.limit.iter().map(|(_, l)| l.as_str())),
-        ))
+        let names = (0..self.panels.len()).flat_map(|p| self.legend_names(p));
+        legend_width(longest(names))
     }
 
     fn ranges(&self) -> Result<(Range, Range), PlotError> {
@@ -236,6 +258,9 @@ impl Chart {
             } else {
                 draw_lines(chart, t, &series, self.markers, finite)?
             };
+            if let Some(captioned) = self.captioned_line(p) {
+                entries.retain(|e| e.label != captioned);
+            }
             if let Some((v, label)) = &self.limit {
                 entries.push(draw_limit(chart, t, (x0, x1), *v, label)?);
             }

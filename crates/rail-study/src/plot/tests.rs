@@ -251,3 +251,22 @@ fn a_y_description_longer_than_a_panel_is_written_once_beside_the_stack() {
     let all = texts(&c.to_svg(false).unwrap());
     assert_eq!(found(&all, "displacement [mm]").len(), 2);
 }
+
+#[test]
+fn a_panel_captioned_with_its_line_lists_only_the_limit() {
+    let signal = "vehicle.frame_front.lateral_acceleration_leading_axle";
+    let line = vec![(0.0, 4.0), (100.0, 5.0), (200.0, 6.0)];
+    let c = Chart::new("EN 14363 rms", "position along the track [m]", "rms [m/s2]")
+        .with_series(signal, line.clone())
+        .with_series("rear", line)
+        .with_limit(5.39, "limit")
+        .one_panel_per_series();
+    let svg = c.to_svg(false).unwrap();
+    let all = texts(&svg);
+    // the signal's name once, as its panel's caption; the limit in each panel's legend
+    assert_eq!(found(&all, signal).len(), 1, "{all:?}");
+    assert_eq!(found(&all, "rear").len(), 1, "{all:?}");
+    assert_eq!(found(&all, "limit").len(), 2, "{all:?}");
+    // a column wide enough for "limit", not for the signal's name
+    assert_eq!(c.legend_px(), legend_width("limit".len()));
+}
