@@ -28,7 +28,7 @@ pub enum Target {
 /// Options of `master characterise` (the description shown by `--help` is the `after_help`).
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Characterise the yaw dampers. Writes CSVs and SVG figures into --out and prints the R1 peak-force table and the R3 eigenfrequency next to the seed's values.\n\nFiles (damper): damper_hysteresis.csv, damper_hysteresis_<A>mm_force_displacement.svg, damper_hysteresis_<A>mm_force_velocity.svg, damper_peak_forces.csv, damper_frf.csv, damper_frf_{modulus,phase,k_eq,c_eq}.svg. Files (actuator): actuator_frf.csv, actuator_frf_{modulus,phase}_alpha.svg."
+    after_help = "Characterise the yaw dampers. Writes CSVs and SVG figures into --out and prints the R1 peak-force table and the R3 eigenfrequency next to the seed's values.\n\nFiles (damper): damper_hysteresis.csv, damper_hysteresis_<A>mm_force_displacement.svg, damper_hysteresis_<A>mm_force_velocity.svg, damper_peak_forces.csv, damper_frf.csv, damper_frf_{modulus,phase,k_eq,c_eq}.svg. Files (actuator): actuator_frf.csv (a phase is NaN where the modulus is zero: an amplitude inside the valve's dead zone moves nothing), actuator_frf_{modulus,phase}_alpha.svg."
 )]
 // help texts for a terminal: `[unit]` and `<name>` are plain text, not links or HTML
 #[allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
