@@ -23,7 +23,7 @@ use frame::{
 };
 pub(crate) use frame::{
     colour, draw_err, draw_legend, draw_limit, draw_lines, legend_width, longest, render_svg,
-    LegendEntry, Swatch,
+    tick_label, LegendEntry, Swatch,
 };
 
 #[derive(Debug, thiserror::Error)]

@@ -16,7 +16,9 @@ use wheel_rail::{compute_table, DeltaR};
 
 use super::{check_options, conicity_at, setup_of, ConicityPoint, GeometryInputs, ProfileSource};
 use crate::analysis::{AnalysisError, Artefacts};
-use crate::plot::{colour, draw_legend, legend_width, longest, LegendEntry, PlotError, Swatch};
+use crate::plot::{
+    colour, draw_legend, legend_width, longest, tick_label, LegendEntry, PlotError, Swatch,
+};
 use master::output::csv_field;
 
 /// File name endings read from a `--wheel-dir` folder (case-insensitive).
@@ -361,6 +363,7 @@ fn category_svg(
             .x_labels(n)
             .axis_desc_style(("sans-serif", 15))
             .x_label_formatter(&name_of)
+            .y_label_formatter(&|v| tick_label(*v, &((lo - pad)..(hi + pad))))
             .disable_x_mesh()
             .draw()
             .map_err(|e| draw(&e))?;
