@@ -47,7 +47,7 @@ def _sweep(args: argparse.Namespace) -> int:
     print(f"{ok} of {len(res.reports)} runs ok; see {res.folder / 'sweep.json'}")
     if res.failed:
         # the first ten names: a set of 100 000 failed runs must not print them all on one line
-        names = ", ".join(res.failed[:10])
+        names = ", ".join(list(res.failed)[:10])
         if len(res.failed) > 10:
             names += f" and {len(res.failed) - 10} more (see sweep.json)"
         print(f"error: {len(res.failed)} run(s) failed: {names}", file=sys.stderr)
