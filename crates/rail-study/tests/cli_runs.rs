@@ -270,6 +270,14 @@ fn run_changes_a_system_from_the_command_line() {
         stderr.contains("--algorithm: an FMU run alone has no coupling"),
         "{stderr}"
     );
+    // nor a start value without '='
+    let (code, stderr) = run(&[fmu.to_str().unwrap(), "-o", "bad.csv", "--set", "mass"]);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("--set: 'mass' is not of the form NAME=VALUE"),
+        "{stderr}"
+    );
+    assert!(!d.join("bad.csv").exists());
 }
 
 /// `master inspect` reads the binaries without loading them: platform, format, architecture

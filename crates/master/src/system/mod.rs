@@ -457,7 +457,9 @@ mod single;
 
 pub use overrides::{OverridesFrom, SystemOverrides};
 pub use prepared::{PreparedSystem, RunChanges};
-pub use single::{default_timing, instance_name, parse_set_value, round_step, SingleFmuOptions};
+pub use single::{
+    default_timing, instance_name, parse_set, parse_set_value, round_step, SingleFmuOptions,
+};
 
 #[cfg(test)]
 mod tests;

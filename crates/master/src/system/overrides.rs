@@ -4,7 +4,7 @@
 
 use serde_json::Value;
 
-use super::{parse_set_value, LoadedSystem, StartValueError, SystemError};
+use super::{parse_set, LoadedSystem, StartValueError, SystemError};
 use crate::coupling::Algorithm;
 use crate::show::text;
 
@@ -59,10 +59,7 @@ impl SystemOverrides {
     fn start_values(&self) -> Result<Vec<(String, Value)>, &str> {
         self.set
             .iter()
-            .map(|s| match s.split_once('=') {
-                Some((k, v)) => Ok((k.trim().to_string(), parse_set_value(v.trim()))),
-                None => Err(s.as_str()),
-            })
+            .map(|s| parse_set(s).ok_or(s.as_str()))
             .collect()
     }
 }

@@ -80,6 +80,13 @@ pub fn parse_set_value(text: &str) -> Value {
         .unwrap_or_else(|| Value::String(text.to_string()))
 }
 
+/// A `--set NAME=VALUE` text as (NAME, value of [`parse_set_value`]), both trimmed; None
+/// without '='.
+pub fn parse_set(text: &str) -> Option<(String, Value)> {
+    let (name, value) = text.split_once('=')?;
+    Some((name.trim().to_string(), parse_set_value(value.trim())))
+}
+
 impl LoadedSystem {
     /// The one-instance system that runs the FMU at `path` alone.
     pub fn single_fmu(path: &Path, opts: &SingleFmuOptions) -> Result<Self, SystemError> {
@@ -103,13 +110,13 @@ impl LoadedSystem {
         let name = instance_name(md);
         let mut parameters = BTreeMap::new();
         for s in &opts.set {
-            let Some((k, v)) = s.split_once('=') else {
+            let Some((k, v)) = parse_set(s) else {
                 return Err(invalid(
                     "--set",
                     format!("'{}' is not of the form NAME=VALUE", text(s)),
                 ));
             };
-            parameters.insert(k.trim().to_string(), parse_set_value(v.trim()));
+            parameters.insert(k, v);
         }
         let record = if opts.record.is_empty() {
             // every output, as fmpy records by default

@@ -251,16 +251,22 @@ mod tests {
     use super::*;
     use crate::analysis::locus::speed_grid_kmh;
 
-    #[test]
-    fn passive_coach_root_locus_gives_r15_and_names_the_mode() {
-        let speeds = speed_grid_kmh(200.0, 320.0, 40.0).unwrap();
-        let r = vehicle_root_locus(
+    /// The calibrated coach with the passive damper over `from..=to` km/h in `step`s.
+    fn passive_locus(from: f64, to: f64, step: f64) -> (Vec<f64>, VehicleLocus) {
+        let speeds = speed_grid_kmh(from, to, step).unwrap();
+        let locus = vehicle_root_locus(
             &VehicleParams::default(),
             DamperSpec::Passive,
             None,
             &speeds,
         )
         .unwrap();
+        (speeds, locus)
+    }
+
+    #[test]
+    fn passive_coach_root_locus_gives_r15_and_names_the_mode() {
+        let (speeds, r) = passive_locus(200.0, 320.0, 40.0);
         let c = r.critical.as_ref().unwrap();
         // fmu-vehicle is calibrated to 285 km/h (R15: 280-290)
         assert!((280.0..=290.0).contains(&c.speed_kmh), "{}", c.speed_kmh);
@@ -295,14 +301,7 @@ mod tests {
 
     #[test]
     fn the_figures_follow_the_hunting_mode_not_the_least_damped_one() {
-        let speeds = speed_grid_kmh(100.0, 400.0, 10.0).unwrap();
-        let r = vehicle_root_locus(
-            &VehicleParams::default(),
-            DamperSpec::Passive,
-            None,
-            &speeds,
-        )
-        .unwrap();
+        let (speeds, r) = passive_locus(100.0, 400.0, 10.0);
         let hunting = r.hunting_mode();
         let ld: Vec<_> = r.results.iter().map(|e| e.least_damped.unwrap()).collect();
         // below about 215 km/h the least-damped mode is a 90 Hz mode of the bogies

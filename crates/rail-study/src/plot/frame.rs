@@ -219,10 +219,14 @@ fn titled<'a>(
 /// Font size plotters gives an axis description by default (that of the tick labels) [px].
 const AXIS_DESC_FONT_PX: u32 = 12;
 
-/// Length of an axis description on the figure [px], estimated as for the legend.
+/// Width of one character of an axis description [px], estimated as for the legend.
+fn axis_desc_char_px() -> f64 {
+    0.56 * f64::from(AXIS_DESC_FONT_PX) / 1.24
+}
+
+/// Length of an axis description on the figure [px].
 pub(super) fn axis_desc_px(text: &str) -> u32 {
-    let em = f64::from(AXIS_DESC_FONT_PX) / 1.24;
-    (text.chars().count() as f64 * 0.56 * em).ceil() as u32
+    (text.chars().count() as f64 * axis_desc_char_px()).ceil() as u32
 }
 
 /// Height of a panel's plotting area for a panel `panel_px` high: less its caption, the
@@ -240,8 +244,10 @@ pub(super) fn draw_shared_y_desc(
     text: &str,
 ) -> Result<(), PlotError> {
     let (_, h) = area.dim_in_pixel();
-    let per_char = axis_desc_px("0000000000") as f64 / 10.0;
-    let text = cut(text, (f64::from(h.saturating_sub(20)) / per_char) as usize);
+    let text = cut(
+        text,
+        (f64::from(h.saturating_sub(20)) / axis_desc_char_px()) as usize,
+    );
     let style = ("sans-serif", AXIS_DESC_FONT_PX)
         .into_font()
         .transform(FontTransform::Rotate270)
