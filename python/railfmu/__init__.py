@@ -1,9 +1,9 @@
 """railfmu: the co-simulation master from Python.
 
-Load a system of FMI 2.0 co-simulation FMUs (the master's JSON system description), set start
-values, run it, and get the results as NumPy or pandas with their units; run a run set (a base
-system plus parameter variations) on local threads or on a Dask cluster; read result folders
-back; assess recorded signals by the EN 14363 stability criterion (:func:`assess_stability`).
+Load a system of FMI 2.0 co-simulation FMUs (the master's JSON system description, or an
+SSP), set start values, run it, and get the results as NumPy or pandas with their units; run a
+run set (a base system plus parameter variations) on local threads or on a Dask cluster; read
+result folders back; assess recorded signals by the EN 14363 stability criterion (:func:`assess_stability`).
 Every run is the master's own (the same Rust code as the ``master`` command, bit for bit);
 the GIL is released while FMUs run. Errors are exceptions carrying the master's messages.
 

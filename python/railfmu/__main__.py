@@ -15,6 +15,8 @@ from . import Error, RunSet
 
 
 def _sweep(args: argparse.Namespace) -> int:
+    if args.jobs is not None and args.dask_scheduler:
+        raise Error("--jobs: the runs go to the Dask scheduler's workers; give --jobs or --dask-scheduler, not both")
     rs = RunSet.load(args.runset)
     client = None
     if args.dask_scheduler:

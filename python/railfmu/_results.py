@@ -306,8 +306,10 @@ class RunSetResults(Mapping[str, Results]):
 
 def read_results(path: PathLike) -> Union[Results, RunSetResults]:
     """Reads results back: a run-set folder (with ``sweep.json``) gives a
-    :class:`RunSetResults`; a run folder (with ``results.csv``) or a CSV file gives a
-    :class:`Results`, with the run's statistics when its ``summary.json`` is beside it."""
+    :class:`RunSetResults`; a run folder (with ``results.csv``), a CSV file or a ``.parquet``
+    file (``master run --format parquet``, or one run of a run set's ``results/``) gives a
+    :class:`Results`, with the run's statistics (a CSV's from the ``summary.json`` beside it, a
+    Parquet file's from its metadata)."""
     p = Path(path)
     if p.is_dir() and (p / "sweep.json").is_file():
         return RunSetResults(p)

@@ -46,7 +46,7 @@ class RunSet:
     """A run set expanded into self-contained jobs: each job is its name, its parameters and
     its resolved system description (FMU paths absolute), exactly as ``master sweep`` runs it.
 
-    >>> rs = RunSet.load("study/speeds.json")
+    >>> rs = RunSet.load("python/examples/passive_speeds.json")
     >>> [j["name"] for j in rs.jobs]
     """
 
@@ -112,6 +112,7 @@ class RunSet:
         * ``client=None``: on ``threads`` local threads (default: all cores), the GIL released.
         * ``client=dask.distributed.Client(...)``: one Dask task per run (see
           :mod:`railfmu.dask`); the results come back to this process, which writes the folder.
+          ``threads`` is refused with it (the cluster's workers run the tasks).
         * ``resume=True``: runs already complete in ``output_dir`` (ok, results present in the
           results format of this call, same resolved system) are kept and not run again. The
           format is decided first (``format``, else by size over every job, as a fresh run
@@ -127,6 +128,9 @@ class RunSet:
         """
         if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1):
             raise ValueError(f"threads must be a whole number >= 1 (or None: all cores), got {threads!r}")
+        if threads is not None and client is not None:
+            # the workers of the Dask cluster take the runs as they come: no local threads
+            raise ValueError("threads: the runs go to the Dask client's workers; give threads or client, not both")
         out = Path(output_dir)
         system = None
         if client is None:

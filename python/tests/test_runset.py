@@ -7,6 +7,8 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -162,6 +164,11 @@ def test_bad_run_set_options_raise_python_errors(dist, tmp_path):
     for threads in (-1, 0, 1.5, True):
         with pytest.raises(ValueError, match="threads must be a whole number >= 1"):
             railfmu.run_set(rs, tmp_path / "out", threads=threads)
+    # the cluster's workers run a Dask set: local threads beside a client are refused (the
+    # check comes before the client is used, so any object stands for one)
+    with pytest.raises(ValueError, match="give threads or client, not both"):
+        railfmu.run_set(rs, tmp_path / "out", threads=2, client=object())
+    assert not (tmp_path / "out").exists()
     a_file = tmp_path / "a_file"
     a_file.write_text("x")
     with pytest.raises(railfmu.OutputError, match="cannot create the output folder"):
@@ -318,3 +325,23 @@ def test_a_second_set_into_a_folder_in_use_is_refused(dist, master_cmd, tmp_path
     # released: the next set runs
     assert railfmu.RunSet.from_dict(speed_set(dist, [70.0], stop_time=0.1)).run(out, threads=1).ok
     assert not [p for p in out.iterdir() if p.name.startswith(".")]
+
+
+def test_the_sweep_command_names_the_failed_runs_and_exits_1(dist, tmp_path):
+    rs = speed_set(dist, [40.0], stop_time=0.2)
+    rs["runs"] = [{"name": "standstill", "parameters": {"bogie.vehicle.speed": 0.0}}]
+    path = tmp_path / "set.json"
+    path.write_text(json.dumps(rs))
+    cmd = [sys.executable, "-m", "railfmu", "sweep", str(path), "-o", str(tmp_path / "out"), "-q"]
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 1, r.stderr
+    assert "error: 1 run(s) failed: standstill" in r.stderr, r.stderr
+    assert "1 of 2 runs ok" in r.stdout, r.stdout
+    assert "standstill: FAILED: " in r.stdout, r.stdout
+    assert (tmp_path / "out" / "run-000" / "results.csv").is_file()
+    # --jobs means nothing on a Dask cluster: refused before anything is read or written
+    cmd = [sys.executable, "-m", "railfmu", "sweep", str(path), "-o", str(tmp_path / "dask")]
+    r = subprocess.run(cmd + ["-j", "2", "--dask-scheduler", "tcp://127.0.0.1:1"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 1, r.stderr
+    assert "error: --jobs: the runs go to the Dask scheduler's workers" in r.stderr, r.stderr
+    assert not (tmp_path / "dask").exists()

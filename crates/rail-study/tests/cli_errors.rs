@@ -257,3 +257,21 @@ fn sweep_with_bad_runset_fails_without_output() {
         .contains("product.bodyy.mass: unknown instance 'bodyy'"));
     assert!(!c.path("out").exists());
 }
+
+#[test]
+fn sweep_refuses_local_jobs_on_a_dask_cluster() {
+    let c = Case::new(SYSTEM);
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .args(["--quiet", "sweep", "set.json", "-j", "2"])
+        .args(["--dask-scheduler", "tcp://127.0.0.1:1", "-o"])
+        .arg(c.path("out"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("'--jobs <JOBS>' cannot be used with '--dask-scheduler <ADDRESS>'"),
+        "{stderr}"
+    );
+    assert!(!c.path("out").exists());
+}

@@ -22,8 +22,9 @@ pub struct Args {
     /// Output folder: one sub-folder per run plus sweep.json.
     #[arg(short, long, default_value = "sweep-out")]
     pub output: PathBuf,
-    /// Number of parallel runs (default: all cores).
-    #[arg(short, long)]
+    /// Number of parallel runs (default: all cores). Not with --dask-scheduler, whose workers
+    /// run the runs.
+    #[arg(short, long, conflicts_with = "dask_scheduler")]
     pub jobs: Option<usize>,
     /// Run on a Dask cluster: one task per run, sent to this scheduler (e.g. tcp://host:8786).
     /// Done by the Python package railfmu (`python -m railfmu sweep`), which must be installed

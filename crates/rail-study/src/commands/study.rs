@@ -52,8 +52,8 @@ pub struct Args {
     pub systems: Option<PathBuf>,
     /// Format of each run's stored results: parquet (full rate, runs/<batch>/results/) or
     /// csv (runs/<batch>/<run>/results.csv, decimated to 100 Hz through an anti-aliasing
-    /// low-pass, about a tenth of the size). The numbers come from the full-rate signals
-    /// either way.
+    /// low-pass, about a third of the full-rate Parquet's size). The numbers come from the
+    /// full-rate signals either way.
     #[arg(long, value_enum, default_value = "parquet")]
     pub format: ResultsFormat,
     /// Speed of the full-active c_v sensitivity runs (Table 4-3, R14) [km/h]. Default 380, the
