@@ -107,6 +107,7 @@ fn sweep_err(e: &SweepError) -> PyErr {
         SweepError::Output(_)
         | SweepError::Dir { .. }
         | SweepError::NotARunFolder { .. }
+        | SweepError::NoOutputFolder
         | SweepError::NotATablesFolder { .. }
         | SweepError::FolderInUse { .. } => OutputError::new_err(error_message(e)),
         SweepError::Pool { .. } => Error::new_err(error_message(e)),

@@ -240,6 +240,12 @@ fn run_changes_a_system_from_the_command_line() {
              integer multiple of step = 0.003 s",
         ),
         (
+            // shorter than one step: no step at all, refused before the run
+            vec!["--stop", "1e-12"],
+            "system.json with --stop: step: stop_time - start_time = 1e-12 s is not an integer \
+             multiple of step = 0.001 s",
+        ),
+        (
             vec!["--stop", "-1"],
             "system.json with --stop: stop_time: must be greater than start_time (0), got -1",
         ),

@@ -242,7 +242,7 @@ pub const NOT_STARTED: &str = "not run: the run set was interrupted before this 
 /// are removed, so that nothing of an earlier run looks like this one's result.
 pub fn not_finished(job: &Job, outdir: &Path, error: &str) -> RunReport {
     let dest = outdir.join(&job.name);
-    if is_run_folder(&dest) {
+    if replaceable_run_folder(&dest) {
         let _ = std::fs::remove_dir_all(&dest);
     }
     let table = results_path(outdir, &job.name, ResultsFormat::Parquet);
@@ -259,21 +259,79 @@ pub fn not_finished(job: &Job, outdir: &Path, error: &str) -> RunReport {
     }
 }
 
-/// Whether `dir` is a run folder written by a sweep (it holds the run's `system.json` or
-/// `summary.json`; a folder is swapped into place only with its description in it).
-fn is_run_folder(dir: &Path) -> bool {
-    dir.symlink_metadata().is_ok_and(|m| m.is_dir())
-        && ["system.json", "summary.json"]
+/// The files a run folder holds (a folder is swapped into place only with its description
+/// and its report in it).
+const RUN_FOLDER_FILES: [&str; 4] = [
+    "system.json",
+    "summary.json",
+    "results.csv",
+    "results.meta.json",
+];
+
+/// A run's `summary.json` larger than this is not one (a report is a few kilobytes).
+const MAX_RUN_REPORT_BYTES: u64 = 16 << 20;
+
+/// Whether `dir` may be a run folder written by a sweep: a folder holding nothing but the
+/// files a run writes, among them its description or its report (an interrupted or altered
+/// run of an earlier set).
+fn holds_only_run_files(dir: &Path) -> bool {
+    if !dir.symlink_metadata().is_ok_and(|m| m.is_dir()) {
+        return false;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return false;
+    };
+    for e in entries {
+        let Ok(e) = e else { return false };
+        let ours = RUN_FOLDER_FILES
             .iter()
-            .any(|f| dir.join(f).symlink_metadata().is_ok_and(|m| m.is_file()))
+            .any(|f| e.file_name().to_str() == Some(*f));
+        if !(ours && e.file_type().is_ok_and(|t| t.is_file())) {
+            return false;
+        }
+    }
+    dir.join("system.json").is_file() || dir.join("summary.json").is_file()
+}
+
+/// Whether `dir` holds the report (`summary.json`) of the run of its own name.
+fn holds_its_runs_report(dir: &Path) -> bool {
+    let report = dir.join("summary.json");
+    let small = report
+        .symlink_metadata()
+        .is_ok_and(|m| m.is_file() && m.len() <= MAX_RUN_REPORT_BYTES);
+    let names_this_run = || -> Option<bool> {
+        let r: RunReport = serde_json::from_str(&std::fs::read_to_string(&report).ok()?).ok()?;
+        Some(dir.file_name()?.to_str()? == r.name)
+    };
+    small && names_this_run() == Some(true)
+}
+
+/// Whether a run of the set may replace `dir`, the folder of its name: one that
+/// [`holds_only_run_files`], or a finished run's folder of that name (with what was added to
+/// it since). Anything else there is the user's and is refused.
+fn replaceable_run_folder(dir: &Path) -> bool {
+    dir.symlink_metadata().is_ok_and(|m| m.is_dir())
+        && (holds_only_run_files(dir) || holds_its_runs_report(dir))
+}
+
+/// Whether `dir` is a finished run folder of an earlier sweep, which a new set removes when
+/// the run is not among its own: it [`holds_only_run_files`] and the run's report naming it
+/// (a user's folder with a `system.json` or a `summary.json` of its own, or a run folder
+/// copied under another name, is not one).
+fn is_earlier_run_folder(dir: &Path) -> bool {
+    holds_only_run_files(dir) && holds_its_runs_report(dir)
 }
 
 /// Refuses a run whose folder `<outdir>/<run>` would replace something that is not a run
 /// folder of an earlier sweep (a file or folder of the user's, the run set itself).
 pub fn check_run_folders(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> {
+    if outdir.as_os_str().is_empty() {
+        // an empty path would be the working folder, which is not chosen by accident
+        return Err(SweepError::NoOutputFolder);
+    }
     for job in jobs {
         let dest = outdir.join(&job.name);
-        if dest.symlink_metadata().is_ok() && !is_run_folder(&dest) {
+        if dest.symlink_metadata().is_ok() && !replaceable_run_folder(&dest) {
             return Err(SweepError::NotARunFolder {
                 path: dest,
                 run: job.name.clone(),
@@ -294,6 +352,9 @@ pub struct OutputFolderLock {
 /// Takes the [`OutputFolderLock`] of `outdir` (created if needed), or says that another set
 /// holds it.
 pub fn lock_output_folder(outdir: &Path) -> Result<OutputFolderLock, SweepError> {
+    if outdir.as_os_str().is_empty() {
+        return Err(SweepError::NoOutputFolder);
+    }
     let dir_err = |source| SweepError::Dir {
         path: outdir.to_path_buf(),
         source,
@@ -311,9 +372,10 @@ pub fn lock_output_folder(outdir: &Path) -> Result<OutputFolderLock, SweepError>
 /// Readies `outdir` for a run set whose whole set of runs (kept ones included) is `jobs`:
 /// refuses, before anything is removed, a run whose folder would replace what is not a run
 /// folder ([`check_run_folders`]); then removes the runs of an earlier set that are not among
-/// `jobs` (their run folders and their tables `results/<run>.parquet`, told from a user's
-/// Parquet file by the metadata in the footer), so that the folder, and the
-/// results folder read as one table, hold this set's runs only. Nothing else is touched.
+/// `jobs` (their run folders, told from a user's folder by holding only a run's files and the
+/// run's report naming them, and their tables `results/<run>.parquet`, told from a user's
+/// Parquet file by the metadata in the footer), so that the folder, and the results folder
+/// read as one table, hold this set's runs only. Nothing else is touched.
 pub fn prepare_run_folder(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> {
     check_run_folders(jobs, outdir)?;
     // the tables are written into <outdir>/results: a link there would put them (and this
@@ -331,7 +393,7 @@ pub fn prepare_run_folder(jobs: &[Job], outdir: &Path) -> Result<(), SweepError>
                 continue;
             }
             let path = e.path();
-            if name != PARQUET_FOLDER && is_run_folder(&path) {
+            if name != PARQUET_FOLDER && is_earlier_run_folder(&path) {
                 std::fs::remove_dir_all(&path).map_err(remove_err(path.clone()))?;
             }
         }

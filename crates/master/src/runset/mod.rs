@@ -92,6 +92,8 @@ pub enum SweepError {
          replace; choose another output folder or rename the run"
     )]
     NotARunFolder { path: PathBuf, run: String },
+    #[error("the output folder is an empty path; name a folder (\".\" for the working folder)")]
+    NoOutputFolder,
     #[error(
         "'{path}' is not a folder (a link or a file), and a run set writes its Parquet tables \
          there; choose another output folder or move it"

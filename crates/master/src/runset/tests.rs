@@ -278,6 +278,47 @@ fn a_new_set_removes_an_earlier_sets_tables_only_not_a_users_parquet_files() {
     assert!(elsewhere.path().join("run-009.parquet").exists());
 }
 
+#[test]
+fn a_new_set_removes_an_earlier_sets_run_folders_only_not_a_users_folders() {
+    let three = jobs(r#"{"product": {"ms.k": [50, 100, 200]}}"#).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path();
+    assert_eq!(resume(&three, out, ResultsFormat::Csv).len(), 3);
+    // folders of the user's that hold a file named like a run's among their own files, or a
+    // summary.json that is not a run's report
+    let vehicle = out.join("my_vehicle");
+    std::fs::create_dir(&vehicle).unwrap();
+    std::fs::write(vehicle.join("system.json"), b"{}").unwrap();
+    std::fs::write(vehicle.join("notes.txt"), b"kept").unwrap();
+    let report = out.join("report");
+    std::fs::create_dir(&report).unwrap();
+    std::fs::write(report.join("summary.json"), b"{\"pages\": 3}").unwrap();
+    std::fs::write(report.join("system.json"), b"{}").unwrap();
+    // an earlier run's folder copied under another name is not that run's either
+    let copy = out.join("backup");
+    std::fs::create_dir(&copy).unwrap();
+    for f in ["system.json", "summary.json", "results.csv"] {
+        std::fs::copy(out.join("run-002").join(f), copy.join(f)).unwrap();
+    }
+    let two = jobs(r#"{"product": {"ms.k": [50, 100]}}"#).unwrap();
+    prepare_run_folder(&two, out).unwrap();
+    assert!(!out.join("run-002").exists(), "the earlier set's third run");
+    assert!(out.join("run-000").join("results.csv").exists());
+    for kept in [&vehicle, &report, &copy] {
+        assert!(kept.is_dir(), "{}", kept.display());
+    }
+    assert!(vehicle.join("notes.txt").exists());
+    // a run whose folder is one of those is refused, nothing removed
+    let named = jobs(r#"{"runs": [{"name": "my_vehicle", "parameters": {}}]}"#).unwrap();
+    let e = prepare_run_folder(&named, out).unwrap_err();
+    assert!(matches!(e, SweepError::NotARunFolder { .. }), "{e}");
+    assert!(out.join("run-000").exists() && vehicle.join("notes.txt").exists());
+    // an empty path is not taken for the working folder
+    let e = prepare_run_folder(&two, Path::new("")).unwrap_err();
+    assert!(matches!(e, SweepError::NoOutputFolder), "{e}");
+    assert!(lock_output_folder(Path::new("")).is_err());
+}
+
 /// Resumes a run set as `master sweep --resume` does: keeps the runs complete in `format`,
 /// runs the others; returns the names run.
 fn resume(j: &[Job], outdir: &Path, format: ResultsFormat) -> Vec<String> {

@@ -350,7 +350,8 @@ impl LoadedSystem {
             return Err(self.invalid("step", "step", why));
         }
         let n = (span / d.step).round();
-        if (n * d.step - span).abs() > 1e-9 * span.max(d.step) {
+        // a span shorter than half a step rounds to no step, which the run refuses too
+        if n < 1.0 || (n * d.step - span).abs() > 1e-9 * span.max(d.step) {
             return Err(self.invalid(
                 "step",
                 "step",

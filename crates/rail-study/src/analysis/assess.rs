@@ -315,8 +315,17 @@ impl ResultsTable {
                 t.len()
             )));
         }
+        if let Some(k) = t.iter().position(|x| !x.is_finite()) {
+            // a NaN compares false with every step, so the uniformity check below passes it
+            return Err(AnalysisError::Input(format!(
+                "{}: the time column (first column) holds {} at sample {}",
+                self.path.display(),
+                t[k],
+                k + 1
+            )));
+        }
         let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
-        if dt.is_nan() || dt <= 0.0 {
+        if !(dt > 0.0 && dt.is_finite()) {
             return Err(AnalysisError::Input(format!(
                 "{}: the time column (first column) does not increase",
                 self.path.display()
@@ -836,6 +845,15 @@ mod tests {
         let t = ResultsTable::parse("time,a\n0,1\n0.1,1\n0.3,1\n0.4,1\n", p).unwrap();
         let e = t.sampling_rate_hz().unwrap_err();
         assert!(e.to_string().contains("not uniformly sampled"), "{e}");
+        // a NaN or an infinity inside the time column of columns given as such (Python's
+        // assess_stability; a file's are refused when read): a NaN passes every step comparison
+        for bad in [f64::NAN, f64::INFINITY] {
+            let mut t = ResultsTable::parse("time,a\n0,1\n0.1,1\n0.2,1\n0.3,1\n", p).unwrap();
+            t.columns[0][2] = bad;
+            let e = t.sampling_rate_hz().unwrap_err().to_string();
+            assert!(e.contains("the time column (first column) holds"), "{e}");
+            assert!(e.contains("at sample 3"), "{e}");
+        }
     }
 
     #[test]
