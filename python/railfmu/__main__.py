@@ -93,7 +93,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     args = p.parse_args(argv)
     try:
         return _sweep(args)
-    except Error as e:
+    except (Error, ValueError, TypeError) as e:
+        # railfmu's errors and its refused options: one line, as master sweep prints them
         print(f"error: {e}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:

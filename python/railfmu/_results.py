@@ -47,6 +47,7 @@ class Results:
         texts: Optional[Mapping[str, Any]] = None,
         metadata: Optional[Dict[str, Any]] = None,
     ):
+        values = np.asarray(values, dtype=float)
         if values.ndim != 2 or values.shape[1] != len(header):
             raise ValueError(f"{values.shape} values do not match {len(header)} columns")
         self.header: List[str] = list(header)
@@ -60,6 +61,12 @@ class Results:
         carry their full band. False when unknown (a table read back: its file's metadata
         say, see :func:`assess_stability`)."""
         split = [split_label(h) for h in self.header]
+        seen: Dict[str, str] = {}
+        for label, (name, _) in zip(self.header, split):
+            if name in seen:
+                # columns are found by name (units apart): a second one would hide the first
+                raise ValueError(f"columns '{seen[name]}' and '{label}' have the same name '{name}'")
+            seen[name] = label
         self.names: List[str] = [n for n, _ in split]
         """Column names without units; the first is ``time``."""
         self.units: Dict[str, Optional[str]] = {n: u for n, u in split}
@@ -99,7 +106,11 @@ class Results:
         header, data, texts, meta = _railfmu.read_results(os.fspath(path))
         meta = json.loads(meta) if meta is not None else None
         summary = meta.get("summary") if meta is not None else None
-        return cls._from_bytes(header, data, summary, texts=texts, metadata=meta)
+        try:
+            return cls._from_bytes(header, data, summary, texts=texts, metadata=meta)
+        except ValueError as e:
+            # a host's file with two columns of one name (the master never writes one)
+            raise _railfmu.OutputError(f"'{os.fspath(path)}': {e}") from None
 
     @classmethod
     def read_csv(cls, path: PathLike) -> "Results":
@@ -210,6 +221,9 @@ class RunSetResults(Mapping[str, Results]):
                 raise _railfmu.OutputError(f"cannot read '{path}': {e}") from None
             except ValueError as e:
                 raise _railfmu.OutputError(f"'{path}' is not a run-set summary: {e}") from None
+            why = _not_reports(reports)
+            if why:
+                raise _railfmu.OutputError(f"'{path}' is not a run-set summary: {why}")
         self.reports: List[Dict[str, Any]] = list(reports)
         """Each run's report in job order: name, parameters, ok, error, summary, results."""
         self._cache: Dict[str, Results] = {}
@@ -278,6 +292,8 @@ class RunSetResults(Mapping[str, Results]):
             row: Dict[str, Any] = {"run": r["name"], **r.get("parameters", {}), "ok": r["ok"], "error": r.get("error")}
             row.update(r.get("summary") or {})
             rows.append(row)
+        if not rows:
+            return pd.DataFrame(columns=["ok", "error"], index=pd.Index([], name="run"))
         df = pd.DataFrame(rows).set_index("run")
         try:
             parameters = self.parameter_units
@@ -304,6 +320,20 @@ class RunSetResults(Mapping[str, Results]):
         return df
 
 
+def _not_reports(reports: Any) -> Optional[str]:
+    """Why ``reports`` (a ``sweep.json`` read) is not a list of run reports; None if it is."""
+    if not isinstance(reports, list):
+        return f"a list of run reports expected, got {type(reports).__name__}"
+    for k, r in enumerate(reports):
+        if not (isinstance(r, dict) and isinstance(r.get("name"), str) and isinstance(r.get("ok"), bool)):
+            return f"entry {k} is not a run report (an object with a text 'name' and a true/false 'ok')"
+        if r["name"] in ("", ".", "..") or any(c in r["name"] for c in "/\\\0"):
+            return f"entry {k}: run name {r['name']!r} is not a folder name"
+        if not isinstance(r.get("parameters", {}), dict) or not isinstance(r.get("summary") or {}, dict):
+            return f"entry {k} ('{r['name']}'): 'parameters' and 'summary' must be objects"
+    return None
+
+
 def read_results(path: PathLike) -> Union[Results, RunSetResults]:
     """Reads results back: a run-set folder (with ``sweep.json``) gives a
     :class:`RunSetResults`; a run folder (with ``results.csv``), a CSV file or a ``.parquet``
@@ -323,7 +353,11 @@ def read_results(path: PathLike) -> Union[Results, RunSetResults]:
     if summary.is_file():
         try:
             s = json.loads(summary.read_text())
-            res.summary = dict(s.get("summary") or {}) if "ok" in s else dict(s)
+            # a run's report, or a run summary of its own; anything else is not the run's
+            if isinstance(s, dict):
+                inner = s.get("summary") if "ok" in s else s
+                if isinstance(inner, dict) or inner is None:
+                    res.summary = dict(inner or {})
         except (OSError, ValueError):
             pass
     return res

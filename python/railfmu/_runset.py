@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any, Callable, Dict, List, Mapping, Optional, Union
 
 from . import _railfmu
+from ._json import description_json
 from ._progress import bar
 from ._results import RunSetResults
 
@@ -64,7 +65,7 @@ class RunSet:
     @classmethod
     def from_dict(cls, runset: Mapping[str, Any], base_dir: PathLike = ".", label: str = "<dict>") -> "RunSet":
         """A run set given as a dict; paths relative to ``base_dir``."""
-        return cls(*_railfmu.run_set_from_json(json.dumps(runset), os.fspath(base_dir), label))
+        return cls(*_railfmu.run_set_from_json(description_json(runset, label), os.fspath(base_dir), label))
 
     @property
     def base(self) -> Dict[str, Any]:
@@ -131,12 +132,27 @@ class RunSet:
         if threads is not None and client is not None:
             # the workers of the Dask cluster take the runs as they come: no local threads
             raise ValueError("threads: the runs go to the Dask client's workers; give threads or client, not both")
-        out = Path(output_dir)
+        # every option checked before the folder is touched: a misspelt one must not cost the
+        # earlier set's results
+        if format is not None:
+            if not isinstance(format, str):
+                raise TypeError(f"format must be 'csv', 'parquet' or None, got {format!r}")
+            if format not in ("csv", "parquet"):
+                raise ValueError(f"format must be 'csv', 'parquet' or None, got {format!r}")
+        if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
+            raise ValueError(f"retries must be a whole number >= 0, got {retries!r}")
+        if client is not None and not all(callable(getattr(client, m, None)) for m in ("submit", "scatter")):
+            raise TypeError(f"client must be a dask.distributed.Client (or None: local threads), got {type(client).__name__}")
+        if isinstance(output_dir, (str, bytes)) and len(output_dir) == 0:
+            # an empty path would be the working folder, which is not chosen by accident
+            raise ValueError("output_dir is an empty path; name a folder ('.' for the working folder)")
+        out = Path(os.fsdecode(output_dir))
         system = None
-        if client is None:
+        if client is None or ship_fmus:
             # the FMUs loaded and every run's start values checked (names, types, declared
             # ranges) before anything is written or removed: a misspelt variable is refused
-            # here, not failed run by run
+            # here, not failed run by run. On a cluster too, when this process ships the FMUs
+            # (it reads them anyway); with shared FMUs their paths may be the workers' only.
             system = _railfmu.PreparedSystem.from_json(self._base_json, "", self._label)
             system.check_jobs(self._jobs_json)
         try:
@@ -176,7 +192,7 @@ class RunSet:
                     new: List[Optional[str]] = [None] * len(jobs)
                     local_runs = False
                     try:
-                        if system is not None:
+                        if client is None and system is not None:
                             threads = threads or os.cpu_count() or 1
                             local_runs = True
                             new = system.run_jobs(jobs, os.fspath(out), threads, on_done, format)

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any, Callable, Dict, List, Mapping, Optional, Union
 
 from . import _railfmu
+from ._json import description_json
 from ._results import Results
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -83,7 +84,7 @@ class System:
     @classmethod
     def from_dict(cls, description: Mapping[str, Any], base_dir: PathLike = ".", label: str = "<dict>") -> "System":
         """A system from a description given as a dict (FMU paths relative to ``base_dir``)."""
-        return cls(_railfmu.PreparedSystem.from_json(json.dumps(description), os.fspath(base_dir), label))
+        return cls(_railfmu.PreparedSystem.from_json(description_json(description, label), os.fspath(base_dir), label))
 
     @property
     def file(self) -> str:

@@ -87,6 +87,12 @@ def test_what_cannot_be_assessed_raises_with_the_reason(hunting, tmp_path):
     with pytest.raises(railfmu.OutputError, match="missing.csv"):
         railfmu.assess_stability(tmp_path / "missing.csv", SIGNALS, 320.0)
     assert issubclass(railfmu.AssessmentError, railfmu.Error)
+    # a NaN inside the time column (it passes every comparison of the steps)
+    t = np.arange(0.0, 20.0, 0.001)
+    t[50] = np.nan
+    bad = railfmu.Results(["time [s]", "g [m/s2]"], np.column_stack([t, 1000.0 * np.sin(2 * np.pi * 5 * t)]))
+    with pytest.raises(railfmu.AssessmentError, match="the time column \\(first column\\) holds NaN at sample 51"):
+        railfmu.assess_stability(bad, "g", 200.0)
 
 
 def test_messages_name_the_python_arguments_not_the_command_options(hunting, tmp_path):

@@ -132,7 +132,13 @@ def test_bad_input_fails_its_own_run_and_no_worker(dist, client, tmp_path):
         {"name": "wrong_type", "parameters": {"bogie.track.seed": 1.5}},
         {"name": "negative", "parameters": {"bogie.vehicle.speed": -5.0}},
     ]
-    res = railfmu.run_set(rs, tmp_path / "out", client=client)
+    # shipping the FMUs, this process checks every run first, as a local set does: refused
+    # before the output folder is touched
+    with pytest.raises(railfmu.SystemDescriptionError, match="vehicle.sped"):
+        railfmu.run_set(rs, tmp_path / "out", client=client)
+    assert not (tmp_path / "out").exists()
+    # with shared FMUs the workers alone read them: each bad run fails on its own
+    res = railfmu.run_set(rs, tmp_path / "out", client=client, ship_fmus=False)
     assert set(res) == {"run-000"}
     assert "unknown variable 'vehicle.sped'" in res.failed["typo"]
     assert "is not a 32-bit integer" in res.failed["wrong_type"]
@@ -142,8 +148,11 @@ def test_bad_input_fails_its_own_run_and_no_worker(dist, client, tmp_path):
     broken.write_bytes(b"PK\x03\x04 not a zip archive")
     rs = speed_set(dist, [60.0, 70.0], stop_time=0.2)
     rs["system"]["instances"][1]["fmu"] = str(broken)
+    with pytest.raises(railfmu.FmuError, match="Broken.fmu"):
+        railfmu.run_set(rs, tmp_path / "broken", client=client, retries=0)
+    assert not (tmp_path / "broken").exists()
     with pytest.warns(RuntimeWarning, match="no run of the set succeeded"):
-        res = railfmu.run_set(rs, tmp_path / "broken", client=client, retries=0)
+        res = railfmu.run_set(rs, tmp_path / "broken", client=client, retries=0, ship_fmus=False)
     assert len(res) == 0 and len(res.failed) == 2
     assert all("FmuError" in e and "Broken.fmu" in e for e in res.failed.values()), res.failed
     assert set(client.run(os.getpid).values()) == pids  # no worker crashed

@@ -63,3 +63,15 @@ def test_master_run_writes_parquet_by_extension(passive_file, master_cmd, tmp_pa
     assert table.columns[0] == "time [s]" and len(table) == 1001
     assert "run" not in table.columns
     assert Path(out).with_suffix(".meta.json").exists() is False
+
+
+def test_a_hosts_parquet_file_is_assessed_whatever_its_compression(tmp_path):
+    # pandas writes snappy by default, other tools gzip: both read as our own zstd
+    t = np.arange(0.0, 20.0, 0.001)
+    df = pd.DataFrame({"time [s]": t, "a [m/s2]": 0.5 * np.sin(2 * np.pi * 4 * t)})
+    verdicts = []
+    for compression in ("snappy", "gzip", "zstd", None):
+        path = tmp_path / f"host_{compression}.parquet"
+        df.to_parquet(path, compression=compression, index=False)
+        verdicts.append(str(railfmu.assess_stability(path, "a", 200.0)))
+    assert len(set(verdicts)) == 1 and verdicts[0].endswith("max rms 0.356 m/s2, limit 5.390 m/s2: met>"), verdicts

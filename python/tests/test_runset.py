@@ -345,3 +345,92 @@ def test_the_sweep_command_names_the_failed_runs_and_exits_1(dist, tmp_path):
     assert r.returncode == 1, r.stderr
     assert "error: --jobs: the runs go to the Dask scheduler's workers" in r.stderr, r.stderr
     assert not (tmp_path / "dask").exists()
+
+
+def test_a_bad_option_is_refused_before_the_earlier_sets_results_are_touched(dist, tmp_path):
+    rs = railfmu.RunSet.from_dict(speed_set(dist, [50.0, 60.0], stop_time=0.2))
+    out = tmp_path / "out"
+    first = rs.run(out, threads=2, format="csv")
+    before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    for options, error in [
+        ({"format": "CSV "}, ValueError),
+        ({"format": "pq"}, ValueError),
+        ({"format": 3}, TypeError),
+        ({"retries": -1}, ValueError),
+        ({"retries": "x"}, ValueError),
+        ({"client": object(), "ship_fmus": False}, TypeError),
+    ]:
+        with pytest.raises(error):
+            rs.run(out, resume=True, **options)
+        after = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+        assert after == before, options
+    assert railfmu.read_results(out).ok and len(first) == 2
+    # an empty path is not taken for the working folder
+    with pytest.raises(ValueError, match="empty path"):
+        rs.run("")
+
+
+def test_a_users_folders_beside_the_runs_are_kept(dist, tmp_path):
+    out = tmp_path / "project"
+    vehicle = out / "my_vehicle"
+    vehicle.mkdir(parents=True)
+    (vehicle / "system.json").write_text("{}")
+    (vehicle / "notes.txt").write_text("mine")
+    report = out / "report"
+    report.mkdir()
+    (report / "summary.json").write_text('{"pages": 3}')
+    res = railfmu.RunSet.from_dict(speed_set(dist, [50.0], stop_time=0.2)).run(out, threads=1)
+    assert res.ok
+    assert (vehicle / "notes.txt").read_text() == "mine" and (report / "summary.json").is_file()
+
+
+def test_descriptions_given_as_python_values(dist, tmp_path):
+    # NumPy numbers and arrays are numbers and lists
+    rs = speed_set(dist, [50.0], stop_time=0.2)
+    rs["product"] = {"bogie.vehicle.speed": np.linspace(50.0, 60.0, 2), "bogie.track.seed": [np.int64(1)]}
+    assert len(railfmu.RunSet.from_dict(rs)) == 2
+    # a NaN is named where it is (JSON has no NaN)
+    rs["product"]["bogie.vehicle.speed"] = [50.0, float("nan")]
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"product\.bogie\.vehicle\.speed\[1\]: nan"):
+        railfmu.RunSet.from_dict(rs)
+    system = speed_set(dist, [50.0], stop_time=0.2)["system"]
+    system["step"] = float("inf")
+    with pytest.raises(railfmu.SystemDescriptionError, match="step: inf"):
+        railfmu.System.from_dict(system)
+
+
+def test_malformed_run_set_summaries_are_named(dist, tmp_path):
+    for text, why in [
+        ("[1, 2]", "entry 0 is not a run report"),
+        ('[{"name": "x"}]', "entry 0 is not a run report"),
+        ("null", "a list of run reports expected, got NoneType"),
+        ('[{"name": 5, "ok": true}]', "entry 0 is not a run report"),
+        ('[{"name": "../x", "ok": true}]', "is not a folder name"),
+        ('[{"name": "x", "ok": true, "summary": 5}]', "must be objects"),
+    ]:
+        folder = tmp_path / f"set{abs(hash(text))}"
+        folder.mkdir()
+        (folder / "sweep.json").write_text(text)
+        with pytest.raises(railfmu.OutputError, match="is not a run-set summary") as e:
+            railfmu.read_results(folder)
+        assert why in str(e.value), (text, str(e.value))
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    (empty / "sweep.json").write_text("[]")
+    df = railfmu.read_results(empty).summary_frame()
+    assert len(df) == 0 and df.index.name == "run"
+    # a run folder's summary.json that is not a report is left out (the statistics come
+    # from the results' metadata), not an error
+    run = railfmu.RunSet.from_dict(speed_set(dist, [50.0], stop_time=0.2)).run(tmp_path / "one", threads=1)
+    folder = tmp_path / "one" / next(iter(run))
+    for text in ("[1, 2]", '{"ok": true, "summary": 5}'):
+        (folder / "summary.json").write_text(text)
+        assert railfmu.read_results(folder).summary == run.reports[0]["summary"]
+
+
+def test_two_columns_of_one_name_are_refused():
+    with pytest.raises(ValueError, match="columns 'x \\[m\\]' and 'x \\[mm\\]' have the same name 'x'"):
+        railfmu.Results(["time [s]", "x [m]", "y [N]", "x [mm]"], np.array([[0.0, 1.0, 2.0, 3.0]]))
+    # a list of rows is taken as an array
+    r = railfmu.Results(["time [s]", "x [m]"], [[0.0, 1.0], [0.1, 2.0]])
+    assert r.values.shape == (2, 2)

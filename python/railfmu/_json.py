@@ -1,0 +1,56 @@
+"""Descriptions given as Python values (dicts, lists, NumPy numbers) made the JSON text the
+master reads, with a message naming the entry JSON cannot hold."""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any, List, Optional
+
+import numpy as np
+
+from . import _railfmu
+
+
+def _plain(value: Any) -> Any:
+    """NumPy numbers and arrays as the Python numbers and lists JSON writes."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError
+
+
+def _first_bad(value: Any, path: List[str]) -> Optional[str]:
+    """Where in ``value`` the first number JSON has no form for (NaN, an infinity) is, and what
+    it is; None if there is none."""
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    elif isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return f"{'.'.join(path) or 'the value'}: {value} (JSON has no such number)"
+    if isinstance(value, dict):
+        for k, v in value.items():
+            bad = _first_bad(v, path + [str(k)])
+            if bad:
+                return bad
+    elif isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            bad = _first_bad(v, path[:-1] + [f"{path[-1]}[{i}]"] if path else [f"[{i}]"])
+            if bad:
+                return bad
+    return None
+
+
+def description_json(value: Any, what: str) -> str:
+    """``value`` as JSON text; SystemDescriptionError naming the entry that JSON cannot hold."""
+    bad = _first_bad(value, [])
+    if bad:
+        raise _railfmu.SystemDescriptionError(f"{what}: {bad}")
+    try:
+        return json.dumps(value, default=_plain)
+    except TypeError as e:
+        raise _railfmu.SystemDescriptionError(f"{what}: {e}") from None
+    except ValueError as e:  # a circular reference
+        raise _railfmu.SystemDescriptionError(f"{what}: {e}") from None
