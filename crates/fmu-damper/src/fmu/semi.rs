@@ -252,7 +252,8 @@ impl FmuModel for SemiActiveDamper {
             output "valve.opening_command" [unit = "1", display_unit = "%", depends_on = &["valve.command"]] => s.out.valve_opening_command;
             /// True while valve.command is outside [0, full scale] and clamped
             output "valve.command_clamped" [depends_on = &["valve.command"]] => s.out.command_clamped;
-            /// Orifice loss power dP (Q_f + Q_v) >= 0
+            /// Orifice loss power dP (Q_f + Q_v) >= 0; the simplified pressure model is no energy
+            /// balance, so this is not the heat of damper.power (see the documentation)
             output "damper.dissipated_power" [unit = "W", display_unit = "kW", depends_on = &["valve.command"]] => s.out.dissipated_power_w;
             /// Mechanical power taken from the vehicle, damper.force x damper.elongation_velocity
             output "damper.power" [unit = "W", display_unit = "kW", depends_on = &["damper.elongation_velocity"]] => s.out.mechanical_power_w;
@@ -302,7 +303,8 @@ impl FmuModel for PassiveYawDamper {
         declare_motion_inputs!(v);
         declare_force_outputs!(v);
         model_description::declare! { v;
-            /// Orifice loss power dP (Q_f + Q_v) >= 0 (from the state: no feedthrough)
+            /// Orifice loss power dP (Q_f + Q_v) >= 0 (from the state: no feedthrough); the simplified
+            /// pressure model is no energy balance, so this is not the heat of damper.power
             output "damper.dissipated_power" [unit = "W", display_unit = "kW"] => s.out.dissipated_power_w;
             /// Mechanical power taken from the vehicle, damper.force x damper.elongation_velocity
             output "damper.power" [unit = "W", display_unit = "kW", depends_on = &["damper.elongation_velocity"]] => s.out.mechanical_power_w;
