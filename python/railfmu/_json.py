@@ -45,12 +45,12 @@ def _first_bad(value: Any, path: List[str]) -> Optional[str]:
 
 def description_json(value: Any, what: str) -> str:
     """``value`` as JSON text; SystemDescriptionError naming the entry that JSON cannot hold."""
-    bad = _first_bad(value, [])
-    if bad:
-        raise _railfmu.SystemDescriptionError(f"{what}: {bad}")
     try:
-        return json.dumps(value, default=_plain)
+        return json.dumps(value, default=_plain, allow_nan=False)
     except TypeError as e:
         raise _railfmu.SystemDescriptionError(f"{what}: {e}") from None
-    except ValueError as e:  # a circular reference
-        raise _railfmu.SystemDescriptionError(f"{what}: {e}") from None
+    except ValueError as e:
+        # a NaN or an infinity (looked for only then, and named by its place), or a circular
+        # reference, which the search must not walk into
+        bad = None if "ircular" in str(e) else _first_bad(value, [])
+        raise _railfmu.SystemDescriptionError(f"{what}: {bad or e}") from None
