@@ -149,6 +149,9 @@ impl SetRule {
 /// An FMU instance.
 pub struct Component {
     model: Box<dyn ErasedModel>,
+    /// In Initialization Mode: a copy of the model initialised with the values set so far,
+    /// which the getters read (see [`Component::refresh_initial_outputs`]); None otherwise.
+    initial_view: Option<Box<dyn ErasedModel>>,
     index: VrIndex,
     /// By declaration index.
     rules: Vec<SetRule>,
@@ -203,6 +206,7 @@ impl Component {
         let max_step_s = model.max_communication_step_s();
         Component {
             model,
+            initial_view: None,
             max_step_s,
             index,
             rules,
@@ -246,6 +250,7 @@ impl Component {
     /// until fmi2Reset, or until fmi2SetFMUstate restores a state saved before.
     pub fn enter_error_state(&mut self) {
         self.state = FmiState::Error;
+        self.initial_view = None;
     }
 
     fn warning(&mut self, message: &str) {
@@ -360,6 +365,9 @@ impl Component {
         if self.state != FmiState::InitializationMode {
             return self.wrong_state("fmi2ExitInitializationMode");
         }
+        // a refused exit leaves Initialization Mode on, with the copy initialised again
+        self.initial_view = None;
+        self.outputs_dirty = true;
         if let Err(e) = self.model.exit_initialization(&mut self.diag) {
             let _ = self.flush_diagnostics();
             let msg = format!("fmi2ExitInitializationMode: {e}");
@@ -393,6 +401,7 @@ impl Component {
             return self.error(&msg);
         }
         self.state = FmiState::Instantiated;
+        self.initial_view = None;
         self.time = 0.0;
         self.start_time = 0.0;
         self.stop_time = None;
@@ -413,7 +422,62 @@ impl Component {
         )
     }
 
+    /// What the getters read: the initialised copy in Initialization Mode, else the model.
+    #[inline]
+    fn reader(&self) -> &dyn ErasedModel {
+        match &self.initial_view {
+            Some(view) => view.as_ref(),
+            None => self.model.as_ref(),
+        }
+    }
+
+    /// Outputs read in Initialization Mode are the ones fmi2ExitInitializationMode gives with
+    /// the parameters and inputs set so far (FMI 2.0.4, 4.2.4: a host may solve its initial
+    /// coupling in this mode). A model computes its initial outputs when it is initialised
+    /// (its track, its states from the initial values), so a copy is initialised and read;
+    /// the model itself is initialised once, at exit, as before. When the copy cannot be
+    /// initialised (a parameter the exit refuses), the call warns with the reason and the
+    /// values are the model's own as they stand (the exit then refuses with the same reason).
+    #[cold]
+    #[inline(never)]
+    fn refresh_initial_outputs(&mut self, call: &str) -> Status {
+        let mut view = self.model.duplicate();
+        // the exit reports the model's own messages; the copy's would repeat them
+        let mut quiet = Diagnostics::default();
+        let initialised = view
+            .exit_initialization(&mut quiet)
+            .and_then(|()| view.update_outputs(&mut quiet));
+        match initialised {
+            Ok(()) => {
+                self.initial_view = Some(view);
+                self.outputs_dirty = false;
+                Status::Ok
+            }
+            Err(e) => {
+                self.initial_view = None;
+                let status = self.refresh_model_outputs(call);
+                // every read warns until the values set can be initialised
+                self.outputs_dirty = true;
+                if status > Status::Warning {
+                    return status;
+                }
+                let msg = format!(
+                    "{call} in Initialization Mode: the outputs are not those of the values set                      ({e}; fmi2ExitInitializationMode refuses them)"
+                );
+                self.warning(&msg);
+                Status::Warning
+            }
+        }
+    }
+
     fn refresh_outputs(&mut self, call: &str) -> Status {
+        if self.outputs_dirty && self.state == FmiState::InitializationMode {
+            return self.refresh_initial_outputs(call);
+        }
+        self.refresh_model_outputs(call)
+    }
+
+    fn refresh_model_outputs(&mut self, call: &str) -> Status {
         if self.outputs_dirty
             && matches!(
                 self.state,
@@ -477,7 +541,7 @@ impl Component {
         if status > Status::Warning {
             return status;
         }
-        match self.model.get_reals(vrs, values) {
+        match self.reader().get_reals(vrs, values) {
             // whatever a host reads with fmi2OK is a number: a model whose parameters give
             // no finite value (before initialisation, where they are not yet checked, or
             // through a physics fault) says so instead
@@ -523,7 +587,7 @@ impl Component {
                 Ok(i) => i,
                 Err(s) => return s,
             };
-            match self.model.get_integer(i) {
+            match self.reader().get_integer(i) {
                 Some(v) => *out = v,
                 None => return self.error("fmi2GetInteger: internal type mismatch"),
             }
@@ -541,7 +605,7 @@ impl Component {
                 Ok(i) => i,
                 Err(s) => return s,
             };
-            match self.model.get_boolean(i) {
+            match self.reader().get_boolean(i) {
                 Some(v) => *out = v,
                 None => return self.error("fmi2GetBoolean: internal type mismatch"),
             }
@@ -559,7 +623,7 @@ impl Component {
                 Ok(i) => i,
                 Err(s) => return s,
             };
-            match self.model.get_string(i) {
+            match self.reader().get_string(i) {
                 Some(v) => *out = v,
                 None => return self.error("fmi2GetString: internal type mismatch"),
             }
@@ -945,6 +1009,7 @@ impl Component {
         self.state = snapshot.state;
         self.start_time = snapshot.start_time;
         self.stop_time = snapshot.stop_time;
+        self.initial_view = None;
         self.outputs_dirty = true;
         Status::Ok
     }

@@ -26,6 +26,9 @@ pub trait ErasedModel: Send {
     /// (values before it are written).
     fn set_reals(&mut self, vrs: &[u32], values: &[f64]) -> Result<(), u32>;
     fn reset(&mut self, ctx: &InstanceContext) -> Result<(), ModelError>;
+    /// A copy of this model and its variable table (for the outputs of Initialization Mode,
+    /// computed on a copy so that the model itself is initialised once, at exit).
+    fn duplicate(&self) -> Box<dyn ErasedModel>;
     fn exit_initialization(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError>;
     fn update_outputs(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError>;
     fn do_step(&mut self, time: f64, step: f64, diag: &mut Diagnostics) -> Result<(), StepError>;
@@ -203,6 +206,16 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
     fn reset(&mut self, ctx: &InstanceContext) -> Result<(), ModelError> {
         self.model = M::instantiate(ctx)?;
         Ok(())
+    }
+
+    fn duplicate(&self) -> Box<dyn ErasedModel> {
+        Box::new(Typed {
+            model: self.model.clone(),
+            vars: self.vars.clone(),
+            metas: self.metas.clone(),
+            real_get: self.real_get.clone(),
+            real_set: self.real_set.clone(),
+        })
     }
 
     fn exit_initialization(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError> {
