@@ -24,6 +24,14 @@ vehicle_elements::track_choice_enum!(
     "The input track.lateral_alignment under the leading wheelset (the others see it delayed by their distance over V)"
 );
 
+/// The physics fields the FMU calculates from the masses ([`VehicleParams::wheel_rail_from_masses`]).
+const FROM_THE_MASSES: [&str; 4] = [
+    "wheel_rail.wheel_load_n",
+    "wheel_rail.f11_n",
+    "wheel_rail.f22_n",
+    "wheel_rail.gravity_stiffness_n_per_m",
+];
+
 impl FieldError for PhysicsModelError {
     fn field(&self) -> Option<&str> {
         match self {
@@ -32,13 +40,31 @@ impl FieldError for PhysicsModelError {
             PhysicsModelError::Table(_) | PhysicsModelError::FlangeNotCovered { .. } => {
                 Some("contact")
             }
-            PhysicsModelError::TooStiff(e) => e.parameter.as_deref(),
+            // the load and what follows it are calculated parameters of the masses
+            PhysicsModelError::TooStiff(e) => e.parameter.as_deref().map(|p| {
+                if FROM_THE_MASSES.contains(&p) {
+                    "wheelset.wheel_load"
+                } else {
+                    p
+                }
+            }),
         }
     }
 
     fn reason(&self) -> String {
         match self {
             PhysicsModelError::Param(p) => p.reason(),
+            PhysicsModelError::TooStiff(e)
+                if e.parameter
+                    .as_deref()
+                    .is_some_and(|p| FROM_THE_MASSES.contains(&p)) =>
+            {
+                format!(
+                    "{} (the wheel load and the creep coefficients follow carbody.mass, \
+                     frame.mass and wheelset.mass)",
+                    e.reason()
+                )
+            }
             PhysicsModelError::TooStiff(e) => e.reason(),
             other => other.to_string(),
         }
@@ -81,6 +107,7 @@ impl RailVehicle {
         VehicleParams {
             track: self.track.source(),
             contact: self.contact_source(),
+            wheel_rail: self.params.wheel_rail_from_masses(),
             ..self.params.clone()
         }
     }
@@ -157,8 +184,9 @@ impl FmuModel for RailVehicle {
             parameter "wheelset.wheel_radius" [unit = "m", range = 0.2..=0.8] => params.wheelset.wheel_radius_m;
             /// s: half distance between the contact points (MPE 2019: 0.7465 m)
             parameter "wheelset.half_contact_gauge" [unit = "m", range = 0.3..=1.0] => params.wheelset.half_contact_gauge_m;
-            /// P: static vertical load per wheel (default: the coach's weight / 8 = 54.2 kN)
-            parameter "wheelset.wheel_load" [unit = "N", display_unit = "kN", min = 0.0] => params.wheel_rail.wheel_load_n;
+            /// P: static vertical load per wheel, the coach's weight / 8 (from the masses: 54.2 kN with the
+            /// defaults)
+            calculated_parameter "wheelset.wheel_load" [unit = "N", display_unit = "kN"] => |m| m.params.wheel_rail_from_masses().wheel_load_n;
             /// a: half distance between the bogie centres (seed Table 4-1: 17.5 m between them)
             parameter "geometry.half_bogie_spacing" [unit = "m", min = 0.0] => params.geometry.half_bogie_spacing_m;
             /// p: half wheelbase (seed Table 4-1: wheelbase 2.5 m); at most half of a
@@ -204,14 +232,14 @@ impl FmuModel for RailVehicle {
             parameter "damper.lateral_arm" [unit = "m", min = 0.0] => params.geometry.damper_arm_m;
             /// Equivalent conicity of the linear model (default: the default table at 1 mm)
             parameter "linear.conicity" [unit = "1", range = 0.0..=1.0] => params.wheel_rail.conicity;
-            /// Lateral contact-angle (gravitational) stiffness per wheelset of the linear model (default:
-            /// the default table at 1 mm, at the default wheel load)
-            parameter "linear.gravitational_stiffness" [unit = "N/m", display_unit = "MN/m", min = 0.0] => params.wheel_rail.gravity_stiffness_n_per_m;
+            /// Lateral contact-angle (gravitational) stiffness per wheelset of the linear model: the
+            /// default table's at 1 mm per newton of load, times the wheel load
+            calculated_parameter "linear.gravitational_stiffness" [unit = "N/m", display_unit = "MN/m"] => |m| m.params.wheel_rail_from_masses().gravity_stiffness_n_per_m;
             /// f11: Kalker longitudinal creep coefficient per wheel (Hertz + Kalker, 11.5 MN at 70 kN,
             /// scaled as P^(2/3) to the wheel load)
-            parameter "creep.f11" [unit = "N", min = 0.0] => params.wheel_rail.f11_n;
+            calculated_parameter "creep.f11" [unit = "N"] => |m| m.params.wheel_rail_from_masses().f11_n;
             /// f22: Kalker lateral creep coefficient per wheel (10.4 MN at 70 kN, scaled as P^(2/3))
-            parameter "creep.f22" [unit = "N", min = 0.0] => params.wheel_rail.f22_n;
+            calculated_parameter "creep.f22" [unit = "N"] => |m| m.params.wheel_rail_from_masses().f22_n;
             /// kappa in (0, 1]: reduction of f11, f22 (Polach 2005), both models (0.6, as the 2-dof
             /// bogie)
             parameter "creep.reduction_factor" [unit = "1", range = 0.0..=1.0] => params.wheel_rail.creep_reduction;

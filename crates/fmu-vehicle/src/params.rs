@@ -259,6 +259,21 @@ impl VehicleParams {
     pub fn wheel_load_from_masses_n(&self) -> f64 {
         STANDARD_GRAVITY_MPS2 * self.total_mass_kg() / 8.0
     }
+
+    /// The wheel/rail quantities that follow the wheel load, from the masses: the load
+    /// g m_total / 8, the Kalker coefficients scaled to it from the bogie's (P^(2/3)) and the
+    /// linear model's gravitational stiffness (the default table's at 1 mm, per newton of
+    /// load); conicity, creep reduction and friction as they stand.
+    pub fn wheel_rail_from_masses(&self) -> WheelRail {
+        let load = self.wheel_load_from_masses_n();
+        WheelRail {
+            gravity_stiffness_n_per_m: TABLE_GRAVITY_STIFFNESS_PER_LOAD_1MM * load,
+            f11_n: scale_creep_coefficient(BOGIE_F11_N, BOGIE_WHEEL_LOAD_N, load),
+            f22_n: scale_creep_coefficient(BOGIE_F22_N, BOGIE_WHEEL_LOAD_N, load),
+            wheel_load_n: load,
+            ..self.wheel_rail.clone()
+        }
+    }
 }
 
 /// Kalker coefficient at wheel load `load_n` from its value `f_ref` at `load_ref_n` (Hertz
@@ -289,9 +304,7 @@ impl Default for VehicleParams {
             wheel_radius_m: 0.46,
             half_contact_gauge_m: 0.7465,
         };
-        let total = carbody.mass_kg + 2.0 * frame.mass_kg + 4.0 * wheelset.mass_kg;
-        let load = STANDARD_GRAVITY_MPS2 * total / 8.0;
-        Self {
+        let params = Self {
             speed_mps: 250.0 / 3.6,
             model: ModelKind::NonLinear,
             carbody,
@@ -325,18 +338,23 @@ impl Default for VehicleParams {
             },
             wheel_rail: WheelRail {
                 conicity: TABLE_CONICITY_1MM,
-                gravity_stiffness_n_per_m: TABLE_GRAVITY_STIFFNESS_PER_LOAD_1MM * load,
-                f11_n: scale_creep_coefficient(BOGIE_F11_N, BOGIE_WHEEL_LOAD_N, load),
-                f22_n: scale_creep_coefficient(BOGIE_F22_N, BOGIE_WHEEL_LOAD_N, load),
                 creep_reduction: CREEP_REDUCTION,
-                wheel_load_n: load,
                 friction_coefficient: FRICTION_COEFFICIENT,
+                // the load and what follows it: from the masses, below
+                gravity_stiffness_n_per_m: 0.0,
+                f11_n: 0.0,
+                f22_n: 0.0,
+                wheel_load_n: 0.0,
             },
             gravity_mps2: STANDARD_GRAVITY_MPS2,
             initial: Initial::default(),
             track: TrackSource::None,
             contact: ContactSource::WornSurrogate,
             solver_substep_s: SOLVER_SUBSTEP_S,
+        };
+        Self {
+            wheel_rail: params.wheel_rail_from_masses(),
+            ..params
         }
     }
 }

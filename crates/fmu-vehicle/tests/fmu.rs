@@ -174,6 +174,87 @@ fn impossible_parameters_are_named() {
     }
 }
 
+/// The wheel load, the Kalker coefficients and the linear model's gravitational stiffness are
+/// calculated from the masses: a laden coach loads its wheels without four more parameters to
+/// keep in step (and they cannot be set apart from the masses).
+#[test]
+fn the_wheel_load_and_what_follows_it_come_from_the_masses() {
+    let laden = VehicleParams {
+        speed_mps: FMU_DEFAULT_SPEED_MPS,
+        initial: Initial {
+            lateral_m: FMU_DEFAULT_INITIAL_LATERAL_M,
+            yaw_rad: 0.0,
+        },
+        carbody: fmu_vehicle::params::CarBody {
+            mass_kg: 40_000.0,
+            ..VehicleParams::default().carbody
+        },
+        ..VehicleParams::default()
+    };
+    let expected = laden.wheel_rail_from_masses();
+    let tare = VehicleParams::default().wheel_rail;
+    // g m_total / 8: 64.0 kN against 54.2 kN
+    assert_eq!(expected.wheel_load_n, 9.81 * laden.total_mass_kg() / 8.0);
+    assert!(
+        (expected.wheel_load_n - 64.0e3).abs() < 0.1e3,
+        "{expected:?}"
+    );
+    let (mut c, log) = initialising::<M>();
+    let names = [
+        "wheelset.wheel_load",
+        "creep.f11",
+        "creep.f22",
+        "linear.gravitational_stiffness",
+    ];
+    let read = |c: &mut model_description::Component| names.map(|n| get::<M>(c, n));
+    assert_eq!(
+        read(&mut c),
+        [
+            tare.wheel_load_n,
+            tare.f11_n,
+            tare.f22_n,
+            tare.gravity_stiffness_n_per_m
+        ]
+    );
+    assert_eq!(set::<M>(&mut c, "carbody.mass", 40_000.0), Status::Ok);
+    let values = [
+        expected.wheel_load_n,
+        expected.f11_n,
+        expected.f22_n,
+        expected.gravity_stiffness_n_per_m,
+    ];
+    assert_eq!(read(&mut c), values);
+    // 11.5 MN at 70 kN, scaled as P^(2/3)
+    let f11 = 11.5e6 * (expected.wheel_load_n / 70e3).powf(2.0 / 3.0);
+    assert!((expected.f11_n - f11).abs() < 1e-6 * f11);
+    for name in names {
+        assert_eq!(set::<M>(&mut c, name, 1e6), Status::Error, "{name}");
+        assert!(logged(&log.take(), Status::Error, "calculatedParameter"));
+    }
+    assert_eq!(c.exit_initialization_mode(), Status::Ok);
+    assert_eq!(read(&mut c), values);
+    // the physics runs on them: the FMU's step equals the laden vehicle's
+    let mut v = Vehicle::new(VehicleParams {
+        wheel_rail: expected,
+        ..laden
+    })
+    .unwrap();
+    let h = 1e-3;
+    let mut t = 0.0;
+    for k in 0..200 {
+        assert_eq!(c.do_step(t, h), Status::Ok);
+        // the glue steps from its own time to t + h: the same effective step here
+        let o = v.step((t + h) - t, &Inputs::default()).unwrap();
+        t += h;
+        assert_eq!(
+            get::<M>(&mut c, "wheelset_1.y_over_q"),
+            o.wheelset[0].y_over_q,
+            "step {k}"
+        );
+    }
+    assert!(get::<M>(&mut c, "wheelset_1.y_over_q").abs() > 0.0);
+}
+
 /// A parameter that passes its range but leaves the dynamics faster than any step can follow
 /// (a wheelset of 1e-300 kg) is refused at initialisation, naming it and saying why, instead of
 /// making every later step loop for ever.
