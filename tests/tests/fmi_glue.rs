@@ -464,3 +464,41 @@ fn the_shortest_sub_step_parameters_allow_still_takes_a_one_second_step() {
     assert_eq!(inst.exit_init(), OK);
     assert_eq!(inst.do_step(0.0, 1.0), OK, "{:?}", inst.messages());
 }
+
+/// Every packaged FMU names its copyright and licence in modelDescription.xml and carries the
+/// licence texts it names.
+#[test]
+fn every_fmu_names_its_licence_and_ships_its_texts() {
+    let dist = workspace_root().join("dist");
+    let mut fmus: Vec<_> = std::fs::read_dir(&dist)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "fmu"))
+        .collect();
+    fmus.sort();
+    assert!(fmus.len() >= 10, "{fmus:?}");
+    for path in fmus {
+        let f = TestFmu::open(&path).unwrap();
+        let md = &f.model_description;
+        assert!(
+            md.contains(r#" copyright="Copyright (c) 2026 the rail-fmu authors""#),
+            "{}",
+            path.display()
+        );
+        assert!(
+            md.contains(r#" license="MIT OR Apache-2.0 (documentation/LICENSE-MIT.txt"#),
+            "{}",
+            path.display()
+        );
+        let mit =
+            std::fs::read_to_string(f.dir.path().join("documentation/LICENSE-MIT.txt")).unwrap();
+        assert!(
+            mit.contains("Permission is hereby granted"),
+            "{}",
+            path.display()
+        );
+        let apache =
+            std::fs::read_to_string(f.dir.path().join("documentation/LICENSE-APACHE.txt")).unwrap();
+        assert!(apache.contains("Apache License"), "{}", path.display());
+    }
+}

@@ -263,6 +263,17 @@ pub fn write_fmu(
             model.documentation_html.as_bytes(),
             0o644,
         ),
+        // the licence texts travel with the binary they cover
+        (
+            "documentation/LICENSE-MIT.txt".into(),
+            crate::xml::LICENSE_MIT.as_bytes(),
+            0o644,
+        ),
+        (
+            "documentation/LICENSE-APACHE.txt".into(),
+            crate::xml::LICENSE_APACHE.as_bytes(),
+            0o644,
+        ),
     ];
     for (platform, bytes) in binaries {
         entries.push((

@@ -362,6 +362,18 @@ pub fn model_description<M: FmuModel>() -> Result<Description, DeclarationError>
     })
 }
 
+/// The `copyright` attribute of every FMU.
+pub const COPYRIGHT: &str = "Copyright (c) 2026 the rail-fmu authors";
+/// The `license` attribute: the project's licence, whose texts every FMU ships under
+/// documentation/.
+pub const LICENSE: &str = concat!(
+    env!("CARGO_PKG_LICENSE"),
+    " (documentation/LICENSE-MIT.txt, documentation/LICENSE-APACHE.txt)"
+);
+/// The licence texts of the project (the repository's LICENSE-MIT and LICENSE-APACHE).
+pub const LICENSE_MIT: &str = include_str!("../../../LICENSE-MIT");
+pub const LICENSE_APACHE: &str = include_str!("../../../LICENSE-APACHE");
+
 fn render<M: FmuModel>(vars: &[Variable<M>], starts: &[Option<StartValue>]) -> String {
     let info: ModelInfo = M::INFO;
     let vrs = value_references(vars);
@@ -369,11 +381,13 @@ fn render<M: FmuModel>(vars: &[Variable<M>], starts: &[Option<StartValue>]) -> S
     let _ = writeln!(x, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
     let _ = writeln!(
         x,
-        r#"<fmiModelDescription fmiVersion="2.0" modelName="{}" guid="@GUID@" description="{}" author="{}" version="{}" generationTool="model-description {}" variableNamingConvention="structured" numberOfEventIndicators="0">"#,
+        r#"<fmiModelDescription fmiVersion="2.0" modelName="{}" guid="@GUID@" description="{}" author="{}" version="{}" copyright="{}" license="{}" generationTool="model-description {}" variableNamingConvention="structured" numberOfEventIndicators="0">"#,
         escape(info.name),
         escape(info.description),
         escape(info.author),
         escape(info.version),
+        escape(COPYRIGHT),
+        escape(LICENSE),
         env!("CARGO_PKG_VERSION"),
     );
     let _ = write!(
