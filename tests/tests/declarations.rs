@@ -328,21 +328,24 @@ fn every_parameter_error_names_a_declared_variable() {
             single_parameter_errors::<FullActiveActuator>(),
             18,
         ),
+        // band_pass.order and hill_climb.initial_direction are Enumerations: refused when set
         (
             "MpptController",
             single_parameter_errors::<MpptController>(),
-            11,
+            10,
         ),
+        // sensor.sign is an Enumeration: 0 is refused when set
         (
             "SkyHookController",
             single_parameter_errors::<SkyHookController>(),
-            23,
+            22,
         ),
-        // board.sample_time is refused when set (declared minimum), not at initialisation
+        // board.sample_time is refused when set (declared minimum), not at initialisation, and
+        // force_loop.command_sign is an Enumeration
         (
             "IdealDamperForceController",
             single_parameter_errors::<IdealDamperForceController>(),
-            2,
+            1,
         ),
         ("Bogie2Dof", single_parameter_errors::<Bogie2Dof>(), 14),
         ("RailVehicle", single_parameter_errors::<RailVehicle>(), 20),

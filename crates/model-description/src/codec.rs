@@ -130,13 +130,31 @@ impl<F: FmiValue> Codec<F> for Native {
     }
 }
 
-/// A sign held as `f64` (+1 / -1), exposed as an Integer: reads 0 only for a zero field, and an
-/// Integer set is stored as that value (the declared range [-1, 1] and the physics' validation
-/// reject anything but +-1).
+/// A sign held as `f64` (+1 / -1), exposed as the Enumeration [`SIGN`] (so the glue refuses
+/// anything but -1 and +1 when it is set); reads 0 only for a zero field.
 pub struct Sign;
+
+/// The Enumeration of a sign: `minus` = -1, `plus` = +1.
+pub static SIGN: EnumType = EnumType {
+    name: "Sign",
+    description: "A sign: -1 or +1",
+    items: &[
+        crate::enumeration::EnumItem {
+            name: "minus",
+            value: -1,
+            description: "-1",
+        },
+        crate::enumeration::EnumItem {
+            name: "plus",
+            value: 1,
+            description: "+1",
+        },
+    ],
+};
 
 impl Codec<f64> for Sign {
     type Fmi = i32;
+    const ENUMERATION: Option<&'static EnumType> = Some(&SIGN);
     fn get(field: &f64) -> i32 {
         if *field > 0.0 {
             1

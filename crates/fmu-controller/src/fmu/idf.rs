@@ -84,7 +84,7 @@ impl FmuModel for IdealDamperForceController {
             parameter "spool.command_limit" [unit = "m", display_unit = "mm", min = 0.0] => params.u_max_m;
             /// +1: u = k_p (F_ref - F); -1: u = k_p (F - F_ref) (seed's printed (3.15)).
             /// Must make a positive command increase the measured tension (see documentation)
-            parameter "force_loop.command_sign" [range = -1.0..=1.0] => params.command_sign as Sign;
+            parameter "force_loop.command_sign" => params.command_sign as Sign;
             /// Board sample time (1 kHz board)
             parameter "board.sample_time" [unit = "s", display_unit = "ms", min = crate::MIN_SAMPLE_TIME_S] => params.sample_time_s;
 

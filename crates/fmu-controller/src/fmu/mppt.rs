@@ -1,8 +1,8 @@
 //! `MpptController` FMU: the MPPT board of [`crate::mppt`].
 
 use model_description::{
-    fmi_enum, DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo,
-    Sign, StepError, Variable,
+    fmi_enum, Codec, DefaultExperiment, Diagnostics, EnumItem, EnumType, FmuModel, InstanceContext,
+    ModelError, ModelInfo, Sign, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
 
@@ -13,6 +13,39 @@ fmi_enum! {
     ForceNormaliser as "ForceNormaliser", "Force normaliser of the MPPT cost (3.2)" {
         Fixed = 0, "fixed", "The fixed value F_norm (default: J depends on the current state only)";
         RunningMax = 1, "running_max", "The running maximum of the rms force, from F_norm (the seed literally)";
+    }
+}
+
+/// `band_pass.order` as the Enumeration `BandPassOrder`: the design takes 2 or 4 (one or two
+/// Butterworth prototype poles per edge), so the glue refuses any other order when it is set.
+struct FilterOrder;
+
+static BAND_PASS_ORDER: EnumType = EnumType {
+    name: "BandPassOrder",
+    description: "Order of the Butterworth band-pass",
+    items: &[
+        EnumItem {
+            name: "second",
+            value: 2,
+            description: "Second order (a first-order prototype)",
+        },
+        EnumItem {
+            name: "fourth",
+            value: 4,
+            description: "Fourth order (a second-order prototype)",
+        },
+    ],
+};
+
+impl Codec<u32> for FilterOrder {
+    type Fmi = i32;
+    const ENUMERATION: Option<&'static EnumType> = Some(&BAND_PASS_ORDER);
+    fn get(field: &u32) -> i32 {
+        i32::try_from(*field).unwrap_or(i32::MAX)
+    }
+    fn set(field: &mut u32, value: i32) {
+        // the glue sets items only (2 or 4)
+        *field = u32::try_from(value).unwrap_or(0);
     }
 }
 
@@ -138,7 +171,7 @@ impl FmuModel for MpptController {
             /// Valve command before the first update (0 V = closed, maximum damping)
             parameter "valve.initial_command" [unit = "V", range = 0.0..=10.0] => params.initial_command_v;
             /// Initial hill-climb direction: +1 opening, -1 closing
-            parameter "hill_climb.initial_direction" [range = -1.0..=1.0] => params.initial_direction as Sign;
+            parameter "hill_climb.initial_direction" => params.initial_direction as Sign;
             /// Lower command saturation (seed 4.4.1: 0 V)
             parameter "valve.command_min" [unit = "V", range = 0.0..=10.0] => params.command_min_v;
             /// Upper command saturation (seed 4.4.1: 10 V)
@@ -146,7 +179,7 @@ impl FmuModel for MpptController {
             /// Board sample time (1 kHz board)
             parameter "board.sample_time" [unit = "s", display_unit = "ms", min = crate::MIN_SAMPLE_TIME_S] => params.sample_time_s;
             /// Order of the Butterworth band-pass on the acceleration: 2 or 4
-            parameter "band_pass.order" [range = 2.0..=4.0] => params.filter_order;
+            parameter "band_pass.order" => params.filter_order as FilterOrder;
             /// Band-pass lower -3 dB edge, f0 - 2 Hz (EN 14363 via seed 4.2)
             parameter "band_pass.low" [unit = "Hz", min = 0.0] => params.band_low_hz;
             /// Band-pass upper -3 dB edge, f0 + 2 Hz

@@ -176,7 +176,7 @@ impl FmuModel for SkyHookController {
             parameter "sensor.velocity_source" => params.velocity_source;
             /// Sign applied to sensor.acceleration / sensor.velocity to give x' of (3.6): a mounting
             /// convention (the study uses -1 left, +1 right with the lateral frame acceleration)
-            parameter "sensor.sign" [range = -1.0..=1.0] => params.absolute_sign as Sign;
+            parameter "sensor.sign" => params.absolute_sign as Sign;
             /// Sky-hook damping c_sky (3.6), (3.11) (not in the seed: same as c_v of (3.14))
             parameter "damping.sky_hook" [unit = "N.s/m", display_unit = "kN.s/m", min = 0.0] => params.c_sky_nspm;
             /// Off-state / lower damping bound c_min (3.11), (3.13); default: open end of the table
