@@ -22,10 +22,21 @@ class _TextBar:
             sys.stderr.flush()
 
 
+def check_progress(progress: Any) -> None:
+    """Refuses a ``progress`` that is none of None, True, False or a callable (a number would
+    otherwise pass as True)."""
+    if not (progress is None or isinstance(progress, bool) or callable(progress)):
+        raise TypeError(
+            f"progress must be True, False, None or a callable f(done, total, ...), "
+            f"not {type(progress).__name__} {progress!r}"
+        )
+
+
 @contextlib.contextmanager
 def bar(progress: Any, unit: str) -> Iterator[Optional[Callable[..., Any]]]:
     """The callback for ``progress``: None/False -> None, a callable -> itself, True -> a bar
     ``f(done, total, ...)`` closed on exit."""
+    check_progress(progress)
     if progress is None or progress is False:
         yield None
         return

@@ -345,9 +345,14 @@ def read_results(path: PathLike) -> Union[Results, RunSetResults]:
         return RunSetResults(p)
     if p.suffix == ".parquet":
         return Results.read_parquet(p)
+    if not p.exists():
+        raise _railfmu.OutputError(f"'{p}': no such file or folder")
     csv = p / "results.csv" if p.is_dir() else p
     if not csv.is_file():
-        raise _railfmu.OutputError(f"'{p}' holds neither sweep.json nor results.csv")
+        raise _railfmu.OutputError(
+            f"'{p}' holds neither sweep.json nor results.csv (a folder of a run or a run set, "
+            "a results CSV or a .parquet file)"
+        )
     res = Results.read_csv(csv)
     summary = csv.parent / "summary.json"
     if summary.is_file():

@@ -12,7 +12,7 @@ from typing import Any, Callable, Dict, List, Mapping, Optional, Union
 
 from . import _railfmu
 from ._json import description_json
-from ._progress import bar
+from ._progress import bar, check_progress
 from ._results import RunSetResults
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -139,6 +139,7 @@ class RunSet:
                 raise TypeError(f"format must be 'csv', 'parquet' or None, got {format!r}")
             if format not in ("csv", "parquet"):
                 raise ValueError(f"format must be 'csv', 'parquet' or None, got {format!r}")
+        check_progress(progress)
         if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
             raise ValueError(f"retries must be a whole number >= 0, got {retries!r}")
         if client is not None and not all(callable(getattr(client, m, None)) for m in ("submit", "scatter")):

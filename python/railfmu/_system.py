@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import numbers
 import os
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Mapping, Optional, Union
@@ -32,7 +33,23 @@ def _plain(value: Any) -> Any:
 
 
 def _plain_dict(parameters: Optional[Mapping[str, Any]]) -> Dict[str, Any]:
+    if parameters is not None and not isinstance(parameters, Mapping):
+        raise TypeError(
+            "parameters must be a mapping of 'instance.variable' to a value, "
+            f"not {type(parameters).__name__}"
+        )
     return {k: _plain(v) for k, v in (parameters or {}).items()}
+
+
+def _seconds(name: str, value: Any) -> Optional[float]:
+    """A time option [s]: None, or a real number (NumPy's too); True or '2' is refused rather
+    than read as 1 s or 2 s."""
+    if value is None:
+        return None
+    value = _plain(value)
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a number of seconds, not {type(value).__name__} {value!r}")
+    return float(value)
 
 
 class System:
@@ -75,8 +92,8 @@ class System:
         return cls(
             _railfmu.PreparedSystem.load(
                 os.fspath(path),
-                None if step is None else float(step),
-                None if stop_time is None else float(stop_time),
+                _seconds("step", step),
+                _seconds("stop_time", stop_time),
                 algorithm,
             )
         )
@@ -141,9 +158,10 @@ class System:
 
     @stop_time.setter
     def stop_time(self, value: Optional[float]) -> None:
-        if value is not None:
-            self._prepared.check(self._parameters, float(value))
-        self._stop_time = None if value is None else float(value)
+        seconds = _seconds("stop_time", value)
+        if seconds is not None:
+            self._prepared.check(self._parameters, seconds)
+        self._stop_time = seconds
 
     def run(
         self,
@@ -164,7 +182,8 @@ class System:
         the simulation fails.
         """
         merged = {**self._parameters, **_plain_dict(parameters)}
-        stop = float(stop_time) if stop_time is not None else self._stop_time
+        seconds = _seconds("stop_time", stop_time)
+        stop = seconds if seconds is not None else self._stop_time
         from ._progress import bar
 
         with bar(progress, "steps") as cb:

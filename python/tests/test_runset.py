@@ -168,6 +168,8 @@ def test_bad_run_set_options_raise_python_errors(dist, tmp_path):
     # check comes before the client is used, so any object stands for one)
     with pytest.raises(ValueError, match="give threads or client, not both"):
         railfmu.run_set(rs, tmp_path / "out", threads=2, client=object())
+    with pytest.raises(TypeError, match="progress must be True, False, None or a callable"):
+        railfmu.run_set(rs, tmp_path / "out", progress=5)
     assert not (tmp_path / "out").exists()
     a_file = tmp_path / "a_file"
     a_file.write_text("x")

@@ -422,3 +422,32 @@ print(json.dumps({{"growth_kib": growth, "result_kib": res.values.nbytes / 1024}
     assert m["result_kib"] > 10_000  # 200 000 rows: large beside the interpreter's noise
     ratio = m["growth_kib"] / m["result_kib"]
     assert ratio < 3.0, f"peak growth {ratio:.2f} times the result"
+
+
+def test_arguments_of_the_wrong_type_raise_type_errors_naming_them(passive_file):
+    s = railfmu.System.load(passive_file)
+    with pytest.raises(TypeError, match="parameters must be a mapping of 'instance.variable' to a value, not list"):
+        s.run(["bogie.vehicle.speed", 50.0])
+    # True is not 1 s, '2' is not 2 s
+    for bad in (True, "2"):
+        with pytest.raises(TypeError, match="stop_time must be a number of seconds"):
+            s.run(stop_time=bad)
+        with pytest.raises(TypeError, match="stop_time must be a number of seconds"):
+            s.stop_time = bad
+        with pytest.raises(TypeError, match="step must be a number of seconds"):
+            railfmu.System.load(passive_file, step=bad)
+    # a number is no progress callback (it was taken as True)
+    with pytest.raises(TypeError, match="progress must be True, False, None or a callable"):
+        s.run(stop_time=0.01, progress=5)
+    assert s.stop_time == 1.0
+    # NumPy numbers are numbers
+    s.stop_time = np.float32(0.25)
+    assert s.stop_time == 0.25
+    assert len(s.run(stop_time=np.int64(1))) == 1001
+
+
+def test_read_results_names_what_is_missing(tmp_path):
+    with pytest.raises(railfmu.OutputError, match="no such file or folder"):
+        railfmu.read_results(tmp_path / "missing.csv")
+    with pytest.raises(railfmu.OutputError, match="holds neither sweep.json nor results.csv"):
+        railfmu.read_results(tmp_path)
