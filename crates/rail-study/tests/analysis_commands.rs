@@ -607,6 +607,34 @@ fn contact_geometry_fleet_table_and_figure() {
         std::fs::read_to_string(out2.join("fleet_conicity.csv")).unwrap(),
         csv
     );
+    // one profile twice (named twice, or named and in the folder) is refused, naming it
+    let out_twice = d.path().join("cg_twice");
+    let cylinder = fleet.join("cylinder.dat");
+    for extra in [
+        vec![
+            "--wheels",
+            cylinder.to_str().unwrap(),
+            cylinder.to_str().unwrap(),
+        ],
+        vec![
+            "--wheels",
+            cylinder.to_str().unwrap(),
+            "--wheel-dir",
+            fleet.to_str().unwrap(),
+        ],
+    ] {
+        let mut args = vec!["contact-geometry"];
+        args.extend(extra);
+        args.extend(["--out", out_twice.to_str().unwrap()]);
+        let r = master(&args);
+        assert!(!r.ok);
+        assert!(
+            r.stderr.contains("cylinder.dat") && r.stderr.contains("is given twice"),
+            "{}",
+            r.stderr
+        );
+        assert!(!out_twice.exists());
+    }
     // a malformed profile: all or nothing
     std::fs::write(fleet.join("broken.dat"), "0 0\n1 oops\n2 0\n").unwrap();
     let out3 = d.path().join("cg3");

@@ -93,6 +93,20 @@ pub struct FleetResults {
     pub amplitudes_m: Vec<f64>,
 }
 
+/// Whether two sources are the same profile: equal, or files that are one file.
+fn same_profile(a: &ProfileSource, b: &ProfileSource) -> bool {
+    match (a, b) {
+        (ProfileSource::File(x), ProfileSource::File(y)) => {
+            x == y
+                || matches!(
+                    (std::fs::canonicalize(x), std::fs::canonicalize(y)),
+                    (Ok(cx), Ok(cy)) if cx == cy
+                )
+        }
+        _ => a == b,
+    }
+}
+
 /// Computes the table for `wheels` (each on both wheels) with the set-up of `inputs`, profiles in
 /// parallel.
 pub fn fleet(
@@ -103,6 +117,18 @@ pub fn fleet(
     check_options(inputs)?;
     if wheels.is_empty() {
         return Err(AnalysisError::Input("no wheel profiles given".into()));
+    }
+    // one row per profile: the same file twice (named twice, or named and in the folder) is
+    // a slip, not a second wheel
+    for (i, wheel) in wheels.iter().enumerate() {
+        if let Some(j) = wheels[..i].iter().position(|w| same_profile(w, wheel)) {
+            return Err(AnalysisError::Input(format!(
+                "wheel profile {} is given twice (profiles {} and {} of the fleet)",
+                wheel.describe(),
+                j + 1,
+                i + 1
+            )));
+        }
     }
     if inputs.amplitude_max_m < FIGURE_AMPLITUDE_M - 1e-12 {
         return Err(AnalysisError::Option {
