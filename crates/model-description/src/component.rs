@@ -107,6 +107,8 @@ impl Snapshot {
 struct SetRule {
     /// Settable in Instantiated and InitializationMode.
     before_step: bool,
+    /// An input (what Initialization Mode's copy takes without being initialised again).
+    input: bool,
     /// Settable in StepComplete.
     in_step: bool,
     /// The declared range (infinite when none).
@@ -122,6 +124,7 @@ impl SetRule {
         SetRule {
             before_step: matches!(c, Causality::Parameter | Causality::Input)
                 && v != Variability::Constant,
+            input: c == Causality::Input,
             in_step: c == Causality::Input
                 || (c == Causality::Parameter && v == Variability::Tunable),
             min: meta.min.unwrap_or(f64::NEG_INFINITY),
@@ -472,9 +475,37 @@ impl Component {
 
     fn refresh_outputs(&mut self, call: &str) -> Status {
         if self.outputs_dirty && self.state == FmiState::InitializationMode {
+            // inputs set since the copy was initialised are in it too (see
+            // `mirror_initial_inputs`): its outputs are computed again, as after the exit
+            if let Some(view) = self.initial_view.as_mut() {
+                if view.update_outputs(&mut Diagnostics::default()).is_ok() {
+                    self.outputs_dirty = false;
+                    return Status::Ok;
+                }
+            }
             return self.refresh_initial_outputs(call);
         }
         self.refresh_model_outputs(call)
+    }
+
+    /// Initialization Mode: Reals were set. Inputs go into the initialised copy as well (the
+    /// model's initialisation does not read them, `tests/initialization_mode.rs` checks that
+    /// the outputs read then are those after the exit), so a host iterating its initial
+    /// coupling does not initialise a copy at every step; a parameter drops the copy.
+    #[cold]
+    #[inline(never)]
+    fn mirror_initial_inputs(&mut self, vrs: &[u32], values: &[f64]) {
+        let inputs = vrs
+            .iter()
+            .all(|&vr| self.real_rules.get(vr as usize).is_some_and(|r| r.input));
+        let mirrored = inputs
+            && self
+                .initial_view
+                .as_mut()
+                .is_some_and(|view| view.set_reals(vrs, values).is_ok());
+        if !mirrored {
+            self.initial_view = None;
+        }
     }
 
     fn refresh_model_outputs(&mut self, call: &str) -> Status {
@@ -718,6 +749,9 @@ impl Component {
             return self.set_real_checked(vrs, values);
         }
         self.outputs_dirty = true;
+        if state == FmiState::InitializationMode {
+            self.mirror_initial_inputs(vrs, values);
+        }
         match self.model.set_reals(vrs, values) {
             Ok(()) => Status::Ok,
             Err(vr) => self.error(&format!("{CALL}: internal: no setter for Real {vr}")),
@@ -749,6 +783,9 @@ impl Component {
             }
         }
         self.outputs_dirty = true;
+        if self.state == FmiState::InitializationMode {
+            self.mirror_initial_inputs(vrs, values);
+        }
         match self.model.set_reals(vrs, values) {
             Ok(()) => Status::Ok,
             Err(vr) => self.error(&format!("{CALL}: internal: no setter for Real {vr}")),
@@ -774,6 +811,8 @@ impl Component {
                 self.model.set_integer(i, *v);
             }
         }
+        // a parameter (or a non-Real input) set: Initialization Mode's copy is made again
+        self.initial_view = None;
         self.outputs_dirty = true;
         Status::Ok
     }
@@ -796,6 +835,8 @@ impl Component {
                 self.model.set_boolean(i, *v);
             }
         }
+        // a parameter (or a non-Real input) set: Initialization Mode's copy is made again
+        self.initial_view = None;
         self.outputs_dirty = true;
         Status::Ok
     }
@@ -818,6 +859,8 @@ impl Component {
                 self.model.set_string(i, v);
             }
         }
+        // a parameter (or a non-Real input) set: Initialization Mode's copy is made again
+        self.initial_view = None;
         self.outputs_dirty = true;
         Status::Ok
     }
