@@ -79,7 +79,7 @@ impl FmuModel for Demo {
             /// Force law
             parameter "spring.law" => law;
             /// Sign
-            parameter "spring.sign" [range = -1.0..=1.0] => params.sign as Sign;
+            parameter "spring.sign" => params.sign as Sign;
             /// Optional mounting stiffness, 0 = rigid
             parameter "spring.mounting_stiffness" [unit = "N/m", min = 0.0] => params.mounting_stiffness_n_per_m as ZeroIsNone;
             /// Work bound
@@ -149,10 +149,9 @@ fn one_line_gives_the_xml_entry() {
         r#"description="Spring stiffness, second line of the description" causality="parameter""#
     ));
     assert!(x.contains(r#"<Real start="1000.0" unit="N/m" displayUnit="kN/m" min="0.0"/>"#));
-    assert!(
-        x.contains(r#"<Integer start="-1" min="-1" max="1"/>"#),
-        "{x}"
-    );
+    // a sign is the Enumeration Sign (-1 = minus, 1 = plus)
+    assert!(x.contains(r#"<Enumeration declaredType="Sign" start="-1"/>"#), "{x}");
+    assert!(x.contains(r#"<Item name="minus" value="-1" description="-1"/>"#));
     assert!(x.contains(r#"<Real start="0.0" unit="N/m" min="0.0"/>"#));
     assert!(x.contains(r#"<String start="a"/>"#));
     assert!(x.contains(r#"<Boolean start="false"/>"#));
