@@ -45,9 +45,10 @@ fn moved(start: f64, min: Option<f64>, max: Option<f64>) -> f64 {
 }
 
 /// Sets `choices` (Enumeration parameters by item name) and `parameters` (Reals by name),
-/// moves every Real input off its start, and compares every Real read in Initialization Mode with the same Real right after
-/// the exit, bit for bit. Returns the names of the outputs that the values set changed (read
-/// before and after setting them, both in Initialization Mode).
+/// moves every Real input off its start, and compares every Real read in Initialization Mode
+/// with the same Real of a twin instance set the same way that read nothing before its exit,
+/// and the two instances over 50 steps, bit for bit. Returns the names of the outputs that the
+/// values set changed (read before and after setting them, both in Initialization Mode).
 fn initial_reads_match_exit<M: FmuModel>(
     choices: &[(&str, &str)],
     parameters: &[(&str, f64)],
@@ -55,6 +56,8 @@ fn initial_reads_match_exit<M: FmuModel>(
     let vars = M::variables();
     let names = real_names::<M>();
     let (mut c, log) = initialising::<M>();
+    // the twin is set the same way and reads nothing before its exit
+    let (mut twin, twin_log) = initialising::<M>();
     for (name, item) in choices {
         let (index, meta) = vars
             .iter()
@@ -74,11 +77,13 @@ fn initial_reads_match_exit<M: FmuModel>(
             .filter(|v| v.meta.var_type == VarType::Integer)
             .count() as u32;
         assert_eq!(c.set_integer(&[vr], &[value]), Status::Ok, "{name}");
+        assert_eq!(twin.set_integer(&[vr], &[value]), Status::Ok, "{name}");
     }
     let (status, before) = read_all_reals::<M>(&mut c);
     assert_eq!(status, Status::Ok, "{}: {:?}", M::INFO.name, log.take());
     for (name, x) in parameters {
         assert_eq!(set::<M>(&mut c, name, *x), Status::Ok, "{name}");
+        assert_eq!(set::<M>(&mut twin, name, *x), Status::Ok, "{name}");
     }
     let mut real_vr = 0u32;
     let mut inputs = 0;
@@ -93,6 +98,7 @@ fn initial_reads_match_exit<M: FmuModel>(
         }
         let x = moved(before[vr as usize], v.meta.min, v.meta.max);
         assert_eq!(c.set_real(&[vr], &[x]), Status::Ok, "{}", v.meta.name);
+        assert_eq!(twin.set_real(&[vr], &[x]), Status::Ok, "{}", v.meta.name);
         inputs += 1;
     }
     assert!(inputs > 0, "{} has no Real input", M::INFO.name);
@@ -104,15 +110,42 @@ fn initial_reads_match_exit<M: FmuModel>(
         M::INFO.name,
         log.take()
     );
-    let (status, after_exit) = read_all_reals::<M>(&mut c);
+    assert!(
+        twin.exit_initialization_mode() <= Status::Warning,
+        "{}: {:?}",
+        M::INFO.name,
+        twin_log.take()
+    );
+    let differing = |what: &str, a: &[f64], b: &[f64]| -> Vec<String> {
+        names
+            .iter()
+            .zip(a.iter().zip(b))
+            .filter(|(_, (x, y))| x.to_bits() != y.to_bits())
+            .map(|(n, (x, y))| format!("{n}: {x:?} {what}, {y:?} in the twin"))
+            .collect()
+    };
+    let (status, twin_after_exit) = read_all_reals::<M>(&mut twin);
     assert_eq!(status, Status::Ok);
-    let differing: Vec<String> = names
-        .iter()
-        .zip(initial.iter().zip(&after_exit))
-        .filter(|(_, (a, b))| a.to_bits() != b.to_bits())
-        .map(|(n, (a, b))| format!("{n}: {a:?} in Initialization Mode, {b:?} after the exit"))
-        .collect();
-    assert!(differing.is_empty(), "{}: {differing:#?}", M::INFO.name);
+    let d = differing("in Initialization Mode", &initial, &twin_after_exit);
+    assert!(d.is_empty(), "{}: {d:#?}", M::INFO.name);
+    // and the two run on bit for bit, whatever one of them read before its exit
+    let h = 1e-3;
+    let mut t = 0.0;
+    for k in 0..50 {
+        let (status, a) = read_all_reals::<M>(&mut c);
+        assert_eq!(status, Status::Ok);
+        let (status, b) = read_all_reals::<M>(&mut twin);
+        assert_eq!(status, Status::Ok);
+        let d = differing(&format!("after step {k}"), &a, &b);
+        assert!(d.is_empty(), "{}: {d:#?}", M::INFO.name);
+        assert!(c.do_step(t, h) <= Status::Warning, "{:?}", log.take());
+        assert!(
+            twin.do_step(t, h) <= Status::Warning,
+            "{:?}",
+            twin_log.take()
+        );
+        t += h;
+    }
     let outputs: Vec<&str> = vars
         .iter()
         .filter(|v| v.meta.var_type == VarType::Real && v.meta.causality == Causality::Output)

@@ -155,6 +155,8 @@ pub struct Component {
     /// In Initialization Mode: a copy of the model initialised with the values set so far,
     /// which the getters read (see [`Component::refresh_initial_outputs`]); None otherwise.
     initial_view: Option<Box<dyn ErasedModel>>,
+    /// What the copy's initialisation reported, for the exit that takes it.
+    initial_view_diag: Diagnostics,
     index: VrIndex,
     /// By declaration index.
     rules: Vec<SetRule>,
@@ -210,6 +212,7 @@ impl Component {
         Component {
             model,
             initial_view: None,
+            initial_view_diag: Diagnostics::default(),
             max_step_s,
             index,
             rules,
@@ -368,13 +371,24 @@ impl Component {
         if self.state != FmiState::InitializationMode {
             return self.wrong_state("fmi2ExitInitializationMode");
         }
-        // a refused exit leaves Initialization Mode on, with the copy initialised again
-        self.initial_view = None;
         self.outputs_dirty = true;
-        if let Err(e) = self.model.exit_initialization(&mut self.diag) {
-            let _ = self.flush_diagnostics();
-            let msg = format!("fmi2ExitInitializationMode: {e}");
-            return self.error(&msg);
+        match self.initial_view.take() {
+            // the copy read in Initialization Mode is this model initialised, with the inputs
+            // set since: it becomes the model (one initialisation per instance, whatever the
+            // host read; `tests/initialization_mode.rs` runs an instance that read nothing
+            // beside one that did, bit for bit)
+            Some(view) => {
+                self.model = view;
+                self.diag = std::mem::take(&mut self.initial_view_diag);
+            }
+            None => {
+                // a refused exit leaves Initialization Mode on, the model as the exit left it
+                if let Err(e) = self.model.exit_initialization(&mut self.diag) {
+                    let _ = self.flush_diagnostics();
+                    let msg = format!("fmi2ExitInitializationMode: {e}");
+                    return self.error(&msg);
+                }
+            }
         }
         if let Err(e) = self.model.update_outputs(&mut self.diag) {
             let _ = self.flush_diagnostics();
@@ -438,21 +452,22 @@ impl Component {
     /// the parameters and inputs set so far (FMI 2.0.4, 4.2.4: a host may solve its initial
     /// coupling in this mode). A model computes its initial outputs when it is initialised
     /// (its track, its states from the initial values), so a copy is initialised and read;
-    /// the model itself is initialised once, at exit, as before. When the copy cannot be
+    /// the exit takes that copy as the model unless a parameter changed since. When the copy cannot be
     /// initialised (a parameter the exit refuses), the call warns with the reason and the
     /// values are the model's own as they stand (the exit then refuses with the same reason).
     #[cold]
     #[inline(never)]
     fn refresh_initial_outputs(&mut self, call: &str) -> Status {
         let mut view = self.model.duplicate();
-        // the exit reports the model's own messages; the copy's would repeat them
-        let mut quiet = Diagnostics::default();
+        // the initialisation's messages are the exit's (it reports them when it takes the copy)
+        let mut kept = Diagnostics::default();
         let initialised = view
-            .exit_initialization(&mut quiet)
-            .and_then(|()| view.update_outputs(&mut quiet));
+            .exit_initialization(&mut kept)
+            .and_then(|()| view.update_outputs(&mut Diagnostics::default()));
         match initialised {
             Ok(()) => {
                 self.initial_view = Some(view);
+                self.initial_view_diag = kept;
                 self.outputs_dirty = false;
                 Status::Ok
             }
@@ -465,7 +480,8 @@ impl Component {
                     return status;
                 }
                 let msg = format!(
-                    "{call} in Initialization Mode: the outputs are not those of the values set                      ({e}; fmi2ExitInitializationMode refuses them)"
+                    "{call} in Initialization Mode: the outputs are not those of the values set \
+                     ({e}; fmi2ExitInitializationMode refuses them)"
                 );
                 self.warning(&msg);
                 Status::Warning
