@@ -452,9 +452,10 @@ impl Component {
     /// the parameters and inputs set so far (FMI 2.0.4, 4.2.4: a host may solve its initial
     /// coupling in this mode). A model computes its initial outputs when it is initialised
     /// (its track, its states from the initial values), so a copy is initialised and read;
-    /// the exit takes that copy as the model unless a parameter changed since. When the copy cannot be
-    /// initialised (a parameter the exit refuses), the call warns with the reason and the
-    /// values are the model's own as they stand (the exit then refuses with the same reason).
+    /// the exit takes that copy as the model unless a parameter changed since. When the copy
+    /// cannot be initialised (a parameter the exit refuses), the call warns with the reason
+    /// and the values are the model's own as they stand (the exit then refuses with the same
+    /// reason).
     #[cold]
     #[inline(never)]
     fn refresh_initial_outputs(&mut self, call: &str) -> Status {

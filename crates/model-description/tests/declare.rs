@@ -150,7 +150,10 @@ fn one_line_gives_the_xml_entry() {
     ));
     assert!(x.contains(r#"<Real start="1000.0" unit="N/m" displayUnit="kN/m" min="0.0"/>"#));
     // a sign is the Enumeration Sign (-1 = minus, 1 = plus)
-    assert!(x.contains(r#"<Enumeration declaredType="Sign" start="-1"/>"#), "{x}");
+    assert!(
+        x.contains(r#"<Enumeration declaredType="Sign" start="-1"/>"#),
+        "{x}"
+    );
     assert!(x.contains(r#"<Item name="minus" value="-1" description="-1"/>"#));
     assert!(x.contains(r#"<Real start="0.0" unit="N/m" min="0.0"/>"#));
     assert!(x.contains(r#"<String start="a"/>"#));
