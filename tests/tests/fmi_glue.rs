@@ -466,7 +466,7 @@ fn the_shortest_sub_step_parameters_allow_still_takes_a_one_second_step() {
 }
 
 /// Every packaged FMU names its copyright and licence in modelDescription.xml and carries the
-/// licence texts it names.
+/// licence texts it names, linked from its documentation.
 #[test]
 fn every_fmu_names_its_licence_and_ships_its_texts() {
     let dist = workspace_root().join("dist");
@@ -500,5 +500,12 @@ fn every_fmu_names_its_licence_and_ships_its_texts() {
         let apache =
             std::fs::read_to_string(f.dir.path().join("documentation/LICENSE-APACHE.txt")).unwrap();
         assert!(apache.contains("Apache License"), "{}", path.display());
+        let html = std::fs::read_to_string(f.dir.path().join("documentation/index.html")).unwrap();
+        assert!(
+            html.contains(r#"<a href="LICENSE-MIT.txt">"#)
+                && html.contains("<h2>Initialization Mode</h2>"),
+            "{}",
+            path.display()
+        );
     }
 }

@@ -89,6 +89,22 @@ pub fn documentation_html<M: FmuModel>() -> Result<String, DeclarationError> {
     for (k, v) in CAPABILITIES {
         let _ = writeln!(h, "<li><code>{k}</code> = {v}</li>");
     }
-    let _ = writeln!(h, "</ul>\n</body></html>");
+    let _ = writeln!(h, "</ul>");
+    let _ = writeln!(
+        h,
+        "<h2>Initialization Mode</h2>\n<p>Every variable read in Initialization Mode has the \
+         value the FMU gives it right after fmi2ExitInitializationMode with the parameters and \
+         inputs set so far, so a host may solve its initial coupling there. A parameter that \
+         fmi2ExitInitializationMode would refuse makes those reads return fmi2Warning naming \
+         it.</p>"
+    );
+    let _ = writeln!(
+        h,
+        "<h2>Licence</h2>\n<p>{} {} (<a href=\"LICENSE-MIT.txt\">LICENSE-MIT.txt</a>, \
+         <a href=\"LICENSE-APACHE.txt\">LICENSE-APACHE.txt</a>, in this folder).</p>",
+        crate::xml::COPYRIGHT,
+        env!("CARGO_PKG_LICENSE")
+    );
+    let _ = writeln!(h, "</body></html>");
     Ok(h)
 }
