@@ -4,10 +4,10 @@
 //! over 100 m windows in 10 m steps) with the lateral-acceleration limit `(12 - m_bogie/5)/2`
 //! or the sum-of-guiding-forces limit `(10 + 2 Q0/3)/2`.
 //!
-//! Input format: one header line of column names, the first column the time in seconds; then
-//! one row of numbers per sample, uniformly sampled. Separators: comma (our CSV, with optional
-//! double quotes around names), semicolon, or whitespace. Lines starting with `#` are
-//! comments. A column is selected by its full name or by the name without a trailing
+//! Input format: one header line of column names, the first column the time in seconds (`[ms]`
+//! in milliseconds, another unit refused); then one row of numbers per sample, uniformly
+//! sampled. Separators: comma (our CSV, with optional double quotes around names), semicolon,
+//! or whitespace. Lines starting with `#` are comments. A column is selected by its full name or by the name without a trailing
 //! ` [unit]`; a unit in brackets is checked against the criterion (m/s2 for accelerations; N or
 //! kN for forces, kN converted). A Parquet file (`.parquet`, ours or another tool's) is read
 //! column by column, its first column the time.
@@ -305,8 +305,24 @@ impl ResultsTable {
         }
     }
 
-    /// Sampling rate from the time column \[Hz\]; the sampling must be uniform.
+    /// Seconds per unit of the time column: 1 for `[s]` or no unit, 1e-3 for `[ms]`; any other
+    /// unit is refused (`time [min]` read as seconds would put the windows 60 times off).
+    fn time_scale_s(&self) -> Result<f64, AnalysisError> {
+        let name = self.names.first().map_or("", String::as_str);
+        match split_unit(name).1.map(str::trim) {
+            None | Some("s") => Ok(1.0),
+            Some("ms") => Ok(1e-3),
+            Some(unit) => Err(AnalysisError::Input(format!(
+                "{}: the time column '{name}' is in {unit}: give it in s (or ms)",
+                self.path.display()
+            ))),
+        }
+    }
+
+    /// Sampling rate from the time column \[Hz\] (in s or ms, see [`Self::time_scale_s`]);
+    /// the sampling must be uniform.
     pub fn sampling_rate_hz(&self) -> Result<f64, AnalysisError> {
+        let scale = self.time_scale_s()?;
         let t = &self.columns[0];
         if t.len() < 3 {
             return Err(AnalysisError::Input(format!(
@@ -335,14 +351,15 @@ impl ResultsTable {
             if ((w[1] - w[0]) - dt).abs() > 1e-6 * dt + 1e-12 {
                 return Err(AnalysisError::Input(format!(
                     "{}: the time column is not uniformly sampled (step {} s after t = {} s, \
-                     mean step {dt} s): resample the signals first",
+                     mean step {} s): resample the signals first",
                     self.path.display(),
-                    w[1] - w[0],
-                    w[0]
+                    (w[1] - w[0]) * scale,
+                    w[0] * scale,
+                    dt * scale
                 )));
             }
         }
-        Ok(1.0 / dt)
+        Ok(1.0 / (dt * scale))
     }
 }
 
@@ -670,6 +687,38 @@ mod tests {
             s.push_str(&format!("{t},{},{}\n", amp * (2.0 * PI * f * t).sin(), 0.0));
         }
         s
+    }
+
+    #[test]
+    fn the_time_column_is_read_in_seconds_or_milliseconds_and_any_other_unit_refused() {
+        let in_s = sine_table(6.0, 4.0, 500.0, 10.0, "m/s2");
+        let rate = |text: &str| {
+            ResultsTable::parse(text, Path::new("x.csv"))
+                .unwrap()
+                .sampling_rate_hz()
+        };
+        assert_eq!(rate(&in_s).unwrap(), 500.0);
+        // the same samples with the time in ms
+        let in_ms: String = in_s
+            .lines()
+            .enumerate()
+            .map(|(i, l)| {
+                if i == 0 {
+                    l.replace("time [s]", "time [ms]")
+                } else {
+                    let (t, rest) = l.split_once(',').unwrap();
+                    format!("{},{rest}", t.parse::<f64>().unwrap() * 1e3)
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+        assert!((rate(&in_ms).unwrap() - 500.0).abs() < 1e-9);
+        let in_min = in_s.replacen("time [s]", "time [min]", 1);
+        let e = rate(&in_min).unwrap_err().to_string();
+        assert!(
+            e.contains("the time column 'time [min]' is in min: give it in s (or ms)"),
+            "{e}"
+        );
     }
 
     #[test]
