@@ -319,7 +319,7 @@ impl ResultsTable {
         }
     }
 
-    /// Sampling rate from the time column \[Hz\] (in s or ms, see [`Self::time_scale_s`]);
+    /// Sampling rate from the time column \[Hz\] (in s, or in ms when its name says `[ms]`);
     /// the sampling must be uniform.
     pub fn sampling_rate_hz(&self) -> Result<f64, AnalysisError> {
         let scale = self.time_scale_s()?;
