@@ -2,7 +2,7 @@
 
 use model_description::{
     fmi_enum, Codec, DefaultExperiment, Diagnostics, EnumItem, EnumType, FmuModel, InstanceContext,
-    ModelError, ModelInfo, Sign, StepError, Variable,
+    ModelError, ModelInfo, Native, Sign, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
 
@@ -40,12 +40,12 @@ static BAND_PASS_ORDER: EnumType = EnumType {
 impl Codec<u32> for FilterOrder {
     type Fmi = i32;
     const ENUMERATION: Option<&'static EnumType> = Some(&BAND_PASS_ORDER);
+    // the field's own Integer form; the glue sets items only (2 or 4)
     fn get(field: &u32) -> i32 {
-        i32::try_from(*field).unwrap_or(i32::MAX)
+        <Native as Codec<u32>>::get(field)
     }
     fn set(field: &mut u32, value: i32) {
-        // the glue sets items only (2 or 4)
-        *field = u32::try_from(value).unwrap_or(0);
+        <Native as Codec<u32>>::set(field, value);
     }
 }
 

@@ -7,9 +7,9 @@
 //! Input format: one header line of column names, the first column the time in seconds (`[ms]`
 //! in milliseconds, another unit refused); then one row of numbers per sample, uniformly
 //! sampled. Separators: comma (our CSV, with optional double quotes around names), semicolon,
-//! or whitespace. Lines starting with `#` are comments. A column is selected by its full name or by the name without a trailing
-//! ` [unit]`; a unit in brackets is checked against the criterion (m/s2 for accelerations; N or
-//! kN for forces, kN converted). A Parquet file (`.parquet`, ours or another tool's) is read
+//! or whitespace. Lines starting with `#` are comments. A column is selected by its full name
+//! or by the name without a trailing ` [unit]`; a unit in brackets is checked against the
+//! criterion (m/s2 for accelerations; N or kN for forces, kN converted). A Parquet file (`.parquet`, ours or another tool's) is read
 //! column by column, its first column the time.
 //!
 //! The metadata of our results files (inside a Parquet file, `<name>.meta.json` beside a CSV)
