@@ -9,7 +9,7 @@ use model_description::{
     ModelInfo, StepError, Variable,
 };
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{resource_or_given, Shell, TrackSetting};
+use vehicle_elements::{resource_or_given, Shell, TooStiff, TrackSetting};
 
 use crate::model::{Inputs, ModelError as PhysicsModelError, Outputs, StepError as PStep, Vehicle};
 use crate::params::{ContactSource, Initial, VehicleParams};
@@ -32,6 +32,13 @@ const FROM_THE_MASSES: [&str; 4] = [
     "wheel_rail.gravity_stiffness_n_per_m",
 ];
 
+/// Whether a too-stiff error is about a field calculated from the masses.
+fn from_the_masses(e: &TooStiff) -> bool {
+    e.parameter
+        .as_deref()
+        .is_some_and(|p| FROM_THE_MASSES.contains(&p))
+}
+
 impl FieldError for PhysicsModelError {
     fn field(&self) -> Option<&str> {
         match self {
@@ -41,24 +48,15 @@ impl FieldError for PhysicsModelError {
                 Some("contact")
             }
             // the load and what follows it are calculated parameters of the masses
-            PhysicsModelError::TooStiff(e) => e.parameter.as_deref().map(|p| {
-                if FROM_THE_MASSES.contains(&p) {
-                    "wheelset.wheel_load"
-                } else {
-                    p
-                }
-            }),
+            PhysicsModelError::TooStiff(e) if from_the_masses(e) => Some("wheelset.wheel_load"),
+            PhysicsModelError::TooStiff(e) => e.parameter.as_deref(),
         }
     }
 
     fn reason(&self) -> String {
         match self {
             PhysicsModelError::Param(p) => p.reason(),
-            PhysicsModelError::TooStiff(e)
-                if e.parameter
-                    .as_deref()
-                    .is_some_and(|p| FROM_THE_MASSES.contains(&p)) =>
-            {
+            PhysicsModelError::TooStiff(e) if from_the_masses(e) => {
                 format!(
                     "{} (the wheel load and the creep coefficients follow carbody.mass, \
                      frame.mass and wheelset.mass)",

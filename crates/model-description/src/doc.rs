@@ -103,7 +103,7 @@ pub fn documentation_html<M: FmuModel>() -> Result<String, DeclarationError> {
         "<h2>Licence</h2>\n<p>{} {} (<a href=\"LICENSE-MIT.txt\">LICENSE-MIT.txt</a>, \
          <a href=\"LICENSE-APACHE.txt\">LICENSE-APACHE.txt</a>, in this folder).</p>",
         crate::xml::COPYRIGHT,
-        env!("CARGO_PKG_LICENSE")
+        crate::xml::LICENSE_ID
     );
     let _ = writeln!(h, "</body></html>");
     Ok(h)

@@ -2,6 +2,7 @@
 //! are written once.
 
 use std::any::Any;
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
@@ -54,6 +55,12 @@ type RealSetter<M> = Option<fn(&mut M, f64)>;
 /// A model value plus its variable table.
 pub struct Typed<M: FmuModel> {
     pub model: M,
+    /// Shared with the instance's copies (the Initialization Mode view): it never changes.
+    table: Arc<Table<M>>,
+}
+
+/// The variables of a model: what [`FmuModel::variables`] declares, indexed for the calls.
+struct Table<M: FmuModel> {
     vars: Vec<Variable<M>>,
     metas: Vec<VarMeta>,
     /// The Real accessors by value reference (Real value references are 0, 1, ... in
@@ -68,7 +75,12 @@ impl<M: FmuModel> Typed<M> {
     /// altered is refused here rather than reaching the physics (a negative stiffness, an
     /// unknown model choice).
     fn check_settable_values(&self, model: &M) -> Result<(), String> {
-        for v in self.vars.iter().filter(|v| v.meta.causality.is_settable()) {
+        for v in self
+            .table
+            .vars
+            .iter()
+            .filter(|v| v.meta.causality.is_settable())
+        {
             let m = &v.meta;
             let bad = match &v.access {
                 Access::Real { get, .. } => {
@@ -107,10 +119,12 @@ impl<M: FmuModel> Typed<M> {
         }
         Ok(Typed {
             model: M::instantiate(ctx)?,
-            vars,
-            metas,
-            real_get,
-            real_set,
+            table: Arc::new(Table {
+                vars,
+                metas,
+                real_get,
+                real_set,
+            }),
         })
     }
 }
@@ -125,25 +139,25 @@ struct Tagged<M> {
 
 impl<M: FmuModel> ErasedModel for Typed<M> {
     fn metas(&self) -> &[VarMeta] {
-        &self.metas
+        &self.table.metas
     }
 
     fn get_integer(&self, index: usize) -> Option<i32> {
-        match &self.vars.get(index)?.access {
+        match &self.table.vars.get(index)?.access {
             Access::Integer { get, .. } => Some(get(&self.model)),
             _ => None,
         }
     }
 
     fn get_boolean(&self, index: usize) -> Option<bool> {
-        match &self.vars.get(index)?.access {
+        match &self.table.vars.get(index)?.access {
             Access::Boolean { get, .. } => Some(get(&self.model)),
             _ => None,
         }
     }
 
     fn get_string(&self, index: usize) -> Option<String> {
-        match &self.vars.get(index)?.access {
+        match &self.table.vars.get(index)?.access {
             Access::String { get, .. } => Some(get(&self.model)),
             _ => None,
         }
@@ -151,11 +165,14 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
 
     fn get_reals(&self, vrs: &[u32], out: &mut [f64]) -> Result<(), u32> {
         // every value reference first: a refused call leaves the host's array as it was
-        if let Some(&vr) = vrs.iter().find(|&&vr| vr as usize >= self.real_get.len()) {
+        if let Some(&vr) = vrs
+            .iter()
+            .find(|&&vr| vr as usize >= self.table.real_get.len())
+        {
             return Err(vr);
         }
         for (&vr, x) in vrs.iter().zip(out) {
-            *x = self.real_get[vr as usize](&self.model);
+            *x = self.table.real_get[vr as usize](&self.model);
         }
         Ok(())
     }
@@ -163,6 +180,7 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
     fn set_reals(&mut self, vrs: &[u32], values: &[f64]) -> Result<(), u32> {
         for (&vr, &x) in vrs.iter().zip(values) {
             let set = self
+                .table
                 .real_set
                 .get(vr as usize)
                 .copied()
@@ -174,7 +192,7 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
     }
 
     fn set_integer(&mut self, index: usize, value: i32) -> bool {
-        match self.vars.get(index).map(|v| &v.access) {
+        match self.table.vars.get(index).map(|v| &v.access) {
             Some(Access::Integer { set: Some(set), .. }) => {
                 set(&mut self.model, value);
                 true
@@ -184,7 +202,7 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
     }
 
     fn set_boolean(&mut self, index: usize, value: bool) -> bool {
-        match self.vars.get(index).map(|v| &v.access) {
+        match self.table.vars.get(index).map(|v| &v.access) {
             Some(Access::Boolean { set: Some(set), .. }) => {
                 set(&mut self.model, value);
                 true
@@ -194,7 +212,7 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
     }
 
     fn set_string(&mut self, index: usize, value: &str) -> bool {
-        match self.vars.get(index).map(|v| &v.access) {
+        match self.table.vars.get(index).map(|v| &v.access) {
             Some(Access::String { set: Some(set), .. }) => {
                 set(&mut self.model, value.to_string());
                 true
@@ -211,10 +229,7 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
     fn duplicate(&self) -> Box<dyn ErasedModel> {
         Box::new(Typed {
             model: self.model.clone(),
-            vars: self.vars.clone(),
-            metas: self.metas.clone(),
-            real_get: self.real_get.clone(),
-            real_set: self.real_set.clone(),
+            table: Arc::clone(&self.table),
         })
     }
 

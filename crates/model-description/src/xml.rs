@@ -364,12 +364,10 @@ pub fn model_description<M: FmuModel>() -> Result<Description, DeclarationError>
 
 /// The `copyright` attribute of every FMU.
 pub const COPYRIGHT: &str = "Copyright (c) 2026 the rail-fmu authors";
-/// The `license` attribute: the project's licence, whose texts every FMU ships under
-/// documentation/.
-pub const LICENSE: &str = concat!(
-    env!("CARGO_PKG_LICENSE"),
-    " (documentation/LICENSE-MIT.txt, documentation/LICENSE-APACHE.txt)"
-);
+/// The project's licence (SPDX expression, from the workspace manifest).
+pub const LICENSE_ID: &str = env!("CARGO_PKG_LICENSE");
+/// Where every FMU ships the licence texts, relative to the FMU's root.
+const LICENSE_FILES: &str = "documentation/LICENSE-MIT.txt, documentation/LICENSE-APACHE.txt";
 /// The licence texts of the project (the repository's LICENSE-MIT and LICENSE-APACHE).
 pub const LICENSE_MIT: &str = include_str!("../../../LICENSE-MIT");
 pub const LICENSE_APACHE: &str = include_str!("../../../LICENSE-APACHE");
@@ -387,7 +385,7 @@ fn render<M: FmuModel>(vars: &[Variable<M>], starts: &[Option<StartValue>]) -> S
         escape(info.author),
         escape(info.version),
         escape(COPYRIGHT),
-        escape(LICENSE),
+        escape(&format!("{LICENSE_ID} ({LICENSE_FILES})")),
         env!("CARGO_PKG_VERSION"),
     );
     let _ = write!(
