@@ -531,6 +531,9 @@ impl PySystem {
                 Some(f) => parse_format(f)?,
                 None => format_by_size(&self.prepared, &jobs),
             },
+            integer_columns: self
+                .prepared
+                .integer_parameters(jobs.iter().flat_map(|j| j.parameters.keys())),
             ..ResultsOptions::default()
         };
         let cancel = AtomicBool::new(false);

@@ -30,6 +30,9 @@ def test_a_parquet_run_set_folder_is_one_table_with_units_and_parameters(dist, m
     # the run parameters are columns: each run has its speed and track seed
     params = runs[["bogie.vehicle.speed", "bogie.track.seed"]].first()
     assert sorted(map(tuple, params.to_numpy().tolist())) == [(50.0, 1.0), (50.0, 2.0), (60.0, 1.0), (60.0, 2.0)]
+    # each of the type of its FMU variable: the seed an Integer, the speed a Real
+    assert table["bogie.track.seed"].dtype == np.int32
+    assert table["bogie.vehicle.speed"].dtype == np.float64
     # units, FMU variables and sampling in the file metadata
     meta = json.loads(pq.read_schema(folder / "run-000.parquet").metadata[b"railfmu.results"])
     columns = {c["name"]: c for c in meta["columns"]}

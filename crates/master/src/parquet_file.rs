@@ -4,8 +4,9 @@
 //! split, then zstd: the exponent and high mantissa bytes of smooth signals compress well),
 //! Integers and Enumerations as INT32 (an Enumeration followed by its item names), Booleans
 //! as BOOLEAN, Strings as UTF-8 text. Then the constant columns of a run of a run set: `run`
-//! (its name), its parameters and labels (float64, boolean or text; null where a run does not
-//! set one), so that the files of a run set read as one table. The metadata
+//! (its name), its parameters and labels (float64, int32 for the Integers and Enumerations of
+//! their FMUs, boolean or text; null where a run does not set one), so that the files of a
+//! run set read as one table. The metadata
 //! ([`ResultsMetadata`]) is JSON under the file's key [`PARQUET_METADATA_KEY`]
 //! (`pyarrow.parquet.read_schema(path).metadata`).
 //!
@@ -40,6 +41,9 @@ pub const MAX_PARQUET_BYTES: u64 = 8 << 30;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ConstantKind {
     Float,
+    /// A parameter that is an Integer or Enumeration in its FMU, given as a number in every
+    /// run (INT32, as the FMU's own Integer columns).
+    Integer,
     Boolean,
     Text,
 }
@@ -58,10 +62,11 @@ impl ConstantKind {
 
     /// The kind of a column holding values of both kinds.
     pub fn merge(self, other: Self) -> Self {
-        if self == other {
-            self
-        } else {
-            ConstantKind::Text
+        match (self, other) {
+            (a, b) if a == b => a,
+            (ConstantKind::Integer, ConstantKind::Float)
+            | (ConstantKind::Float, ConstantKind::Integer) => ConstantKind::Float,
+            _ => ConstantKind::Text,
         }
     }
 }
@@ -80,6 +85,7 @@ enum Values {
     Bool(Vec<bool>),
     Text(Vec<ByteArray>),
     OptDouble(Vec<f64>, Vec<i16>),
+    OptInt(Vec<i32>, Vec<i16>),
     OptBool(Vec<bool>, Vec<i16>),
     OptText(Vec<ByteArray>, Vec<i16>),
 }
@@ -89,6 +95,12 @@ fn parquet_err(path: &Path) -> impl Fn(parquet::errors::ParquetError) -> OutputE
         path: path.to_path_buf(),
         source: std::io::Error::other(e.to_string()),
     }
+}
+
+/// A JSON number that is a 32-bit integer (`2` or `2.0`), as an FMI Integer holds it.
+pub fn integer_value(v: &Value) -> Option<i32> {
+    let x = v.as_f64()?;
+    (x.fract() == 0.0 && x >= f64::from(i32::MIN) && x <= f64::from(i32::MAX)).then_some(x as i32)
 }
 
 fn text(s: &str) -> ByteArray {
@@ -195,6 +207,15 @@ pub fn write_results_parquet(
                 let v = k.value.as_ref().and_then(Value::as_f64).unwrap_or(f64::NAN);
                 values.push(Values::OptDouble(vec![v; some], def));
             }
+            ConstantKind::Integer => {
+                add(&name, Physical::INT32, None, Repetition::OPTIONAL).map_err(&perr)?;
+                // the kind is Integer only where every run's value is one (see
+                // `integer_value`); anything else is null rather than a rounded number
+                let v = k.value.as_ref().and_then(integer_value);
+                let some = if v.is_some() { some } else { 0 };
+                let def = vec![i16::from(v.is_some()); n];
+                values.push(Values::OptInt(vec![v.unwrap_or(0); some], def));
+            }
             ConstantKind::Boolean => {
                 add(&name, Physical::BOOLEAN, None, Repetition::OPTIONAL).map_err(&perr)?;
                 let v = k.value.as_ref().and_then(Value::as_bool).unwrap_or(false);
@@ -238,6 +259,7 @@ pub fn write_results_parquet(
             Values::Bool(x) => col.typed::<BoolType>().write_batch(&x, None, None),
             Values::Text(x) => col.typed::<ByteArrayType>().write_batch(&x, None, None),
             Values::OptDouble(x, d) => col.typed::<DoubleType>().write_batch(&x, Some(&d), None),
+            Values::OptInt(x, d) => col.typed::<Int32Type>().write_batch(&x, Some(&d), None),
             Values::OptBool(x, d) => col.typed::<BoolType>().write_batch(&x, Some(&d), None),
             Values::OptText(x, d) => col.typed::<ByteArrayType>().write_batch(&x, Some(&d), None),
         }
@@ -552,12 +574,16 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let ctx = RunContext {
             run: Some("run-007".into()),
-            parameters: BTreeMap::from([("a.k".to_string(), serde_json::json!(300))]),
+            parameters: BTreeMap::from([
+                ("a.k".to_string(), serde_json::json!(300)),
+                ("a.count".to_string(), serde_json::json!(4)),
+            ]),
             labels: BTreeMap::from([("configuration".to_string(), serde_json::json!("passive"))]),
             system: Some(serde_json::json!({"instances": []})),
             kinds: BTreeMap::from([
                 ("a.k".to_string(), ConstantKind::Float),
-                ("a.seed".to_string(), ConstantKind::Float),
+                ("a.count".to_string(), ConstantKind::Integer),
+                ("a.seed".to_string(), ConstantKind::Integer),
             ]),
         };
         let pq = dir.path().join("r.parquet");
@@ -588,7 +614,21 @@ mod tests {
             Some(ColumnData::Texts(vec![Some("passive".into()); 3]))
         );
         assert_eq!(get("a.k"), Some(ColumnData::Numbers(vec![Some(300.0); 3])));
+        assert_eq!(
+            get("a.count"),
+            Some(ColumnData::Numbers(vec![Some(4.0); 3]))
+        );
         assert_eq!(get("a.seed"), Some(ColumnData::Numbers(vec![None; 3])));
+        // a Real parameter is a DOUBLE column, an Integer one INT32 (as pandas reads them)
+        let file = SerializedFileReader::new(std::fs::File::open(&pq).unwrap()).unwrap();
+        let schema = file.metadata().file_metadata().schema_descr_ptr();
+        let physical = |n: &str| {
+            let c = schema.columns().iter().find(|c| c.name() == n).unwrap();
+            c.physical_type()
+        };
+        assert_eq!(physical("a.k"), Physical::DOUBLE);
+        assert_eq!(physical("a.count"), Physical::INT32);
+        assert_eq!(physical("a.seed"), Physical::INT32);
         assert_eq!(
             get("a.e (item)"),
             Some(ColumnData::Texts(vec![
@@ -604,6 +644,31 @@ mod tests {
             .filter(|n| n.starts_with('.'))
             .collect();
         assert!(names.is_empty(), "{names:?}");
+    }
+
+    #[test]
+    fn integer_parameters_are_integer_columns_when_every_run_gives_a_whole_number() {
+        use crate::results::{constant_kinds, with_integer_kinds};
+        let runs = [
+            serde_json::json!({"a.seed": 1, "a.k": 300, "a.order": 2, "a.mode": "fast"}),
+            serde_json::json!({"a.seed": 2.0, "a.k": 310, "a.order": 2.5, "a.mode": 3}),
+        ];
+        let runs: Vec<BTreeMap<String, Value>> = runs
+            .iter()
+            .map(|r| serde_json::from_value(r.clone()).unwrap())
+            .collect();
+        let values = || runs.iter().flatten();
+        let integers = ["a.seed", "a.order", "a.mode"].map(String::from).into();
+        let kinds = with_integer_kinds(constant_kinds(values()), &integers, values());
+        // a.k is a Real of its FMU whatever its values; a.order is not whole in every run;
+        // a.mode is given by item name in one run
+        assert_eq!(kinds["a.seed"], ConstantKind::Integer);
+        assert_eq!(kinds["a.k"], ConstantKind::Float);
+        assert_eq!(kinds["a.order"], ConstantKind::Float);
+        assert_eq!(kinds["a.mode"], ConstantKind::Text);
+        assert_eq!(integer_value(&serde_json::json!(2.0)), Some(2));
+        assert_eq!(integer_value(&serde_json::json!(3e9)), None);
+        assert_eq!(integer_value(&serde_json::json!("2")), None);
     }
 
     #[test]

@@ -109,10 +109,10 @@ impl RunContext {
     /// The constant columns of a Parquet file: `run`, then every parameter and label of the
     /// run set (null where this run has none).
     pub fn constants(&self) -> Vec<Constant> {
+        // the run set's kinds were found from every run's values, this run's among them
         let mut kinds = self.kinds.clone();
         for (k, kind) in constant_kinds(self.parameters.iter().chain(&self.labels)) {
-            let e = kinds.entry(k).or_insert(kind);
-            *e = e.merge(kind);
+            kinds.entry(k).or_insert(kind);
         }
         let mut out = Vec::with_capacity(kinds.len() + 1);
         if let Some(run) = &self.run {
@@ -145,6 +145,33 @@ where
         if let Some(kind) = ConstantKind::of(v) {
             let e = kinds.entry(k.clone()).or_insert(kind);
             *e = e.merge(kind);
+        }
+    }
+    kinds
+}
+
+/// `kinds` with the columns in `integers` (parameters that are Integers or Enumerations in
+/// their FMUs, labels that are whole numbers by nature) made [`ConstantKind::Integer`] where
+/// every run gave them as whole numbers: a JSON number alone does not say whether `2` is an
+/// Integer or a Real.
+pub fn with_integer_kinds<'a, I>(
+    mut kinds: BTreeMap<String, ConstantKind>,
+    integers: &std::collections::BTreeSet<String>,
+    values: I,
+) -> BTreeMap<String, ConstantKind>
+where
+    I: IntoIterator<Item = (&'a String, &'a Value)>,
+{
+    let mut whole: BTreeMap<&str, bool> = BTreeMap::new();
+    for (k, v) in values {
+        if integers.contains(k) && !v.is_null() {
+            let e = whole.entry(k.as_str()).or_insert(true);
+            *e &= crate::parquet_file::integer_value(v).is_some();
+        }
+    }
+    for (k, all_whole) in whole {
+        if let (true, Some(kind @ ConstantKind::Float)) = (all_whole, kinds.get_mut(k)) {
+            *kind = ConstantKind::Integer;
         }
     }
     kinds

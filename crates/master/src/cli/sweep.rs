@@ -100,6 +100,8 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         let cancel = ctx.cancel;
         let results = ResultsOptions {
             format,
+            integer_columns: system
+                .integer_parameters(todo.iter().flat_map(|j| j.parameters.keys())),
             ..ResultsOptions::default()
         };
         fresh = run_all(

@@ -1,7 +1,7 @@
 //! Executing a run set: one job on the prepared system, the jobs in parallel, each run's
 //! results written into a temporary folder and moved into place whole.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -11,7 +11,9 @@ use serde_json::Value;
 use super::{Job, RunReport, SweepError, PARQUET_FOLDER};
 use crate::coupling::{CouplingPlan, RunOptions, SimOutput, Summary};
 use crate::output::write_json_atomic;
-use crate::results::{constant_kinds, write_results, ConstantKind, ResultsFormat, RunContext};
+use crate::results::{
+    constant_kinds, with_integer_kinds, write_results, ConstantKind, ResultsFormat, RunContext,
+};
 use crate::system::{LoadedSystem, PreparedSystem, SystemDescription, SystemError};
 
 /// The start values and stop time of every job, checked against the prepared system's FMUs
@@ -68,6 +70,11 @@ pub struct ResultsOptions {
     pub format: ResultsFormat,
     /// Constant columns besides the parameters, per run name (e.g. a study's configuration).
     pub labels: BTreeMap<String, BTreeMap<String, Value>>,
+    /// The parameters that are Integers or Enumerations in their FMUs
+    /// ([`PreparedSystem::integer_parameters`]) and the labels that are whole numbers by
+    /// nature (a track seed): their Parquet columns are INT32 where every run gives a whole
+    /// number, not float64.
+    pub integer_columns: BTreeSet<String>,
 }
 
 impl Default for ResultsOptions {
@@ -75,6 +82,7 @@ impl Default for ResultsOptions {
         ResultsOptions {
             format: ResultsFormat::Csv,
             labels: BTreeMap::new(),
+            integer_columns: BTreeSet::new(),
         }
     }
 }
@@ -170,11 +178,19 @@ pub fn execute_with<F>(
 where
     F: Fn(&Job) -> Result<SimOutput, String> + Sync,
 {
-    let kinds = constant_kinds(jobs.iter().flat_map(|j| {
-        j.parameters
-            .iter()
-            .chain(results.labels.get(&j.name).into_iter().flatten())
-    }));
+    let kinds = with_integer_kinds(
+        constant_kinds(jobs.iter().flat_map(|j| {
+            j.parameters
+                .iter()
+                .chain(results.labels.get(&j.name).into_iter().flatten())
+        })),
+        &results.integer_columns,
+        jobs.iter().flat_map(|j| {
+            j.parameters
+                .iter()
+                .chain(results.labels.get(&j.name).into_iter().flatten())
+        }),
+    );
     let dir_err = |source| SweepError::Dir {
         path: outdir.to_path_buf(),
         source,

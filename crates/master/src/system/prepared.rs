@@ -1,7 +1,7 @@
 //! A system prepared once for many runs: FMUs opened, checked, unpacked and loaded once, the
 //! coupling plan built once; a run is then typed start values plus a stop time.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -11,6 +11,7 @@ use super::plan::start_value;
 use super::{split_ref, LoadedSystem, RunError, SystemError};
 use crate::coupling::{simulate, CouplingPlan, RunOptions, SimOutput};
 use crate::fmu::{FmuSlave, PreparedFmu};
+use crate::model_description::VarType;
 use crate::show::text;
 use crate::slave::{Slave, VarRef};
 
@@ -92,6 +93,31 @@ impl PreparedSystem {
     /// Absolute FMU path of each instance.
     pub fn fmu_paths(&self) -> &[PathBuf] {
         &self.fmu_paths
+    }
+
+    /// Of the parameter names `keys` (`instance.variable`), those that are Integers or
+    /// Enumerations in their FMUs (the others, and names that are not the system's, are left
+    /// out: [`Self::changes`] refuses the latter).
+    pub fn integer_parameters<'a>(
+        &self,
+        keys: impl IntoIterator<Item = &'a String>,
+    ) -> BTreeSet<String> {
+        keys.into_iter()
+            .filter(|key| {
+                split_ref(key).is_some_and(|(inst, var)| {
+                    let instances = &self.system.desc.instances;
+                    instances
+                        .iter()
+                        .position(|s| s.name == inst)
+                        .is_some_and(|i| {
+                            self.fmus[i].model().variable(var).is_some_and(|(_, v)| {
+                                matches!(v.var_type, VarType::Integer | VarType::Enumeration)
+                            })
+                        })
+                })
+            })
+            .cloned()
+            .collect()
     }
 
     /// Validates the start values of one run (`instance.variable` -> value, as in a run set)

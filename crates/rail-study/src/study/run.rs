@@ -10,7 +10,7 @@
 //! anti-aliasing low-pass ([`master::decimation`]); the time histories the plots draw are
 //! decimated the same way.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
@@ -268,12 +268,16 @@ impl Executor<'_> {
         let mut specs: HashMap<String, (MetricSpec, bool, &PreparedSystem)> = HashMap::new();
         let mut results = ResultsOptions {
             format: self.settings.stored_format,
+            integer_columns: BTreeSet::from(["track_seed".to_string()]),
             ..ResultsOptions::default()
         };
-        for p in &planned {
+        for (p, job) in planned.iter().zip(&jobs) {
             let Some(system) = prepared.get(p.request.config.id) else {
                 return Err(StudyError::UnknownConfiguration(p.request.config.id.into()));
             };
+            results
+                .integer_columns
+                .extend(system.integer_parameters(job.parameters.keys()));
             let r = &p.request;
             results.labels.insert(
                 r.name.clone(),
