@@ -277,3 +277,75 @@ fn a_state_of_another_model_in_the_same_binary_is_not_freed_as_ours() {
     }
     assert!(state.is_null());
 }
+
+/// `fmi2DeSerializeFMUstate`'s state argument is an output: a host that reuses a variable
+/// holding a state it still uses, or passes one never initialised, keeps its state whole and
+/// gets the new one (the argument's value on entry was once freed: a double free, or a crash
+/// on a stale pointer).
+#[test]
+fn deserialising_into_a_variable_that_holds_a_pointer_frees_nothing() {
+    let f = mass_spring();
+    let (inst, bytes) = serialised_state(&f);
+    // SAFETY: plain FMI calls on a live instance; `kept` stays owned by the host throughout,
+    // and the dangling pointer below is only ever written over.
+    unsafe {
+        let mut kept: ffi::fmi2FMUstate = std::ptr::null_mut();
+        assert_eq!(inst.b().fmi2GetFMUstate(inst.component, &mut kept), OK);
+        let mut reused = kept;
+        assert_eq!(
+            inst.b().fmi2DeSerializeFMUstate(
+                inst.component,
+                bytes.as_ptr(),
+                bytes.len(),
+                &mut reused
+            ),
+            OK
+        );
+        assert!(
+            !reused.is_null() && reused != kept,
+            "a new state is returned"
+        );
+        // the earlier state is still the host's to use and free, once
+        assert_eq!(inst.b().fmi2SetFMUstate(inst.component, kept), OK);
+        assert_eq!(inst.b().fmi2FreeFMUstate(inst.component, &mut kept), OK);
+        assert_eq!(inst.b().fmi2SetFMUstate(inst.component, reused), OK);
+        assert_eq!(inst.b().fmi2FreeFMUstate(inst.component, &mut reused), OK);
+        // a variable never initialised: any pointer value, written over
+        let mut stale = std::ptr::NonNull::<u8>::dangling().as_ptr() as ffi::fmi2FMUstate;
+        assert_eq!(
+            inst.b().fmi2DeSerializeFMUstate(
+                inst.component,
+                bytes.as_ptr(),
+                bytes.len(),
+                &mut stale
+            ),
+            OK
+        );
+        assert_eq!(inst.b().fmi2FreeFMUstate(inst.component, &mut stale), OK);
+    }
+}
+
+/// After fmi2Terminate "the final values of all variables can be inquired": an output that
+/// feeds through from an input set after the last step reads the same whether the host read
+/// it before terminating or not.
+#[test]
+fn outputs_read_after_terminate_follow_the_inputs_set_before_it() {
+    let f = TestFmu::open_dist("SpringDamperMass").expect("dist/SpringDamperMass.fmu");
+    let run = |read_before: bool| {
+        let inst = f.instantiate("s").unwrap();
+        assert_eq!(inst.initialize(0.0), OK);
+        assert_eq!(inst.do_step(0.0, 1e-3), OK);
+        assert_eq!(inst.set_real("input_position", 0.02), OK);
+        assert_eq!(inst.set_real("input_velocity", 0.3), OK);
+        if read_before {
+            assert_eq!(inst.get_real("coupling_force").0, OK);
+        }
+        assert_eq!(inst.terminate(), OK);
+        let (status, force) = inst.get_real("coupling_force");
+        assert_eq!(status, OK);
+        force
+    };
+    let (unread, read) = (run(false), run(true));
+    assert_eq!(unread.to_bits(), read.to_bits(), "{unread} vs {read}");
+    assert!(unread != 0.0, "the inputs move the coupling force");
+}

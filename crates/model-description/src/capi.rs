@@ -810,9 +810,8 @@ pub unsafe fn deserialize_fmu_state(
         };
         match cc.component.deserialize_fmu_state(bytes) {
             Ok(snapshot) => {
-                if !(*state).is_null() {
-                    drop(Box::from_raw((*state) as *mut Snapshot));
-                }
+                // `*state` is an output only (FMI 2.0, 2.1.8): what it held on entry is the
+                // host's, maybe a state it still uses or an uninitialised pointer; never freed
                 *state = Box::into_raw(snapshot) as fmi2FMUstate;
                 Status::Ok
             }

@@ -403,8 +403,14 @@ impl Component {
     pub fn terminate(&mut self) -> Status {
         match self.state {
             FmiState::StepComplete | FmiState::StepFailed => {
+                // "the final values of all variables can be inquired" afterwards: outputs of
+                // inputs set since the last computation are computed now, not left stale
+                let status = self.refresh_model_outputs("fmi2Terminate");
+                if status > Status::Warning {
+                    return status;
+                }
                 self.state = FmiState::Terminated;
-                Status::Ok
+                status
             }
             _ => self.wrong_state("fmi2Terminate"),
         }
