@@ -82,6 +82,10 @@ pub struct RunMetrics {
     pub rms_hydraulic_power_w: Option<f64>,
     /// Mean valve command over the tail (all dampers) \[V\], if recorded.
     pub tail_command_v: Option<f64>,
+    /// Mean valve command over the tail of each damper, in [`Signals::commands`] order \[V\]
+    /// (empty if none is recorded): dampers of one bogie may settle far apart.
+    #[serde(default)]
+    pub tail_command_by_damper_v: Vec<f64>,
     /// rms of the car-body floor lateral acceleration after the skip, largest over the
     /// measuring points [m/s^2]; `None` without a car body.
     pub carbody_rms_mps2: Option<f64>,
@@ -130,6 +134,18 @@ impl RunMetrics {
             rms_power_w: max_opt(|r| r.rms_power_w),
             rms_hydraulic_power_w: max_opt(|r| r.rms_hydraulic_power_w),
             tail_command_v: max_opt(|r| r.tail_command_v),
+            // each damper's the largest over the runs, as the mean's
+            tail_command_by_damper_v: (0..runs
+                .iter()
+                .map(|r| r.tail_command_by_damper_v.len())
+                .max()
+                .unwrap_or(0))
+                .map(|k| {
+                    runs.iter()
+                        .filter_map(|r| r.tail_command_by_damper_v.get(k).copied())
+                        .fold(f64::NEG_INFINITY, f64::max)
+                })
+                .collect(),
             carbody_rms_mps2: max_opt(|r| r.carbody_rms_mps2),
             comfort_ny: max_opt(|r| r.comfort_ny),
             damper_stroke_m: max_opt(|r| r.damper_stroke_m),
@@ -251,7 +267,14 @@ pub fn run_metrics(
     let rms_force_n = mean_over(out, &signals.forces, rms_after_skip);
     let rms_power_w = mean_over(out, &signals.powers, rms_after_skip);
     let rms_hydraulic_power_w = mean_over(out, &signals.hydraulic_powers, rms_after_skip);
-    let tail_command_v = mean_over(out, &signals.commands, |x| mean(&x[tail..]));
+    let tail_command_by_damper_v: Vec<f64> = signals
+        .commands
+        .iter()
+        .filter_map(|n| out.column(n))
+        .map(|c| mean(&c[tail..]))
+        .collect();
+    let tail_command_v =
+        (!tail_command_by_damper_v.is_empty()).then(|| mean(&tail_command_by_damper_v));
     let damper_stroke_m = signals
         .elongations
         .iter()
@@ -287,6 +310,7 @@ pub fn run_metrics(
         rms_power_w,
         rms_hydraulic_power_w,
         tail_command_v,
+        tail_command_by_damper_v,
         carbody_rms_mps2,
         comfort_ny,
         damper_stroke_m,
@@ -428,6 +452,35 @@ mod tests {
         assert!((stroke - 2e-3).abs() < 0.01 * 2e-3, "{stroke}");
     }
 
+    /// Each damper's tail command is its own; the mean command is their mean (one damper at
+    /// 2 V, the other at 8 V: 5 V, which no damper holds).
+    #[test]
+    fn tail_command_is_given_per_damper() {
+        let b = bogie();
+        let mut out = synthetic(6.0, 4.0, 20.0, true);
+        let width = out.header.len();
+        out.header.push(format!("{} [V]", b.commands[1]));
+        let rows: Vec<Vec<f64>> = out.data.chunks(width).map(<[f64]>::to_vec).collect();
+        out.data.clear();
+        for mut row in rows {
+            row.push(if row[0] < 10.0 { 0.0 } else { 8.0 });
+            out.data.extend(row);
+        }
+        let spec = MetricSpec {
+            skip_s: 5.0,
+            tail_s: 4.0,
+            speed_kmh: 300.0,
+        };
+        let m = run_metrics(&out, &spec, &b).unwrap();
+        assert_eq!(m.tail_command_by_damper_v, vec![2.0, 8.0]);
+        assert_eq!(m.tail_command_v, Some(5.0));
+        // over two runs each damper's the larger
+        let mut other = m.clone();
+        other.tail_command_by_damper_v = vec![3.0, 1.0];
+        let worst = RunMetrics::largest_over(&[m, other]).unwrap();
+        assert_eq!(worst.tail_command_by_damper_v, vec![3.0, 8.0]);
+    }
+
     #[test]
     fn peak_reference_force_is_the_largest_after_the_skip() {
         let b = bogie();
@@ -546,6 +599,7 @@ mod tests {
             rms_power_w: power,
             rms_hydraulic_power_w: None,
             tail_command_v: None,
+            tail_command_by_damper_v: Vec::new(),
             carbody_rms_mps2: Some(0.1 * rms[1]),
             comfort_ny: Some(rms[0]),
             damper_stroke_m: Some(1e-3),

@@ -59,7 +59,8 @@ fn write_series_csv(path: &Path, columns: &[(String, Vec<(f64, f64)>)]) -> Resul
     header.extend(columns.iter().map(|c| c.0.clone()));
     let rows: Vec<Vec<f64>> = (0..n)
         .map(|i| {
-            let mut row = vec![columns[0].1[i].0];
+            // times to the nanosecond: k x 0.01 s reads 0.35, not 0.35000000000000003
+            let mut row = vec![(columns[0].1[i].0 * 1e9).round() / 1e9];
             row.extend(columns.iter().map(|c| c.1[i].1));
             row
         })
@@ -338,7 +339,15 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         .filter(|(_, n)| !n.ends_with("full_active"))
         .cloned()
         .collect();
-    let title = |what: &str| format!("{what} at {v_hist:.0} km/h, irregular track");
+    // the stored record is low-passed before decimation: flange-contact spikes are rounded
+    // off, and a switching command shows as pulses, not as its 0 / 10 V steps
+    // (skyhook_valve_zoom has the switching)
+    let filtered = format!(
+        "{:.0} Hz low-pass, {:.0} Hz samples",
+        master::decimation::ANTI_ALIAS_CUTOFF * r.settings.stored_rate_hz,
+        r.settings.stored_rate_hz
+    );
+    let title = |what: &str| format!("{what} at {v_hist:.0} km/h, irregular track ({filtered})");
     let ws_y = signals.displacements[0].as_str();
     let acc = signals.stability[0].as_str();
     let (acc_what, damper_what) = if coach {
@@ -356,18 +365,16 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     let command = vehicle.first("controller", "valve.command");
     let opening = vehicle.first("damper", "valve.opening");
     let carbody_mid = signals.carbody.get(1).cloned().unwrap_or_default();
-    // the stored record is low-passed before decimation: a switching command shows as pulses
-    // rounded by that filter, not as its 0 / 10 V steps (skyhook_valve_zoom has the switching)
-    let command_what = format!(
-        "first damper's valve command ({:.0} Hz low-pass of the {:.0} Hz record)",
-        master::decimation::ANTI_ALIAS_CUTOFF * r.settings.stored_rate_hz,
-        r.settings.stored_rate_hz
-    );
+    let command_what = if coach {
+        "front-left damper's valve command"
+    } else {
+        "left damper's valve command"
+    };
     let mut histories = vec![
         (stem::HISTORY_DISPLACEMENT, "leading wheelset lateral displacement relative to the track", "displacement [mm]", ws_y, 1e3, &hist_runs, "wheelset displacement, passive / MPPT2 / sky-hook / full-active (Figs. 4.18, 4.21, 4.25)"),
-        (stem::HISTORY_ACCELERATION, acc_what, "acceleration [m/s^2]", acc, 1.0, &hist_runs, "EN 14363 acceleration (Figs. 4.18, 4.21, 4.26)"),
+        (stem::HISTORY_ACCELERATION, acc_what, "acceleration [m/s^2]", acc, 1.0, &hist_runs, "the assessed acceleration as recorded (the EN 14363 rms band-passes it first; Figs. 4.18, 4.21, 4.26)"),
         (stem::HISTORY_FORCE, damper_what, "force [kN]", force.as_str(), 1e-3, &semi_runs, "damper force (Figs. 4.18, 4.21)"),
-        (stem::HISTORY_COMMAND, command_what.as_str(), "command [V]", command.as_str(), 1.0, &semi_runs, "valve command MPPT2 vs sky-hook (Figs. 4.18, 4.21)"),
+        (stem::HISTORY_COMMAND, command_what, "command [V]", command.as_str(), 1.0, &semi_runs, "valve command MPPT2 vs sky-hook (Figs. 4.18, 4.21)"),
     ];
     if coach {
         histories.push((
@@ -448,6 +455,15 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     // ---- MPPT valve commands (Figs. 4.16, 5.22) and the HIL runs (5.19-5.24)
     let v_low = r.settings.mppt_low_speed_kmh;
     let v_hil = r.settings.hil_speed_kmh;
+    let first_damper = if coach {
+        "front-left damper"
+    } else {
+        "left damper"
+    };
+    let hil_what = format!(
+        "ideal track, {:.1} mm initial displacement",
+        r.settings.perturbation_lateral_m * 1e3
+    );
     let low_runs: Vec<(&str, String)> = ["mppt1", "mppt2"]
         .iter()
         .map(|id| (label_of(id), scenario::mppt_low(id)))
@@ -456,7 +472,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         r,
         out,
         stem::MPPT_COMMAND_CLOSED_START,
-        &format!("MPPT valve command from a closed valve at {v_low:.0} km/h"),
+        &format!("MPPT valve command of the {first_damper} from a closed valve at {v_low:.0} km/h, irregular track"),
         "command [V]",
         &low_runs,
         &command,
@@ -481,8 +497,8 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         out,
         stem::MPPT_COMMAND_OPEN_START,
         &format!(
-            "MPPT valve command from {:.0} V, slow valve, {v_hil:.0} km/h",
-            r.settings.hil_initial_command_v
+            "MPPT valve command of the {first_damper} from {:.0} V, slow valve, {v_hil:.0} km/h, {}",
+            r.settings.hil_initial_command_v, hil_what
         ),
         "command [V]",
         &mppt_hil,
@@ -499,7 +515,8 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         out,
         stem::SLOW_VALVE_DISPLACEMENT,
         &format!(
-            "slow valve at {v_hil:.0} km/h: leading wheelset displacement relative to the track"
+            "leading wheelset displacement relative to the track at {v_hil:.0} km/h, {hil_what} \
+             (each panel names its valve)"
         ),
         "displacement [mm]",
         &hil_runs,
@@ -515,7 +532,10 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         r,
         out,
         stem::SLOW_VALVE_OPENING,
-        &format!("slow valve at {v_hil:.0} km/h: actual valve opening (first damper)"),
+        &format!(
+            "actual valve opening of the {first_damper} at {v_hil:.0} km/h, {hil_what} (each \
+             panel names its valve)"
+        ),
         "opening [-]",
         &hil_runs,
         &opening,
@@ -643,7 +663,8 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         )
         .with_markers()
         .with_series(&ours_label, acceleration)
-        .with_series(
+        // the seed in grey in both c_v figures (a colour there means one of ours)
+        .with_reference(
             "seed (Table 4-3)",
             SEED_TABLE_4_3.iter().map(|s| (s.0, s.1)).collect(),
         )
@@ -667,7 +688,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             chart = chart.with_series(&format!("{ours_label}: peak reference c_v v"), reference);
         }
         chart
-            .with_series(
+            .with_reference(
                 "seed (Table 4-3): F_max",
                 SEED_TABLE_4_3.iter().map(|s| (s.0, s.2)).collect(),
             )

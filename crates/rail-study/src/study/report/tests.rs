@@ -18,6 +18,7 @@ fn metrics(rms: f64, amp: f64, cmd: Option<f64>) -> RunMetrics {
         rms_power_w: Some(250.0),
         rms_hydraulic_power_w: Some(8000.0),
         tail_command_v: cmd,
+        tail_command_by_damper_v: cmd.into_iter().collect(),
         carbody_rms_mps2: None,
         comfort_ny: None,
         damper_stroke_m: None,
