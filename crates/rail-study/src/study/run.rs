@@ -7,8 +7,8 @@
 //! output inside the worker. Its results are stored at the full rate as Parquet
 //! (`runs/<batch>/results/<run>.parquet`, with the configuration, speed and seed as
 //! columns), or as CSV decimated to [`StudySettings::stored_rate_hz`] through an
-//! anti-aliasing low-pass ([`master::decimation`]); the time histories the plots draw are
-//! decimated the same way.
+//! anti-aliasing low-pass ([`master::decimation`]). The time histories the plots draw are
+//! every n-th sample of the full-rate output, unfiltered ([`every_nth_row`]).
 
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
@@ -217,6 +217,29 @@ struct Executor<'a> {
     collected: Collected,
 }
 
+/// Every `factor`-th row of `out` as recorded (the first always): what the figures draw. A
+/// switching valve command then shows its 0 and 10 V and an opening stays within 0..1, where
+/// the anti-aliasing low-pass of the stored CSV rings at each step (-0.8..11 V). For the
+/// figures only: nothing above half the new rate is removed, so no spectrum is taken of it.
+fn every_nth_row(out: &SimOutput, factor: usize) -> SimOutput {
+    let w = out.header.len().max(1);
+    let data: Vec<f64> = out
+        .data
+        .chunks_exact(w)
+        .step_by(factor.max(1))
+        .flatten()
+        .copied()
+        .collect();
+    SimOutput {
+        header: out.header.clone(),
+        data,
+        summary: out.summary.clone(),
+        columns: out.columns.clone(),
+        strings: out.strings.clone(),
+        decimation: out.decimation.clone(),
+    }
+}
+
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
@@ -324,14 +347,14 @@ impl Executor<'_> {
             let out = run_job(system, job, cancel)?;
             let m = run_metrics(&out, spec, signals).map_err(|e| e.to_string());
             lock(&metrics).insert(job.name.clone(), m);
-            if !*keep && full_rate {
+            let factor = factor_for_rate(&out, rate);
+            if *keep {
+                lock(&kept).insert(job.name.clone(), every_nth_row(&out, factor));
+            }
+            if full_rate {
                 return Ok(out);
             }
-            let small = decimate(&out, factor_for_rate(&out, rate)).map_err(|e| e.to_string())?;
-            if *keep {
-                lock(&kept).insert(job.name.clone(), small.clone());
-            }
-            Ok(if full_rate { out } else { small })
+            decimate(&out, factor).map_err(|e| e.to_string())
         };
         let dir = self.opts.out.join("runs").join(batch);
         // this batch's runs only (an earlier study's other runs would read as part of it)
@@ -776,5 +799,58 @@ pub fn default_fmu_dir() -> PathBuf {
         PathBuf::from("dist")
     } else {
         ws
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use master::coupling::Summary;
+
+    /// A valve command stepping from 0 to 10 V, 1 kHz, 1 s.
+    fn switching_command() -> SimOutput {
+        let data = (0..1000)
+            .flat_map(|k| [k as f64 * 1e-3, if k < 503 { 0.0 } else { 10.0 }])
+            .collect();
+        SimOutput {
+            header: vec!["time [s]".into(), "controller.valve.command [V]".into()],
+            data,
+            summary: Summary {
+                steps: 999,
+                rejected_steps: 0,
+                simulated_time_s: 1.0,
+                wall_time_s: 1.0,
+                realtime_ratio: 1.0,
+                terminated: None,
+            },
+            columns: vec![],
+            strings: vec![],
+            decimation: None,
+        }
+    }
+
+    /// The figures' samples are the record's own values at every n-th time: a step stays a
+    /// step between 0 and 10 V, where the stored CSV's anti-aliasing low-pass rings.
+    #[test]
+    fn figures_draw_every_nth_sample_as_recorded() {
+        let out = switching_command();
+        let drawn = every_nth_row(&out, 10);
+        assert_eq!(drawn.header, out.header);
+        let times = drawn.column("time").unwrap();
+        assert_eq!(times.len(), 100);
+        assert_eq!((times[0], times[1], times[99]), (0.0, 10e-3, 990e-3));
+        let command = drawn.column("controller.valve.command").unwrap();
+        assert!(
+            command.iter().all(|&v| v == 0.0 || v == 10.0),
+            "{command:?}"
+        );
+        assert_eq!((command[50], command[51]), (0.0, 10.0));
+        // what the low-pass would have drawn
+        let filtered = decimate(&out, 10).unwrap();
+        let ringing = filtered.column("controller.valve.command").unwrap();
+        assert!(ringing.iter().any(|&v| !(0.0..=10.0).contains(&v)));
+        // factor 1 (or 0): every row
+        assert_eq!(every_nth_row(&out, 1).data, out.data);
+        assert_eq!(every_nth_row(&out, 0).data, out.data);
     }
 }

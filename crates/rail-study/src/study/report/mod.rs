@@ -339,15 +339,8 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         .filter(|(_, n)| !n.ends_with("full_active"))
         .cloned()
         .collect();
-    // the stored record is low-passed before decimation: flange-contact spikes are rounded
-    // off, and a switching command shows as pulses, not as its 0 / 10 V steps
-    // (skyhook_valve_zoom has the switching)
-    let filtered = format!(
-        "{:.0} Hz low-pass, {:.0} Hz samples",
-        master::decimation::ANTI_ALIAS_CUTOFF * r.settings.stored_rate_hz,
-        r.settings.stored_rate_hz
-    );
-    let title = |what: &str| format!("{what} at {v_hist:.0} km/h, irregular track ({filtered})");
+    let sampled = format!("{:.0} Hz samples, unfiltered", r.settings.stored_rate_hz);
+    let title = |what: &str| format!("{what} at {v_hist:.0} km/h, irregular track ({sampled})");
     let ws_y = signals.displacements[0].as_str();
     let acc = signals.stability[0].as_str();
     let (acc_what, damper_what) = if coach {
