@@ -8,7 +8,7 @@
 //! (`runs/<batch>/results/<run>.parquet`, with the configuration, speed and seed as
 //! columns), or as CSV decimated to [`StudySettings::stored_rate_hz`] through an
 //! anti-aliasing low-pass ([`master::decimation`]). The time histories the plots draw are
-//! every n-th sample of the full-rate output, unfiltered ([`every_nth_row`]).
+//! every n-th sample of the full-rate output, unfiltered (`every_nth_row`).
 
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
