@@ -112,19 +112,19 @@ impl RunMetrics {
         let max = |f: fn(&RunMetrics) -> f64| runs.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
         let max_opt =
             |f: fn(&RunMetrics) -> Option<f64>| runs.iter().filter_map(f).reduce(f64::max);
-        let signals = runs
-            .iter()
-            .map(|r| r.rms_by_signal.len())
-            .max()
-            .unwrap_or(0);
-        Some(RunMetrics {
-            rms_by_signal: (0..signals)
+        // a list per signal or damper: each entry the largest over the runs that have it
+        let each_max = |f: fn(&RunMetrics) -> &[f64]| -> Vec<f64> {
+            let n = runs.iter().map(|r| f(r).len()).max().unwrap_or(0);
+            (0..n)
                 .map(|k| {
                     runs.iter()
-                        .filter_map(|r| r.rms_by_signal.get(k).copied())
+                        .filter_map(|r| f(r).get(k).copied())
                         .fold(f64::NEG_INFINITY, f64::max)
                 })
-                .collect(),
+                .collect()
+        };
+        Some(RunMetrics {
+            rms_by_signal: each_max(|r| &r.rms_by_signal),
             frequency_hz: worst.frequency_hz,
             tail_amplitude_m: max(|r| r.tail_amplitude_m),
             max_displacement_m: max(|r| r.max_displacement_m),
@@ -134,18 +134,7 @@ impl RunMetrics {
             rms_power_w: max_opt(|r| r.rms_power_w),
             rms_hydraulic_power_w: max_opt(|r| r.rms_hydraulic_power_w),
             tail_command_v: max_opt(|r| r.tail_command_v),
-            // each damper's the largest over the runs, as the mean's
-            tail_command_by_damper_v: (0..runs
-                .iter()
-                .map(|r| r.tail_command_by_damper_v.len())
-                .max()
-                .unwrap_or(0))
-                .map(|k| {
-                    runs.iter()
-                        .filter_map(|r| r.tail_command_by_damper_v.get(k).copied())
-                        .fold(f64::NEG_INFINITY, f64::max)
-                })
-                .collect(),
+            tail_command_by_damper_v: each_max(|r| &r.tail_command_by_damper_v),
             carbody_rms_mps2: max_opt(|r| r.carbody_rms_mps2),
             comfort_ny: max_opt(|r| r.comfort_ny),
             damper_stroke_m: max_opt(|r| r.damper_stroke_m),
@@ -388,6 +377,18 @@ mod tests {
         }
     }
 
+    /// Appends the columns `names` to `out`, their values in each row `values(time)`.
+    fn with_columns(out: &mut SimOutput, names: &[String], values: impl Fn(f64) -> Vec<f64>) {
+        let width = out.header.len();
+        out.header.extend(names.iter().cloned());
+        let rows: Vec<Vec<f64>> = out.data.chunks(width).map(<[f64]>::to_vec).collect();
+        out.data.clear();
+        for mut row in rows {
+            row.extend(values(row[0]));
+            out.data.extend(row);
+        }
+    }
+
     #[test]
     fn sine_gives_its_rms_frequency_amplitude_and_force() {
         let out = synthetic(6.0, 4.0, 20.0, true);
@@ -430,18 +431,15 @@ mod tests {
     fn damper_stroke_is_the_elongation_amplitude_after_the_skip() {
         let mut out = synthetic(6.0, 4.0, 20.0, false);
         let b = bogie();
-        let width = out.header.len();
-        out.header.push(format!("{} [m]", b.elongations[0]));
-        out.header.push(format!("{} [m]", b.elongations[1]));
-        let rows: Vec<Vec<f64>> = out.data.chunks(width).map(<[f64]>::to_vec).collect();
-        out.data.clear();
-        for mut row in rows {
-            let t = row[0];
+        let names = [
+            format!("{} [m]", b.elongations[0]),
+            format!("{} [m]", b.elongations[1]),
+        ];
+        with_columns(&mut out, &names, |t| {
             let swing = if t < 5.0 { 0.03 } else { 0.0 };
             let s = (2.0 * PI * 4.0 * t).sin();
-            row.extend([5e-3 + (2e-3 + swing) * s, 1e-3 * s]);
-            out.data.extend(row);
-        }
+            vec![5e-3 + (2e-3 + swing) * s, 1e-3 * s]
+        });
         let spec = MetricSpec {
             skip_s: 5.0,
             tail_s: 4.0,
@@ -458,14 +456,9 @@ mod tests {
     fn tail_command_is_given_per_damper() {
         let b = bogie();
         let mut out = synthetic(6.0, 4.0, 20.0, true);
-        let width = out.header.len();
-        out.header.push(format!("{} [V]", b.commands[1]));
-        let rows: Vec<Vec<f64>> = out.data.chunks(width).map(<[f64]>::to_vec).collect();
-        out.data.clear();
-        for mut row in rows {
-            row.push(if row[0] < 10.0 { 0.0 } else { 8.0 });
-            out.data.extend(row);
-        }
+        with_columns(&mut out, &[format!("{} [V]", b.commands[1])], |t| {
+            vec![if t < 10.0 { 0.0 } else { 8.0 }]
+        });
         let spec = MetricSpec {
             skip_s: 5.0,
             tail_s: 4.0,
