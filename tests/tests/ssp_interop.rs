@@ -139,6 +139,37 @@ fn enumeration_items_are_exported_as_their_integer_values() {
     assert_eq!(text, member(&by_number));
 }
 
+/// A String parameter with a character XML 1.0 cannot hold (even as a reference) is refused
+/// with its name, and no archive is written: the SSD and SSV would not parse in any importer.
+/// Line breaks and tabs are written as character references and read back.
+#[test]
+fn texts_xml_cannot_hold_are_refused_and_nothing_is_written() {
+    let mut sys = system("passive.json");
+    let table = "worn\u{1}";
+    sys.desc.instances[0]
+        .parameters
+        .insert("contact.table".into(), table.into());
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("system.ssp");
+    let e = ssp::export(&sys, &out).unwrap_err().to_string();
+    assert!(
+        e.contains("bogie.contact.table") && e.contains("U+0001") && e.contains("XML"),
+        "{e}"
+    );
+    assert!(!out.exists(), "an archive was written");
+
+    let table = "line\nbreak\ttab";
+    sys.desc.instances[0]
+        .parameters
+        .insert("contact.table".into(), table.into());
+    let file = export(&sys, dir.path());
+    let imported = ssp::import(&file, &ImportOptions::default()).unwrap();
+    assert_eq!(
+        imported.system.desc.instances[0].parameters["contact.table"],
+        table
+    );
+}
+
 /// Largest difference over the run relative to the largest magnitude of the master's signal.
 fn relative_difference(ours: &[f64], theirs: &[f64]) -> f64 {
     let scale = ours.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);

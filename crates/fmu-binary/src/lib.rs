@@ -28,7 +28,7 @@ pub use policy::{
     GLIBC_BASELINE,
 };
 pub use version::{ParseVersionError, SymbolVersion};
-pub use xml_text::escape_attribute;
+pub use xml_text::{escape_attribute, forbidden_in_xml};
 
 /// The functions every FMI 2.0 binary exports, whatever its interface type (FMI 2.0.4, 2.1.9).
 pub const FMI2_COMMON_FUNCTIONS: [&str; 25] = [

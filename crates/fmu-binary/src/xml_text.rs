@@ -24,9 +24,32 @@ pub fn escape_attribute(s: &str) -> String {
     out
 }
 
+/// The first character of `s` that XML 1.0 cannot hold, not even as a character reference
+/// (section 2.2: the C0 controls other than tab, line feed and carriage return, and U+FFFE,
+/// U+FFFF). A writer refuses such a text instead of writing a file no parser reads.
+pub fn forbidden_in_xml(s: &str) -> Option<char> {
+    s.chars().find(|&c| {
+        (c < ' ' && !matches!(c, '\t' | '\n' | '\r')) || c == '\u{FFFE}' || c == '\u{FFFF}'
+    })
+}
+
 #[cfg(test)]
 mod tests {
-    use super::escape_attribute;
+    use super::{escape_attribute, forbidden_in_xml};
+
+    #[test]
+    fn characters_xml_cannot_hold_are_found() {
+        assert_eq!(forbidden_in_xml("tab\tline\nreturn\r ünï ✓"), None);
+        assert_eq!(forbidden_in_xml("a\u{1}b"), Some('\u{1}'));
+        assert_eq!(forbidden_in_xml("nul\0"), Some('\0'));
+        assert_eq!(forbidden_in_xml("\u{FFFF}"), Some('\u{FFFF}'));
+        // DEL and the C1 controls are allowed in XML 1.0
+        assert_eq!(forbidden_in_xml("\u{7F}\u{85}"), None);
+        for bad in ["a\u{1}b", "\u{1F}", "\u{FFFE}"] {
+            let xml = format!(r#"<a v="{}"/>"#, escape_attribute(bad));
+            assert!(roxmltree::Document::parse(&xml).is_err(), "{bad:?} parsed");
+        }
+    }
 
     #[test]
     fn every_value_reads_back_as_written() {

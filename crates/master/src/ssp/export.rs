@@ -168,12 +168,12 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
 
     let mut units_used: BTreeMap<String, Unit> = BTreeMap::new();
     let mut ssd = String::new();
-    let name = escape(
-        Path::new(&sys.file)
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or("system"),
-    );
+    let stem = Path::new(&sys.file)
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("system");
+    writable("the system's file name", stem)?;
+    let name = escape(stem);
     let _ = writeln!(ssd, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
     let _ = writeln!(
         ssd,
@@ -343,6 +343,18 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
     })
 }
 
+/// Refuses a text that XML 1.0 cannot hold (see [`fmu_binary::forbidden_in_xml`]): the
+/// archive would hold a file that no SSP importer reads.
+fn writable(what: &str, text: &str) -> Result<(), SspError> {
+    match fmu_binary::forbidden_in_xml(text) {
+        None => Ok(()),
+        Some(c) => Err(SspError::Export(format!(
+            "{what} holds the character U+{:04X}, which an SSP file (XML 1.0) cannot hold",
+            u32::from(c)
+        ))),
+    }
+}
+
 fn note_unit(
     used: &mut BTreeMap<String, Unit>,
     name: &str,
@@ -431,6 +443,7 @@ fn parameter_set(
             }
             (VarType::Boolean, Json::Bool(b)) => format!(r#"<ssv:Boolean value="{b}"/>"#),
             (VarType::String, Json::String(t)) => {
+                writable(&format!("the value of {instance}.{name}"), t)?;
                 format!(r#"<ssv:String value="{}"/>"#, escape(t))
             }
             _ => return Err(bad()),

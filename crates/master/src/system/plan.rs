@@ -40,12 +40,17 @@ impl LoadedSystem {
         let mut strings = Vec::new();
         for (i, inst) in d.instances.iter().enumerate() {
             let f = format!("instances[{i}].name");
-            if inst.name.is_empty() || inst.name.contains('.') || inst.name.contains('\0') {
+            // a control character would also break a result file's column names
+            if inst.name.is_empty()
+                || inst.name.contains('.')
+                || inst.name.contains(char::is_control)
+            {
                 return Err(self.invalid(
                     f,
                     &inst.name,
                     format!(
-                        "'{}' is not a valid instance name (non-empty, no '.')",
+                        "'{}' is not a valid instance name (non-empty, no '.', no control \
+                         character)",
                         text(&inst.name)
                     ),
                 ));

@@ -205,6 +205,11 @@ fn malformed_json_and_timing() {
     );
     let e = err_of(&SYS.replace("\"name\": \"ms\"", "\"name\": \"m.s\""));
     assert!(e.contains("not a valid instance name"), "{e}");
+    let e = err_of(&SYS.replace("\"name\": \"ms\"", "\"name\": \"m\\u0001s\""));
+    assert!(
+        e.contains("not a valid instance name") && e.contains("no control character"),
+        "{e}"
+    );
 }
 
 #[test]
