@@ -262,6 +262,19 @@ fn run_changes_a_system_from_the_command_line() {
         assert!(!stderr.contains(" line "), "{args:?}: {stderr}");
         assert!(!d.join("bad.csv").exists(), "{args:?}");
     }
+    // a results name that says no format needs --format: without, nothing is run or written
+    let (code, stderr) = run(&["system.json", "-o", "bad.out"]);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains(
+            "'bad.out' names no results format: name it .csv or .parquet, or give --format"
+        ),
+        "{stderr}"
+    );
+    assert!(!d.join("bad.out").exists() && !d.join("bad.meta.json").exists());
+    let (code, stderr) = run(&["system.json", "-o", "named.out", "--format", "csv"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(d.join("named.out").is_file() && d.join("named.meta.json").is_file());
     // an FMU alone has no coupling to choose
     let fmu = dist().join("MassSpring.fmu");
     let (code, stderr) = run(&[

@@ -928,6 +928,15 @@ fn outputs_never_replace_an_input_or_a_device() {
     assert!(e.contains("--format csv writes csv: name it .csv"), "{e}");
     let e = c.fails(&["export-ssp", "system.json", "system.ssp.json"], &[]);
     assert!(e.contains("an SSP is written as a .ssp file"), "{e}");
+    // an archive as the system to export is named for what it is, not read as JSON text
+    let e = c.fails(&["export-ssp", "Hostile.fmu", "again.ssp"], &[]);
+    assert!(
+        e.contains("'Hostile.fmu' is not a JSON system description")
+            && e.contains("`master run Hostile.fmu`"),
+        "{e}"
+    );
+    let e = c.fails(&["run", "system.json", "-o", "r.out"], &[]);
+    assert!(e.contains("'r.out' names no results format"), "{e}");
     assert_eq!(std::fs::read(c.path("system.json")).unwrap(), system);
     assert_eq!(std::fs::read(c.path("Hostile.fmu")).unwrap(), fmu);
     for f in [
@@ -937,6 +946,8 @@ fn outputs_never_replace_an_input_or_a_device() {
         "results.parquet",
         "results.csv",
         "system.ssp.json",
+        "again.ssp",
+        "r.out",
     ] {
         assert!(!c.path(f).exists(), "{f}");
     }

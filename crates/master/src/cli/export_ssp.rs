@@ -18,6 +18,20 @@ pub struct Args {
 }
 
 pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
+    // an archive given as the system would be read as JSON text ("not valid UTF-8")
+    let is = |ext: &str| {
+        args.system
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+    };
+    if crate::ssp::is_ssp_path(&args.system) || is("fmu") {
+        return Err(CommandError::Failed(format!(
+            "'{}' is not a JSON system description: export-ssp writes one as an SSP (an SSP or \
+             an FMU runs as it is: `master run {}`)",
+            args.system.display(),
+            args.system.display()
+        )));
+    }
     let sys = LoadedSystem::load(&args.system)?;
     let inputs: Vec<PathBuf> = std::iter::once(args.system.clone())
         .chain((0..sys.desc.instances.len()).map(|i| sys.fmu_path(i)))

@@ -21,6 +21,7 @@ pub struct Args {
     /// or a .ssd next to its FMUs), or an .fmu to run alone over its DefaultExperiment.
     pub system: PathBuf,
     /// Results file (time plus recorded variables, units in the header); written atomically.
+    /// Named .csv, .parquet or .pq, or any name with --format.
     /// Default: results.csv, or results.parquet for large results (see --format); the other
     /// one of these two, from an earlier run, is then removed (a CSV with its metadata file).
     #[arg(short, long)]
@@ -160,6 +161,16 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             &written(output, chosen.unwrap_or(ResultsFormat::Parquet)),
         )?,
         None => check_outputs_apart(&inputs, &args.summary.iter().cloned().collect::<Vec<_>>())?,
+    }
+    // a name that says no format would get one by the results' size, and a CSV's metadata
+    // file beside it that a later Parquet run to the same name would leave behind
+    if let (None, Some(output)) = (args.format, &args.output) {
+        if ResultsFormat::of_path(output).is_none() {
+            return Err(CommandError::Failed(format!(
+                "'{}' names no results format: name it .csv or .parquet, or give --format",
+                output.display()
+            )));
+        }
     }
     // a file named for one format does not take the other's content
     if let (Some(format), Some(output)) = (args.format, &args.output) {
