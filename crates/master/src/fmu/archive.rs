@@ -216,6 +216,37 @@ mod tests {
         assert!(matches!(e, FmuError::InstanceName { .. }));
     }
 
+    /// A damaged entry (its data no longer matches its CRC-32) stops the unpacking with an
+    /// error that names the entry.
+    #[test]
+    fn a_damaged_entry_is_named() {
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join("x.fmu");
+        let (dir, suf) = platform_binary_dir().unwrap();
+        let bin = format!("binaries/{dir}/MassSpring{suf}");
+        let f = std::fs::File::create(&p).unwrap();
+        let mut z = zip::ZipWriter::new(f);
+        let stored = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Stored);
+        for (name, data) in [
+            ("modelDescription.xml", MD.as_bytes()),
+            ("resources/table.csv", b"MARKER-0123456789".as_slice()),
+            (bin.as_str(), b"".as_slice()),
+        ] {
+            z.start_file(name, stored).unwrap();
+            z.write_all(data).unwrap();
+        }
+        z.finish().unwrap();
+        let mut bytes = std::fs::read(&p).unwrap();
+        let data = bytes.windows(6).position(|w| w == b"MARKER").unwrap();
+        bytes[data] ^= 0x20;
+        std::fs::write(&p, bytes).unwrap();
+        let a = FmuArchive::open(&p).unwrap();
+        let e = a.instantiate("ms", false).unwrap_err();
+        assert!(matches!(e, FmuError::Unpack { .. }), "{e}");
+        assert!(e.to_string().contains("entry 'resources/table.csv'"), "{e}");
+    }
+
     #[test]
     fn oversized_model_description_is_refused_unread() {
         // 300 MB of spaces (above the default 256 MiB), deflated to a few hundred kB

@@ -358,28 +358,33 @@ pub(crate) fn unpack(
     }
     let mut left = limits.max_unpacked_bytes;
     for i in 0..zip.len() {
-        let mut entry = zip.by_index(i).map_err(|e| err(e.to_string()))?;
+        // every failure names the entry (as the archive spells it until it is read)
+        let listed = zip.name_for_index(i).unwrap_or("?").to_string();
+        let mut entry = zip
+            .by_index(i)
+            .map_err(|e| err(format!("entry '{}': {e}", listed.escape_debug())))?;
         let Some(rel) = entry.enclosed_name() else {
-            return Err(err(format!("entry '{}' leaves the archive", entry.name())));
+            return Err(err(format!(
+                "entry '{}' leaves the archive",
+                entry.name().escape_debug()
+            )));
         };
+        let at = |e: std::io::Error| err(format!("entry '{}': {e}", rel.display()));
         let target = dir.path().join(&rel);
         if entry.is_dir() {
-            std::fs::create_dir_all(&target).map_err(|e| err(e.to_string()))?;
+            std::fs::create_dir_all(&target).map_err(at)?;
             continue;
         }
         if let Some(parent) = target.parent() {
-            std::fs::create_dir_all(parent).map_err(|e| err(e.to_string()))?;
+            std::fs::create_dir_all(parent).map_err(at)?;
         }
         let declared = entry.size();
-        let mut out = std::fs::File::create(&target).map_err(|e| err(e.to_string()))?;
+        let mut out = std::fs::File::create(&target).map_err(at)?;
         // at most what it declares and what is left of the total
         let cap = declared.min(left);
-        let copied = std::io::copy(&mut entry.by_ref().take(cap), &mut out)
-            .map_err(|e| err(format!("entry '{}': {e}", rel.display())))?;
+        let copied = std::io::copy(&mut entry.by_ref().take(cap), &mut out).map_err(at)?;
         let mut probe = [0u8; 1];
-        let more = entry
-            .read(&mut probe)
-            .map_err(|e| err(format!("entry '{}': {e}", rel.display())))?;
+        let more = entry.read(&mut probe).map_err(at)?;
         if more > 0 {
             return Err(err(format!(
                 "entry '{}' inflates to more than the {declared} bytes it declares \
@@ -389,14 +394,13 @@ pub(crate) fn unpack(
             )));
         }
         left -= copied;
-        out.flush().map_err(|e| err(e.to_string()))?;
+        out.flush().map_err(at)?;
         #[cfg(unix)]
         {
             use std::os::unix::fs::PermissionsExt;
             // keep the execute bits of binaries; never setuid/setgid/sticky or world-writable
             let mode = entry.unix_mode().unwrap_or(0o644) & 0o755 | 0o600;
-            std::fs::set_permissions(&target, std::fs::Permissions::from_mode(mode))
-                .map_err(|e| err(e.to_string()))?;
+            std::fs::set_permissions(&target, std::fs::Permissions::from_mode(mode)).map_err(at)?;
         }
     }
     Ok(ExtractionDir { dir, _lock: lock })
