@@ -73,6 +73,31 @@ impl Elem<'_> {
             Some(v) => Err(self.invalid(key, v, "expected true or false")),
         }
     }
+    /// The value of `key` must read as a value of type `t` (xs:double, xs:int, xs:boolean; a
+    /// String anything), as fmpy and FMI Library read it: a start value or bound that does
+    /// not is a broken modelDescription.xml, not a value to guess at.
+    fn typed(&self, key: &str, t: VarType) -> Result<(), ModelDescriptionError> {
+        let Some(v) = self.get(key) else {
+            return Ok(());
+        };
+        let x = v.trim();
+        let (ok, expected) = match t {
+            VarType::Real => (x.parse::<f64>().is_ok(), "expected a Real number"),
+            VarType::Integer | VarType::Enumeration => {
+                (x.parse::<i32>().is_ok(), "expected a 32-bit integer")
+            }
+            VarType::Boolean => (
+                matches!(x, "true" | "false" | "1" | "0"),
+                "expected true or false",
+            ),
+            VarType::String => (true, ""),
+        };
+        if ok {
+            Ok(())
+        } else {
+            Err(self.invalid(key, v, expected))
+        }
+    }
     fn f64(&self, key: &str) -> Result<Option<f64>, ModelDescriptionError> {
         match self.get(key) {
             None => Ok(None),
@@ -173,7 +198,7 @@ impl ModelDescription {
         // SimpleType name -> unit, and a Real's or Integer's (min, max)
         let mut type_units: HashMap<String, Option<String>> = HashMap::new();
         let mut type_ranges: HashMap<String, (Option<f64>, Option<f64>)> = HashMap::new();
-        // a bound that is not a number is not enforced here (the FMU has the last word)
+        // bounds are checked to be numbers of their type where they are read
         let bound = |e: &Elem, key: &str| e.get(key).and_then(|x| x.trim().parse::<f64>().ok());
         let mut current_type: Option<String> = None;
         let mut pending: Vec<PendingVar> = Vec::new();
@@ -272,6 +297,8 @@ impl ModelDescription {
                                 current_type = Some(n);
                             }
                             ("SimpleType", "Real") => {
+                                e.typed("min", VarType::Real)?;
+                                e.typed("max", VarType::Real)?;
                                 if let Some(t) = &current_type {
                                     type_units.insert(t.clone(), e.get("unit").map(String::from));
                                     type_ranges
@@ -279,6 +306,8 @@ impl ModelDescription {
                                 }
                             }
                             ("SimpleType", "Integer") => {
+                                e.typed("min", VarType::Integer)?;
+                                e.typed("max", VarType::Integer)?;
                                 if let Some(t) = &current_type {
                                     type_ranges
                                         .insert(t.clone(), (bound(&e, "min"), bound(&e, "max")));
@@ -346,6 +375,13 @@ impl ModelDescription {
                                     "Enumeration" => Some(VarType::Enumeration),
                                     _ => None,
                                 };
+                                if let Some(t) = var_type {
+                                    e.typed("start", t)?;
+                                    if t != VarType::String {
+                                        e.typed("min", t)?;
+                                        e.typed("max", t)?;
+                                    }
+                                }
                                 if let (Some(t), Some(v)) = (var_type, pending.last_mut()) {
                                     v.var_type = Some(t);
                                     v.unit = e.get("unit").map(String::from);

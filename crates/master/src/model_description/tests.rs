@@ -449,3 +449,51 @@ fn ranges_come_from_the_variable_else_from_its_declared_type() {
     assert_eq!(range("position"), (Some(-1.0), Some(0.5)));
     assert_eq!(range("m"), (None, None));
 }
+
+/// A start value or bound that does not read as its variable's type is refused with the
+/// attribute, the value and the line, as fmpy and FMI Library refuse it.
+#[test]
+fn start_values_and_bounds_must_read_as_their_type() {
+    let parse = |from: &str, to: &str| {
+        assert!(MASS_SPRING.contains(from), "fixture lacks {from}");
+        ModelDescription::parse(&MASS_SPRING.replace(from, to)).map_err(|e| e.to_string())
+    };
+    for (from, to, attribute) in [
+        (
+            r#"<Real start="1" unit="kg"/>"#,
+            r#"<Real start="one" unit="kg"/>"#,
+            "start",
+        ),
+        (
+            r#"<Real start="100" unit="N/m"/>"#,
+            r#"<Real start="100" min="low" unit="N/m"/>"#,
+            "min",
+        ),
+        ("<Integer/>", r#"<Integer start="1.5"/>"#, "start"),
+        ("<Integer/>", r#"<Integer start="4294967296"/>"#, "start"),
+        (
+            r#"<Real quantity="Length" unit="m"/>"#,
+            r#"<Real quantity="Length" unit="m" max="far"/>"#,
+            "max",
+        ),
+    ] {
+        let e = parse(from, to).unwrap_err();
+        assert!(
+            e.contains(attribute) && e.contains("expected a"),
+            "{to}: {e}"
+        );
+        assert!(e.contains("line"), "{to}: {e}");
+    }
+    // the forms the XML schema types allow
+    parse(
+        r#"<Real start="1" unit="kg"/>"#,
+        r#"<Real start=" 1e-3 " unit="kg"/>"#,
+    )
+    .unwrap();
+    parse(
+        r#"<Real start="1" unit="kg"/>"#,
+        r#"<Real start="INF" unit="kg"/>"#,
+    )
+    .unwrap();
+    parse("<Integer/>", r#"<Integer max="+7" min="-2147483648"/>"#).unwrap();
+}
