@@ -347,17 +347,23 @@ impl ResultsTable {
                 self.path.display()
             )));
         }
-        for w in t.windows(2) {
-            if ((w[1] - w[0]) - dt).abs() > 1e-6 * dt + 1e-12 {
-                return Err(AnalysisError::Input(format!(
-                    "{}: the time column is not uniformly sampled (step {} s after t = {} s, \
-                     mean step {} s): resample the signals first",
-                    self.path.display(),
-                    (w[1] - w[0]) * scale,
-                    w[0] * scale,
-                    dt * scale
-                )));
-            }
+        // the first step unlike the usual one (the median): a single gap in a long record
+        // shifts the mean step off every step, so the mean would point at the first sample
+        let mut steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+        let mid = steps.len() / 2;
+        let usual = *steps.select_nth_unstable_by(mid, f64::total_cmp).1;
+        let off = |step: f64| (step - usual).abs() > 1e-6 * usual.abs() + 1e-12;
+        if let Some(w) = t.windows(2).find(|w| off(w[1] - w[0])) {
+            // to the nanosecond: the differences of times carry rounding noise
+            let ns = |x: f64| (x * scale * 1e9).round() / 1e9;
+            return Err(AnalysisError::Input(format!(
+                "{}: the time column is not uniformly sampled (step {} s after t = {} s, \
+                 where the others are {} s): resample the signals first",
+                self.path.display(),
+                ns(w[1] - w[0]),
+                ns(w[0]),
+                ns(usual)
+            )));
         }
         Ok(1.0 / (dt * scale))
     }
@@ -894,6 +900,20 @@ mod tests {
         let t = ResultsTable::parse("time,a\n0,1\n0.1,1\n0.3,1\n0.4,1\n", p).unwrap();
         let e = t.sampling_rate_hz().unwrap_err();
         assert!(e.to_string().contains("not uniformly sampled"), "{e}");
+        // one missing sample in a long record is named where it is, against the usual step
+        let mut text = String::from("time,a\n");
+        for k in (0..1000).filter(|&k| k != 700) {
+            text.push_str(&format!("{},1\n", k as f64 * 1e-3));
+        }
+        let e = ResultsTable::parse(&text, p)
+            .unwrap()
+            .sampling_rate_hz()
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("(step 0.002 s after t = 0.699 s, where the others are 0.001 s)"),
+            "{e}"
+        );
         // a NaN or an infinity inside the time column of columns given as such (Python's
         // assess_stability; a file's are refused when read): a NaN passes every step comparison
         for bad in [f64::NAN, f64::INFINITY] {
