@@ -436,6 +436,36 @@ fn contact_geometry_unequal_radii_conventions() {
 fn contact_geometry_without_a_value_fails_and_writes_nothing() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("cg");
+    // options out of the model's range are named as given, in millimetres
+    for (options, expected) in [
+        (
+            ["--radius-right", "-5"],
+            "invalid option --radius-right = -5: must be a rolling radius in (100, 2000) mm",
+        ),
+        (
+            ["--radius", "5000"],
+            "invalid option --radius = 5000: must be a rolling radius in (100, 2000) mm",
+        ),
+        (
+            ["--gauge", "5"],
+            "invalid option --gauge = 5: must be a track gauge in (300, 3000) mm",
+        ),
+        (
+            ["--step", "-1"],
+            "invalid option --step = -1: must be > 0 mm",
+        ),
+    ] {
+        let mut args = vec!["contact-geometry"];
+        args.extend(options);
+        args.extend(["--out", out.to_str().unwrap()]);
+        let r = master(&args);
+        assert!(
+            !r.ok && r.stderr.contains(expected),
+            "{options:?}: {}",
+            r.stderr
+        );
+        assert!(!out.exists());
+    }
     let r = master(&[
         "contact-geometry",
         "--radius",
@@ -494,7 +524,10 @@ fn contact_geometry_without_a_value_fails_and_writes_nothing() {
             ["--step", "1e-5"],
             "--step = 1e-5: with --y-max 10 mm gives 2000000 table rows",
         ),
-        (["--gauge", "1e300"], "`rail_placement.gauge_m` = 1e297"),
+        (
+            ["--gauge", "1e300"],
+            "--gauge = 1e300: must be a track gauge",
+        ),
     ] {
         let r = master(&[
             "contact-geometry",
@@ -651,6 +684,73 @@ fn contact_geometry_fleet_table_and_figure() {
     // --wheels and --wheel cannot be mixed
     let r = master(&["contact-geometry", "--wheels", "a.dat", "--wheel", "b.dat"]);
     assert!(!r.ok && r.stderr.contains("--wheel"), "{}", r.stderr);
+}
+
+/// An output folder used again: the files of the command's previous run that this run does
+/// not write (the other mode's) are removed, as listed in `contact-geometry.json`; the
+/// profiles in the folder stay; a fleet written into its own profile folder does not read
+/// its earlier results as profiles.
+#[test]
+fn contact_geometry_in_a_reused_folder_keeps_only_this_runs_files() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path().join("fleet");
+    std::fs::create_dir(&dir).unwrap();
+    write_cylinder_wheel(&dir.join("cylinder.dat"));
+    std::fs::write(dir.join("notes.txt.bak"), "not ours\n").unwrap();
+    let fleet = || {
+        master(&[
+            "contact-geometry",
+            "--wheel-dir",
+            dir.to_str().unwrap(),
+            "--out",
+            dir.to_str().unwrap(),
+        ])
+    };
+    let first = fleet();
+    assert!(first.ok, "{}", first.stderr);
+    let table = std::fs::read_to_string(dir.join("fleet_conicity.csv")).unwrap();
+    assert_eq!(table.lines().count(), 2, "{table}");
+    let again = fleet();
+    assert!(again.ok, "{}", again.stderr);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("fleet_conicity.csv")).unwrap(),
+        table,
+        "the second run read its own table as a profile"
+    );
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("contact-geometry.json")).unwrap())
+            .unwrap();
+    assert_eq!(
+        manifest["files"],
+        serde_json::json!(["fleet_conicity.csv", "fleet_conicity_3mm.svg"])
+    );
+    // the single-profile mode into the same folder: the fleet's files go
+    let single = master(&["contact-geometry", "--out", dir.to_str().unwrap()]);
+    assert!(single.ok, "{}", single.stderr);
+    check_files(
+        &dir,
+        &["conicity.csv", "wheel_rail_table.csv", "conicity.svg"],
+    );
+    assert!(!dir.join("fleet_conicity.csv").exists());
+    assert!(!dir.join("fleet_conicity_3mm.svg").exists());
+    assert!(dir.join("cylinder.dat").is_file() && dir.join("notes.txt.bak").is_file());
+    // a manifest that names a path outside the folder removes nothing there
+    let outside = d.path().join("keep.csv");
+    std::fs::write(&outside, "x\n1\n").unwrap();
+    let path = dir.join("contact-geometry.json");
+    let mut manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let files = manifest["files"].as_array_mut().unwrap();
+    files.extend(["../keep.csv".into(), "..".into()]);
+    std::fs::write(&path, manifest.to_string()).unwrap();
+    let r = fleet();
+    assert!(r.ok, "{}", r.stderr);
+    assert!(outside.is_file());
+    assert!(!dir.join("conicity.csv").exists());
+    assert_eq!(
+        std::fs::read_to_string(dir.join("fleet_conicity.csv")).unwrap(),
+        table
+    );
 }
 
 #[test]
@@ -1058,10 +1158,40 @@ fn assess_reports_the_en14363_verdict_and_refuses_bad_input() {
     assert!(
         !r.ok
             && r.stderr
-                .contains("a static wheel load must lie within 1 .. 300 kN"),
+                .contains("invalid option --wheel-load = 1e300: must be a static wheel load within 1 .. 300 kN"),
         "{}",
         r.stderr
     );
+    // options out of range are named as given, negative numbers included
+    for (options, expected) in [
+        (
+            ["--speed", "-5", "--skip", "0"],
+            "invalid option --speed = -5: must be a speed > 0 km/h",
+        ),
+        (
+            ["--speed", "300", "--skip", "-1"],
+            "invalid option --skip = -1: must be a time >= 0 s",
+        ),
+        (
+            ["--speed", "300", "--bogie-mass", "100"],
+            "invalid option --bogie-mass = 100: must be in (0, 60) t",
+        ),
+        (
+            ["--speed", "300", "--f0", "0"],
+            "invalid option --f0 = 0: must be a frequency > 0 Hz",
+        ),
+    ] {
+        let mut args = vec!["assess", csv_s, "--signal", "front"];
+        args.extend(options);
+        args.extend(["--out", none_s]);
+        let r = master(&args);
+        assert!(
+            !r.ok && r.stderr.contains(expected),
+            "{options:?}: {}",
+            r.stderr
+        );
+    }
+    assert!(!none.exists());
     // one sample of 1e308: unstable, and the numbers in short form, not 300 digits
     let spike = dir.path().join("spike.csv");
     let spiked: String = text

@@ -238,6 +238,26 @@ pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
         value: master::show::num(v).to_string(),
         reason: reason.to_string(),
     };
+    // the ranges of wheel_rail's ContactSetup::validate, in the options' millimetres
+    for (option, radius_m) in [
+        ("--radius", inputs.radius_left_m),
+        ("--radius-right", inputs.radius_right_m),
+    ] {
+        if !(radius_m.is_finite() && radius_m > 0.1 && radius_m < 2.0) {
+            return Err(bad(
+                option,
+                radius_m * 1e3,
+                "must be a rolling radius in (100, 2000) mm",
+            ));
+        }
+    }
+    if !(inputs.gauge_m.is_finite() && inputs.gauge_m > 0.3 && inputs.gauge_m < 3.0) {
+        return Err(bad(
+            "--gauge",
+            inputs.gauge_m * 1e3,
+            "must be a track gauge in (300, 3000) mm",
+        ));
+    }
     if !(inputs.step_m.is_finite() && inputs.step_m > 0.0) {
         return Err(bad("--step", inputs.step_m * 1e3, "must be > 0 mm"));
     }

@@ -8,6 +8,9 @@ use crate::analysis::assess::{assess_checked, BandRemark, Criterion, ResultsTabl
 use crate::en14363::StabilitySettings;
 use master::cli::{CommandError, Context};
 
+/// The subcommand's name, which also names its file list in the output folder.
+const COMMAND: &str = "assess";
+
 /// EN 14363 quantity of the signals.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Quantity {
@@ -32,22 +35,37 @@ pub struct Args {
     #[arg(long = "signal", required = true, value_name = "COLUMN")]
     pub signals: Vec<String>,
     /// Vehicle speed over the record [km/h] (constant).
-    #[arg(long, value_name = "KMH")]
+    #[arg(long, value_name = "KMH", allow_negative_numbers = true)]
     pub speed: f64,
     /// EN 14363 quantity of the signals.
     #[arg(long, value_enum, default_value = "acceleration")]
     pub quantity: Quantity,
     /// Bogie mass for the acceleration limit [t] (the seed's 6.1 t gives 5.39 m/s2).
-    #[arg(long, value_name = "T", default_value_t = 6.1)]
+    #[arg(
+        long,
+        value_name = "T",
+        default_value_t = 6.1,
+        allow_negative_numbers = true
+    )]
     pub bogie_mass: f64,
     /// Static wheel load Q0 for the guiding-force limit [kN].
-    #[arg(long, value_name = "KN", default_value_t = 70.0)]
+    #[arg(
+        long,
+        value_name = "KN",
+        default_value_t = 70.0,
+        allow_negative_numbers = true
+    )]
     pub wheel_load: f64,
     /// Start-up time excluded from the assessment [s].
-    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    #[arg(
+        long,
+        value_name = "S",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
     pub skip: f64,
     /// Dominant frequency [Hz] instead of the spectrum's peak (searched in 0.5-20 Hz).
-    #[arg(long, value_name = "HZ")]
+    #[arg(long, value_name = "HZ", allow_negative_numbers = true)]
     pub f0: Option<f64>,
     /// Assess even when the file's metadata records a pass band narrower than the assessed
     /// band (a loud warning is printed instead of the refusal).
@@ -77,7 +95,45 @@ impl Quantity {
     }
 }
 
+/// The options the computation would refuse, named as given (the computation's own messages
+/// name its internal parameters, e.g. the wheel load in N).
+fn check_options(args: &Args) -> Result<(), CommandError> {
+    let bad = |option: &str, value: f64, reason: &str| {
+        Err(CommandError::Failed(format!(
+            "invalid option {option} = {}: {reason}",
+            master::show::num(value)
+        )))
+    };
+    if !(args.speed.is_finite() && args.speed > 0.0) {
+        return bad("--speed", args.speed, "must be a speed > 0 km/h");
+    }
+    if !(args.skip.is_finite() && args.skip >= 0.0) {
+        return bad("--skip", args.skip, "must be a time >= 0 s");
+    }
+    if let Some(f) = args.f0.filter(|f| !(f.is_finite() && *f > 0.0)) {
+        return bad("--f0", f, "must be a frequency > 0 Hz");
+    }
+    match args.quantity {
+        Quantity::Acceleration if !(args.bogie_mass > 0.0 && args.bogie_mass < 60.0) => bad(
+            "--bogie-mass",
+            args.bogie_mass,
+            "must be in (0, 60) t (the limit (12 - m/5)/2 must stay > 0)",
+        ),
+        Quantity::GuidingForce
+            if !crate::en14363::STATIC_WHEEL_LOAD_RANGE_N.contains(&(args.wheel_load * 1e3)) =>
+        {
+            bad(
+                "--wheel-load",
+                args.wheel_load,
+                "must be a static wheel load within 1 .. 300 kN",
+            )
+        }
+        _ => Ok(()),
+    }
+}
+
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
+    check_options(args)?;
     let criterion = args.quantity.criterion(args.bogie_mass, args.wheel_load);
     let settings = StabilitySettings {
         skip_s: args.skip,
@@ -102,6 +158,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         }
     }
     write_analysis(
+        COMMAND,
         &args.out,
         std::slice::from_ref(&args.table),
         ctx.cancel,

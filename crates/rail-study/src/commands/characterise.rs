@@ -12,6 +12,9 @@ use crate::analysis::actuator::{characterise_actuator, ActuatorOptions};
 use crate::analysis::damper::{characterise_damper, DamperOptions};
 use master::cli::{CommandError, Context};
 
+/// The subcommand's name, which also names its file list in the output folder.
+const COMMAND: &str = "characterise";
+
 /// Which model to characterise.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Target {
@@ -128,7 +131,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         .map(|r| r.summary())
         .chain(actuator.iter().map(|r| r.summary()));
     let summary: String = summary.collect();
-    write_analysis(&args.out, &[], ctx.cancel, &summary, |f| {
+    write_analysis(COMMAND, &args.out, &[], ctx.cancel, &summary, |f| {
         if let Some(r) = &damper {
             r.add_artefacts(f)?;
         }

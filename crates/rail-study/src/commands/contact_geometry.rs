@@ -5,12 +5,15 @@ use std::path::PathBuf;
 
 use wheel_rail::RadiusConvention;
 
-use super::{failed, write_analysis};
+use super::{failed, write_analysis, written_before};
 use crate::analysis::geometry::fleet::{fleet, profiles_in};
 use crate::analysis::geometry::{
     contact_geometry, parse_inclination, GeometryInputs, ProfileSource,
 };
 use master::cli::{CommandError, Context};
+
+/// The subcommand's name, which also names its file list in the output folder.
+const COMMAND: &str = "contact-geometry";
 
 /// How unequal wheel radii enter (`--radius-convention`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -51,26 +54,51 @@ pub struct Args {
     #[arg(long, value_name = "FILE")]
     pub rail_right: Option<PathBuf>,
     /// Track gauge [mm], measured 14 mm below the top of rail.
-    #[arg(long, value_name = "MM", default_value_t = 1435.16)]
+    #[arg(
+        long,
+        value_name = "MM",
+        default_value_t = 1435.16,
+        allow_negative_numbers = true
+    )]
     pub gauge: f64,
     /// Rail inclination to APPLY to the rail profiles: 1:40, 1:20, or 0 when the file already
     /// contains it (the built-in rail A does).
     #[arg(long, default_value = "0", value_parser = parse_inclination)]
     pub inclination: f64,
     /// Nominal rolling radius [mm] (left, and right unless --radius-right).
-    #[arg(long, value_name = "MM", default_value_t = 460.0)]
+    #[arg(
+        long,
+        value_name = "MM",
+        default_value_t = 460.0,
+        allow_negative_numbers = true
+    )]
     pub radius: f64,
     /// Nominal rolling radius of the right wheel [mm].
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     pub radius_right: Option<f64>,
     /// The table covers y from -y_max to +y_max [mm].
-    #[arg(long, value_name = "MM", default_value_t = 10.0)]
+    #[arg(
+        long,
+        value_name = "MM",
+        default_value_t = 10.0,
+        allow_negative_numbers = true
+    )]
     pub y_max: f64,
     /// Table step in y [mm].
-    #[arg(long, value_name = "MM", default_value_t = 0.05)]
+    #[arg(
+        long,
+        value_name = "MM",
+        default_value_t = 0.05,
+        allow_negative_numbers = true
+    )]
     pub step: f64,
     /// Largest amplitude of the conicity curve [mm].
-    #[arg(long, value_name = "MM", default_value_t = 7.0)]
+    #[arg(
+        long,
+        value_name = "MM",
+        default_value_t = 7.0,
+        allow_negative_numbers = true
+    )]
     pub amplitude_max: f64,
     /// How unequal wheel radii enter delta r and the conicity.
     #[arg(long, value_enum, default_value = "en15302-offset")]
@@ -127,19 +155,25 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             .collect();
         let mut skipped = Vec::new();
         if let Some(dir) = &args.wheel_dir {
-            let (files, other) = profiles_in(dir).map_err(failed)?;
+            // the output folder as the profile folder: the files written there by the
+            // previous run are results, not profiles
+            let ours = match (std::fs::canonicalize(dir), std::fs::canonicalize(&args.out)) {
+                (Ok(d), Ok(o)) if d == o => written_before(&args.out, COMMAND),
+                _ => Vec::new(),
+            };
+            let (files, other) = profiles_in(dir, &ours).map_err(failed)?;
             read.extend(files.iter().cloned());
             wheels.extend(files.into_iter().map(ProfileSource::File));
             skipped = other;
         }
         let r = fleet(&inputs, &wheels, ctx.cancel).map_err(failed)?;
         let summary = r.summary(&skipped);
-        return write_analysis(&args.out, &read, ctx.cancel, &summary, |f| {
+        return write_analysis(COMMAND, &args.out, &read, ctx.cancel, &summary, |f| {
             r.add_artefacts(f)
         });
     }
     let r = contact_geometry(&inputs).map_err(failed)?;
-    write_analysis(&args.out, &read, ctx.cancel, &r.summary(), |f| {
+    write_analysis(COMMAND, &args.out, &read, ctx.cancel, &r.summary(), |f| {
         r.add_artefacts(f)
     })
 }

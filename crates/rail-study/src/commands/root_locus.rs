@@ -13,6 +13,9 @@ use crate::analysis::vehicle_locus::vehicle_root_locus;
 use crate::study::VehicleModel;
 use master::cli::{CommandError, Context};
 
+/// The subcommand's name, which also names its file list in the output folder.
+const COMMAND: &str = "root-locus";
+
 /// Options of `master root-locus` (the description shown by `--help` is the `after_help`).
 #[derive(Debug, clap::Args)]
 #[command(
@@ -78,7 +81,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             }
             let r = vehicle_root_locus(&params, args.damper, args.mounting_stiffness, &speeds)
                 .map_err(failed)?;
-            write_analysis(&args.out, &[], ctx.cancel, &r.summary(), |f| {
+            write_analysis(COMMAND, &args.out, &[], ctx.cancel, &r.summary(), |f| {
                 r.add_artefacts(f)
             })
         }
@@ -93,7 +96,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
                 params.conicity = c;
             }
             let r = root_locus(&params, args.damper, &speeds).map_err(failed)?;
-            write_analysis(&args.out, &[], ctx.cancel, &r.summary(), |f| {
+            write_analysis(COMMAND, &args.out, &[], ctx.cancel, &r.summary(), |f| {
                 r.add_artefacts(f)
             })
         }

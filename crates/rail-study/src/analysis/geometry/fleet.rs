@@ -28,8 +28,12 @@ pub const PROFILE_EXTENSIONS: [&str; 4] = ["dat", "txt", "csv", "prf"];
 pub const FIGURE_AMPLITUDE_M: f64 = 3e-3;
 
 /// The profile files of a folder with one of [`PROFILE_EXTENSIONS`], sorted by name, and the
-/// names of the other (skipped) entries.
-pub fn profiles_in(dir: &Path) -> Result<(Vec<PathBuf>, Vec<String>), AnalysisError> {
+/// names of the other (skipped) entries; the names in `not_profiles` (files the command wrote
+/// there before) are skipped too.
+pub fn profiles_in(
+    dir: &Path,
+    not_profiles: &[String],
+) -> Result<(Vec<PathBuf>, Vec<String>), AnalysisError> {
     let io = |e: std::io::Error| AnalysisError::Input(format!("{}: {e}", dir.display()));
     let mut files = Vec::new();
     let mut skipped = Vec::new();
@@ -39,6 +43,7 @@ pub fn profiles_in(dir: &Path) -> Result<(Vec<PathBuf>, Vec<String>), AnalysisEr
         let name = entry.file_name().to_string_lossy().to_string();
         let is_profile = path.is_file()
             && !name.starts_with('.')
+            && !not_profiles.contains(&name)
             && path
                 .extension()
                 .and_then(|e| e.to_str())
@@ -461,7 +466,7 @@ mod tests {
         for f in ["b.dat", "a.TXT", "notes.md", ".hidden.dat"] {
             std::fs::write(d.path().join(f), "0 0\n1 0\n2 0\n").unwrap();
         }
-        let (files, skipped) = profiles_in(d.path()).unwrap();
+        let (files, skipped) = profiles_in(d.path(), &[]).unwrap();
         let names: Vec<_> = files
             .iter()
             .map(|p| p.file_name().unwrap().to_string_lossy().to_string())
@@ -469,6 +474,6 @@ mod tests {
         assert_eq!(names, ["a.TXT", "b.dat"]);
         assert_eq!(skipped, [".hidden.dat", "notes.md"]);
         let empty = tempfile::tempdir().unwrap();
-        assert!(profiles_in(empty.path()).is_err());
+        assert!(profiles_in(empty.path(), &[]).is_err());
     }
 }
