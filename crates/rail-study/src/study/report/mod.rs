@@ -79,7 +79,12 @@ fn speed_curve(chart: Chart, id: &str, label: &str, points: Vec<(f64, f64)>) -> 
     }
 }
 
-/// A time-history chart + CSV of one column across several runs, one panel per run.
+/// (time, value) pairs of a series.
+type Points = Vec<(f64, f64)>;
+
+/// A time-history figure, one panel per run (`<stem>.svg`, its data `<stem>.csv`), and with
+/// `detail` = (stem, title) the same over the last [`HISTORY_DETAIL_S`] of the record; `None`
+/// when no run has the column.
 #[allow(clippy::too_many_arguments)]
 fn history_chart(
     r: &StudyResults,
@@ -90,24 +95,47 @@ fn history_chart(
     runs: &[(&str, String)],
     column: &str,
     scale: f64,
+    detail: Option<(&str, &str)>,
 ) -> Result<Option<String>, StudyError> {
-    let mut cols = Vec::new();
-    let mut chart = Chart::new(title, "time [s]", y_label);
-    for (label, run) in runs {
-        if let Some(s) = series(r, run, column, scale) {
-            chart = chart.with_series(label, s.clone());
-            cols.push((format!("{label}: {y_label}"), s));
-        }
-    }
-    if cols.is_empty() {
+    // (panel label, CSV header, points) of each run that has the column
+    let found: Vec<(&str, String, Points)> = runs
+        .iter()
+        .filter_map(|(label, run)| {
+            series(r, run, column, scale).map(|s| (*label, format!("{label}: {y_label}"), s))
+        })
+        .collect();
+    if found.is_empty() {
         return Ok(None);
     }
-    write_series_csv(&dir.join(format!("{stem}.csv")), &cols)?;
-    chart
-        .one_panel_per_series()
-        .write_lines(&dir.join(format!("{stem}.svg")))?;
+    let t_end = found
+        .iter()
+        .filter_map(|(_, _, s)| s.last().map(|p| p.0))
+        .fold(f64::NEG_INFINITY, f64::max);
+    let mut views = vec![(stem, title, f64::NEG_INFINITY)];
+    if let Some((stem, title)) = detail {
+        views.push((stem, title, t_end - HISTORY_DETAIL_S));
+    }
+    for (stem, title, from_s) in views {
+        let cols: Vec<(String, Vec<(f64, f64)>)> = found
+            .iter()
+            .map(|(_, header, s)| (header.clone(), from_time(s, from_s)))
+            .collect();
+        write_series_csv(&dir.join(format!("{stem}.csv")), &cols)?;
+        let mut chart = Chart::new(title, "time [s]", y_label);
+        for ((label, _, _), (_, points)) in found.iter().zip(cols) {
+            chart = chart.with_series(label, points);
+        }
+        chart
+            .one_panel_per_series()
+            .write_lines(&dir.join(format!("{stem}.svg")))?;
+    }
     Ok(Some(stem.to_string()))
 }
+
+/// The window of a time history's detail figure, at the end of the run \[s\]: over the whole
+/// record a limit cycle or an on/off command fills its panel as a solid band; over 2 s its
+/// cycles (8-10 at the hunting frequency) and switchings can be told apart.
+pub const HISTORY_DETAIL_S: f64 = 2.0;
 
 /// Writes a CSV of text cells (quoted where needed).
 fn write_text_csv(path: &Path, header: &[String], rows: &[Vec<String>]) -> Result<(), StudyError> {
@@ -143,6 +171,11 @@ pub mod stem {
     pub const HISTORY_FORCE: &str = "history_force";
     pub const HISTORY_COMMAND: &str = "history_command";
     pub const HISTORY_CARBODY: &str = "history_carbody";
+    pub const HISTORY_DISPLACEMENT_DETAIL: &str = "history_displacement_detail";
+    pub const HISTORY_ACCELERATION_DETAIL: &str = "history_acceleration_detail";
+    pub const HISTORY_FORCE_DETAIL: &str = "history_force_detail";
+    pub const HISTORY_COMMAND_DETAIL: &str = "history_command_detail";
+    pub const HISTORY_CARBODY_DETAIL: &str = "history_carbody_detail";
     pub const FULL_ACTIVE_FORCE: &str = "full_active_force";
     pub const PERTURBATION: &str = "perturbation";
     pub const MPPT_COMMAND_CLOSED_START: &str = "mppt_command_closed_start";
@@ -156,7 +189,7 @@ pub mod stem {
 
 /// The figures a study may write into its output folder, each as `<stem>.svg` with its data
 /// in `<stem>.csv` (which of them depends on the vehicle and on the runs that succeeded).
-pub const FIGURE_STEMS: [&str; 17] = [
+pub const FIGURE_STEMS: [&str; 22] = [
     stem::RMS_VS_SPEED,
     stem::CARBODY_VS_SPEED,
     stem::COMFORT_VS_SPEED,
@@ -165,6 +198,11 @@ pub const FIGURE_STEMS: [&str; 17] = [
     stem::HISTORY_FORCE,
     stem::HISTORY_COMMAND,
     stem::HISTORY_CARBODY,
+    stem::HISTORY_DISPLACEMENT_DETAIL,
+    stem::HISTORY_ACCELERATION_DETAIL,
+    stem::HISTORY_FORCE_DETAIL,
+    stem::HISTORY_COMMAND_DETAIL,
+    stem::HISTORY_CARBODY_DETAIL,
     stem::FULL_ACTIVE_FORCE,
     stem::PERTURBATION,
     stem::MPPT_COMMAND_CLOSED_START,
@@ -341,6 +379,12 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         .collect();
     let sampled = format!("{:.0} Hz samples, unfiltered", r.settings.stored_rate_hz);
     let title = |what: &str| format!("{what} at {v_hist:.0} km/h, irregular track ({sampled})");
+    let detail_title = |what: &str| {
+        format!(
+            "{what} over the last {HISTORY_DETAIL_S:.0} s at {v_hist:.0} km/h, irregular track \
+             ({sampled})"
+        )
+    };
     let ws_y = signals.displacements[0].as_str();
     let acc = signals.stability[0].as_str();
     let (acc_what, damper_what) = if coach {
@@ -364,14 +408,14 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         "left damper's valve command"
     };
     let mut histories = vec![
-        (stem::HISTORY_DISPLACEMENT, "leading wheelset lateral displacement relative to the track", "displacement [mm]", ws_y, 1e3, &hist_runs, "wheelset displacement, passive / MPPT2 / sky-hook / full-active (Figs. 4.18, 4.21, 4.25)"),
-        (stem::HISTORY_ACCELERATION, acc_what, "acceleration [m/s^2]", acc, 1.0, &hist_runs, "the assessed acceleration as recorded (the EN 14363 rms band-passes it first; Figs. 4.18, 4.21, 4.26)"),
-        (stem::HISTORY_FORCE, damper_what, "force [kN]", force.as_str(), 1e-3, &semi_runs, "damper force (Figs. 4.18, 4.21)"),
-        (stem::HISTORY_COMMAND, command_what, "command [V]", command.as_str(), 1.0, &semi_runs, "valve command MPPT2 vs sky-hook (Figs. 4.18, 4.21)"),
+        ((stem::HISTORY_DISPLACEMENT, stem::HISTORY_DISPLACEMENT_DETAIL), "leading wheelset lateral displacement relative to the track", "displacement [mm]", ws_y, 1e3, &hist_runs, "wheelset displacement, passive / MPPT2 / sky-hook / full-active (Figs. 4.18, 4.21, 4.25)"),
+        ((stem::HISTORY_ACCELERATION, stem::HISTORY_ACCELERATION_DETAIL), acc_what, "acceleration [m/s^2]", acc, 1.0, &hist_runs, "the assessed acceleration as recorded (the EN 14363 rms band-passes it first; Figs. 4.18, 4.21, 4.26)"),
+        ((stem::HISTORY_FORCE, stem::HISTORY_FORCE_DETAIL), damper_what, "force [kN]", force.as_str(), 1e-3, &semi_runs, "damper force (Figs. 4.18, 4.21)"),
+        ((stem::HISTORY_COMMAND, stem::HISTORY_COMMAND_DETAIL), command_what, "command [V]", command.as_str(), 1.0, &semi_runs, "valve command MPPT2 vs sky-hook (Figs. 4.18, 4.21)"),
     ];
     if coach {
         histories.push((
-            stem::HISTORY_CARBODY,
+            (stem::HISTORY_CARBODY, stem::HISTORY_CARBODY_DETAIL),
             "car-body floor lateral acceleration at mid-length",
             "acceleration [m/s^2]",
             carbody_mid.as_str(),
@@ -380,9 +424,25 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             "what each damper concept transmits to the car body (the seed's future work)",
         ));
     }
-    for (stem, what, ylab, col, scale, runs, caption) in histories {
-        if let Some(s) = history_chart(r, out, stem, &title(what), ylab, runs, col, scale)? {
+    for ((stem, detail), what, ylab, col, scale, runs, caption) in histories {
+        let detail_title = detail_title(what);
+        let written = history_chart(
+            r,
+            out,
+            stem,
+            &title(what),
+            ylab,
+            runs,
+            col,
+            scale,
+            Some((detail, &detail_title)),
+        )?;
+        if let Some(s) = written {
             figures.push((s, caption));
+            figures.push((
+                detail.to_string(),
+                "the same over the last 2 s, where its cycles and switchings show",
+            ));
         }
     }
     // full-active force tracking (Fig. 4.27)
@@ -470,6 +530,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         &low_runs,
         &command,
         1.0,
+        None,
     )? {
         figures.push((
             s,
@@ -497,6 +558,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         &mppt_hil,
         &command,
         1.0,
+        None,
     )? {
         figures.push((
             s,
@@ -515,6 +577,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         &hil_runs,
         ws_y,
         1e3,
+        None,
     )? {
         figures.push((
             s,
@@ -533,6 +596,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         &hil_runs,
         &opening,
         1.0,
+        None,
     )? {
         figures.push((
             s,

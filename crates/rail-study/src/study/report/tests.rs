@@ -375,3 +375,57 @@ fn the_valve_zoom_takes_the_second_where_the_command_switches() {
     assert_eq!((w.len(), w[0].0, w[100].0), (101, 39.0, 40.0));
     assert_eq!(super::busiest_second(&[]), 0.0);
 }
+
+/// Each time history has a detail figure over the last 2 s of the same runs (its CSV holds
+/// those rows only, the whole figure's every row), and the report shows both.
+#[test]
+fn time_histories_have_a_detail_figure_of_their_last_two_seconds() {
+    let mut r = results();
+    let column = Signals::of(VehicleModel::Bogie2Dof).displacements[0].clone();
+    let (fs, t_end) = (100.0, 40.0);
+    let n = (t_end * fs) as usize + 1;
+    let data: Vec<f64> = (0..n)
+        .flat_map(|k| {
+            let t = k as f64 / fs;
+            [t, 5e-3 * (2.0 * std::f64::consts::PI * 4.0 * t).sin()]
+        })
+        .collect();
+    let run = master::coupling::SimOutput {
+        header: vec!["time [s]".into(), format!("{column} [m]")],
+        data,
+        summary: master::coupling::Summary {
+            steps: n as u64 - 1,
+            rejected_steps: 0,
+            simulated_time_s: t_end,
+            wall_time_s: 1.0,
+            realtime_ratio: t_end,
+            terminated: None,
+        },
+        columns: vec![],
+        strings: vec![],
+        decimation: None,
+    };
+    r.kept.insert(scenario::history("passive"), run);
+    let (d, text) = outputs_of(&r);
+    let times = |stem: &str| -> Vec<f64> {
+        std::fs::read_to_string(d.path().join(format!("{stem}.csv")))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').next().unwrap().parse().unwrap())
+            .collect()
+    };
+    let whole = times(stem::HISTORY_DISPLACEMENT);
+    assert_eq!((whole.len(), whole[0], whole[n - 1]), (n, 0.0, t_end));
+    let detail = times(stem::HISTORY_DISPLACEMENT_DETAIL);
+    assert_eq!(
+        (detail.len(), detail[0], detail[detail.len() - 1]),
+        (201, 38.0, t_end)
+    );
+    let svg = std::fs::read_to_string(d.path().join("history_displacement_detail.svg")).unwrap();
+    assert!(
+        svg.contains("over the last 2 s") && svg.contains("time [s]"),
+        "{svg}"
+    );
+    assert!(text.contains("history_displacement_detail.svg"), "{text}");
+}
