@@ -179,6 +179,10 @@ pub struct StudyResults {
     /// Outputs of the runs the plots need, decimated to the stored rate, by run name.
     #[serde(skip)]
     pub kept: BTreeMap<String, SimOutput>,
+    /// The last [`HISTORY_DETAIL_S`] of the same runs at the full recorded rate (the detail
+    /// figures: a valve switching within 10 ms falls between the stored rate's samples).
+    #[serde(skip)]
+    pub kept_tail: BTreeMap<String, SimOutput>,
 }
 
 impl StudyResults {
@@ -202,6 +206,7 @@ struct Planned {
 struct Collected {
     metrics: BTreeMap<String, Result<RunMetrics, String>>,
     kept: BTreeMap<String, SimOutput>,
+    kept_tail: BTreeMap<String, SimOutput>,
     simulated_s: f64,
     run_wall_s: f64,
     runs: usize,
@@ -227,6 +232,31 @@ fn every_nth_row(out: &SimOutput, factor: usize) -> SimOutput {
         .data
         .chunks_exact(w)
         .step_by(factor.max(1))
+        .flatten()
+        .copied()
+        .collect();
+    SimOutput {
+        header: out.header.clone(),
+        data,
+        summary: out.summary.clone(),
+        columns: out.columns.clone(),
+        strings: out.strings.clone(),
+        decimation: out.decimation.clone(),
+    }
+}
+
+/// The window of a time history's detail figure, at the end of the run \[s\]: over the whole
+/// record a limit cycle or an on/off command fills its panel as a solid band; over 2 s its
+/// cycles (8-10 at the hunting frequency) and switchings can be told apart.
+pub const HISTORY_DETAIL_S: f64 = 2.0;
+
+/// The rows of `out` from `seconds` before its last time on, as recorded.
+fn last_rows(out: &SimOutput, seconds: f64) -> SimOutput {
+    let w = out.header.len().max(1);
+    let rows = out.data.chunks_exact(w);
+    let t_end = rows.clone().last().map_or(0.0, |r| r[0]);
+    let data: Vec<f64> = rows
+        .filter(|r| r[0] >= t_end - seconds - 1e-9)
         .flatten()
         .copied()
         .collect();
@@ -336,6 +366,7 @@ impl Executor<'_> {
         let metrics: Mutex<BTreeMap<String, Result<RunMetrics, String>>> =
             Mutex::new(BTreeMap::new());
         let kept: Mutex<BTreeMap<String, SimOutput>> = Mutex::new(BTreeMap::new());
+        let kept_tail: Mutex<BTreeMap<String, SimOutput>> = Mutex::new(BTreeMap::new());
         let cancel = self.opts.cancel;
         let rate = self.settings.stored_rate_hz;
         let full_rate = self.settings.stored_format == ResultsFormat::Parquet;
@@ -350,6 +381,7 @@ impl Executor<'_> {
             let factor = factor_for_rate(&out, rate);
             if *keep {
                 lock(&kept).insert(job.name.clone(), every_nth_row(&out, factor));
+                lock(&kept_tail).insert(job.name.clone(), last_rows(&out, HISTORY_DETAIL_S));
             }
             if full_rate {
                 return Ok(out);
@@ -390,6 +422,11 @@ impl Executor<'_> {
         }
         self.collected.kept.extend(
             kept.into_inner()
+                .unwrap_or_else(std::sync::PoisonError::into_inner),
+        );
+        self.collected.kept_tail.extend(
+            kept_tail
+                .into_inner()
                 .unwrap_or_else(std::sync::PoisonError::into_inner),
         );
         Ok(())
@@ -789,6 +826,7 @@ pub fn run_study_checked(
         simulated_s: ex.collected.simulated_s,
         run_wall_s: ex.collected.run_wall_s,
         kept: std::mem::take(&mut ex.collected.kept),
+        kept_tail: std::mem::take(&mut ex.collected.kept_tail),
     })
 }
 
@@ -850,6 +888,23 @@ mod tests {
         let ringing = filtered.column("controller.valve.command").unwrap();
         assert!(ringing.iter().any(|&v| !(0.0..=10.0).contains(&v)));
         // factor 1 (or 0): every row
+        // the last 0.1 s as recorded, both ends included
+        let tail = last_rows(&out, 0.1);
+        let times: Vec<f64> = tail
+            .data
+            .chunks_exact(out.header.len())
+            .map(|r| r[0])
+            .collect();
+        let all: Vec<f64> = out
+            .data
+            .chunks_exact(out.header.len())
+            .map(|r| r[0])
+            .collect();
+        assert_eq!(times, all[all.len() - times.len()..]);
+        assert!(
+            (times[times.len() - 1] - times[0] - 0.1).abs() < 1e-9,
+            "{times:?}"
+        );
         assert_eq!(every_nth_row(&out, 1).data, out.data);
         assert_eq!(every_nth_row(&out, 0).data, out.data);
     }

@@ -8,6 +8,7 @@ use crate::study::configurations::configuration;
 use crate::study::critical::Critical;
 use crate::study::run::{
     scenario, ConfigResult, SpeedPoint, StudyError, StudyResults, HIL_CONFIGS, HISTORY_CONFIGS,
+    HISTORY_DETAIL_S,
 };
 use crate::study::vehicle::{Signals, VehicleModel};
 use master::output::{write_bytes_atomic, write_csv_atomic, write_json_atomic};
@@ -44,7 +45,15 @@ fn label_of(id: &str) -> &'static str {
 
 /// (time, value) series of a column of a kept run, in display units via `scale`.
 fn series(r: &StudyResults, run: &str, column: &str, scale: f64) -> Option<Vec<(f64, f64)>> {
-    let out = r.kept.get(run)?;
+    series_of(r.kept.get(run)?, column, scale)
+}
+
+/// [`series`] of the last [`HISTORY_DETAIL_S`] of a kept run at the full recorded rate.
+fn tail_series(r: &StudyResults, run: &str, column: &str, scale: f64) -> Option<Points> {
+    series_of(r.kept_tail.get(run)?, column, scale)
+}
+
+fn series_of(out: &master::coupling::SimOutput, column: &str, scale: f64) -> Option<Points> {
     let t = out.column("time")?;
     let y = out.column(column)?;
     Some(t.into_iter().zip(y).map(|(t, y)| (t, y * scale)).collect())
@@ -83,8 +92,8 @@ fn speed_curve(chart: Chart, id: &str, label: &str, points: Vec<(f64, f64)>) -> 
 type Points = Vec<(f64, f64)>;
 
 /// A time-history figure, one panel per run (`<stem>.svg`, its data `<stem>.csv`), and with
-/// `detail` = (stem, title) the same over the last [`HISTORY_DETAIL_S`] of the record; `None`
-/// when no run has the column.
+/// `detail` = (stem, title) the same over the last [`HISTORY_DETAIL_S`] of the record at the
+/// full recorded rate, the rate appended to its title; `None` when no run has the column.
 #[allow(clippy::too_many_arguments)]
 fn history_chart(
     r: &StudyResults,
@@ -98,30 +107,35 @@ fn history_chart(
     detail: Option<(&str, &str)>,
 ) -> Result<Option<String>, StudyError> {
     // (panel label, CSV header, points) of each run that has the column
-    let found: Vec<(&str, String, Points)> = runs
-        .iter()
-        .filter_map(|(label, run)| {
-            series(r, run, column, scale).map(|s| (*label, format!("{label}: {y_label}"), s))
-        })
-        .collect();
+    let of = |get: &dyn Fn(&str) -> Option<Points>| -> Vec<(&str, String, Points)> {
+        runs.iter()
+            .filter_map(|(label, run)| get(run).map(|s| (*label, format!("{label}: {y_label}"), s)))
+            .collect()
+    };
+    let found = of(&|run| series(r, run, column, scale));
     if found.is_empty() {
         return Ok(None);
     }
-    let t_end = found
-        .iter()
-        .filter_map(|(_, _, s)| s.last().map(|p| p.0))
-        .fold(f64::NEG_INFINITY, f64::max);
-    let mut views = vec![(stem, title, f64::NEG_INFINITY)];
+    let mut views = vec![(stem, title.to_string(), found)];
     if let Some((stem, title)) = detail {
-        views.push((stem, title, t_end - HISTORY_DETAIL_S));
+        let tail = of(&|run| tail_series(r, run, column, scale));
+        // the samples per second of the first run's tail, as recorded
+        let rate_hz = tail.first().and_then(|(_, _, s)| {
+            let span = s.last()?.0 - s.first()?.0;
+            (span > 0.0).then(|| (s.len() - 1) as f64 / span)
+        });
+        if let Some(rate_hz) = rate_hz {
+            let title = format!("{title} ({rate_hz:.0} Hz samples, unfiltered)");
+            views.push((stem, title, tail));
+        }
     }
-    for (stem, title, from_s) in views {
-        let cols: Vec<(String, Vec<(f64, f64)>)> = found
+    for (stem, title, found) in views {
+        let cols: Vec<(String, Points)> = found
             .iter()
-            .map(|(_, header, s)| (header.clone(), from_time(s, from_s)))
+            .map(|(_, header, s)| (header.clone(), s.clone()))
             .collect();
         write_series_csv(&dir.join(format!("{stem}.csv")), &cols)?;
-        let mut chart = Chart::new(title, "time [s]", y_label);
+        let mut chart = Chart::new(&title, "time [s]", y_label);
         for ((label, _, _), (_, points)) in found.iter().zip(cols) {
             chart = chart.with_series(label, points);
         }
@@ -131,11 +145,6 @@ fn history_chart(
     }
     Ok(Some(stem.to_string()))
 }
-
-/// The window of a time history's detail figure, at the end of the run \[s\]: over the whole
-/// record a limit cycle or an on/off command fills its panel as a solid band; over 2 s its
-/// cycles (8-10 at the hunting frequency) and switchings can be told apart.
-pub const HISTORY_DETAIL_S: f64 = 2.0;
 
 /// Writes a CSV of text cells (quoted where needed).
 fn write_text_csv(path: &Path, header: &[String], rows: &[Vec<String>]) -> Result<(), StudyError> {
@@ -380,10 +389,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     let sampled = format!("{:.0} Hz samples, unfiltered", r.settings.stored_rate_hz);
     let title = |what: &str| format!("{what} at {v_hist:.0} km/h, irregular track ({sampled})");
     let detail_title = |what: &str| {
-        format!(
-            "{what} over the last {HISTORY_DETAIL_S:.0} s at {v_hist:.0} km/h, irregular track \
-             ({sampled})"
-        )
+        format!("{what} over the last {HISTORY_DETAIL_S:.0} s at {v_hist:.0} km/h, irregular track")
     };
     let ws_y = signals.displacements[0].as_str();
     let acc = signals.stability[0].as_str();

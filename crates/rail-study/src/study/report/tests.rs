@@ -113,6 +113,7 @@ fn results_on(vehicle: VehicleModel) -> StudyResults {
         simulated_s: 70.0,
         run_wall_s: 10.0,
         kept: BTreeMap::new(),
+        kept_tail: BTreeMap::new(),
     }
 }
 
@@ -376,36 +377,40 @@ fn the_valve_zoom_takes_the_second_where_the_command_switches() {
     assert_eq!(super::busiest_second(&[]), 0.0);
 }
 
-/// Each time history has a detail figure over the last 2 s of the same runs (its CSV holds
-/// those rows only, the whole figure's every row), and the report shows both.
+/// Each time history has a detail figure over the last 2 s of the same runs at the full
+/// recorded rate (its CSV holds those rows, the whole figure's the stored ones), and the report
+/// shows both.
 #[test]
 fn time_histories_have_a_detail_figure_of_their_last_two_seconds() {
     let mut r = results();
     let column = Signals::of(VehicleModel::Bogie2Dof).displacements[0].clone();
-    let (fs, t_end) = (100.0, 40.0);
-    let n = (t_end * fs) as usize + 1;
-    let data: Vec<f64> = (0..n)
-        .flat_map(|k| {
-            let t = k as f64 / fs;
-            [t, 5e-3 * (2.0 * std::f64::consts::PI * 4.0 * t).sin()]
-        })
-        .collect();
-    let run = master::coupling::SimOutput {
-        header: vec!["time [s]".into(), format!("{column} [m]")],
-        data,
-        summary: master::coupling::Summary {
-            steps: n as u64 - 1,
-            rejected_steps: 0,
-            simulated_time_s: t_end,
-            wall_time_s: 1.0,
-            realtime_ratio: t_end,
-            terminated: None,
-        },
-        columns: vec![],
-        strings: vec![],
-        decimation: None,
+    let run = |fs: f64, t0: f64, t_end: f64| {
+        let n = ((t_end - t0) * fs).round() as usize + 1;
+        let data: Vec<f64> = (0..n)
+            .flat_map(|k| {
+                let t = t0 + k as f64 / fs;
+                [t, 5e-3 * (2.0 * std::f64::consts::PI * 4.0 * t).sin()]
+            })
+            .collect();
+        master::coupling::SimOutput {
+            header: vec!["time [s]".into(), format!("{column} [m]")],
+            data,
+            summary: master::coupling::Summary {
+                steps: n as u64 - 1,
+                rejected_steps: 0,
+                simulated_time_s: t_end,
+                wall_time_s: 1.0,
+                realtime_ratio: t_end,
+                terminated: None,
+            },
+            columns: vec![],
+            strings: vec![],
+            decimation: None,
+        }
     };
-    r.kept.insert(scenario::history("passive"), run);
+    let name = scenario::history("passive");
+    r.kept.insert(name.clone(), run(100.0, 0.0, 40.0));
+    r.kept_tail.insert(name, run(1000.0, 38.0, 40.0));
     let (d, text) = outputs_of(&r);
     let times = |stem: &str| -> Vec<f64> {
         std::fs::read_to_string(d.path().join(format!("{stem}.csv")))
@@ -416,16 +421,18 @@ fn time_histories_have_a_detail_figure_of_their_last_two_seconds() {
             .collect()
     };
     let whole = times(stem::HISTORY_DISPLACEMENT);
-    assert_eq!((whole.len(), whole[0], whole[n - 1]), (n, 0.0, t_end));
+    assert_eq!((whole.len(), whole[0], whole[4000]), (4001, 0.0, 40.0));
     let detail = times(stem::HISTORY_DISPLACEMENT_DETAIL);
     assert_eq!(
         (detail.len(), detail[0], detail[detail.len() - 1]),
-        (201, 38.0, t_end)
+        (2001, 38.0, 40.0)
     );
     let svg = std::fs::read_to_string(d.path().join("history_displacement_detail.svg")).unwrap();
     assert!(
-        svg.contains("over the last 2 s") && svg.contains("time [s]"),
+        svg.contains("over the last 2 s") && svg.contains("1000 Hz") && svg.contains("time [s]"),
         "{svg}"
     );
+    let svg = std::fs::read_to_string(d.path().join("history_displacement.svg")).unwrap();
+    assert!(svg.contains("(100 Hz"), "{svg}");
     assert!(text.contains("history_displacement_detail.svg"), "{text}");
 }
