@@ -454,6 +454,10 @@ fn contact_geometry_without_a_value_fails_and_writes_nothing() {
             ["--step", "-1"],
             "invalid option --step = -1: must be > 0 mm",
         ),
+        (
+            ["--inclination", "-0.5"],
+            "-0.5: inclination must be a small tangent (|tan| < 0.2)",
+        ),
     ] {
         let mut args = vec!["contact-geometry"];
         args.extend(options);
@@ -734,21 +738,55 @@ fn contact_geometry_in_a_reused_folder_keeps_only_this_runs_files() {
     assert!(!dir.join("fleet_conicity.csv").exists());
     assert!(!dir.join("fleet_conicity_3mm.svg").exists());
     assert!(dir.join("cylinder.dat").is_file() && dir.join("notes.txt.bak").is_file());
-    // a manifest that names a path outside the folder removes nothing there
+    // a manifest that lists other files (a path outside the folder, a profile, a user's
+    // file) removes none of them: only the command's own kinds of file go
     let outside = d.path().join("keep.csv");
     std::fs::write(&outside, "x\n1\n").unwrap();
+    std::fs::write(dir.join("README.md"), "measured 2026\n").unwrap();
     let path = dir.join("contact-geometry.json");
     let mut manifest: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     let files = manifest["files"].as_array_mut().unwrap();
-    files.extend(["../keep.csv".into(), "..".into()]);
+    files.extend(
+        [
+            "../keep.csv",
+            "..",
+            "cylinder.dat",
+            "README.md",
+            "notes.txt.bak",
+        ]
+        .map(Into::into),
+    );
     std::fs::write(&path, manifest.to_string()).unwrap();
     let r = fleet();
     assert!(r.ok, "{}", r.stderr);
-    assert!(outside.is_file());
+    for kept in [&outside, &dir.join("README.md"), &dir.join("notes.txt.bak")] {
+        assert!(kept.is_file(), "{} was removed", kept.display());
+    }
     assert!(!dir.join("conicity.csv").exists());
     assert_eq!(
         std::fs::read_to_string(dir.join("fleet_conicity.csv")).unwrap(),
+        table
+    );
+    // a folder of profiles with an earlier run's results in it, written elsewhere: the
+    // results are named as such and not read as profiles
+    let elsewhere = d.path().join("elsewhere");
+    let r = master(&[
+        "contact-geometry",
+        "--wheel-dir",
+        dir.to_str().unwrap(),
+        "--out",
+        elsewhere.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(
+        r.stdout
+            .contains("results of an earlier contact-geometry run: fleet_conicity.csv"),
+        "{}",
+        r.stdout
+    );
+    assert_eq!(
+        std::fs::read_to_string(elsewhere.join("fleet_conicity.csv")).unwrap(),
         table
     );
 }

@@ -3,13 +3,21 @@
 
 use std::path::PathBuf;
 
-use super::{failed, write_analysis};
+use super::{csv_or_svg_starting, failed, write_analysis, AnalysisCommand};
 use crate::analysis::assess::{assess_checked, BandRemark, Criterion, ResultsTable};
 use crate::en14363::StabilitySettings;
 use master::cli::{CommandError, Context};
 
-/// The subcommand's name, which also names its file list in the output folder.
-const COMMAND: &str = "assess";
+/// The subcommand as its output folder knows it.
+const COMMAND: AnalysisCommand = AnalysisCommand {
+    name: "assess",
+    owns,
+};
+
+/// The names of the files the subcommand writes.
+fn owns(name: &str) -> bool {
+    csv_or_svg_starting(name, &["assess"])
+}
 
 /// EN 14363 quantity of the signals.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -23,7 +31,7 @@ pub enum Quantity {
 /// Options of `master assess`.
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Applies the EN 14363 rms stability criterion as the seed does (section 4.2): band-pass +-2 Hz around the dominant frequency of each signal, rms over 100 m of track in 10 m steps at the given constant speed, maximum compared with the limit. Works on our results (`master run`, the study's runs; CSV or Parquet) or on a host's export (Simpack, ...): first column the time in seconds (a name ending in [ms] is read in milliseconds, another unit is refused), uniformly sampled; separators comma, semicolon or whitespace; '#' comment lines; or a Parquet file. Our files record their sampling (Parquet inside, CSV in <name>.meta.json): a signal whose recorded band (Nyquist frequency, or the anti-aliasing filter of a decimated file) does not cover the assessed band is refused.\n\nFiles: assess.csv (rms per window), assess_summary.csv (per signal), assess.svg (rms along the track with the limit). Exit status 0 whether or not the limit is exceeded (read the verdict line); 1 when the input cannot be assessed (nothing is written then)."
+    after_help = "Applies the EN 14363 rms stability criterion as the seed does (section 4.2): band-pass +-2 Hz around the dominant frequency of each signal, rms over 100 m of track in 10 m steps at the given constant speed, maximum compared with the limit. Works on our results (`master run`, the study's runs; CSV or Parquet) or on a host's export (Simpack, ...): first column the time in seconds (a name ending in [ms] is read in milliseconds, another unit is refused), uniformly sampled; separators comma, semicolon or whitespace; '#' comment lines; or a Parquet file. Our files record their sampling (Parquet inside, CSV in <name>.meta.json): a signal whose recorded band (Nyquist frequency, or the anti-aliasing filter of a decimated file) does not cover the assessed band is refused.\n\nFiles: assess.csv (rms per window), assess_summary.csv (per signal), assess.svg (rms along the track with the limit). Exit status 0 whether or not the limit is exceeded (read the verdict line); 1 when the input cannot be assessed (nothing is written then). Also assess.json: the summary and the files written; a run into the same folder removes the files of its previous run there that it does not write again."
 )]
 // help texts for a terminal: `[unit]` and `<name>` are plain text, not links or HTML
 #[allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
@@ -95,41 +103,66 @@ impl Quantity {
     }
 }
 
-/// The options the computation would refuse, named as given (the computation's own messages
-/// name its internal parameters, e.g. the wheel load in N).
-fn check_options(args: &Args) -> Result<(), CommandError> {
-    let bad = |option: &str, value: f64, reason: &str| {
-        Err(CommandError::Failed(format!(
-            "invalid option {option} = {}: {reason}",
-            master::show::num(value)
-        )))
-    };
-    if !(args.speed.is_finite() && args.speed > 0.0) {
-        return bad("--speed", args.speed, "must be a speed > 0 km/h");
-    }
-    if !(args.skip.is_finite() && args.skip >= 0.0) {
-        return bad("--skip", args.skip, "must be a time >= 0 s");
-    }
-    if let Some(f) = args.f0.filter(|f| !(f.is_finite() && *f > 0.0)) {
-        return bad("--f0", f, "must be a frequency > 0 Hz");
-    }
-    match args.quantity {
-        Quantity::Acceleration if !(args.bogie_mass > 0.0 && args.bogie_mass < 60.0) => bad(
-            "--bogie-mass",
-            args.bogie_mass,
-            "must be in (0, 60) t (the limit (12 - m/5)/2 must stay > 0)",
-        ),
-        Quantity::GuidingForce
-            if !crate::en14363::STATIC_WHEEL_LOAD_RANGE_N.contains(&(args.wheel_load * 1e3)) =>
-        {
-            bad(
-                "--wheel-load",
-                args.wheel_load,
-                "must be a static wheel load within 1 .. 300 kN",
-            )
+/// The numbers of an assessment as given, with the names they go by (the command's options
+/// or the arguments of Python's `railfmu.assess_stability`).
+pub struct AssessNumbers<'a> {
+    pub speed_kmh: (&'a str, f64),
+    pub skip_s: (&'a str, f64),
+    pub f0_hz: (&'a str, Option<f64>),
+    pub bogie_mass_t: (&'a str, f64),
+    pub wheel_load_kn: (&'a str, f64),
+}
+
+impl AssessNumbers<'_> {
+    /// The numbers the computation would refuse, as `NAME = VALUE: reason` (the computation's
+    /// own messages name its internal parameters, e.g. the wheel load in N).
+    pub fn check(&self, quantity: Quantity) -> Result<(), String> {
+        let bad = |(name, value): (&str, f64), reason: &str| {
+            Err(format!("{name} = {}: {reason}", master::show::num(value)))
+        };
+        let (_, speed) = self.speed_kmh;
+        if !(speed.is_finite() && speed > 0.0) {
+            return bad(self.speed_kmh, "must be a speed > 0 km/h");
         }
-        _ => Ok(()),
+        let (_, skip) = self.skip_s;
+        if !(skip.is_finite() && skip >= 0.0) {
+            return bad(self.skip_s, "must be a time >= 0 s");
+        }
+        let (f0_name, f0) = self.f0_hz;
+        if let Some(f) = f0.filter(|f| !(f.is_finite() && *f > 0.0)) {
+            return bad((f0_name, f), "must be a frequency > 0 Hz");
+        }
+        let (_, mass) = self.bogie_mass_t;
+        let (_, load) = self.wheel_load_kn;
+        match quantity {
+            Quantity::Acceleration if !(mass > 0.0 && mass < 60.0) => bad(
+                self.bogie_mass_t,
+                "must be in (0, 60) t (the limit (12 - m/5)/2 must stay > 0)",
+            ),
+            Quantity::GuidingForce
+                if !crate::en14363::STATIC_WHEEL_LOAD_RANGE_N.contains(&(load * 1e3)) =>
+            {
+                bad(
+                    self.wheel_load_kn,
+                    "must be a static wheel load within 1 .. 300 kN",
+                )
+            }
+            _ => Ok(()),
+        }
     }
+}
+
+/// The options the computation would refuse, named as given.
+fn check_options(args: &Args) -> Result<(), CommandError> {
+    AssessNumbers {
+        speed_kmh: ("--speed", args.speed),
+        skip_s: ("--skip", args.skip),
+        f0_hz: ("--f0", args.f0),
+        bogie_mass_t: ("--bogie-mass", args.bogie_mass),
+        wheel_load_kn: ("--wheel-load", args.wheel_load),
+    }
+    .check(args.quantity)
+    .map_err(|e| CommandError::Failed(format!("invalid option {e}")))
 }
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
@@ -158,7 +191,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         }
     }
     write_analysis(
-        COMMAND,
+        &COMMAND,
         &args.out,
         std::slice::from_ref(&args.table),
         ctx.cancel,

@@ -7,13 +7,21 @@ use std::path::PathBuf;
 
 use fmu_damper::{ActuatorParams, SemiActiveParams};
 
-use super::{failed, write_analysis};
+use super::{csv_or_svg_starting, failed, write_analysis, AnalysisCommand};
 use crate::analysis::actuator::{characterise_actuator, ActuatorOptions};
 use crate::analysis::damper::{characterise_damper, DamperOptions};
 use master::cli::{CommandError, Context};
 
-/// The subcommand's name, which also names its file list in the output folder.
-const COMMAND: &str = "characterise";
+/// The subcommand as its output folder knows it.
+const COMMAND: AnalysisCommand = AnalysisCommand {
+    name: "characterise",
+    owns,
+};
+
+/// The names of the files the subcommand writes.
+fn owns(name: &str) -> bool {
+    csv_or_svg_starting(name, &["damper_", "actuator_"])
+}
 
 /// Which model to characterise.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -31,7 +39,7 @@ pub enum Target {
 /// Options of `master characterise` (the description shown by `--help` is the `after_help`).
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Characterise the yaw dampers. Writes CSVs and SVG figures into --out and prints the R1 peak-force table and the R3 eigenfrequency next to the seed's values.\n\nFiles (damper): damper_hysteresis.csv, damper_hysteresis_<A>mm_force_displacement.svg, damper_hysteresis_<A>mm_force_velocity.svg, damper_peak_forces.csv, damper_frf.csv, damper_frf_{modulus,phase,k_eq,c_eq}.svg. Files (actuator): actuator_frf.csv (a phase is NaN where the modulus is zero: an amplitude inside the valve's dead zone moves nothing), actuator_frf_{modulus,phase}_alpha.svg."
+    after_help = "Characterise the yaw dampers. Writes CSVs and SVG figures into --out and prints the R1 peak-force table and the R3 eigenfrequency next to the seed's values.\n\nFiles (damper): damper_hysteresis.csv, damper_hysteresis_<A>mm_force_displacement.svg, damper_hysteresis_<A>mm_force_velocity.svg, damper_peak_forces.csv, damper_frf.csv, damper_frf_{modulus,phase,k_eq,c_eq}.svg. Files (actuator): actuator_frf.csv (a phase is NaN where the modulus is zero: an amplitude inside the valve's dead zone moves nothing), actuator_frf_{modulus,phase}_alpha.svg. Also characterise.json: the summary and the files written; a run into the same folder removes the files of its previous run there that it does not write again (another model or amplitude)."
 )]
 // help texts for a terminal: `[unit]` and `<name>` are plain text, not links or HTML
 #[allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
@@ -131,7 +139,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         .map(|r| r.summary())
         .chain(actuator.iter().map(|r| r.summary()));
     let summary: String = summary.collect();
-    write_analysis(COMMAND, &args.out, &[], ctx.cancel, &summary, |f| {
+    write_analysis(&COMMAND, &args.out, &[], ctx.cancel, &summary, |f| {
         if let Some(r) = &damper {
             r.add_artefacts(f)?;
         }

@@ -5,15 +5,33 @@ use std::path::PathBuf;
 
 use wheel_rail::RadiusConvention;
 
-use super::{failed, write_analysis, written_before};
-use crate::analysis::geometry::fleet::{fleet, profiles_in};
+use super::{failed, write_analysis, AnalysisCommand};
+use crate::analysis::geometry::fleet::{fleet, profiles_in, ProfileFolder};
 use crate::analysis::geometry::{
     contact_geometry, parse_inclination, GeometryInputs, ProfileSource,
 };
 use master::cli::{CommandError, Context};
 
-/// The subcommand's name, which also names its file list in the output folder.
-const COMMAND: &str = "contact-geometry";
+/// The subcommand as its output folder knows it.
+const COMMAND: AnalysisCommand = AnalysisCommand {
+    name: "contact-geometry",
+    owns,
+};
+
+/// The names of the files the subcommand writes.
+fn owns(name: &str) -> bool {
+    [
+        "wheel_rail_table.csv",
+        "contact_detail.csv",
+        "conicity.csv",
+        "delta_r.svg",
+        "tan_gamma.svg",
+        "conicity.svg",
+        "fleet_conicity.csv",
+        "fleet_conicity_3mm.svg",
+    ]
+    .contains(&name)
+}
 
 /// How unequal wheel radii enter (`--radius-convention`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -36,7 +54,7 @@ impl From<RadiusConventionArg> for RadiusConvention {
 /// Options of `master contact-geometry` (the description shown by `--help` is the `after_help`).
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Wheel/rail contact geometry from profiles. Without options: EN 15302 case E1 (wheel A, rail A, 920 mm wheels, gauge 1435.16 mm) with the built-in benchmark profiles.\n\nProfile files: two numbers per line, lateral and vertical in mm (whitespace, comma or semicolon separated), '#' comments, optional header line; lateral positive towards the field side (flange at negative values), vertical up, wheel origin on the nominal rolling circle. A bad file stops the command with file:line and writes nothing.\n\nUnequal radii (--radius-right): delta r, contact_detail.csv and the conicity follow --radius-convention (EN 15302's offset by default, named in the CSV headers); wheel_rail_table.csv is always the rigid wheelset's (rigid-roll), the geometry the bogie model feels.\n\nThe conicity is EN 15302 Annex B (with the Annex C regression and the harmonic linearisation beside it), 0 on a flat tread; an amplitude without a value is an error naming it and why (exit code 1, nothing written).\n\nFiles: wheel_rail_table.csv (the bogie model's contact table format), contact_detail.csv (with the located two-point contacts), conicity.csv (1 mm to --amplitude-max), delta_r.svg, tan_gamma.svg, conicity.svg. With --wheels or --wheel-dir (a fleet of wheel profiles, each on both wheels): fleet_conicity.csv (a row per profile) and fleet_conicity_3mm.svg instead."
+    after_help = "Wheel/rail contact geometry from profiles. Without options: EN 15302 case E1 (wheel A, rail A, 920 mm wheels, gauge 1435.16 mm) with the built-in benchmark profiles.\n\nProfile files: two numbers per line, lateral and vertical in mm (whitespace, comma or semicolon separated), '#' comments, optional header line; lateral positive towards the field side (flange at negative values), vertical up, wheel origin on the nominal rolling circle. A bad file stops the command with file:line and writes nothing.\n\nUnequal radii (--radius-right): delta r, contact_detail.csv and the conicity follow --radius-convention (EN 15302's offset by default, named in the CSV headers); wheel_rail_table.csv is always the rigid wheelset's (rigid-roll), the geometry the bogie model feels.\n\nThe conicity is EN 15302 Annex B (with the Annex C regression and the harmonic linearisation beside it), 0 on a flat tread; an amplitude without a value is an error naming it and why (exit code 1, nothing written).\n\nFiles: wheel_rail_table.csv (the bogie model's contact table format), contact_detail.csv (with the located two-point contacts), conicity.csv (1 mm to --amplitude-max), delta_r.svg, tan_gamma.svg, conicity.svg. With --wheels or --wheel-dir (a fleet of wheel profiles, each on both wheels): fleet_conicity.csv (a row per profile) and fleet_conicity_3mm.svg instead. Also contact-geometry.json: the summary and the files written; a run into the same folder removes the files of its previous run there that it does not write again (the other mode's), and a --wheel-dir folder's earlier results (these names) are not read as profiles."
 )]
 // help texts for a terminal: `[unit]` and `<name>` are plain text, not links or HTML
 #[allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
@@ -63,7 +81,7 @@ pub struct Args {
     pub gauge: f64,
     /// Rail inclination to APPLY to the rail profiles: 1:40, 1:20, or 0 when the file already
     /// contains it (the built-in rail A does).
-    #[arg(long, default_value = "0", value_parser = parse_inclination)]
+    #[arg(long, default_value = "0", value_parser = parse_inclination, allow_hyphen_values = true)]
     pub inclination: f64,
     /// Nominal rolling radius [mm] (left, and right unless --radius-right).
     #[arg(
@@ -153,27 +171,21 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             .iter()
             .map(|p| ProfileSource::File(p.clone()))
             .collect();
-        let mut skipped = Vec::new();
+        let mut folder = ProfileFolder::default();
         if let Some(dir) = &args.wheel_dir {
-            // the output folder as the profile folder: the files written there by the
-            // previous run are results, not profiles
-            let ours = match (std::fs::canonicalize(dir), std::fs::canonicalize(&args.out)) {
-                (Ok(d), Ok(o)) if d == o => written_before(&args.out, COMMAND),
-                _ => Vec::new(),
-            };
-            let (files, other) = profiles_in(dir, &ours).map_err(failed)?;
-            read.extend(files.iter().cloned());
-            wheels.extend(files.into_iter().map(ProfileSource::File));
-            skipped = other;
+            // a run into that folder left its results there: they are not profiles
+            folder = profiles_in(dir, owns).map_err(failed)?;
+            read.extend(folder.files.iter().cloned());
+            wheels.extend(folder.files.iter().cloned().map(ProfileSource::File));
         }
         let r = fleet(&inputs, &wheels, ctx.cancel).map_err(failed)?;
-        let summary = r.summary(&skipped);
-        return write_analysis(COMMAND, &args.out, &read, ctx.cancel, &summary, |f| {
+        let summary = r.summary(&folder);
+        return write_analysis(&COMMAND, &args.out, &read, ctx.cancel, &summary, |f| {
             r.add_artefacts(f)
         });
     }
     let r = contact_geometry(&inputs).map_err(failed)?;
-    write_analysis(COMMAND, &args.out, &read, ctx.cancel, &r.summary(), |f| {
+    write_analysis(&COMMAND, &args.out, &read, ctx.cancel, &r.summary(), |f| {
         r.add_artefacts(f)
     })
 }

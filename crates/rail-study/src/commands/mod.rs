@@ -28,16 +28,33 @@ pub(crate) fn failed(e: AnalysisError) -> CommandError {
     CommandError::Failed(e.to_string())
 }
 
+/// An analysis subcommand as its output folder knows it: its name, which names its file list
+/// `<name>.json`, and the file names it writes.
+pub(crate) struct AnalysisCommand {
+    pub name: &'static str,
+    /// Whether a bare file name is one of the command's results: only such a name, listed in
+    /// its earlier `<name>.json`, is removed from a reused folder or skipped as a result.
+    pub owns: fn(&str) -> bool,
+}
+
+/// A CSV or SVG whose name starts with one of `prefixes`.
+pub(crate) fn csv_or_svg_starting(name: &str, prefixes: &[&str]) -> bool {
+    (name.ends_with(".csv") || name.ends_with(".svg"))
+        && prefixes.iter().any(|p| name.starts_with(p))
+}
+
 /// Ends an analysis command: unless interrupted, collects its files (`add`), writes them into
 /// `out` (only now, after everything is computed, and none over one of the files it read,
 /// `inputs`) and prints `summary` with the file list.
 ///
 /// The folder also gets `<command>.json`: the command, its summary and the files it wrote.
-/// A file listed there by the command's previous run into the same folder and not written
-/// this time (another mode, another amplitude, a figure drawn only sometimes) is removed, so
-/// that the folder never mixes two runs' results; nothing else in the folder is touched.
+/// A file of the command's kind ([`AnalysisCommand::owns`]) listed there by its previous run
+/// into the same folder and not written this time (another mode, another amplitude, a figure
+/// drawn only sometimes) is removed, so that the folder never mixes two runs' results;
+/// nothing else in the folder is touched. A file that cannot be removed is warned about and
+/// stays listed, for the next run to try again.
 pub(crate) fn write_analysis(
-    command: &str,
+    command: &AnalysisCommand,
     out: &Path,
     inputs: &[PathBuf],
     cancel: &AtomicBool,
@@ -47,31 +64,46 @@ pub(crate) fn write_analysis(
     check_cancel(cancel).map_err(failed)?;
     let mut files = Artefacts::default();
     add(&mut files).map_err(failed)?;
-    let manifest_name = manifest_name(command);
     let written: Vec<String> = files.names().iter().map(|n| n.to_string()).collect();
+    if let Some(n) = written.iter().find(|n| !(command.owns)(n)) {
+        return Err(CommandError::Failed(format!(
+            "internal: {} writes '{n}', which is not among its file names",
+            command.name
+        )));
+    }
+    let manifest_name = manifest_name(command.name);
+    let mut paths: Vec<PathBuf> = files.names().iter().map(|n| out.join(n)).collect();
+    paths.push(out.join(&manifest_name));
+    master::output::check_outputs_apart(inputs, &paths)?;
+    let stale: Vec<String> = written_before(out, command)
+        .into_iter()
+        .filter(|n| !written.contains(n))
+        // a file read this time (a profile passed back in) stays
+        .filter(|n| master::output::check_outputs_apart(inputs, &[out.join(n)]).is_ok())
+        .collect();
+    files.write_all(out)?;
+    let mut listed = written;
+    for name in stale {
+        if let Err(e) = master::output::remove_stale_file(&out.join(&name)) {
+            eprintln!(
+                "warning: cannot remove '{}', a file of the previous {} run: {e}",
+                out.join(&name).display(),
+                command.name
+            );
+            listed.push(name);
+        }
+    }
     let manifest = serde_json::json!({
-        "command": command,
+        "command": command.name,
         "summary": summary,
-        "files": written,
+        "files": listed,
     });
     let text = serde_json::to_string_pretty(&manifest)
         .map_err(|e| CommandError::Failed(format!("{manifest_name}: {e}")))?;
-    files.add_text(&manifest_name, text + "\n");
-    let paths: Vec<PathBuf> = files.names().iter().map(|n| out.join(n)).collect();
-    master::output::check_outputs_apart(inputs, &paths)?;
-    let stale: Vec<PathBuf> = written_before(out, command)
-        .into_iter()
-        .filter(|n| *n != manifest_name && !written.contains(n))
-        .map(|n| out.join(n))
-        // a file read this time (a profile passed back in) stays
-        .filter(|p| master::output::check_outputs_apart(inputs, std::slice::from_ref(p)).is_ok())
-        .collect();
-    files.write_all(out)?;
-    for path in stale {
-        master::output::remove_stale_file(&path).map_err(|source| {
-            CommandError::Output(master::output::OutputError::Io { path, source })
-        })?;
-    }
+    let mut list = Artefacts::default();
+    list.add_text(&manifest_name, text + "\n");
+    list.write_all(out)?;
+    files.files.extend(list.files);
     print_report(summary, &files, out);
     Ok(())
 }
@@ -81,12 +113,12 @@ fn manifest_name(command: &str) -> String {
     format!("{command}.json")
 }
 
-/// The files that `<command>.json` in `out` lists (an earlier run's), if it is a regular file
-/// of at most 1 MiB that reads as one; only bare file names (a name with a folder in it, `.`
-/// or `..` is not the command's).
-pub(crate) fn written_before(out: &Path, command: &str) -> Vec<String> {
+/// The files of the command's kind ([`AnalysisCommand::owns`]) that `<command>.json` in `out`
+/// lists (an earlier run's), if it is a regular file of at most 1 MiB that reads as one; only
+/// a bare file name (one plain path component) can be one.
+pub(crate) fn written_before(out: &Path, command: &AnalysisCommand) -> Vec<String> {
     const LIMIT_BYTES: u64 = 1 << 20;
-    let manifest = &out.join(manifest_name(command));
+    let manifest = &out.join(manifest_name(command.name));
     let regular = std::fs::symlink_metadata(manifest)
         .is_ok_and(|m| m.file_type().is_file() && m.len() <= LIMIT_BYTES);
     if !regular {
@@ -98,12 +130,18 @@ pub(crate) fn written_before(out: &Path, command: &str) -> Vec<String> {
     let Ok(json) = serde_json::from_str::<serde_json::Value>(&text) else {
         return Vec::new();
     };
+    let bare = |n: &str| {
+        let mut parts = Path::new(n).components();
+        matches!(parts.next(), Some(std::path::Component::Normal(_)))
+            && parts.next().is_none()
+            && !n.contains(['/', '\\', ':', '\0'])
+    };
     json["files"]
         .as_array()
         .into_iter()
         .flatten()
         .filter_map(|v| v.as_str())
-        .filter(|n| !n.is_empty() && *n != "." && *n != ".." && !n.contains(['/', '\\', '\0']))
+        .filter(|n| bare(n) && (command.owns)(n))
         .map(str::to_string)
         .collect()
 }

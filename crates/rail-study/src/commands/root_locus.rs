@@ -7,19 +7,27 @@ use std::path::PathBuf;
 use fmu_bogie2dof::Params;
 use fmu_vehicle::VehicleParams;
 
-use super::{failed, write_analysis};
+use super::{csv_or_svg_starting, failed, write_analysis, AnalysisCommand};
 use crate::analysis::locus::{parse_damper, root_locus, speed_grid_kmh, DamperSpec};
 use crate::analysis::vehicle_locus::vehicle_root_locus;
 use crate::study::VehicleModel;
 use master::cli::{CommandError, Context};
 
-/// The subcommand's name, which also names its file list in the output folder.
-const COMMAND: &str = "root-locus";
+/// The subcommand as its output folder knows it.
+const COMMAND: AnalysisCommand = AnalysisCommand {
+    name: "root-locus",
+    owns,
+};
+
+/// The names of the files the subcommand writes.
+fn owns(name: &str) -> bool {
+    csv_or_svg_starting(name, &["root_locus", "damping_ratio", "hunting_frequency"])
+}
 
 /// Options of `master root-locus` (the description shown by `--help` is the `after_help`).
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Eigenvalues of the linear coach (calibrated fmu-vehicle parameters, --model vehicle) or of the linear 2-dof bogie (calibrated fmu-bogie2dof parameters, --model bogie2dof) over speed. Prints the linear critical speed (bisection) and the mode at onset next to the seed's (coach: 280-290 km/h, R15; bogie: 270 km/h, about 21 rad/s, 3-4 Hz).\n\nFiles: root_locus_eigenvalues.csv (every eigenvalue per speed: real, imaginary, frequency, damping ratio, flag of the hunting mode; on the coach it is followed over speed from the mode that crosses), root_locus_hunting.csv (bogie) or root_locus_least_damped.csv (coach: the least-damped mode per speed with its kinetic-energy shares and name), root_locus.svg and root_locus_zoom.svg (points coloured by speed, the hunting mode ringed), damping_ratio.svg and hunting_frequency.svg (the hunting mode)."
+    after_help = "Eigenvalues of the linear coach (calibrated fmu-vehicle parameters, --model vehicle) or of the linear 2-dof bogie (calibrated fmu-bogie2dof parameters, --model bogie2dof) over speed. Prints the linear critical speed (bisection) and the mode at onset next to the seed's (coach: 280-290 km/h, R15; bogie: 270 km/h, about 21 rad/s, 3-4 Hz).\n\nFiles: root_locus_eigenvalues.csv (every eigenvalue per speed: real, imaginary, frequency, damping ratio, flag of the hunting mode; on the coach it is followed over speed from the mode that crosses), root_locus_hunting.csv (bogie) or root_locus_least_damped.csv (coach: the least-damped mode per speed with its kinetic-energy shares and name), root_locus.svg and root_locus_zoom.svg (points coloured by speed, the hunting mode ringed), damping_ratio.svg and hunting_frequency.svg (the hunting mode). Also root-locus.json: the summary and the files written; a run into the same folder removes the files of its previous run there that it does not write again."
 )]
 // help texts for a terminal: `[unit]` and `<name>` are plain text, not links or HTML
 #[allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
@@ -81,7 +89,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             }
             let r = vehicle_root_locus(&params, args.damper, args.mounting_stiffness, &speeds)
                 .map_err(failed)?;
-            write_analysis(COMMAND, &args.out, &[], ctx.cancel, &r.summary(), |f| {
+            write_analysis(&COMMAND, &args.out, &[], ctx.cancel, &r.summary(), |f| {
                 r.add_artefacts(f)
             })
         }
@@ -96,7 +104,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
                 params.conicity = c;
             }
             let r = root_locus(&params, args.damper, &speeds).map_err(failed)?;
-            write_analysis(COMMAND, &args.out, &[], ctx.cancel, &r.summary(), |f| {
+            write_analysis(&COMMAND, &args.out, &[], ctx.cancel, &r.summary(), |f| {
                 r.add_artefacts(f)
             })
         }

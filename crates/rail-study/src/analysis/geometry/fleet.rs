@@ -27,43 +27,56 @@ pub const PROFILE_EXTENSIONS: [&str; 4] = ["dat", "txt", "csv", "prf"];
 /// Amplitude of the fleet figure \[m\].
 pub const FIGURE_AMPLITUDE_M: f64 = 3e-3;
 
-/// The profile files of a folder with one of [`PROFILE_EXTENSIONS`], sorted by name, and the
-/// names of the other (skipped) entries; the names in `not_profiles` (files the command wrote
-/// there before) are skipped too.
+/// The entries of a `--wheel-dir` folder, sorted by name.
+#[derive(Debug, Default)]
+pub struct ProfileFolder {
+    /// The profile files: one of [`PROFILE_EXTENSIONS`], not hidden, not a result.
+    pub files: Vec<PathBuf>,
+    /// The names of the other entries, skipped.
+    pub skipped: Vec<String>,
+    /// The names of the files that are results of an earlier contact-geometry run, skipped.
+    pub results: Vec<String>,
+}
+
+/// The profile files of a folder ([`ProfileFolder`]); `is_result` tells the names of the
+/// command's own results, which a run into that folder may have left there.
 pub fn profiles_in(
     dir: &Path,
-    not_profiles: &[String],
-) -> Result<(Vec<PathBuf>, Vec<String>), AnalysisError> {
+    is_result: fn(&str) -> bool,
+) -> Result<ProfileFolder, AnalysisError> {
     let io = |e: std::io::Error| AnalysisError::Input(format!("{}: {e}", dir.display()));
-    let mut files = Vec::new();
-    let mut skipped = Vec::new();
+    let mut found = ProfileFolder::default();
     for entry in std::fs::read_dir(dir).map_err(io)? {
         let entry = entry.map_err(io)?;
         let path = entry.path();
         let name = entry.file_name().to_string_lossy().to_string();
+        if is_result(&name) {
+            found.results.push(name);
+            continue;
+        }
         let is_profile = path.is_file()
             && !name.starts_with('.')
-            && !not_profiles.contains(&name)
             && path
                 .extension()
                 .and_then(|e| e.to_str())
                 .is_some_and(|e| PROFILE_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()));
         if is_profile {
-            files.push(path);
+            found.files.push(path);
         } else {
-            skipped.push(name);
+            found.skipped.push(name);
         }
     }
-    files.sort();
-    skipped.sort();
-    if files.is_empty() {
+    found.files.sort();
+    found.skipped.sort();
+    found.results.sort();
+    if found.files.is_empty() {
         return Err(AnalysisError::Input(format!(
             "{}: no wheel profile files (.{}) in the folder",
             dir.display(),
             PROFILE_EXTENSIONS.join(", .")
         )));
     }
-    Ok((files, skipped))
+    Ok(found)
 }
 
 /// One profile's row.
@@ -293,7 +306,8 @@ impl FleetResults {
         Ok(())
     }
 
-    pub fn summary(&self, skipped: &[String]) -> String {
+    pub fn summary(&self, folder: &ProfileFolder) -> String {
+        let skipped = &folder.skipped;
         let mut s = format!(
             "{} wheel profiles, each on both wheels; rails {} / {}, nominal radius {:.1} / {:.1} \
              mm, gauge {:.2} mm; conicity in the {} convention\n",
@@ -311,6 +325,13 @@ impl FleetResults {
                 skipped.len(),
                 PROFILE_EXTENSIONS.join(", ."),
                 skipped.join(", ")
+            ));
+        }
+        if !folder.results.is_empty() {
+            s.push_str(&format!(
+                "skipped {} results of an earlier contact-geometry run: {}\n",
+                folder.results.len(),
+                folder.results.join(", ")
             ));
         }
         for r in &self.rows {
@@ -463,17 +484,25 @@ mod tests {
     #[test]
     fn folder_listing_keeps_profiles_and_names_the_rest() {
         let d = tempfile::tempdir().unwrap();
-        for f in ["b.dat", "a.TXT", "notes.md", ".hidden.dat"] {
+        for f in [
+            "b.dat",
+            "a.TXT",
+            "notes.md",
+            ".hidden.dat",
+            "fleet_conicity.csv",
+        ] {
             std::fs::write(d.path().join(f), "0 0\n1 0\n2 0\n").unwrap();
         }
-        let (files, skipped) = profiles_in(d.path(), &[]).unwrap();
-        let names: Vec<_> = files
+        let found = profiles_in(d.path(), |n| n == "fleet_conicity.csv").unwrap();
+        let names: Vec<_> = found
+            .files
             .iter()
             .map(|p| p.file_name().unwrap().to_string_lossy().to_string())
             .collect();
         assert_eq!(names, ["a.TXT", "b.dat"]);
-        assert_eq!(skipped, [".hidden.dat", "notes.md"]);
+        assert_eq!(found.skipped, [".hidden.dat", "notes.md"]);
+        assert_eq!(found.results, ["fleet_conicity.csv"]);
         let empty = tempfile::tempdir().unwrap();
-        assert!(profiles_in(empty.path(), &[]).is_err());
+        assert!(profiles_in(empty.path(), |_| false).is_err());
     }
 }
