@@ -88,12 +88,17 @@ fn speed_curve(chart: Chart, id: &str, label: &str, points: Vec<(f64, f64)>) -> 
     }
 }
 
+/// The caption of a time history's detail figure in the report.
+const HISTORY_DETAIL_CAPTION: &str =
+    "the same over the last 2 s at the full recorded rate, where its cycles and switchings show";
+
 /// (time, value) pairs of a series.
 type Points = Vec<(f64, f64)>;
 
 /// A time-history figure, one panel per run (`<stem>.svg`, its data `<stem>.csv`), and with
 /// `detail` = (stem, title) the same over the last [`HISTORY_DETAIL_S`] of the record at the
-/// full recorded rate, the rate appended to its title; `None` when no run has the column.
+/// full recorded rate, the rate appended to its title (written when every run's tail has the
+/// same times); the stems written, `None` when no run has the column.
 #[allow(clippy::too_many_arguments)]
 fn history_chart(
     r: &StudyResults,
@@ -105,7 +110,7 @@ fn history_chart(
     column: &str,
     scale: f64,
     detail: Option<(&str, &str)>,
-) -> Result<Option<String>, StudyError> {
+) -> Result<Option<(String, Option<String>)>, StudyError> {
     // (panel label, CSV header, points) of each run that has the column
     let of = |get: &dyn Fn(&str) -> Option<Points>| -> Vec<(&str, String, Points)> {
         runs.iter()
@@ -117,16 +122,21 @@ fn history_chart(
         return Ok(None);
     }
     let mut views = vec![(stem, title.to_string(), found)];
+    let mut detail_written = None;
     if let Some((stem, title)) = detail {
         let tail = of(&|run| tail_series(r, run, column, scale));
-        // the samples per second of the first run's tail, as recorded
+        // one time grid for every run (one time column in the CSV, one rate in the title):
+        // a run ended early by its FMU, or at another step, has none of its own here
+        let grid = |s: &Points| s.iter().map(|p| p.0).collect::<Vec<f64>>();
+        let same_grid = tail.windows(2).all(|w| grid(&w[0].2) == grid(&w[1].2));
         let rate_hz = tail.first().and_then(|(_, _, s)| {
             let span = s.last()?.0 - s.first()?.0;
             (span > 0.0).then(|| (s.len() - 1) as f64 / span)
         });
-        if let Some(rate_hz) = rate_hz {
+        if let (Some(rate_hz), true) = (rate_hz, same_grid) {
             let title = format!("{title} ({rate_hz:.0} Hz samples, unfiltered)");
             views.push((stem, title, tail));
+            detail_written = Some(stem.to_string());
         }
     }
     for (stem, title, found) in views {
@@ -143,7 +153,7 @@ fn history_chart(
             .one_panel_per_series()
             .write_lines(&dir.join(format!("{stem}.svg")))?;
     }
-    Ok(Some(stem.to_string()))
+    Ok(Some((stem.to_string(), detail_written)))
 }
 
 /// Writes a CSV of text cells (quoted where needed).
@@ -443,12 +453,11 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             scale,
             Some((detail, &detail_title)),
         )?;
-        if let Some(s) = written {
-            figures.push((s, caption));
-            figures.push((
-                detail.to_string(),
-                "the same over the last 2 s, where its cycles and switchings show",
-            ));
+        if let Some((whole, detail)) = written {
+            figures.push((whole, caption));
+            if let Some(detail) = detail {
+                figures.push((detail, HISTORY_DETAIL_CAPTION));
+            }
         }
     }
     // full-active force tracking (Fig. 4.27)
@@ -527,7 +536,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         .iter()
         .map(|id| (label_of(id), scenario::mppt_low(id)))
         .collect();
-    if let Some(s) = history_chart(
+    if let Some((s, _)) = history_chart(
         r,
         out,
         stem::MPPT_COMMAND_CLOSED_START,
@@ -552,7 +561,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         .filter(|(_, n)| n.contains("mppt"))
         .cloned()
         .collect();
-    if let Some(s) = history_chart(
+    if let Some((s, _)) = history_chart(
         r,
         out,
         stem::MPPT_COMMAND_OPEN_START,
@@ -571,7 +580,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             "MPPT1 vs MPPT2 valve command, open start, slow valve (Figs. 5.19, 5.21, 5.22, R10)",
         ));
     }
-    if let Some(s) = history_chart(
+    if let Some((s, _)) = history_chart(
         r,
         out,
         stem::SLOW_VALVE_DISPLACEMENT,
@@ -590,7 +599,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             "slow valve: sky-hook vs MPPT wheelset displacement (Figs. 5.19-5.24, R12)",
         ));
     }
-    if let Some(s) = history_chart(
+    if let Some((s, _)) = history_chart(
         r,
         out,
         stem::SLOW_VALVE_OPENING,

@@ -1,7 +1,7 @@
 use super::*;
 use crate::study::critical::Critical;
 use crate::study::metrics::RunMetrics;
-use crate::study::run::{ConfigResult, NamedRun, SpeedPoint};
+use crate::study::run::{ConfigResult, NamedRun, SpeedPoint, HISTORY_DETAIL_S};
 use crate::study::settings::StudySettings;
 use crate::study::vehicle::VehicleModel;
 use std::collections::BTreeMap;
@@ -435,4 +435,17 @@ fn time_histories_have_a_detail_figure_of_their_last_two_seconds() {
     let svg = std::fs::read_to_string(d.path().join("history_displacement.svg")).unwrap();
     assert!(svg.contains("(100 Hz"), "{svg}");
     assert!(text.contains("history_displacement_detail.svg"), "{text}");
+    assert!(
+        super::HISTORY_DETAIL_CAPTION.contains(&format!("last {HISTORY_DETAIL_S:.0} s")),
+        "the caption names another window than HISTORY_DETAIL_S"
+    );
+    // a run whose tail has other times (ended early): no detail figure, none in the report
+    r.kept_tail
+        .insert(scenario::history("mppt2"), run(1000.0, 37.0, 39.0));
+    r.kept
+        .insert(scenario::history("mppt2"), run(100.0, 0.0, 39.0));
+    let (d, text) = outputs_of(&r);
+    assert!(d.path().join("history_displacement.svg").is_file());
+    assert!(!d.path().join("history_displacement_detail.svg").exists());
+    assert!(!text.contains("history_displacement_detail"), "{text}");
 }
