@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use master::decimation::Sampling;
 use rail_study::analysis::assess::{assess_checked, BandRemark, ResultsTable};
-use rail_study::commands::assess::Quantity;
+use rail_study::commands::assess::{AssessNumbers, Quantity};
 use rail_study::en14363::StabilitySettings;
 use serde::{Deserialize, Serialize};
 
@@ -119,40 +119,19 @@ pub fn table_from_file(path: &Path) -> Result<ResultsTable, String> {
 }
 
 /// The options the computation would refuse, named as the arguments of
-/// `railfmu.assess_stability` (the computation's own messages name the command's options or
-/// its internal parameters, e.g. the wheel load in N).
+/// `railfmu.assess_stability` (the same checks as `master assess`).
 fn check_options(o: &AssessOptions, quantity: Quantity) -> Result<(), String> {
-    let bad = |name: &str, value: f64, reason: &str| {
-        Err(format!("{name} = {}: {reason}", master::show::num(value)))
-    };
     if o.signals.is_empty() {
         return Err("signals: none given (name at least one column)".into());
     }
-    if !(o.speed_kmh.is_finite() && o.speed_kmh > 0.0) {
-        return bad("speed_kmh", o.speed_kmh, "must be a speed > 0 km/h");
+    AssessNumbers {
+        speed_kmh: ("speed_kmh", o.speed_kmh),
+        skip_s: ("skip_s", o.skip_s),
+        f0_hz: ("f0_hz", o.f0_hz),
+        bogie_mass_t: ("bogie_mass_t", o.bogie_mass_t),
+        wheel_load_kn: ("wheel_load_kn", o.wheel_load_kn),
     }
-    if o.skip_s.is_nan() || o.skip_s < 0.0 {
-        return bad("skip_s", o.skip_s, "must be >= 0 s");
-    }
-    if let Some(f) = o.f0_hz.filter(|f| f.is_nan() || *f <= 0.0) {
-        return bad("f0_hz", f, "must be a frequency > 0 Hz");
-    }
-    match quantity {
-        Quantity::Acceleration if !(o.bogie_mass_t > 0.0 && o.bogie_mass_t < 60.0) => {
-            bad("bogie_mass_t", o.bogie_mass_t, "must be in (0, 60) t")
-        }
-        Quantity::GuidingForce
-            if !rail_study::en14363::STATIC_WHEEL_LOAD_RANGE_N
-                .contains(&(o.wheel_load_kn * 1e3)) =>
-        {
-            bad(
-                "wheel_load_kn",
-                o.wheel_load_kn,
-                "must be a static wheel load within 1 .. 300 kN",
-            )
-        }
-        _ => Ok(()),
-    }
+    .check(quantity)
 }
 
 /// A message of the assessment with the command's option names replaced by the arguments of

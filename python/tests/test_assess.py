@@ -99,7 +99,7 @@ def test_messages_name_the_python_arguments_not_the_command_options(hunting, tmp
     cases = [
         ({"signals": []}, "signals: none given"),
         ({"speed_kmh": -1.0}, "speed_kmh = -1: must be a speed > 0 km/h"),
-        ({"skip_s": -1.0}, "skip_s = -1: must be >= 0 s"),
+        ({"skip_s": -1.0}, "skip_s = -1: must be a time >= 0 s"),
         ({"f0_hz": -2.0}, "f0_hz = -2: must be a frequency > 0 Hz"),
         ({"bogie_mass_t": 80.0}, r"bogie_mass_t = 80: must be in \(0, 60\) t"),
         ({"quantity": "guiding_force", "wheel_load_kn": -5.0},

@@ -862,8 +862,16 @@ fn outputs_never_replace_an_input_or_a_device() {
     let system = std::fs::read(c.path("system.json")).unwrap();
     let fmu = std::fs::read(c.path("Hostile.fmu")).unwrap();
     for args in [
-        &["run", "system.json", "-o", "system.json"][..],
-        &["run", "system.json", "-o", "./Hostile.fmu"],
+        // --format: a name that says no format is refused before it is compared
+        &["run", "system.json", "-o", "system.json", "--format", "csv"][..],
+        &[
+            "run",
+            "system.json",
+            "-o",
+            "./Hostile.fmu",
+            "--format",
+            "parquet",
+        ],
         &[
             "run",
             "system.json",
@@ -880,7 +888,7 @@ fn outputs_never_replace_an_input_or_a_device() {
             "--summary",
             "r.meta.json",
         ],
-        &["run", "Hostile.fmu", "-o", "Hostile.fmu"],
+        &["run", "Hostile.fmu", "-o", "Hostile.fmu", "--format", "csv"],
         &["export-ssp", "system.json", "system.json"],
         &["export-ssp", "system.json", "Hostile.fmu"],
     ] {
@@ -894,7 +902,17 @@ fn outputs_never_replace_an_input_or_a_device() {
         .status()
         .unwrap()
         .success());
-    let e = c.fails(&["run", "system.json", "-o", "results.fifo"], &[]);
+    let e = c.fails(
+        &[
+            "run",
+            "system.json",
+            "-o",
+            "results.fifo",
+            "--format",
+            "csv",
+        ],
+        &[],
+    );
     assert!(e.contains("not a regular file"), "{e}");
     use std::os::unix::fs::FileTypeExt;
     assert!(std::fs::symlink_metadata(&fifo)
