@@ -106,6 +106,16 @@ fn default_output(format: ResultsFormat) -> PathBuf {
 }
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
+    // a name that says no format would get one by the results' size, and a CSV's metadata
+    // file beside it that a later Parquet run to the same name would leave behind
+    if let (None, Some(output)) = (args.format, &args.output) {
+        if ResultsFormat::of_path(output).is_none() {
+            return Err(CommandError::Failed(format!(
+                "'{}' names no results format: name it .csv or .parquet, or give --format",
+                output.display()
+            )));
+        }
+    }
     // an imported SSP's FMUs live in a temporary folder as long as `_imported` does
     let (sys, _imported) = if args.is_fmu() {
         if args.algorithm.is_some() {
@@ -161,16 +171,6 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             &written(output, chosen.unwrap_or(ResultsFormat::Parquet)),
         )?,
         None => check_outputs_apart(&inputs, &args.summary.iter().cloned().collect::<Vec<_>>())?,
-    }
-    // a name that says no format would get one by the results' size, and a CSV's metadata
-    // file beside it that a later Parquet run to the same name would leave behind
-    if let (None, Some(output)) = (args.format, &args.output) {
-        if ResultsFormat::of_path(output).is_none() {
-            return Err(CommandError::Failed(format!(
-                "'{}' names no results format: name it .csv or .parquet, or give --format",
-                output.display()
-            )));
-        }
     }
     // a file named for one format does not take the other's content
     if let (Some(format), Some(output)) = (args.format, &args.output) {

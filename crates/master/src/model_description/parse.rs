@@ -74,8 +74,9 @@ impl Elem<'_> {
         }
     }
     /// The value of `key` must read as a value of type `t` (xs:double, xs:int, xs:boolean; a
-    /// String anything), as fmpy and FMI Library read it: a start value or bound that does
-    /// not is a broken modelDescription.xml, not a value to guess at.
+    /// String anything), as the FMI 2.0 schema types them: a start value or bound that does
+    /// not is a broken modelDescription.xml, not a value to guess at (FMI Library would read
+    /// `1.5` as the Integer 1).
     fn typed(&self, key: &str, t: VarType) -> Result<(), ModelDescriptionError> {
         let Some(v) = self.get(key) else {
             return Ok(());
@@ -377,7 +378,10 @@ impl ModelDescription {
                                 };
                                 if let Some(t) = var_type {
                                     e.typed("start", t)?;
-                                    if t != VarType::String {
+                                    if matches!(
+                                        t,
+                                        VarType::Real | VarType::Integer | VarType::Enumeration
+                                    ) {
                                         e.typed("min", t)?;
                                         e.typed("max", t)?;
                                     }

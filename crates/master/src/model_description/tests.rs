@@ -450,8 +450,8 @@ fn ranges_come_from_the_variable_else_from_its_declared_type() {
     assert_eq!(range("m"), (None, None));
 }
 
-/// A start value or bound that does not read as its variable's type is refused with the
-/// attribute, the value and the line, as fmpy and FMI Library refuse it.
+/// A start value or bound that does not read as its variable's type (the FMI 2.0 schema's
+/// xs:double, xs:int, xs:boolean) is refused with the attribute, the value and the line.
 #[test]
 fn start_values_and_bounds_must_read_as_their_type() {
     let parse = |from: &str, to: &str| {
