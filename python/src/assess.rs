@@ -272,7 +272,7 @@ mod tests {
             ("speed_kmh = -1: must be a speed > 0 km/h", |o| {
                 o.speed_kmh = -1.0
             }),
-            ("skip_s = -1: must be >= 0 s", |o| o.skip_s = -1.0),
+            ("skip_s = -1: must be a time >= 0 s", |o| o.skip_s = -1.0),
             ("f0_hz = 0: must be a frequency > 0 Hz", |o| {
                 o.f0_hz = Some(0.0)
             }),
