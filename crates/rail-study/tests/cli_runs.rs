@@ -98,7 +98,7 @@ fn sweep_runs_in_parallel_and_keeps_failures() {
     assert_eq!(refused.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&refused.stderr);
     assert!(
-        stderr.contains("run 'light'") && stderr.contains("-1 is below its minimum 1e-9"),
+        stderr.contains("run 'light'") && stderr.contains("-1 kg is below its minimum 1e-9 kg"),
         "{stderr}"
     );
     assert_eq!(
@@ -232,7 +232,7 @@ fn run_changes_a_system_from_the_command_line() {
         ),
         (
             vec!["--set", "ms.mass=-1"],
-            "system.json with --set: instances[1].parameters.mass: -1 is below its minimum",
+            "system.json with --set: instances[1].parameters.mass: -1 kg is below its minimum",
         ),
         (
             vec!["--stop", "0.2", "--step", "0.003"],
@@ -318,6 +318,10 @@ fn inspect_reports_platforms_and_the_glibc_a_binary_needs() {
     );
     // the packaged binaries meet the baseline: no warning
     assert!(!text.contains("warning:"), "{text}");
+    assert!(
+        text.contains("default experiment: start 0 s, stop 5 s, step 0.001 s"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -511,4 +515,41 @@ fn an_interrupted_sweep_stops_at_once_and_resumes() {
     assert!(not_started
         .iter()
         .all(|n| out.join(n).join("results.csv").is_file()));
+}
+
+/// A run without -o writes results.csv (small results) and removes a results.parquet that an
+/// earlier run of the master wrote there (it would read as this run's), but never a file of
+/// that name without the master's metadata: the user's own.
+#[test]
+fn a_run_without_output_removes_only_the_masters_own_other_default_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("system.json"), system_json(0.1)).unwrap();
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_master"))
+            .args(["--quiet", "run", "system.json"])
+            .args(args)
+            .current_dir(d)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    std::fs::write(d.join("results.parquet"), "the user's own").unwrap();
+    run(&[]);
+    assert!(d.join("results.csv").is_file() && d.join("results.meta.json").is_file());
+    assert_eq!(
+        std::fs::read_to_string(d.join("results.parquet")).unwrap(),
+        "the user's own"
+    );
+    std::fs::remove_file(d.join("results.parquet")).unwrap();
+    run(&["--format", "parquet"]);
+    assert!(d.join("results.parquet").is_file());
+    // the CSV of the first run is the master's: removed with its metadata
+    assert!(!d.join("results.csv").exists() && !d.join("results.meta.json").exists());
+    run(&[]);
+    assert!(d.join("results.csv").is_file() && !d.join("results.parquet").exists());
 }

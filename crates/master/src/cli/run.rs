@@ -23,7 +23,8 @@ pub struct Args {
     /// Results file (time plus recorded variables, units in the header); written atomically.
     /// Named .csv, .parquet or .pq, or any name with --format.
     /// Default: results.csv, or results.parquet for large results (see --format); the other
-    /// one of these two, from an earlier run, is then removed (a CSV with its metadata file).
+    /// one of these two, written by an earlier run (its metadata says so), is then removed
+    /// (a CSV with its metadata file); a file of that name without it stays.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Results format; default: by the extension of --output (.csv, .parquet), else Parquet
@@ -226,7 +227,10 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         // the default file of the other format, from an earlier run, would read as a result
         // of this one (unless it is an input or the --summary file, which stay)
         let other = default_output(format.other());
-        if check_outputs_apart(&inputs, &written(&other, format.other())).is_ok() {
+        // only a results file of the master's (its metadata reads as such): a user's own
+        // results.csv or results.parquet stays
+        let ours = crate::results::read_metadata(&other).is_ok_and(|m| m.is_some());
+        if ours && check_outputs_apart(&inputs, &written(&other, format.other())).is_ok() {
             remove_results(&other, format.other())?;
         }
     }
