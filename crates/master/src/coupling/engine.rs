@@ -16,7 +16,10 @@ pub(super) struct Engine<'p, 's, 'd, 'o> {
     n_steps: u64,
     rejected: u64,
     initialised: Vec<bool>,
-    fatal: Vec<bool>,
+    /// Instances that returned fmi2Error or fmi2Fatal: FMI 2.0 allows only fmi2Reset,
+    /// fmi2SetFMUstate or fmi2FreeInstance after an error (only the last after a fatal one),
+    /// so they get no fmi2Terminate.
+    failed: Vec<bool>,
     /// Latest connected outputs of each instance (in its `Source::outputs` order).
     outputs: Vec<Vec<f64>>,
     /// Per instance: how many calls that may change its values (set, step, state restore,
@@ -115,7 +118,7 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             n_steps,
             rejected: 0,
             initialised: vec![false; n],
-            fatal: vec![false; n],
+            failed: vec![false; n],
             outputs: vec![Vec::new(); n],
             changes: vec![0; n],
             read_at: vec![u64::MAX; n],
@@ -216,8 +219,8 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
     }
 
     fn slave_err(&mut self, time: f64, i: usize, e: SlaveError) -> SimError {
-        if e.status == FailStatus::Fatal {
-            self.fatal[i] = true;
+        if matches!(e.status, FailStatus::Error | FailStatus::Fatal) {
+            self.failed[i] = true;
         }
         SimError::Slave {
             time,
@@ -953,11 +956,12 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         Ok(data)
     }
 
-    /// fmi2Terminate on every slave that reached step mode and did not fail fatally.
+    /// fmi2Terminate on every slave that reached step mode and did not return fmi2Error or
+    /// fmi2Fatal.
     pub(super) fn terminate_all(&mut self) -> Result<(), SimError> {
         let mut first = None;
         for i in 0..self.slaves.len() {
-            if self.initialised[i] && !self.fatal[i] {
+            if self.initialised[i] && !self.failed[i] {
                 self.initialised[i] = false;
                 if let Err(e) = self.slaves[i].terminate() {
                     first.get_or_insert(SimError::Slave {

@@ -23,6 +23,8 @@ pub struct Hooks {
     pub fail_set_vr: Option<u32>,
     /// From this time on, every step is discarded with fmi2Terminated (the slave ends the run).
     pub terminate_from: Option<f64>,
+    /// From this time on, every step returns `fail_step_status`.
+    pub fail_step_from: Option<(f64, crate::slave::FailStatus)>,
     /// Number of get and set calls (each a batch).
     pub gets: usize,
     pub sets: usize,
@@ -200,6 +202,16 @@ impl<M: Model + Clone> Slave for Mock<M> {
         }
         if self.hooks.discard_above.is_some_and(|hmax| h > hmax) {
             return Ok(StepStatus::Discard);
+        }
+        if let Some((from, status)) = &self.hooks.fail_step_from {
+            if t + 1e-12 >= *from {
+                return Err(SlaveError {
+                    instance: self.name.clone(),
+                    call: "fmi2DoStep",
+                    status: status.clone(),
+                    reason: None,
+                });
+            }
         }
         // RK4 with 10 internal steps, inputs held
         let n = 10;
@@ -436,6 +448,33 @@ fn discard_is_retried_with_halved_steps() {
     );
     // and ms was restored too
     assert!(a.hooks.log.borrow().iter().any(|s| s == "ms:restore"));
+}
+
+/// FMI 2.0 allows only fmi2Reset, fmi2SetFMUstate or fmi2FreeInstance after fmi2Error (and
+/// only fmi2FreeInstance after fmi2Fatal): an instance that returned either is not
+/// terminated, the others are.
+#[test]
+fn an_instance_that_returned_an_error_is_not_terminated() {
+    use crate::slave::FailStatus;
+    for status in [FailStatus::Error, FailStatus::Fatal] {
+        let plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.2);
+        let (mut a, mut b) = slaves();
+        let log = CallLog::default();
+        a.hooks.log = log.clone();
+        b.hooks.log = log.clone();
+        b.hooks.fail_step_from = Some((0.1, status.clone()));
+        let e = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap_err();
+        assert!(e.to_string().contains("fmi2DoStep"), "{e}");
+        let log = log.borrow();
+        assert!(
+            log.contains(&"ms:terminate".to_string()),
+            "{status}: {log:?}"
+        );
+        assert!(
+            !log.contains(&"sdm:terminate".to_string()),
+            "{status}: {log:?}"
+        );
+    }
 }
 
 #[test]
