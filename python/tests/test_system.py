@@ -136,7 +136,7 @@ def test_bad_input_raises_with_the_masters_message_and_changes_nothing(passive_f
     with pytest.raises(TypeError, match=r"not list"):
         sys.run({"bogie.vehicle.speed": [1.0]})
     # outside the range the model description declares: refused here, not in every run
-    with pytest.raises(railfmu.SystemDescriptionError, match=r"250 is above its maximum 200 \(declared by model 'Bogie2Dof' for 'vehicle.speed'\)"):
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"250 m/s is above its maximum 200 m/s \(declared by model 'Bogie2Dof' for 'vehicle.speed'\)"):
         sys.set_parameter("bogie.vehicle.speed", 250.0)
     with pytest.raises(railfmu.SystemDescriptionError, match=r"-1 is below its minimum 0"):
         sys.run({"bogie.track.seed": -1})

@@ -47,9 +47,12 @@ pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
         );
     }
     if let Some(d) = &md.default_experiment {
+        let given = |x: Option<f64>| x.map_or("not given".to_string(), |x| format!("{x} s"));
         println!(
-            "default experiment: start {:?}, stop {:?}, step {:?}",
-            d.start_time, d.stop_time, d.step_size
+            "default experiment: start {}, stop {}, step {}",
+            given(d.start_time),
+            given(d.stop_time),
+            given(d.step_size)
         );
     }
     print_binaries(&args.fmu);

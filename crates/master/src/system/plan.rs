@@ -414,14 +414,15 @@ pub(super) fn start_value(
     let x = json_value_for(md, v, value, strings).map_err(|r| invalid(field.clone(), name, r))?;
     if matches!(v.var_type, VarType::Real | VarType::Integer) {
         // the FMU refuses such a value at fmi2SetXXX, in every run: said here, before one
+        let unit = v.unit.as_deref().map_or(String::new(), |u| format!(" {u}"));
         let outside = match (v.min, v.max) {
-            (Some(lo), _) if x < lo => Some(format!("below its minimum {}", num(lo))),
-            (_, Some(hi)) if x > hi => Some(format!("above its maximum {}", num(hi))),
+            (Some(lo), _) if x < lo => Some(format!("below its minimum {}{unit}", num(lo))),
+            (_, Some(hi)) if x > hi => Some(format!("above its maximum {}{unit}", num(hi))),
             _ => None,
         };
         if let Some(why) = outside {
             let reason = format!(
-                "{} is {why} (declared by model '{}' for '{}')",
+                "{}{unit} is {why} (declared by model '{}' for '{}')",
                 num(x),
                 md.model_name,
                 text(name)
