@@ -78,7 +78,7 @@ def assess_stability(
     *,
     quantity: str = "acceleration",
     bogie_mass_t: float = 6.1,
-    wheel_load_kn: float = 70.0,
+    wheel_load_kn: Optional[float] = None,
     skip_s: float = 0.0,
     f0_hz: Optional[float] = None,
     accept_narrow_band: bool = False,
@@ -92,8 +92,9 @@ def assess_stability(
     metadata record how they were sampled, or a host's export with the time in the first
     column). ``signals``: column names, with or without their `` [unit]``. ``quantity``:
     ``"acceleration"`` (lateral, m/s2; limit from ``bogie_mass_t``, 5.39 m/s2 for the seed's
-    6.1 t) or ``"guiding_force"`` (sum of guiding forces of a wheelset, N or kN; limit from the
-    static wheel load ``wheel_load_kn``). ``skip_s``: start-up excluded. A signal recorded with
+    6.1 t) or ``"guiding_force"`` (also ``"guiding-force"``: sum of guiding forces of a
+    wheelset, N or kN; limit from the static wheel load ``wheel_load_kn``, which it needs: the
+    coach's is 54.2 kN, the 2-dof bogie's 70 kN). ``skip_s``: start-up excluded. A signal recorded with
     a narrower band than the one assessed (decimated too far) is refused unless
     ``accept_narrow_band``.
 
@@ -106,9 +107,11 @@ def assess_stability(
     cannot be read.
     """
     names = [signals] if isinstance(signals, str) else list(signals)
-    numbers = {"speed_kmh": speed_kmh, "bogie_mass_t": bogie_mass_t, "wheel_load_kn": wheel_load_kn, "skip_s": skip_s}
+    numbers = {"speed_kmh": speed_kmh, "bogie_mass_t": bogie_mass_t, "skip_s": skip_s}
     if f0_hz is not None:
         numbers["f0_hz"] = f0_hz
+    if wheel_load_kn is not None:
+        numbers["wheel_load_kn"] = wheel_load_kn
     for key, value in numbers.items():
         if not np.isfinite(float(value)):
             raise _railfmu.AssessmentError(f"{key} = {value}: not a finite number")
@@ -118,7 +121,7 @@ def assess_stability(
             "speed_kmh": float(speed_kmh),
             "quantity": quantity,
             "bogie_mass_t": float(bogie_mass_t),
-            "wheel_load_kn": float(wheel_load_kn),
+            "wheel_load_kn": None if wheel_load_kn is None else float(wheel_load_kn),
             "skip_s": float(skip_s),
             "f0_hz": None if f0_hz is None else float(f0_hz),
             "accept_narrow_band": bool(accept_narrow_band),

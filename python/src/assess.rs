@@ -22,7 +22,8 @@ pub struct AssessOptions {
     /// "acceleration" (limit from the bogie mass) or "guiding_force" (from the wheel load).
     pub quantity: String,
     pub bogie_mass_t: f64,
-    pub wheel_load_kn: f64,
+    /// Needed for guiding forces only.
+    pub wheel_load_kn: Option<f64>,
     /// Start-up excluded \[s\].
     pub skip_s: f64,
     /// Dominant frequency instead of the spectrum's peak \[Hz\].
@@ -145,7 +146,7 @@ fn python_names(message: &str) -> String {
 pub fn assess(table: &ResultsTable, options: &AssessOptions) -> Result<AssessAnswer, String> {
     let quantity = match options.quantity.as_str() {
         "acceleration" => Quantity::Acceleration,
-        "guiding_force" => Quantity::GuidingForce,
+        "guiding_force" | "guiding-force" => Quantity::GuidingForce,
         other => {
             return Err(format!(
                 "quantity '{other}': expected 'acceleration' or 'guiding_force'"
@@ -162,7 +163,10 @@ pub fn assess(table: &ResultsTable, options: &AssessOptions) -> Result<AssessAns
         table,
         &options.signals,
         options.speed_kmh,
-        quantity.criterion(options.bogie_mass_t, options.wheel_load_kn),
+        quantity.criterion(
+            options.bogie_mass_t,
+            options.wheel_load_kn.unwrap_or(f64::NAN),
+        ),
         &settings,
         options.accept_narrow_band,
     )
@@ -211,7 +215,7 @@ mod tests {
             speed_kmh: 300.0,
             quantity: "acceleration".into(),
             bogie_mass_t: 6.1,
-            wheel_load_kn: 70.0,
+            wheel_load_kn: None,
             skip_s: 0.0,
             f0_hz: None,
             accept_narrow_band: false,
@@ -283,7 +287,7 @@ mod tests {
                 "wheel_load_kn = -5: must be a static wheel load within 1 .. 300 kN",
                 |o| {
                     o.quantity = "guiding_force".into();
-                    o.wheel_load_kn = -5.0;
+                    o.wheel_load_kn = Some(-5.0);
                 },
             ),
             ("speed_kmh = NaN", |o| o.speed_kmh = f64::NAN),

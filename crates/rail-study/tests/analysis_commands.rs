@@ -1154,12 +1154,37 @@ fn assess_reports_the_en14363_verdict_and_refuses_bad_input() {
         "front",
         "--quantity",
         "guiding-force",
+        "--wheel-load",
+        "70",
         "--speed",
         "300",
         "--out",
         none_s,
     ]);
     assert!(!r.ok && r.stderr.contains("wrong unit"), "{}", r.stderr);
+    // guiding forces need the vehicle's wheel load (no default: the coach's 54.2 kN would be
+    // assessed against the 2-dof bogie's 70 kN limit); Python's spelling is taken too
+    let r = master(&[
+        "assess",
+        csv_s,
+        "--signal",
+        "front",
+        "--quantity",
+        "guiding_force",
+        "--speed",
+        "300",
+        "--out",
+        none_s,
+    ]);
+    assert!(
+        !r.ok
+            && r.stderr.contains(
+                "--wheel-load: needed for guiding forces, the static wheel load Q0 of the \
+                 assessed vehicle in kN"
+            ),
+        "{}",
+        r.stderr
+    );
     // a speed at which the 10 m window step lasts less than a sample: refused (it started
     // windows at the same sample until memory ran out and the process aborted)
     let r = master(&[

@@ -25,6 +25,7 @@ pub enum Quantity {
     /// Lateral acceleration of the bogie frame / wheelset [m/s2]; limit (12 - m_bogie/5)/2.
     Acceleration,
     /// Sum of guiding forces of a wheelset [N or kN]; limit (10 + 2 Q0/3)/2 kN.
+    #[value(alias = "guiding_force")]
     GuidingForce,
 }
 
@@ -57,13 +58,8 @@ pub struct Args {
     )]
     pub bogie_mass: f64,
     /// Static wheel load Q0 for the guiding-force limit [kN].
-    #[arg(
-        long,
-        value_name = "KN",
-        default_value_t = 70.0,
-        allow_negative_numbers = true
-    )]
-    pub wheel_load: f64,
+    #[arg(long, value_name = "KN", allow_negative_numbers = true)]
+    pub wheel_load: Option<f64>,
     /// Start-up time excluded from the assessment [s].
     #[arg(
         long,
@@ -93,6 +89,7 @@ pub struct Args {
 impl Quantity {
     /// The criterion of this quantity: the limit from the bogie mass \[t\] or the static wheel
     /// load \[kN\].
+    /// (`wheel_load_kn` is not used for accelerations.)
     pub fn criterion(self, bogie_mass_t: f64, wheel_load_kn: f64) -> Criterion {
         match self {
             Quantity::Acceleration => Criterion::LateralAcceleration { bogie_mass_t },
@@ -110,7 +107,9 @@ pub struct AssessNumbers<'a> {
     pub skip_s: (&'a str, f64),
     pub f0_hz: (&'a str, Option<f64>),
     pub bogie_mass_t: (&'a str, f64),
-    pub wheel_load_kn: (&'a str, f64),
+    /// Needed for guiding forces only: no default, since the vehicles differ (the coach 54.2
+    /// kN, the 2-dof bogie 70 kN).
+    pub wheel_load_kn: (&'a str, Option<f64>),
 }
 
 impl AssessNumbers<'_> {
@@ -133,17 +132,21 @@ impl AssessNumbers<'_> {
             return bad((f0_name, f), "must be a frequency > 0 Hz");
         }
         let (_, mass) = self.bogie_mass_t;
-        let (_, load) = self.wheel_load_kn;
-        match quantity {
-            Quantity::Acceleration if !(mass > 0.0 && mass < 60.0) => bad(
+        let (load_name, load) = self.wheel_load_kn;
+        match (quantity, load) {
+            (Quantity::Acceleration, _) if !(mass > 0.0 && mass < 60.0) => bad(
                 self.bogie_mass_t,
                 "must be in (0, 60) t (the limit (12 - m/5)/2 must stay > 0)",
             ),
-            Quantity::GuidingForce
+            (Quantity::GuidingForce, None) => Err(format!(
+                "{load_name}: needed for guiding forces, the static wheel load Q0 of the \
+                 assessed vehicle in kN (the coach's 54.2, the 2-dof bogie's 70)"
+            )),
+            (Quantity::GuidingForce, Some(load))
                 if !crate::en14363::STATIC_WHEEL_LOAD_RANGE_N.contains(&(load * 1e3)) =>
             {
                 bad(
-                    self.wheel_load_kn,
+                    (load_name, load),
                     "must be a static wheel load within 1 .. 300 kN",
                 )
             }
@@ -167,7 +170,9 @@ fn check_options(args: &Args) -> Result<(), CommandError> {
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     check_options(args)?;
-    let criterion = args.quantity.criterion(args.bogie_mass, args.wheel_load);
+    let criterion = args
+        .quantity
+        .criterion(args.bogie_mass, args.wheel_load.unwrap_or(f64::NAN));
     let settings = StabilitySettings {
         skip_s: args.skip,
         dominant_frequency_hz: args.f0,
