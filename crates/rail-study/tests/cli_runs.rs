@@ -215,6 +215,7 @@ fn run_changes_a_system_from_the_command_line() {
     let text = meta.to_string();
     assert!(text.contains("\"coupling_stiffness\":50"), "{text}");
     assert!(text.contains("\"stop_time\":0.2"), "{text}");
+
     // --stop-time, as for an SSP, is the same option
     let (code, stderr) = run(&["system.json", "-o", "alias.csv", "--stop-time", "0.1"]);
     assert_eq!(code, Some(0), "{stderr}");
@@ -552,4 +553,42 @@ fn a_run_without_output_removes_only_the_masters_own_other_default_file() {
     assert!(!d.join("results.csv").exists() && !d.join("results.meta.json").exists());
     run(&[]);
     assert!(d.join("results.csv").is_file() && !d.join("results.parquet").exists());
+}
+
+/// The description in a run's metadata names its FMUs by absolute paths: saved anywhere, it
+/// runs again and gives the same results (a relative path was relative to the original file).
+#[test]
+fn the_description_in_the_metadata_runs_again_from_another_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir(d.join("fmus")).unwrap();
+    for f in ["SpringDamperMass.fmu", "MassSpring.fmu"] {
+        std::fs::copy(dist().join(f), d.join("fmus").join(f)).unwrap();
+    }
+    let relative = system_json(0.1).replace(&dist().join("").display().to_string(), "fmus/");
+    assert!(relative.contains("\"fmus/MassSpring.fmu\""), "{relative}");
+    std::fs::write(d.join("system.json"), relative).unwrap();
+    let run = |dir: &Path, system: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_master"))
+            .args(["--quiet", "run", system, "-o", "r.csv"])
+            .current_dir(dir)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        std::fs::read_to_string(dir.join("r.csv")).unwrap()
+    };
+    let first = run(d, "system.json");
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("r.meta.json")).unwrap()).unwrap();
+    let elsewhere = tempfile::tempdir().unwrap();
+    std::fs::write(
+        elsewhere.path().join("again.json"),
+        meta["system"].to_string(),
+    )
+    .unwrap();
+    assert_eq!(run(elsewhere.path(), "again.json"), first);
 }

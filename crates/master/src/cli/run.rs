@@ -218,8 +218,15 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     if args.output.is_none() || (chosen.is_none() && format == ResultsFormat::Csv) {
         check_outputs_apart(&inputs, &written(&output, format))?;
     }
+    // FMU paths absolute, so that the description runs again from wherever it is saved (an
+    // SSP's FMUs lie in a temporary folder: its description is kept as imported)
+    let described = if _imported.is_some() {
+        sys.desc.clone()
+    } else {
+        sys.resolved()
+    };
     let ctx = RunContext {
-        system: serde_json::to_value(&sys.desc).ok(),
+        system: serde_json::to_value(&described).ok(),
         ..RunContext::default()
     };
     write_results(&output, &out, format, &ctx)?;
