@@ -292,6 +292,12 @@ impl PySystem {
 }
 
 impl PySystem {
+    /// How messages name a run's own parameters and stop time: not by the description's
+    /// file and line, which hold other values.
+    fn run_label(&self) -> String {
+        format!("{} with the run's arguments", self.prepared.system().file)
+    }
+
     /// The description (FMU paths absolute) with a run's start values and stop time, as
     /// JSON.
     fn run_description(
@@ -401,7 +407,7 @@ impl PySystem {
     ) -> PyResult<()> {
         let params = json_parameters(parameters)?;
         self.prepared
-            .changes(&params, stop_time, &self.prepared.system().file)
+            .changes(&params, stop_time, &self.run_label())
             .map(|_| ())
             .map_err(|e| system_err(&e))
     }
@@ -420,7 +426,7 @@ impl PySystem {
         let params = json_parameters(parameters)?;
         let changes = self
             .prepared
-            .changes(&params, stop_time, &self.prepared.system().file)
+            .changes(&params, stop_time, &self.run_label())
             .map_err(|e| system_err(&e))?;
         let cancel = AtomicBool::new(false);
         let want_progress = progress.is_some();

@@ -138,8 +138,12 @@ def test_bad_input_raises_with_the_masters_message_and_changes_nothing(passive_f
     # outside the range the model description declares: refused here, not in every run
     with pytest.raises(railfmu.SystemDescriptionError, match=r"250 m/s is above its maximum 200 m/s \(declared by model 'Bogie2Dof' for 'vehicle.speed'\)"):
         sys.set_parameter("bogie.vehicle.speed", 250.0)
-    with pytest.raises(railfmu.SystemDescriptionError, match=r"-1 is below its minimum 0"):
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"with the run's arguments: bogie.track.seed: -1 is below its minimum 0"):
         sys.run({"bogie.track.seed": -1})
+    # a stop time that does not fit the step: said of the argument, not at the file's line
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"with the run's arguments: step: stop_time - start_time = 0.0015 s") as e:
+        sys.run(stop_time=0.0015)
+    assert "line" not in str(e.value)
     with pytest.raises(railfmu.SystemDescriptionError, match=r"stop_time"):
         sys.stop_time = -1.0
     assert sys.parameters == {} and sys.stop_time == 1.0

@@ -137,6 +137,13 @@ impl PreparedSystem {
         let mut start_values = Vec::with_capacity(parameters.len());
         let mut strings = Vec::new();
         for (key, value) in parameters {
+            // named as given ("bogie.vehicle.speed"), not by the description's field
+            let invalid_key = |_: String, _: &str, reason: String| SystemError::Invalid {
+                file: run.to_string(),
+                line: None,
+                field: key.clone(),
+                reason,
+            };
             let Some((inst, var)) = split_ref(key) else {
                 return Err(invalid(
                     key.clone(),
@@ -152,12 +159,23 @@ impl PreparedSystem {
                     format!("unknown instance '{}'", text(inst)),
                 ));
             };
-            let (v, x) = start_value(i, self.fmus[i].model(), var, value, &mut strings, &invalid)?;
+            let (v, x) = start_value(
+                i,
+                self.fmus[i].model(),
+                var,
+                value,
+                &mut strings,
+                &invalid_key,
+            )?;
             start_values.push((i, var.to_string(), v, x));
         }
         if let Some(t) = stop_time {
             if t != self.system.desc.stop_time {
-                self.system.check_stop_time(t)?;
+                // said of this run's stop time, not at the line of the description's
+                self.system.check_stop_time(t).map_err(|e| match e {
+                    SystemError::Invalid { field, reason, .. } => invalid(field, "", reason),
+                    other => other,
+                })?;
             }
         }
         Ok(RunChanges {
