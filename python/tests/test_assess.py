@@ -49,7 +49,7 @@ def test_a_runs_results_are_assessed_as_the_command_line_assesses_their_file(hun
     assert len(rows) == len(SIGNALS)
     for row in rows:
         s = a.signals[row["signal"]]
-        assert s.max_rms == pytest.approx(float(row["max rms"]), rel=1e-12)
+        assert s.max_rms == pytest.approx(float(row["max rms [m/s2]"]), rel=1e-12)
         assert s.dominant_frequency_hz == pytest.approx(float(row["dominant frequency [Hz]"]), rel=1e-12)
         assert (row["stable"] == "true") == s.stable
     # and from Python on the file: the same numbers; its metadata file records how it was

@@ -1078,6 +1078,13 @@ fn assess_reports_the_en14363_verdict_and_refuses_bad_input() {
         r.stdout
     );
     check_files(&out, &["assess.csv", "assess.svg", "assess_summary.csv"]);
+    let summary = std::fs::read_to_string(out.join("assess_summary.csv")).unwrap();
+    assert!(
+        summary.starts_with(
+            "signal index,signal,dominant frequency [Hz],max rms [m/s2],limit [m/s2],stable\n"
+        ),
+        "{summary}"
+    );
     let max_rms = number_after(&r.stdout, "max rms");
     // the same record with the text columns a recorded Enumeration and String give
     let with_text = dir.path().join("with_text.csv");

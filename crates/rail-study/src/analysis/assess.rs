@@ -483,8 +483,9 @@ impl AssessReport {
         }
         files.add_table("assess.csv", &t)?;
         files.add_lines("assess.svg", &chart)?;
-        let mut legend =
-            String::from("signal index,signal,dominant frequency [Hz],max rms,limit,stable\n");
+        let mut legend = format!(
+            "signal index,signal,dominant frequency [Hz],max rms [{u}],limit [{u}],stable\n"
+        );
         for (k, (name, a)) in self.signals.iter().enumerate() {
             legend.push_str(&format!(
                 "{k},{},{},{},{},{}\n",
