@@ -323,6 +323,9 @@ fn inspect_reports_platforms_and_the_glibc_a_binary_needs() {
         text.contains("default experiment: start 0 s, stop 5 s, step 0.001 s"),
         "{text}"
     );
+    // each variable's declared range beside its start value
+    let mass = text.lines().find(|l| l.starts_with("mass ")).unwrap();
+    assert!(mass.contains(" 1e-9..- "), "{mass}");
 }
 
 #[test]

@@ -77,12 +77,19 @@ pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
     }
     println!();
     println!(
-        "{:<32} {:>5} {:<12} {:<11} {:<8} {:<8} {:>10}  description",
-        "name", "vr", "causality", "variability", "type", "unit", "start"
+        "{:<32} {:>5} {:<12} {:<11} {:<8} {:<8} {:>10} {:<14}  description",
+        "name", "vr", "causality", "variability", "type", "unit", "start", "range"
     );
     for v in &md.variables {
+        // the declared bounds, in the variable's unit ("-" where none is declared)
+        let bound = |b: Option<f64>| b.map_or("-".to_string(), |x| crate::show::num(x).to_string());
+        let range = if v.min.is_none() && v.max.is_none() {
+            "-".to_string()
+        } else {
+            format!("{}..{}", bound(v.min), bound(v.max))
+        };
         println!(
-            "{:<32} {:>5} {:<12} {:<11} {:<8} {:<8} {:>10}  {}",
+            "{:<32} {:>5} {:<12} {:<11} {:<8} {:<8} {:>10} {:<14}  {}",
             v.name,
             v.value_reference,
             v.causality.to_string(),
@@ -90,6 +97,7 @@ pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
             v.var_type.to_string(),
             v.unit.as_deref().unwrap_or("-"),
             v.start.as_deref().unwrap_or("-"),
+            range,
             v.description.as_deref().unwrap_or("")
         );
     }
