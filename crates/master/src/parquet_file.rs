@@ -317,26 +317,27 @@ where
         .collect())
 }
 
-/// Whether `path` is a run's table of a run set written by the master: a regular file (not a
-/// link) whose footer holds our metadata naming a run. Only the footer is read.
-pub fn is_run_table(path: &Path) -> bool {
+/// The master's metadata in the footer of the Parquet file `path`, if it is a regular file
+/// (not a link) written by the master. Only the footer is read.
+pub fn footer_metadata(path: &Path) -> Option<ResultsMetadata> {
     if !path.symlink_metadata().is_ok_and(|m| m.is_file()) {
-        return false;
+        return None;
     }
-    let Ok(file) = crate::input::open_regular_file(path) else {
-        return false;
-    };
-    let Ok(reader) = SerializedFileReader::new(file) else {
-        return false;
-    };
-    let meta = reader
+    let file = crate::input::open_regular_file(path).ok()?;
+    let reader = SerializedFileReader::new(file).ok()?;
+    reader
         .metadata()
         .file_metadata()
         .key_value_metadata()
         .and_then(|kv| kv.iter().find(|k| k.key == PARQUET_METADATA_KEY))
         .and_then(|k| k.value.as_deref())
-        .and_then(|json| serde_json::from_str::<ResultsMetadata>(json).ok());
-    meta.is_some_and(|m| m.run.is_some())
+        .and_then(|json| serde_json::from_str::<ResultsMetadata>(json).ok())
+}
+
+/// Whether `path` is a run's table of a run set written by the master: [`footer_metadata`]
+/// naming a run.
+pub fn is_run_table(path: &Path) -> bool {
+    footer_metadata(path).is_some_and(|m| m.run.is_some())
 }
 
 /// Reads every column of a Parquet file.

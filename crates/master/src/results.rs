@@ -266,6 +266,23 @@ pub fn write_results(
     }
 }
 
+/// Whether the results file `path` of `format` was written by the master: a Parquet file's
+/// footer, or a CSV's metadata file beside it, reads as the master's metadata (only those are
+/// read, not the values).
+pub fn written_by_master(path: &Path, format: ResultsFormat) -> bool {
+    match format {
+        ResultsFormat::Parquet => crate::parquet_file::footer_metadata(path).is_some(),
+        ResultsFormat::Csv => {
+            path.symlink_metadata().is_ok_and(|m| m.is_file())
+                && crate::input::read_text_file(
+                    &csv_metadata_path(path),
+                    crate::input::MAX_TEXT_FILE_BYTES,
+                )
+                .is_ok_and(|text| serde_json::from_str::<ResultsMetadata>(&text).is_ok())
+        }
+    }
+}
+
 /// Removes the results file `path` written as `format` (a CSV together with its metadata
 /// file), if there is one. Only regular files and symbolic links are removed (a folder or a
 /// FIFO of that name is left alone); a missing file is no error.

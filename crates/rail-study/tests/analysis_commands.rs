@@ -27,6 +27,19 @@ fn master(args: &[&str]) -> Run {
     }
 }
 
+/// `master` with `head`, `options` and `--out out` fails with `expected` in its message.
+fn refused(head: &[&str], options: &[&str], out: &str, expected: &str) {
+    let mut args = head.to_vec();
+    args.extend(options);
+    args.extend(["--out", out]);
+    let r = master(&args);
+    assert!(
+        !r.ok && r.stderr.contains(expected),
+        "{options:?}: {}",
+        r.stderr
+    );
+}
+
 fn check_files(dir: &Path, names: &[&str]) {
     for n in names {
         let p = dir.join(n);
@@ -459,14 +472,11 @@ fn contact_geometry_without_a_value_fails_and_writes_nothing() {
             "-0.5: inclination must be a small tangent (|tan| < 0.2)",
         ),
     ] {
-        let mut args = vec!["contact-geometry"];
-        args.extend(options);
-        args.extend(["--out", out.to_str().unwrap()]);
-        let r = master(&args);
-        assert!(
-            !r.ok && r.stderr.contains(expected),
-            "{options:?}: {}",
-            r.stderr
+        refused(
+            &["contact-geometry"],
+            &options,
+            out.to_str().unwrap(),
+            expected,
         );
         assert!(!out.exists());
     }
@@ -1251,14 +1261,11 @@ fn assess_reports_the_en14363_verdict_and_refuses_bad_input() {
             "invalid option --f0 = 0: must be a frequency > 0 Hz",
         ),
     ] {
-        let mut args = vec!["assess", csv_s, "--signal", "front"];
-        args.extend(options);
-        args.extend(["--out", none_s]);
-        let r = master(&args);
-        assert!(
-            !r.ok && r.stderr.contains(expected),
-            "{options:?}: {}",
-            r.stderr
+        refused(
+            &["assess", csv_s, "--signal", "front"],
+            &options,
+            none_s,
+            expected,
         );
     }
     assert!(!none.exists());

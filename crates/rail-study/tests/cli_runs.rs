@@ -11,6 +11,21 @@ fn dist() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../dist")
 }
 
+/// `master --quiet run ARGS` in `dir`, which must succeed.
+fn run_ok_in(dir: &Path, args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .args(["--quiet", "run"])
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// The two example FMUs coupled by position, velocity and force.
 fn system_json(stop: f64) -> String {
     let d = dist();
@@ -529,19 +544,7 @@ fn a_run_without_output_removes_only_the_masters_own_other_default_file() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     std::fs::write(d.join("system.json"), system_json(0.1)).unwrap();
-    let run = |args: &[&str]| {
-        let out = Command::new(env!("CARGO_BIN_EXE_master"))
-            .args(["--quiet", "run", "system.json"])
-            .args(args)
-            .current_dir(d)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-    };
+    let run = |args: &[&str]| run_ok_in(d, &[&["system.json"][..], args].concat());
     std::fs::write(d.join("results.parquet"), "the user's own").unwrap();
     run(&[]);
     assert!(d.join("results.csv").is_file() && d.join("results.meta.json").is_file());
@@ -572,16 +575,7 @@ fn the_description_in_the_metadata_runs_again_from_another_folder() {
     assert!(relative.contains("\"fmus/MassSpring.fmu\""), "{relative}");
     std::fs::write(d.join("system.json"), relative).unwrap();
     let run = |dir: &Path, system: &str| {
-        let out = Command::new(env!("CARGO_BIN_EXE_master"))
-            .args(["--quiet", "run", system, "-o", "r.csv"])
-            .current_dir(dir)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        run_ok_in(dir, &[system, "-o", "r.csv"]);
         std::fs::read_to_string(dir.join("r.csv")).unwrap()
     };
     let first = run(d, "system.json");

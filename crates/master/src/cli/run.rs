@@ -117,8 +117,8 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             )));
         }
     }
-    // an imported SSP's FMUs live in a temporary folder as long as `_imported` does
-    let (sys, _imported) = if args.is_fmu() {
+    // an imported SSP's FMUs live in a temporary folder as long as `imported` does
+    let (sys, imported) = if args.is_fmu() {
         if args.algorithm.is_some() {
             return Err(CommandError::Failed(
                 "--algorithm: an FMU run alone has no coupling".into(),
@@ -220,7 +220,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     }
     // FMU paths absolute, so that the description runs again from wherever it is saved (an
     // SSP's FMUs lie in a temporary folder: its description is kept as imported)
-    let described = if _imported.is_some() {
+    let described = if imported.is_some() {
         sys.desc.clone()
     } else {
         sys.resolved()
@@ -236,7 +236,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         let other = default_output(format.other());
         // only a results file of the master's (its metadata reads as such): a user's own
         // results.csv or results.parquet stays
-        let ours = crate::results::read_metadata(&other).is_ok_and(|m| m.is_some());
+        let ours = crate::results::written_by_master(&other, format.other());
         if ours && check_outputs_apart(&inputs, &written(&other, format.other())).is_ok() {
             remove_results(&other, format.other())?;
         }

@@ -124,11 +124,18 @@ mod tests {
     use std::io::{Read, Write};
 
     fn write_zip(path: &Path, files: &[(&str, &[u8])]) {
+        write_zip_with(path, files, zip::write::SimpleFileOptions::default());
+    }
+
+    fn write_zip_with(
+        path: &Path,
+        files: &[(&str, &[u8])],
+        options: zip::write::SimpleFileOptions,
+    ) {
         let f = std::fs::File::create(path).unwrap();
         let mut z = zip::ZipWriter::new(f);
         for (name, data) in files {
-            z.start_file(*name, zip::write::SimpleFileOptions::default())
-                .unwrap();
+            z.start_file(*name, options).unwrap();
             z.write_all(data).unwrap();
         }
         z.finish().unwrap();
@@ -224,19 +231,17 @@ mod tests {
         let p = d.path().join("x.fmu");
         let (dir, suf) = platform_binary_dir().unwrap();
         let bin = format!("binaries/{dir}/MassSpring{suf}");
-        let f = std::fs::File::create(&p).unwrap();
-        let mut z = zip::ZipWriter::new(f);
         let stored = zip::write::SimpleFileOptions::default()
             .compression_method(zip::CompressionMethod::Stored);
-        for (name, data) in [
-            ("modelDescription.xml", MD.as_bytes()),
-            ("resources/table.csv", b"MARKER-0123456789".as_slice()),
-            (bin.as_str(), b"".as_slice()),
-        ] {
-            z.start_file(name, stored).unwrap();
-            z.write_all(data).unwrap();
-        }
-        z.finish().unwrap();
+        write_zip_with(
+            &p,
+            &[
+                ("modelDescription.xml", MD.as_bytes()),
+                ("resources/table.csv", b"MARKER-0123456789"),
+                (&bin, b""),
+            ],
+            stored,
+        );
         let mut bytes = std::fs::read(&p).unwrap();
         let data = bytes.windows(6).position(|w| w == b"MARKER").unwrap();
         bytes[data] ^= 0x20;

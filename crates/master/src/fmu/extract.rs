@@ -370,8 +370,8 @@ pub(crate) fn unpack(
             )));
         };
         // a hostile name's control characters are shown escaped, not sent to the terminal
-        let shown = rel.display().to_string().escape_debug().to_string();
-        let at = |e: std::io::Error| err(format!("entry '{shown}': {e}"));
+        let shown = || rel.display().to_string().escape_debug().to_string();
+        let at = |e: std::io::Error| err(format!("entry '{}': {e}", shown()));
         let target = dir.path().join(&rel);
         if entry.is_dir() {
             std::fs::create_dir_all(&target).map_err(at)?;
@@ -389,8 +389,9 @@ pub(crate) fn unpack(
         let more = entry.read(&mut probe).map_err(at)?;
         if more > 0 {
             return Err(err(format!(
-                "entry '{shown}' inflates to more than the {declared} bytes it declares \
+                "entry '{}' inflates to more than the {declared} bytes it declares \
                  (or beyond the {} bytes allowed in total, {MAX_UNPACKED_BYTES_VAR})",
+                shown(),
                 limits.max_unpacked_bytes
             )));
         }

@@ -78,25 +78,22 @@ impl Elem<'_> {
     /// not is a broken modelDescription.xml, not a value to guess at (FMI Library would read
     /// `1.5` as the Integer 1).
     fn typed(&self, key: &str, t: VarType) -> Result<(), ModelDescriptionError> {
-        let Some(v) = self.get(key) else {
-            return Ok(());
-        };
-        let x = v.trim();
-        let (ok, expected) = match t {
-            VarType::Real => (x.parse::<f64>().is_ok(), "expected a Real number"),
-            VarType::Integer | VarType::Enumeration => {
-                (x.parse::<i32>().is_ok(), "expected a 32-bit integer")
-            }
-            VarType::Boolean => (
-                matches!(x, "true" | "false" | "1" | "0"),
-                "expected true or false",
-            ),
-            VarType::String => (true, ""),
-        };
-        if ok {
-            Ok(())
-        } else {
-            Err(self.invalid(key, v, expected))
+        match t {
+            VarType::Real => self.f64(key).map(|_| ()),
+            // xs:boolean collapses whitespace, which the capability flags' bool() does not
+            VarType::Boolean => match self.get(key) {
+                Some(v) if !matches!(v.trim(), "true" | "false" | "1" | "0") => {
+                    Err(self.invalid(key, v, "expected true or false"))
+                }
+                _ => Ok(()),
+            },
+            VarType::Integer | VarType::Enumeration => match self.get(key) {
+                Some(v) if v.trim().parse::<i32>().is_err() => {
+                    Err(self.invalid(key, v, "expected a 32-bit integer"))
+                }
+                _ => Ok(()),
+            },
+            VarType::String => Ok(()),
         }
     }
     fn f64(&self, key: &str) -> Result<Option<f64>, ModelDescriptionError> {

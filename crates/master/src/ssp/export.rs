@@ -168,12 +168,12 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
 
     let mut units_used: BTreeMap<String, Unit> = BTreeMap::new();
     let mut ssd = String::new();
-    let stem = Path::new(&sys.file)
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or("system");
-    writable("the system's file name", stem)?;
-    let name = escape(stem);
+    let name = escape(
+        Path::new(&sys.file)
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("system"),
+    );
     let _ = writeln!(ssd, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
     let _ = writeln!(
         ssd,
@@ -307,6 +307,12 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
     let _ = writeln!(ssd, "  </ssd:DefaultExperiment>");
     let _ = writeln!(ssd, "</ssd:SystemStructureDescription>");
 
+    // every text written, checked once where it is whole (names of the system, its file,
+    // instances, units): a String parameter's value was refused by name already
+    writable("SystemStructure.ssd", &ssd)?;
+    for (member, text) in &ssv_members {
+        writable(member, text)?;
+    }
     // the archive, built in memory and written atomically
     let io = |e: std::io::Error| SspError::Export(e.to_string());
     let zerr = |e: zip::result::ZipError| SspError::Export(e.to_string());

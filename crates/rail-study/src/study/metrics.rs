@@ -319,7 +319,6 @@ fn standard_deviation(x: &[f64]) -> f64 {
 mod tests {
     use super::*;
     use crate::study::vehicle::VehicleModel;
-    use master::coupling::Summary;
     use std::f64::consts::PI;
 
     fn bogie() -> Signals {
@@ -360,21 +359,7 @@ mod tests {
                 data.push(if t < t_end / 2.0 { 10.0 } else { 2.0 });
             }
         }
-        SimOutput {
-            header,
-            data,
-            summary: Summary {
-                steps: n as u64,
-                rejected_steps: 0,
-                simulated_time_s: t_end,
-                wall_time_s: 1.0,
-                realtime_ratio: t_end,
-                terminated: None,
-            },
-            columns: vec![],
-            strings: vec![],
-            decimation: None,
-        }
+        crate::study::run::recorded(header, data)
     }
 
     /// Appends the columns `names` to `out`, their values in each row `values(time)`.

@@ -228,21 +228,14 @@ struct Executor<'a> {
 /// figures only: nothing above half the new rate is removed, so no spectrum is taken of it.
 fn every_nth_row(out: &SimOutput, factor: usize) -> SimOutput {
     let w = out.header.len().max(1);
-    let data: Vec<f64> = out
+    let data = out
         .data
         .chunks_exact(w)
         .step_by(factor.max(1))
         .flatten()
         .copied()
         .collect();
-    SimOutput {
-        header: out.header.clone(),
-        data,
-        summary: out.summary.clone(),
-        columns: out.columns.clone(),
-        strings: out.strings.clone(),
-        decimation: out.decimation.clone(),
-    }
+    with_data(out, data)
 }
 
 /// The window of a time history's detail figure, at the end of the run \[s\]: over the whole
@@ -254,12 +247,17 @@ pub const HISTORY_DETAIL_S: f64 = 2.0;
 fn last_rows(out: &SimOutput, seconds: f64) -> SimOutput {
     let w = out.header.len().max(1);
     let rows = out.data.chunks_exact(w);
-    let t_end = rows.clone().last().map_or(0.0, |r| r[0]);
-    let data: Vec<f64> = rows
-        .filter(|r| r[0] >= t_end - seconds - 1e-9)
-        .flatten()
-        .copied()
-        .collect();
+    let t_end = rows.clone().next_back().map_or(0.0, |r| r[0]);
+    // the times increase: the window is the rows counted from the end
+    let n = rows
+        .rev()
+        .take_while(|r| r[0] >= t_end - seconds - 1e-9)
+        .count();
+    with_data(out, out.data[out.data.len() - n * w..].to_vec())
+}
+
+/// `out` with its rows replaced by `data` (the same columns).
+fn with_data(out: &SimOutput, data: Vec<f64>) -> SimOutput {
     SimOutput {
         header: out.header.clone(),
         data,
@@ -267,6 +265,30 @@ fn last_rows(out: &SimOutput, seconds: f64) -> SimOutput {
         columns: out.columns.clone(),
         strings: out.strings.clone(),
         decimation: out.decimation.clone(),
+    }
+}
+
+/// A recorded output of the given columns and rows (time first), for tests of what is drawn
+/// and computed from one.
+#[cfg(test)]
+pub(crate) fn recorded(header: Vec<String>, data: Vec<f64>) -> SimOutput {
+    let w = header.len().max(1);
+    let times: Vec<f64> = data.chunks_exact(w).map(|r| r[0]).collect();
+    let span_s = times.last().zip(times.first()).map_or(0.0, |(b, a)| b - a);
+    SimOutput {
+        header,
+        data,
+        summary: master::coupling::Summary {
+            steps: times.len().saturating_sub(1) as u64,
+            rejected_steps: 0,
+            simulated_time_s: span_s,
+            wall_time_s: 1.0,
+            realtime_ratio: span_s,
+            terminated: None,
+        },
+        columns: vec![],
+        strings: vec![],
+        decimation: None,
     }
 }
 
@@ -843,28 +865,16 @@ pub fn default_fmu_dir() -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use master::coupling::Summary;
 
     /// A valve command stepping from 0 to 10 V, 1 kHz, 1 s.
     fn switching_command() -> SimOutput {
         let data = (0..1000)
             .flat_map(|k| [k as f64 * 1e-3, if k < 503 { 0.0 } else { 10.0 }])
             .collect();
-        SimOutput {
-            header: vec!["time [s]".into(), "controller.valve.command [V]".into()],
+        recorded(
+            vec!["time [s]".into(), "controller.valve.command [V]".into()],
             data,
-            summary: Summary {
-                steps: 999,
-                rejected_steps: 0,
-                simulated_time_s: 1.0,
-                wall_time_s: 1.0,
-                realtime_ratio: 1.0,
-                terminated: None,
-            },
-            columns: vec![],
-            strings: vec![],
-            decimation: None,
-        }
+        )
     }
 
     /// The figures' samples are the record's own values at every n-th time: a step stays a

@@ -392,21 +392,7 @@ fn time_histories_have_a_detail_figure_of_their_last_two_seconds() {
                 [t, 5e-3 * (2.0 * std::f64::consts::PI * 4.0 * t).sin()]
             })
             .collect();
-        master::coupling::SimOutput {
-            header: vec!["time [s]".into(), format!("{column} [m]")],
-            data,
-            summary: master::coupling::Summary {
-                steps: n as u64 - 1,
-                rejected_steps: 0,
-                simulated_time_s: t_end,
-                wall_time_s: 1.0,
-                realtime_ratio: t_end,
-                terminated: None,
-            },
-            columns: vec![],
-            strings: vec![],
-            decimation: None,
-        }
+        crate::study::run::recorded(vec!["time [s]".into(), format!("{column} [m]")], data)
     };
     let name = scenario::history("passive");
     r.kept.insert(name.clone(), run(100.0, 0.0, 40.0));
