@@ -829,20 +829,63 @@ pub unsafe fn do_step(c: fmi2Component, t: fmi2Real, h: fmi2Real) -> fmi2Status 
     with(c, "fmi2DoStep", |cc| cc.component.do_step(t, h))
 }
 
+/// A status kind this FMU does not provide (steps are never asynchronous; the models never
+/// end the simulation early): fmi2Discard in the states that allow the query, as FMI 2.0,
+/// 4.2.3, says, not fmi2Error, which would end the host's run.
+unsafe fn status_unavailable(
+    c: fmi2Component,
+    call: &'static str,
+    value_is_null: bool,
+    why: &str,
+) -> fmi2Status {
+    with(c, call, |cc| {
+        if value_is_null {
+            return null_arg(cc, call);
+        }
+        if let Err(s) = cc.component.check_status_query(call) {
+            return s;
+        }
+        cc.component.status_unavailable(&format!("{call}: {why}"))
+    })
+}
+
 pub unsafe fn get_status(
     c: fmi2Component,
-    kind: fmi2StatusKind,
+    _kind: fmi2StatusKind,
     value: *mut fmi2Status,
 ) -> fmi2Status {
-    with(c, "fmi2GetStatus", |cc| {
-        if value.is_null() {
-            return null_arg(cc, "fmi2GetStatus");
-        }
-        let _ = kind;
-        // Steps are never asynchronous, so there is no pending status to report.
-        cc.component
-            .error("fmi2GetStatus: no asynchronous step (canRunAsynchronuously = false)")
-    })
+    status_unavailable(
+        c,
+        "fmi2GetStatus",
+        value.is_null(),
+        "no asynchronous step to report on (canRunAsynchronuously = false)",
+    )
+}
+
+pub unsafe fn get_integer_status(
+    c: fmi2Component,
+    _kind: fmi2StatusKind,
+    value: *mut fmi2Integer,
+) -> fmi2Status {
+    status_unavailable(
+        c,
+        "fmi2GetIntegerStatus",
+        value.is_null(),
+        "no Integer status is defined for co-simulation",
+    )
+}
+
+pub unsafe fn get_string_status(
+    c: fmi2Component,
+    _kind: fmi2StatusKind,
+    value: *mut fmi2String,
+) -> fmi2Status {
+    status_unavailable(
+        c,
+        "fmi2GetStringStatus",
+        value.is_null(),
+        "no pending status (canRunAsynchronuously = false)",
+    )
 }
 
 pub unsafe fn get_real_status(
@@ -850,6 +893,14 @@ pub unsafe fn get_real_status(
     kind: fmi2StatusKind,
     value: *mut fmi2Real,
 ) -> fmi2Status {
+    if kind != ffi::fmi2StatusKind_fmi2LastSuccessfulTime {
+        return status_unavailable(
+            c,
+            "fmi2GetRealStatus",
+            value.is_null(),
+            "only fmi2LastSuccessfulTime is available",
+        );
+    }
     with(c, "fmi2GetRealStatus", |cc| {
         if value.is_null() {
             return null_arg(cc, "fmi2GetRealStatus");
@@ -857,13 +908,8 @@ pub unsafe fn get_real_status(
         if let Err(s) = cc.component.check_status_query("fmi2GetRealStatus") {
             return s;
         }
-        if kind == ffi::fmi2StatusKind_fmi2LastSuccessfulTime {
-            *value = cc.component.last_successful_time();
-            Status::Ok
-        } else {
-            cc.component
-                .error("fmi2GetRealStatus: only fmi2LastSuccessfulTime is available")
-        }
+        *value = cc.component.last_successful_time();
+        Status::Ok
     })
 }
 
@@ -872,6 +918,14 @@ pub unsafe fn get_boolean_status(
     kind: fmi2StatusKind,
     value: *mut fmi2Boolean,
 ) -> fmi2Status {
+    if kind != ffi::fmi2StatusKind_fmi2Terminated {
+        return status_unavailable(
+            c,
+            "fmi2GetBooleanStatus",
+            value.is_null(),
+            "only fmi2Terminated is available",
+        );
+    }
     with(c, "fmi2GetBooleanStatus", |cc| {
         if value.is_null() {
             return null_arg(cc, "fmi2GetBooleanStatus");
@@ -879,14 +933,9 @@ pub unsafe fn get_boolean_status(
         if let Err(s) = cc.component.check_status_query("fmi2GetBooleanStatus") {
             return s;
         }
-        if kind == ffi::fmi2StatusKind_fmi2Terminated {
-            // The models never ask to end the simulation early.
-            *value = 0;
-            Status::Ok
-        } else {
-            cc.component
-                .error("fmi2GetBooleanStatus: only fmi2Terminated is available")
-        }
+        // The models never ask to end the simulation early.
+        *value = 0;
+        Status::Ok
     })
 }
 
@@ -995,11 +1044,11 @@ macro_rules! export_fmus {
             #[no_mangle]
             pub unsafe extern "C" fn fmi2GetRealStatus(c_: fmi2Component, k: fmi2StatusKind, v: *mut fmi2Real) -> fmi2Status { c::get_real_status(c_, k, v) }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetIntegerStatus(c_: fmi2Component, _k: fmi2StatusKind, _v: *mut fmi2Integer) -> fmi2Status { c::unsupported(c_, "fmi2GetIntegerStatus", "no integer status is defined for co-simulation") }
+            pub unsafe extern "C" fn fmi2GetIntegerStatus(c_: fmi2Component, k: fmi2StatusKind, v: *mut fmi2Integer) -> fmi2Status { c::get_integer_status(c_, k, v) }
             #[no_mangle]
             pub unsafe extern "C" fn fmi2GetBooleanStatus(c_: fmi2Component, k: fmi2StatusKind, v: *mut fmi2Boolean) -> fmi2Status { c::get_boolean_status(c_, k, v) }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetStringStatus(c_: fmi2Component, _k: fmi2StatusKind, _v: *mut fmi2String) -> fmi2Status { c::unsupported(c_, "fmi2GetStringStatus", "no pending status (canRunAsynchronuously = false)") }
+            pub unsafe extern "C" fn fmi2GetStringStatus(c_: fmi2Component, k: fmi2StatusKind, v: *mut fmi2String) -> fmi2Status { c::get_string_status(c_, k, v) }
         }
     };
 }

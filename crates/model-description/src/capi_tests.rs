@@ -386,3 +386,115 @@ fn an_instance_freed_twice_or_a_pointer_not_ours_is_not_freed_again() {
         assert!(!live_instances().contains(&(other as usize)));
     }
 }
+
+#[test]
+fn a_communication_point_off_by_more_than_rounding_is_refused_at_any_time_and_time_never_goes_back()
+{
+    let (c, log) = fragile();
+    let u = [value_reference::<Fragile>("u").unwrap()];
+    let last = |c| unsafe {
+        let mut t = f64::NAN;
+        assert_eq!(
+            get_real_status(c, ffi::fmi2StatusKind_fmi2LastSuccessfulTime, &mut t),
+            FMI2_OK
+        );
+        t
+    };
+    unsafe {
+        // an epoch start time: a point 1 ms or 0.5 s off is refused, not stepped over
+        let t0 = 1.7e9;
+        start_at(c, t0);
+        assert_eq!(set_real(c, u.as_ptr(), 1, [1.0].as_ptr()), FMI2_OK);
+        assert_eq!(do_step(c, t0, 1e-3), FMI2_OK);
+        let t1 = t0 + 1e-3;
+        for off in [-0.5, -1e-3, 1e-3, 0.5] {
+            assert_eq!(do_step(c, t1 + off, 1e-3), FMI2_ERROR, "{off}");
+        }
+        assert!(log
+            .take()
+            .iter()
+            .any(|(_, _, m)| m.contains("does not match the instance time")));
+        assert_eq!(last(c), t1);
+        // the host's t0 + 2 h against our (t0 + h) + h: a few ulps apart, accepted
+        assert_eq!(do_step(c, t1, 1e-3), FMI2_OK);
+        let host = t0 + 2.0 * 1e-3;
+        assert_eq!(do_step(c, host, 1e-3), FMI2_OK);
+        free_instance(c);
+    }
+    let (c, _log) = fragile();
+    unsafe {
+        start_at(c, 1.0);
+        assert_eq!(do_step(c, 1.0, 0.25), FMI2_OK);
+        // points within the tolerance before our time with zero or shorter steps: time stays
+        for _ in 0..1000 {
+            assert_eq!(do_step(c, 1.25 - 1e-10, 0.0), FMI2_OK);
+            assert_eq!(do_step(c, 1.25 - 1e-10, 5e-11), FMI2_OK);
+        }
+        assert_eq!(last(c), 1.25);
+        free_instance(c);
+    }
+}
+
+#[test]
+fn status_kinds_the_fmu_does_not_provide_are_discarded_not_errors() {
+    let (c, log) = fragile();
+    unsafe {
+        start_at(c, 0.0);
+        assert_eq!(do_step(c, 0.0, 0.1), FMI2_OK);
+        let mut status = FMI2_OK;
+        let mut real = f64::NAN;
+        let mut integer = 0;
+        let mut boolean: fmi2Boolean = 0;
+        let mut text: fmi2String = std::ptr::null();
+        let pending = ffi::fmi2StatusKind_fmi2PendingStatus;
+        let answers = [
+            get_status(c, ffi::fmi2StatusKind_fmi2DoStepStatus, &mut status),
+            get_real_status(c, pending, &mut real),
+            get_integer_status(c, pending, &mut integer),
+            get_boolean_status(c, pending, &mut boolean),
+            get_string_status(c, pending, &mut text),
+        ];
+        assert_eq!(answers, [FMI2_DISCARD; 5]);
+        let messages = log.take();
+        assert_eq!(messages.len(), 5, "{messages:?}");
+        assert!(
+            messages
+                .iter()
+                .all(|(s, cat, _)| *s == Status::Discard && cat == "logStatusDiscard"),
+            "{messages:?}"
+        );
+        // the instance goes on; a NULL value pointer is still an error
+        assert_eq!(do_step(c, 0.1, 0.1), FMI2_OK);
+        assert_eq!(
+            get_status(
+                c,
+                ffi::fmi2StatusKind_fmi2DoStepStatus,
+                std::ptr::null_mut()
+            ),
+            FMI2_ERROR
+        );
+        free_instance(c);
+    }
+}
+
+#[test]
+fn an_fmu_state_can_be_taken_in_the_error_state_and_restores_it() {
+    let (c, _log) = fragile();
+    let u = [value_reference::<Fragile>("u").unwrap()];
+    unsafe {
+        start_at(c, 0.0);
+        assert_eq!(set_real(c, u.as_ptr(), 1, [-1.0].as_ptr()), FMI2_OK);
+        // the panic puts the instance in the Error state
+        assert_eq!(do_step(c, 0.0, 0.1), FMI2_ERROR);
+        let mut state: fmi2FMUstate = std::ptr::null_mut();
+        assert_eq!(get_fmu_state(c, &mut state), FMI2_OK);
+        assert!(!state.is_null());
+        assert_eq!(reset(c), FMI2_OK);
+        start_at(c, 0.0);
+        assert_eq!(set_fmu_state(c, state), FMI2_OK);
+        // restored to the Error state: the model does not step
+        assert_eq!(do_step(c, 0.0, 0.1), FMI2_ERROR);
+        assert_eq!(free_fmu_state(c, &mut state), FMI2_OK);
+        free_instance(c);
+    }
+}

@@ -251,6 +251,14 @@ impl Component {
         Status::Error
     }
 
+    /// A status query the instance cannot answer: fmi2Discard (FMI 2.0, 4.2.3: "If a status
+    /// is required which cannot be retrieved by the slave it returns fmi2Discard"); the
+    /// instance stays as it was.
+    pub fn status_unavailable(&mut self, message: &str) -> Status {
+        self.sink.log(Status::Discard, "logStatusDiscard", message);
+        Status::Discard
+    }
+
     /// The instance can no longer be trusted (a call panicked part-way through): the calls the
     /// Error state refuses (steps, sets, initialisation, termination) are refused from now on
     /// until fmi2Reset, or until fmi2SetFMUstate restores a state saved before.
@@ -888,11 +896,13 @@ impl Component {
         Status::Ok
     }
 
-    /// Tolerance for comparing a host's communication point with our time: hosts accumulate
-    /// t += h or compute n h, and drift by a few ulps of t (or of h) per step; a billionth of
-    /// either leaves room for that and for a step of 1000 s refuses a point 1 µs off.
+    /// Tolerance for comparing a host's communication point with our time. Our time is the
+    /// host's previous point plus its step, so the two differ only by how the host forms its
+    /// next point (t += h, t0 + n h, integer nanoseconds converted): a few ulps of t. 16 ulps
+    /// of t, plus a nanosecond and a billionth of the step, so that a point 1 ms off is
+    /// refused at t = 1.7e9 s (an epoch start time) as at t = 0.
     fn time_tolerance(&self, step: f64) -> f64 {
-        1.0e-9 * (self.time.abs().max(1.0) + step.abs())
+        1.0e-9 * (1.0 + step.abs()) + 16.0 * f64::EPSILON * self.time.abs()
     }
 
     #[inline]
@@ -923,8 +933,10 @@ impl Component {
                 return self.step_failed(e, effective);
             }
         }
-        self.time = target;
-        self.last_successful_time = target;
+        // a point within the tolerance before our time with a shorter step: time stays, it
+        // never goes back without a restored state
+        self.time = target.max(self.time);
+        self.last_successful_time = self.time;
         // a model whose step computed its outputs needs no second computation before a read
         self.outputs_dirty = !(effective > 0.0 && self.model.step_computes_outputs());
         self.flush_diagnostics()
@@ -1022,14 +1034,9 @@ impl Component {
         self.state == FmiState::Terminated
     }
 
-    fn can_handle_state(&self) -> bool {
-        !matches!(self.state, FmiState::Error)
-    }
-
+    /// Allowed in every state but Fatal, the Error state included (FMI 2.0, 4.2.4): a state
+    /// taken there restores to the Error state, whose refusals keep the model from stepping.
     pub fn get_fmu_state(&mut self) -> Result<Box<Snapshot>, Status> {
-        if !self.can_handle_state() {
-            return Err(self.wrong_state("fmi2GetFMUstate"));
-        }
         Ok(Box::new(Snapshot {
             id: next_snapshot_id(),
             model: self.model.snapshot(),
@@ -1042,9 +1049,6 @@ impl Component {
 
     /// fmi2GetFMUstate with an existing state: overwrite it without a new allocation.
     pub fn update_fmu_state(&mut self, snapshot: &mut Snapshot) -> Status {
-        if !self.can_handle_state() {
-            return self.wrong_state("fmi2GetFMUstate");
-        }
         if !self.model.update_snapshot(snapshot.model.as_mut()) {
             return self.error("fmi2GetFMUstate: the given FMU state belongs to another model");
         }
