@@ -4,6 +4,7 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use crate::coupling::{ColumnInfo, SimOutput};
 use crate::slave::ScalarType;
@@ -29,6 +30,8 @@ pub enum OutputError {
          folder), which writing results would replace; choose another output path"
     )]
     NotAFile { path: PathBuf },
+    #[error("cannot write '{path}': the folder '{folder}' does not exist")]
+    NoFolder { path: PathBuf, folder: PathBuf },
     #[error("cannot write '{output}': it is the same file as {what} '{other}'")]
     SameFile {
         output: PathBuf,
@@ -64,12 +67,73 @@ pub fn remove_stale_file(path: &Path) -> std::io::Result<()> {
     }
 }
 
-/// Writes `path` atomically: `fill` writes the content into a buffered temporary file in the
-/// same folder, which is flushed, fsync'ed and renamed onto `path` only if `fill` succeeded.
-/// On any error the temporary file is removed and `path` is left untouched. A `path` that
-/// exists and is not a regular file (or a symbolic link, which the rename replaces) is
-/// refused: renaming onto it would replace a device such as /dev/null, or a FIFO.
-pub fn write_atomic<F>(path: &Path, fill: F) -> Result<(), OutputError>
+/// Temporary files being written, not yet renamed onto their destination: a second Ctrl-C,
+/// which ends the process at once, removes them ([`remove_unfinished`]), so that an aborted
+/// write leaves no partial file behind.
+static UNFINISHED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn unfinished_files() -> MutexGuard<'static, Vec<PathBuf>> {
+    UNFINISHED.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Removes every temporary file still being written ([`write_unfinished`]); for a process
+/// about to exit without unwinding.
+pub fn remove_unfinished() {
+    for path in unfinished_files().drain(..) {
+        let _ = std::fs::remove_file(path);
+    }
+}
+
+/// A file written in full to a temporary file in its destination's folder, flushed and
+/// fsync'ed, waiting for [`Unfinished::commit`] to rename it onto the destination; dropped
+/// uncommitted, the temporary file is removed and the destination left as it was. Several
+/// files written this way and committed together replace the earlier ones only once all of
+/// them are written.
+pub struct Unfinished {
+    path: PathBuf,
+    tmp: tempfile::NamedTempFile,
+    _listed: Listed,
+}
+
+/// A temporary file's entry in [`UNFINISHED`], removed when dropped.
+struct Listed(PathBuf);
+
+impl Listed {
+    fn new(tmp: &Path) -> Self {
+        unfinished_files().push(tmp.to_path_buf());
+        Listed(tmp.to_path_buf())
+    }
+}
+
+impl Drop for Listed {
+    fn drop(&mut self) {
+        unfinished_files().retain(|p| p != &self.0);
+    }
+}
+
+impl Unfinished {
+    /// Where the file goes.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Renames the temporary file onto the destination.
+    pub fn commit(self) -> Result<(), OutputError> {
+        let Unfinished { path, tmp, _listed } = self;
+        tmp.persist(&path).map(drop).map_err(|e| OutputError::Io {
+            path,
+            source: e.error,
+        })
+    }
+}
+
+/// Writes `path`'s content into a temporary file beside it: `fill` writes into a buffered
+/// temporary file in the same folder, which is flushed and fsync'ed; [`Unfinished::commit`]
+/// renames it onto `path`. On any error the temporary file is removed and `path` is left
+/// untouched. A `path` that exists and is not a regular file (or a symbolic link, which the
+/// rename replaces) is refused: renaming onto it would replace a device such as /dev/null, or
+/// a FIFO.
+pub fn write_unfinished<F>(path: &Path, fill: F) -> Result<Unfinished, OutputError>
 where
     F: FnOnce(&mut dyn Write) -> Result<(), OutputError>,
 {
@@ -82,6 +146,8 @@ where
         .prefix(".tmp-")
         .tempfile_in(&dir)
         .map_err(io_err(path))?;
+    // listed before it is filled, dropped (so removed) after it on an error
+    let listed = Listed::new(tmp.path());
     {
         let mut w = std::io::BufWriter::new(tmp.as_file());
         fill(&mut w)?;
@@ -96,10 +162,36 @@ where
             .map_err(io_err(path))?;
     }
     tmp.as_file().sync_all().map_err(io_err(path))?;
-    tmp.persist(path).map_err(|e| OutputError::Io {
+    Ok(Unfinished {
         path: path.to_path_buf(),
-        source: e.error,
-    })?;
+        tmp,
+        _listed: listed,
+    })
+}
+
+/// Writes `path` atomically ([`write_unfinished`], then committed at once).
+pub fn write_atomic<F>(path: &Path, fill: F) -> Result<(), OutputError>
+where
+    F: FnOnce(&mut dyn Write) -> Result<(), OutputError>,
+{
+    write_unfinished(path, fill)?.commit()
+}
+
+/// The folders the outputs go into exist: checked before a command computes anything, so
+/// that a mistyped folder is named at once, not after a long run.
+pub fn check_folders_exist(outputs: &[PathBuf]) -> Result<(), OutputError> {
+    for out in outputs {
+        let folder = match out.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        if !folder.is_dir() {
+            return Err(OutputError::NoFolder {
+                path: out.clone(),
+                folder: folder.to_path_buf(),
+            });
+        }
+    }
     Ok(())
 }
 
@@ -181,16 +273,29 @@ pub fn check_outputs_apart(inputs: &[PathBuf], outputs: &[PathBuf]) -> Result<()
 
 /// Writes a whole byte string atomically.
 pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
-    write_atomic(path, |w| w.write_all(bytes).map_err(io_err(path)))
+    bytes_unfinished(path, bytes)?.commit()
+}
+
+/// A whole byte string written beside `path`, not yet committed ([`write_unfinished`]).
+pub fn bytes_unfinished(path: &Path, bytes: &[u8]) -> Result<Unfinished, OutputError> {
+    write_unfinished(path, |w| w.write_all(bytes).map_err(io_err(path)))
 }
 
 /// Writes a value as pretty JSON atomically.
 pub fn write_json_atomic<T: serde::Serialize>(path: &Path, value: &T) -> Result<(), OutputError> {
+    json_unfinished(path, value)?.commit()
+}
+
+/// A value as pretty JSON written beside `path`, not yet committed ([`write_unfinished`]).
+pub fn json_unfinished<T: serde::Serialize>(
+    path: &Path,
+    value: &T,
+) -> Result<Unfinished, OutputError> {
     let text = serde_json::to_string_pretty(value).map_err(|source| OutputError::Json {
         path: path.to_path_buf(),
         source,
     })?;
-    write_bytes_atomic(path, text.as_bytes())
+    bytes_unfinished(path, text.as_bytes())
 }
 
 /// Quotes a CSV field if it contains a separator, quote or newline (RFC 4180).
@@ -253,8 +358,13 @@ pub fn results_header(out: &SimOutput) -> Vec<String> {
 /// round-trip form, Integers and Enumerations as integers (an Enumeration followed by its item
 /// name), Booleans as 0/1, Strings quoted (RFC 4180).
 pub fn write_results_csv(path: &Path, out: &SimOutput) -> Result<(), OutputError> {
+    results_csv_unfinished(path, out)?.commit()
+}
+
+/// [`write_results_csv`], not yet committed ([`write_unfinished`]).
+pub fn results_csv_unfinished(path: &Path, out: &SimOutput) -> Result<Unfinished, OutputError> {
     let types: Vec<ColumnInfo> = (0..out.header.len()).map(|c| out.column_info(c)).collect();
-    write_atomic(path, |w| {
+    write_unfinished(path, |w| {
         let head: Vec<String> = results_header(out).iter().map(|h| csv_field(h)).collect();
         writeln!(w, "{}", head.join(",")).map_err(io_err(path))?;
         let mut line = String::new();

@@ -10,7 +10,7 @@
 //! ([`ResultsMetadata`]) is JSON under the file's key [`PARQUET_METADATA_KEY`]
 //! (`pyarrow.parquet.read_schema(path).metadata`).
 //!
-//! The file is built in memory and written atomically ([`write_bytes_atomic`]).
+//! The file is built in memory and written atomically ([`crate::output::write_unfinished`]).
 
 use std::io::Read;
 use std::path::Path;
@@ -27,7 +27,7 @@ use parquet::schema::types::{ColumnPath, Type};
 use serde_json::Value;
 
 use crate::coupling::SimOutput;
-use crate::output::{write_bytes_atomic, OutputError};
+use crate::output::{bytes_unfinished, OutputError, Unfinished};
 use crate::results::{ReadError, ResultsMetadata, PARQUET_METADATA_KEY};
 use crate::slave::ScalarType;
 
@@ -114,6 +114,16 @@ pub fn write_results_parquet(
     meta: &ResultsMetadata,
     constants: &[Constant],
 ) -> Result<(), OutputError> {
+    results_parquet_unfinished(path, out, meta, constants)?.commit()
+}
+
+/// [`write_results_parquet`], not yet committed.
+pub fn results_parquet_unfinished(
+    path: &Path,
+    out: &SimOutput,
+    meta: &ResultsMetadata,
+    constants: &[Constant],
+) -> Result<Unfinished, OutputError> {
     let perr = parquet_err(path);
     let w = out.header.len().max(1);
     let n = out.data.len() / w;
@@ -268,7 +278,7 @@ pub fn write_results_parquet(
     }
     group.close().map_err(&perr)?;
     writer.close().map_err(&perr)?;
-    write_bytes_atomic(path, &buf)
+    bytes_unfinished(path, &buf)
 }
 
 /// A column read back: numbers (Integers, Booleans as 0/1) or texts; `None` is a null.

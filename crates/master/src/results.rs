@@ -15,7 +15,7 @@ use serde_json::Value;
 
 use crate::coupling::{ColumnInfo, SimOutput, Summary};
 use crate::decimation::Sampling;
-use crate::output::{write_json_atomic, write_results_csv, OutputError};
+use crate::output::{json_unfinished, results_csv_unfinished, OutputError, Unfinished};
 pub use crate::parquet_file::{Constant, ConstantKind};
 
 /// Version of the metadata layout, written into every file.
@@ -230,6 +230,51 @@ pub fn write_results(
     format: ResultsFormat,
     ctx: &RunContext,
 ) -> Result<(), OutputError> {
+    prepare_results(path, out, format, ctx)?.commit()
+}
+
+/// Results written in full beside their destination, not yet in place: [`Self::commit`]
+/// puts them there, so a command that writes several files can write all of them before it
+/// replaces any earlier one.
+pub struct PreparedResults {
+    files: Vec<Unfinished>,
+    /// A CSV's metadata file: removed before the CSV is renamed into place, so that a CSV
+    /// never sits beside the metadata of another run.
+    metadata: Option<PathBuf>,
+}
+
+impl PreparedResults {
+    pub fn commit(self) -> Result<(), OutputError> {
+        if let Some(meta_path) = &self.metadata {
+            crate::output::remove_stale_file(meta_path).map_err(|source| OutputError::Io {
+                path: meta_path.clone(),
+                source,
+            })?;
+        }
+        let mut files = self.files.into_iter();
+        let Some(results) = files.next() else {
+            return Ok(());
+        };
+        let path = results.path().to_path_buf();
+        results.commit()?;
+        for f in files {
+            if let Err(e) = f.commit() {
+                // a CSV whose metadata cannot be put beside it is removed again
+                let _ = crate::output::remove_stale_file(&path);
+                return Err(e);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// [`write_results`] up to the files' renaming ([`PreparedResults::commit`]).
+pub fn prepare_results(
+    path: &Path,
+    out: &SimOutput,
+    format: ResultsFormat,
+    ctx: &RunContext,
+) -> Result<PreparedResults, OutputError> {
     let meta = ResultsMetadata::of(out, ctx);
     match format {
         ResultsFormat::Csv => {
@@ -247,22 +292,22 @@ pub fn write_results(
                     ),
                 });
             }
-            // the earlier metadata goes first, so that a CSV never sits beside the metadata
-            // of another run; a CSV whose metadata cannot be written is removed again
-            crate::output::remove_stale_file(&meta_path).map_err(|source| OutputError::Io {
-                path: meta_path.clone(),
-                source,
-            })?;
-            write_results_csv(path, out)?;
-            if let Err(e) = write_json_atomic(&meta_path, &meta) {
-                let _ = crate::output::remove_stale_file(path);
-                return Err(e);
-            }
-            Ok(())
+            let csv = results_csv_unfinished(path, out)?;
+            let meta = json_unfinished(&meta_path, &meta)?;
+            Ok(PreparedResults {
+                files: vec![csv, meta],
+                metadata: Some(meta_path),
+            })
         }
-        ResultsFormat::Parquet => {
-            crate::parquet_file::write_results_parquet(path, out, &meta, &ctx.constants())
-        }
+        ResultsFormat::Parquet => Ok(PreparedResults {
+            files: vec![crate::parquet_file::results_parquet_unfinished(
+                path,
+                out,
+                &meta,
+                &ctx.constants(),
+            )?],
+            metadata: None,
+        }),
     }
 }
 

@@ -589,3 +589,76 @@ fn the_description_in_the_metadata_runs_again_from_another_folder() {
     .unwrap();
     assert_eq!(run(elsewhere.path(), "again.json"), first);
 }
+
+/// SIGTERM (a job scheduler's stop) ends a run as Ctrl-C does: at the next communication
+/// point, without a results file.
+#[test]
+fn sigterm_stops_cleanly_without_result_file() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("system.json"), system_json(2000.0)).unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_master"))
+        .args(["--quiet", "run"])
+        .arg(dir.path().join("system.json"))
+        .arg("-o")
+        .arg(dir.path().join("r.csv"))
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(800));
+    let st = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("cancelled at t ="), "{stderr}");
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left, ["system.json"], "{left:?}");
+}
+
+/// Every output's folder is checked before the run, and the results and the summary are
+/// both written before either replaces an earlier file: a --summary that cannot be written
+/// leaves the earlier results as they were.
+#[test]
+fn a_run_whose_outputs_cannot_all_be_written_changes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("system.json"), system_json(0.1)).unwrap();
+    run_ok_in(d, &["system.json", "-o", "r.csv"]);
+    let before = |name: &str| std::fs::read(d.join(name)).unwrap();
+    let (csv, meta) = (before("r.csv"), before("r.meta.json"));
+    let refused = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_master"))
+            .args(["--quiet", "run", "system.json", "--set", "ms.mass=2"])
+            .args(args)
+            .current_dir(d)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1));
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    for args in [
+        &["-o", "r.csv", "--summary", "nodir/s.json"][..],
+        &["-o", "nodir/r.csv"][..],
+    ] {
+        let e = refused(args);
+        assert!(e.contains("the folder 'nodir' does not exist"), "{e}");
+    }
+    // a summary path that exists as a folder: refused before the run too
+    std::fs::create_dir(d.join("s.json")).unwrap();
+    let e = refused(&["-o", "r.csv", "--summary", "s.json"]);
+    assert!(e.contains("s.json"), "{e}");
+    assert_eq!(before("r.csv"), csv);
+    assert_eq!(before("r.meta.json"), meta);
+    let mut names: Vec<_> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["r.csv", "r.meta.json", "s.json", "system.json"]);
+}

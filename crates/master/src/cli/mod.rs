@@ -101,7 +101,8 @@ where
     crate::fmu::install_logger(global.log_level);
     if let Err(e) = ctrlc::set_handler(|| {
         if CANCEL.swap(true, Ordering::SeqCst) {
-            // second Ctrl-C: give up immediately
+            // second Ctrl-C: give up immediately, without the files half written
+            crate::output::remove_unfinished();
             std::process::exit(130);
         }
         eprintln!("interrupt: stopping at the next communication point (Ctrl-C again to abort)");

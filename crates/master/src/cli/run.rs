@@ -6,8 +6,10 @@ use std::path::PathBuf;
 
 use super::{CommandError, Context};
 use crate::coupling::{Algorithm, RunOptions};
-use crate::output::{check_outputs_apart, write_json_atomic};
-use crate::results::{csv_metadata_path, remove_results, write_results, ResultsFormat, RunContext};
+use crate::output::{check_outputs_apart, json_unfinished};
+use crate::results::{
+    csv_metadata_path, prepare_results, remove_results, ResultsFormat, RunContext,
+};
 use crate::ssp::{self, ImportOptions};
 use crate::system::{LoadedSystem, OverridesFrom, SingleFmuOptions, SystemOverrides};
 
@@ -166,13 +168,12 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     let chosen = args
         .format
         .or_else(|| args.output.as_deref().and_then(ResultsFormat::of_path));
-    match &args.output {
-        Some(output) => check_outputs_apart(
-            &inputs,
-            &written(output, chosen.unwrap_or(ResultsFormat::Parquet)),
-        )?,
-        None => check_outputs_apart(&inputs, &args.summary.iter().cloned().collect::<Vec<_>>())?,
-    }
+    let known = match &args.output {
+        Some(output) => written(output, chosen.unwrap_or(ResultsFormat::Parquet)),
+        None => args.summary.iter().cloned().collect::<Vec<_>>(),
+    };
+    check_outputs_apart(&inputs, &known)?;
+    crate::output::check_folders_exist(&known)?;
     // a file named for one format does not take the other's content
     if let (Some(format), Some(output)) = (args.format, &args.output) {
         if let Some(named) = ResultsFormat::of_path(output).filter(|&n| n != format) {
@@ -229,7 +230,16 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         system: serde_json::to_value(&described).ok(),
         ..RunContext::default()
     };
-    write_results(&output, &out, format, &ctx)?;
+    // every file written before any earlier one is replaced
+    let results = prepare_results(&output, &out, format, &ctx)?;
+    let summary = match &args.summary {
+        Some(p) => Some(json_unfinished(p, &out.summary)?),
+        None => None,
+    };
+    results.commit()?;
+    if let Some(summary) = summary {
+        summary.commit()?;
+    }
     if args.output.is_none() {
         // the default file of the other format, from an earlier run, would read as a result
         // of this one (unless it is an input or the --summary file, which stay)
@@ -240,9 +250,6 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         if ours && check_outputs_apart(&inputs, &written(&other, format.other())).is_ok() {
             remove_results(&other, format.other())?;
         }
-    }
-    if let Some(p) = &args.summary {
-        write_json_atomic(p, &out.summary)?;
     }
     println!("{}: {}", output.display(), out.summary);
     if let Some(t) = &out.summary.terminated {
