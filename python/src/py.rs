@@ -32,38 +32,38 @@ use crate::assess::{self, AssessOptions};
 use crate::{error_message, f64_from_bytes, f64_pybytes, results, runs};
 
 pyo3::create_exception!(
-    _railfmu,
+    railfmu,
     Error,
     PyException,
     "Base class of every error of railfmu; the message is the master's."
 );
 pyo3::create_exception!(
-    _railfmu,
+    railfmu,
     SystemDescriptionError,
     Error,
     "A system or run-set description, a parameter name or a parameter value is invalid."
 );
 pyo3::create_exception!(
-    _railfmu,
+    railfmu,
     FmuError,
     Error,
     "An FMU cannot be opened, checked, loaded or instantiated."
 );
 pyo3::create_exception!(
-    _railfmu,
+    railfmu,
     SimulationError,
     Error,
     "A simulation stopped: an FMU failed or discarded a step, or a value is not finite."
 );
 pyo3::create_exception!(
-    _railfmu,
+    railfmu,
     OutputError,
     Error,
     "A result file or folder cannot be written or read."
 );
 
 pyo3::create_exception!(
-    _railfmu,
+    railfmu,
     AssessmentError,
     Error,
     "Signals cannot be assessed: an unknown column, too short a record, a recorded band narrower than the assessed one, a bad option."
@@ -107,6 +107,7 @@ fn sweep_err(e: &SweepError) -> PyErr {
         SweepError::Output(_)
         | SweepError::Dir { .. }
         | SweepError::NotARunFolder { .. }
+        | SweepError::NotARunTable { .. }
         | SweepError::NoOutputFolder
         | SweepError::NotATablesFolder { .. }
         | SweepError::FolderInUse { .. } => OutputError::new_err(error_message(e)),
@@ -740,14 +741,32 @@ struct PyRunWriter {
 
 #[pymethods]
 impl PyRunWriter {
+    /// `base_json` and `label`: the run set's base system (resolved JSON), whose FMUs' model
+    /// descriptions say which parameters are Integers or Enumerations.
     #[new]
-    fn new(outdir: PathBuf, jobs_json: Vec<String>, format: &str) -> PyResult<Self> {
+    fn new(
+        outdir: PathBuf,
+        jobs_json: Vec<String>,
+        format: &str,
+        base_json: &str,
+        label: &str,
+    ) -> PyResult<Self> {
         let jobs = parse_jobs(&jobs_json)?;
+        let format = parse_format(format)?;
+        // FMUs this process cannot read (workers reading their own paths; a broken FMU,
+        // which fails every run on the workers) say nothing here: the tables then type each
+        // parameter by its values alone
+        let integers = LoadedSystem::from_json_str(base_json, Path::new(""), label)
+            .ok()
+            .and_then(|base| {
+                runs::integer_parameters(&base, jobs.iter().flat_map(|j| j.parameters.keys())).ok()
+            })
+            .unwrap_or_default();
         std::fs::create_dir_all(&outdir).map_err(|e| {
             OutputError::new_err(format!("cannot create '{}': {e}", outdir.display()))
         })?;
         Ok(PyRunWriter {
-            writer: runs::RunSetWriter::new(&outdir, &jobs, parse_format(format)?),
+            writer: runs::RunSetWriter::new(&outdir, &jobs, format, integers),
         })
     }
 

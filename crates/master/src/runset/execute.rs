@@ -353,6 +353,15 @@ pub fn check_run_folders(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> 
                 run: job.name.clone(),
             });
         }
+        // a run removes its earlier table whatever the format: a user's file of that name
+        // (or a file the master cannot read as a run's table) is not one
+        let table = results_path(outdir, &job.name, ResultsFormat::Parquet);
+        if table.symlink_metadata().is_ok() && !crate::parquet_file::is_run_table(&table) {
+            return Err(SweepError::NotARunTable {
+                path: table,
+                run: job.name.clone(),
+            });
+        }
     }
     Ok(())
 }
@@ -626,7 +635,11 @@ pub fn completed(outdir: &Path, job: &Job, format: ResultsFormat) -> Option<RunR
         && system == job.system
         && report.results.as_deref().and_then(Path::file_name) == results.file_name()
         && results.is_file()
-        && other.symlink_metadata().is_err();
+        && other.symlink_metadata().is_err()
+        // a table cut short or replaced since is no result: its footer names this run
+        && (format != ResultsFormat::Parquet
+            || crate::parquet_file::footer_metadata(&results)
+                .is_some_and(|m| m.run.as_deref() == Some(job.name.as_str())));
     report.results = Some(results);
     complete.then_some(report)
 }

@@ -92,6 +92,12 @@ pub enum SweepError {
          replace; choose another output folder or rename the run"
     )]
     NotARunFolder { path: PathBuf, run: String },
+    #[error(
+        "'{path}' exists and is not the table of a run of an earlier sweep (no run set's \
+         metadata in its footer), which run '{run}' would replace; choose another output folder \
+         or move it"
+    )]
+    NotARunTable { path: PathBuf, run: String },
     #[error("the output folder is an empty path; name a folder (\".\" for the working folder)")]
     NoOutputFolder,
     #[error(

@@ -246,6 +246,44 @@ fn parquet_results_of_a_set_share_one_folder_and_a_failed_rerun_leaves_none() {
 }
 
 #[test]
+fn a_users_file_where_a_runs_table_goes_is_refused_and_a_table_of_another_run_is_run_again() {
+    let j = jobs(r#"{"product": {"ms.k": [50, 100]}}"#).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path();
+    let table = out.join(PARQUET_FOLDER);
+    std::fs::create_dir(&table).unwrap();
+    // a fresh set, in either format: the user's file is refused before any run, and stays
+    std::fs::write(table.join("run-000.parquet"), b"my own table").unwrap();
+    for format in [ResultsFormat::Parquet, ResultsFormat::Csv] {
+        let e = check_run_folders(&j, out).unwrap_err().to_string();
+        assert!(
+            e.contains("run-000.parquet") && e.contains("not the table of a run"),
+            "{e}"
+        );
+        let opts = ResultsOptions {
+            format,
+            ..ResultsOptions::default()
+        };
+        let ran = execute_with(&j, out, 1, false, &opts, None, |_: &Job| {
+            Err::<SimOutput, String>("must not run".into())
+        });
+        assert!(ran.is_err(), "{format:?}");
+        assert_eq!(
+            std::fs::read(table.join("run-000.parquet")).unwrap(),
+            b"my own table"
+        );
+    }
+    std::fs::remove_file(table.join("run-000.parquet")).unwrap();
+    assert_eq!(resume(&j, out, ResultsFormat::Parquet).len(), 2);
+    // run-001's table replaced by run-000's: not run-001's result, so run again on resume
+    std::fs::copy(table.join("run-000.parquet"), table.join("run-001.parquet")).unwrap();
+    assert!(completed(out, &j[0], ResultsFormat::Parquet).is_some());
+    assert!(completed(out, &j[1], ResultsFormat::Parquet).is_none());
+    assert_eq!(resume(&j, out, ResultsFormat::Parquet), ["run-001"]);
+    assert!(completed(out, &j[1], ResultsFormat::Parquet).is_some());
+}
+
+#[test]
 fn a_new_set_removes_an_earlier_sets_tables_only_not_a_users_parquet_files() {
     let three = jobs(r#"{"product": {"ms.k": [50, 100, 200]}}"#).unwrap();
     let dir = tempfile::tempdir().unwrap();
@@ -396,6 +434,9 @@ fn a_run_set_resumed_in_the_other_format_reruns_every_run_into_one_format() {
         );
     }
     assert!(resume(&j, out, ResultsFormat::Parquet).is_empty());
+    let kept = tempfile::tempdir().unwrap();
+    let table = kept.path().join("run-000.parquet");
+    std::fs::copy(results_path(out, "run-000", ResultsFormat::Parquet), &table).unwrap();
     // and back to CSV: every run again, no Parquet file (nor an empty results/) left
     assert_eq!(resume(&j, out, ResultsFormat::Csv), names);
     let files = files_under(out);
@@ -409,7 +450,7 @@ fn a_run_set_resumed_in_the_other_format_reruns_every_run_into_one_format() {
     );
     // a run with results in both formats (e.g. an interrupted rerun) is complete in neither
     std::fs::create_dir_all(out.join("results")).unwrap();
-    std::fs::write(results_path(out, "run-000", ResultsFormat::Parquet), b"x").unwrap();
+    std::fs::copy(&table, results_path(out, "run-000", ResultsFormat::Parquet)).unwrap();
     assert!(completed(out, &j[0], ResultsFormat::Csv).is_none());
     assert!(completed(out, &j[0], ResultsFormat::Parquet).is_none());
     assert_eq!(resume(&j, out, ResultsFormat::Csv), ["run-000"]);
