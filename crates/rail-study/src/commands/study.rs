@@ -354,10 +354,27 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     Ok(())
 }
 
+/// Whether `out` holds an earlier study: its `study.json` is a regular file that reads as a
+/// study's numbers (settings and configurations).
+fn holds_earlier_study(out: &std::path::Path) -> bool {
+    let path = out.join("study.json");
+    if !std::fs::symlink_metadata(&path).is_ok_and(|m| m.file_type().is_file()) {
+        return false;
+    }
+    master::input::read_text_file(&path, master::input::MAX_TEXT_FILE_BYTES)
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+        .is_some_and(|v| v.get("settings").is_some() && v["configs"].is_array())
+}
+
 /// Removes the files an earlier study wrote into `out` ([`output_files`]: report, figures,
-/// tables): regular files (and symbolic links) of these names only; a user's other files, and
-/// a folder or FIFO of such a name, stay.
+/// tables), if `out` holds one ([`holds_earlier_study`]): regular files (and symbolic links)
+/// of these names only; a user's other files, and a folder or FIFO of such a name, stay, and
+/// in a folder without an earlier study nothing is removed.
 fn remove_earlier_outputs(out: &std::path::Path) -> Result<(), StudyError> {
+    if !holds_earlier_study(out) {
+        return Ok(());
+    }
     for name in output_files() {
         let path = out.join(name);
         master::output::remove_stale_file(&path).map_err(|e| {
@@ -489,6 +506,12 @@ mod tests {
         for f in earlier {
             std::fs::write(out.join(f), "an earlier study's").unwrap();
         }
+        // without an earlier study's numbers, files of these names are the user's: kept
+        remove_earlier_outputs(out).unwrap();
+        for f in earlier {
+            assert!(out.join(f).is_file(), "{f} removed");
+        }
+        std::fs::write(out.join("study.json"), r#"{"settings": {}, "configs": []}"#).unwrap();
         let users = [
             "notes.svg",
             "my_table.csv",
