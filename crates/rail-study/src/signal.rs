@@ -175,6 +175,18 @@ pub fn dominant_frequency(x: &[f64], fs: f64, f_min: f64, f_max: f64) -> Result<
     check("fs", fs, fs > 0.0, "sampling rate must be > 0")?;
     check("f_min", f_min, f_min >= 0.0, "must be >= 0")?;
     check("f_max", f_max, f_max > f_min, "must be > f_min")?;
+    // the peak's frequency does not depend on the signal's scale, but the PSD squares the
+    // samples: beyond 1e100 (or below 1e-100) they would overflow (or underflow) on the way,
+    // so they are scaled first, by a power of two (exactly)
+    let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let scaled: Vec<f64>;
+    let x = if peak.is_finite() && peak > 0.0 && !(1e-100..=1e100).contains(&peak) {
+        let scale = (-peak.log2().round()).exp2();
+        scaled = x.iter().map(|v| v * scale).collect();
+        &scaled[..]
+    } else {
+        x
+    };
     let (f, p) = welch_padded(x, fs, dominant_segment_len(x.len(), fs))?;
     spectral_peak(&f, &p, f_min, f_max)
 }
@@ -335,6 +347,26 @@ mod tests {
             (samples - full).abs() > 0.04,
             "512 samples {samples} vs 1 kHz {full}"
         );
+    }
+
+    #[test]
+    fn the_dominant_frequency_does_not_depend_on_the_signals_scale() {
+        let fs = 1000.0;
+        let x: Vec<f64> = (0..20_000)
+            .map(|k| {
+                let t = k as f64 / fs;
+                (2.0 * PI * 6.0 * t).sin() + 0.3 * (2.0 * PI * 19.0 * t).sin()
+            })
+            .collect();
+        let at = |scale: f64| {
+            let y: Vec<f64> = x.iter().map(|v| v * scale).collect();
+            dominant_frequency(&y, fs, 1.0, 30.0).unwrap()
+        };
+        let f = at(1.0);
+        assert!((f - 6.0).abs() < 0.1, "{f}");
+        for scale in [1e153, 1e300, 1e-150, 1e-300] {
+            assert!((at(scale) - f).abs() < 1e-9, "{scale:e}: {} Hz", at(scale));
+        }
     }
 
     #[test]
