@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import numbers as numbers_abc
 import os
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple, Union
@@ -113,6 +114,9 @@ def assess_stability(
     if wheel_load_kn is not None:
         numbers["wheel_load_kn"] = wheel_load_kn
     for key, value in numbers.items():
+        # a number, not a text that reads as one (as System.run takes its times)
+        if isinstance(value, (str, bytes, bool, np.bool_)) or not isinstance(value, (numbers_abc.Real, np.number)):
+            raise TypeError(f"{key} must be a number, got {value!r}")
         if not np.isfinite(float(value)):
             raise _railfmu.AssessmentError(f"{key} = {value}: not a finite number")
     options = json.dumps(

@@ -5,10 +5,13 @@ from __future__ import annotations
 
 import contextlib
 import json
+import operator
 import os
 import warnings
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Mapping, Optional, Union
+
+import numpy as np
 
 from . import _railfmu
 from ._json import description_json
@@ -127,8 +130,17 @@ class RunSet:
         ``sweep.json`` lists every run with its outcome, so ``resume=True`` runs only what is
         missing. A set of 100 000 runs stops at once.
         """
-        if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1):
-            raise ValueError(f"threads must be a whole number >= 1 (or None: all cores), got {threads!r}")
+        if threads is not None:
+            # a whole number, NumPy's included (operator.index), not a bool or a float
+            try:
+                count = -1 if isinstance(threads, (bool, np.bool_)) else operator.index(threads)
+            except TypeError:
+                count = -1
+            if count < 1:
+                raise ValueError(f"threads must be a whole number >= 1 (or None: all cores), got {threads!r}")
+            threads = count
+        if not isinstance(resume, (bool, np.bool_)):
+            raise TypeError(f"resume must be True or False, got {resume!r}")
         if threads is not None and client is not None:
             # the workers of the Dask cluster take the runs as they come: no local threads
             raise ValueError("threads: the runs go to the Dask client's workers; give threads or client, not both")

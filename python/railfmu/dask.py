@@ -284,7 +284,7 @@ def run_jobs_on_cluster(
     if format is None:
         format = results_format(client, base_json, label, jobs_json, ship_fmus=ship_fmus, retries=retries)
     fmus_arg = _scatter_fmus(client, base_json) if ship_fmus else None
-    writer = _railfmu.RunWriter(os.fspath(outdir), jobs_json, format)
+    writer = _railfmu.RunWriter(os.fspath(outdir), jobs_json, format, base_json, label)
     if reports is None:
         reports = [None] * len(jobs_json)
     # keys unique per submission: a key resubmitted while the scheduler still releases it from

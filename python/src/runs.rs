@@ -3,12 +3,13 @@
 //! in a format, and which format a run set chooses by size, are the master's rules
 //! ([`completed`], [`format_by_description`], re-exported).
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use master::coupling::{ColumnInfo, SimOutput};
+use master::model_description::VarType;
 use master::output::{write_json_atomic, OutputError};
-use master::results::{constant_kinds, ConstantKind, ResultsFormat};
+use master::results::{constant_kinds, with_integer_kinds, ConstantKind, ResultsFormat};
 pub use master::runset::{completed, format_by_description};
 use master::runset::{run_one_with, Job, ResultsOptions, RunReport};
 use master::system::{split_ref, LoadedSystem, SystemError};
@@ -35,6 +36,30 @@ pub fn parameter_units(
             let v = archives[i].model.variables.iter().find(|v| v.name == var)?;
             v.unit.clone()
         })
+        .collect())
+}
+
+/// Of the `instance.variable` names `names` (a run set's parameters), those that are
+/// Integers or Enumerations in their FMUs' model descriptions (nothing loaded): the columns a
+/// run set's tables hold as integers, as a local run set's do.
+pub fn integer_parameters<'a>(
+    system: &LoadedSystem,
+    names: impl IntoIterator<Item = &'a String>,
+) -> Result<BTreeSet<String>, SystemError> {
+    let archives = system.open_fmus()?;
+    let instances = &system.desc.instances;
+    Ok(names
+        .into_iter()
+        .filter(|name| {
+            split_ref(name).is_some_and(|(inst, var)| {
+                instances
+                    .iter()
+                    .position(|s| s.name == inst)
+                    .and_then(|i| archives[i].model.variables.iter().find(|v| v.name == var))
+                    .is_some_and(|v| matches!(v.var_type, VarType::Integer | VarType::Enumeration))
+            })
+        })
+        .cloned()
         .collect())
 }
 
@@ -71,14 +96,23 @@ impl RunSetWriter {
         master::runset::not_finished(job, &self.outdir, error)
     }
 
-    pub fn new(outdir: &Path, jobs: &[Job], format: ResultsFormat) -> Self {
+    /// `integer_columns`: the parameters that are Integers or Enumerations in their FMUs
+    /// ([`integer_parameters`]), held as integers in the tables as a local run set holds them.
+    pub fn new(
+        outdir: &Path,
+        jobs: &[Job],
+        format: ResultsFormat,
+        integer_columns: BTreeSet<String>,
+    ) -> Self {
+        let parameters = || jobs.iter().flat_map(|j| &j.parameters);
         RunSetWriter {
             outdir: outdir.to_path_buf(),
+            kinds: with_integer_kinds(constant_kinds(parameters()), &integer_columns, parameters()),
             results: ResultsOptions {
                 format,
+                integer_columns,
                 ..ResultsOptions::default()
             },
-            kinds: constant_kinds(jobs.iter().flat_map(|j| &j.parameters)),
         }
     }
 
@@ -140,7 +174,12 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let j = job("run-000", 100.0);
         assert!(completed(dir.path(), &j, ResultsFormat::Csv).is_none());
-        let writer = RunSetWriter::new(dir.path(), std::slice::from_ref(&j), ResultsFormat::Csv);
+        let writer = RunSetWriter::new(
+            dir.path(),
+            std::slice::from_ref(&j),
+            ResultsFormat::Csv,
+            BTreeSet::new(),
+        );
         let report = writer.write(&j, Ok(output()));
         assert!(report.ok, "{report:?}");
         let csv = std::fs::read_to_string(dir.path().join("run-000/results.csv")).unwrap();
@@ -171,7 +210,12 @@ mod tests {
         let mut b = job("run-001", 200.0);
         b.parameters
             .insert("ms.label".to_string(), serde_json::json!("stiff"));
-        let writer = RunSetWriter::new(dir.path(), &[a.clone(), b], ResultsFormat::Parquet);
+        let writer = RunSetWriter::new(
+            dir.path(),
+            &[a.clone(), b],
+            ResultsFormat::Parquet,
+            BTreeSet::new(),
+        );
         let report = writer.write(&a, Ok(output()));
         assert!(report.ok, "{report:?}");
         let file = dir.path().join("results/run-000.parquet");
@@ -196,7 +240,12 @@ mod tests {
     fn a_failed_run_is_written_and_never_complete() {
         let dir = tempfile::tempdir().unwrap();
         let j = job("bad", -1.0);
-        let writer = RunSetWriter::new(dir.path(), std::slice::from_ref(&j), ResultsFormat::Csv);
+        let writer = RunSetWriter::new(
+            dir.path(),
+            std::slice::from_ref(&j),
+            ResultsFormat::Csv,
+            BTreeSet::new(),
+        );
         let report = writer.write(&j, Err("negative stiffness".into()));
         assert!(!report.ok);
         assert_eq!(report.error.as_deref(), Some("negative stiffness"));

@@ -84,6 +84,9 @@ def test_what_cannot_be_assessed_raises_with_the_reason(hunting, tmp_path):
         railfmu.assess_stability(hunting, SIGNALS, 320.0, quantity="jerk")
     with pytest.raises(railfmu.AssessmentError, match="speed_kmh = nan: not a finite number"):
         railfmu.assess_stability(hunting, SIGNALS, float("nan"))
+    # a text is no speed, even one that reads as a number
+    with pytest.raises(TypeError, match="speed_kmh must be a number, got '320'"):
+        railfmu.assess_stability(hunting, SIGNALS, "320")
     with pytest.raises(railfmu.OutputError, match="missing.csv"):
         railfmu.assess_stability(tmp_path / "missing.csv", SIGNALS, 320.0)
     assert issubclass(railfmu.AssessmentError, railfmu.Error)

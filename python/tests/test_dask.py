@@ -99,6 +99,12 @@ def test_a_cluster_run_set_writes_the_parquet_table_of_the_local_one(dist, clien
     mine = parquet_meta(tmp_path / "local" / "results" / "run-001.parquet")
     for key in ("columns", "sampling", "run", "parameters", "system"):
         assert meta[key] == mine[key], key
+    # each parameter column of the type the local table gives it: the seed (an Integer of the
+    # FMU) as int32, not as a float
+    theirs, ours = (pq.read_schema(t / "run-001.parquet") for t in (folder, tmp_path / "local" / "results"))
+    for name in ("bogie.vehicle.speed", "bogie.track.seed"):
+        assert theirs.field(name).type == ours.field(name).type, name
+    assert str(theirs.field("bogie.track.seed").type) == "int32"
     assert meta["summary"]["steps"] == mine["summary"]["steps"] == 500
     expected = pd.read_parquet(tmp_path / "local" / "results")
     assert list(table.columns) == list(expected.columns)

@@ -170,7 +170,12 @@ def test_bad_run_set_options_raise_python_errors(dist, tmp_path):
         railfmu.run_set(rs, tmp_path / "out", threads=2, client=object())
     with pytest.raises(TypeError, match="progress must be True, False, None or a callable"):
         railfmu.run_set(rs, tmp_path / "out", progress=5)
+    # "no" is no False (it was taken as True)
+    with pytest.raises(TypeError, match="resume must be True or False, got 'no'"):
+        railfmu.run_set(rs, tmp_path / "out", resume="no")
     assert not (tmp_path / "out").exists()
+    # a NumPy whole number is a whole number
+    assert railfmu.run_set(rs, tmp_path / "numpy", threads=np.int64(1)).ok
     a_file = tmp_path / "a_file"
     a_file.write_text("x")
     with pytest.raises(railfmu.OutputError, match="cannot create the output folder"):

@@ -455,3 +455,18 @@ def test_read_results_names_what_is_missing(tmp_path):
         railfmu.read_results(tmp_path / "missing.csv")
     with pytest.raises(railfmu.OutputError, match="holds neither sweep.json nor results.csv"):
         railfmu.read_results(tmp_path)
+
+
+def test_errors_cross_process_boundaries_as_themselves(passive_file):
+    """A railfmu error pickles (as Dask and process pools send it back) into its own class."""
+    import pickle
+
+    s = railfmu.System.load(passive_file)
+    with pytest.raises(railfmu.SystemDescriptionError) as raised:
+        s.run({"bogie.vehicle.speed": -5.0}, stop_time=0.01)
+    again = pickle.loads(pickle.dumps(raised.value))
+    assert type(again) is railfmu.SystemDescriptionError and isinstance(again, railfmu.Error)
+    assert str(again) == str(raised.value)
+    for cls in (railfmu.Error, railfmu.FmuError, railfmu.SimulationError, railfmu.OutputError, railfmu.AssessmentError):
+        assert cls.__module__ == "railfmu"
+        assert type(pickle.loads(pickle.dumps(cls("x")))) is cls
