@@ -716,3 +716,39 @@ fn serialised_state_continues_identically() {
     let b = run(&mut c);
     assert_eq!(a, b);
 }
+
+/// A serialised state is refused when the physics inside it was not built from its declared
+/// parameters (bytes forged with a valid checksum): it would reach the physics otherwise.
+#[test]
+fn a_forged_state_whose_physics_disagrees_with_its_parameters_is_refused() {
+    fn check<M: FmuModel>(parameter: &str, marker: f64) {
+        let (mut c, log) = init::<M>(&[(parameter, marker)]);
+        let state = c.get_fmu_state().unwrap();
+        let bytes = c.serialize_fmu_state(&state).unwrap();
+        assert!(c.deserialize_fmu_state(&bytes).is_ok());
+        let at: Vec<usize> = bytes
+            .windows(8)
+            .enumerate()
+            .filter(|(_, w)| *w == marker.to_le_bytes())
+            .map(|(k, _)| k)
+            .collect();
+        // the declared value and the physics' copy
+        assert_eq!(at.len(), 2, "{parameter}");
+        for k in at {
+            let mut forged = bytes.clone();
+            forged[k..k + 8].copy_from_slice(&(1.5 * marker).to_le_bytes());
+            model_description::testing::reseal_state(&mut forged);
+            assert!(
+                c.deserialize_fmu_state(&forged).is_err(),
+                "{parameter} at {k}"
+            );
+            assert!(
+                logged(&log.take(), Status::Error, "does not hold together"),
+                "{parameter}"
+            );
+        }
+    }
+    check::<FullActiveActuator>("supply.pressure", 10.123_456_7e6);
+    check::<SemiActiveDamper>("damper.bulk_modulus", 1.234_567_89e9);
+    check::<PassiveYawDamper>("damper.bulk_modulus", 1.234_567_89e9);
+}

@@ -302,6 +302,10 @@ impl<M: FmuModel> ErasedModel for Typed<M> {
         }
         crate::finite::check_finite(&tagged.model).map_err(|e| e.to_string())?;
         self.check_settable_values(&tagged.model)?;
+        tagged
+            .model
+            .check_restored()
+            .map_err(|e| format!("the serialised state does not hold together: {e}"))?;
         Ok(Box::new(tagged.model))
     }
 }

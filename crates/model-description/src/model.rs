@@ -119,6 +119,15 @@ pub trait FmuModel: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// the call (so a host can retry after fmi2Discard).
     fn do_step(&mut self, time: f64, step: f64, diag: &mut Diagnostics) -> Result<(), StepError>;
 
+    /// A state decoded from bytes (fmi2DeSerializeFMUstate) holds, besides the variables the
+    /// glue checks against their declarations, what the model derived from them at
+    /// initialisation (its physics with a copy of the parameters): whether that still agrees
+    /// with them. Bytes altered on purpose, with a valid checksum, are refused here rather
+    /// than reaching the physics. Default: nothing derived to check.
+    fn check_restored(&self) -> Result<(), String> {
+        Ok(())
+    }
+
     /// Whether a successful [`Self::do_step`] leaves the outputs exactly as
     /// [`Self::update_outputs`] would compute them at the new time with the held inputs. Then
     /// the outputs read after a step are not computed a second time (a co-simulation master

@@ -176,6 +176,15 @@ impl FmuModel for FullActiveActuator {
         Ok(())
     }
 
+    fn check_restored(&self) -> Result<(), String> {
+        match &self.actuator {
+            Some(a) if a.params() != &self.params => {
+                Err("the actuator's parameters are not the declared ones".into())
+            }
+            _ => Ok(()),
+        }
+    }
+
     fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
         if let Some(a) = &mut self.actuator {
             a.set_inputs(&self.inputs)

@@ -93,6 +93,16 @@ impl SemiShell {
         Ok(())
     }
 
+    /// A restored state's physics was built from the declared parameters.
+    fn check_restored(&self) -> Result<(), String> {
+        match &self.damper {
+            Some(d) if d.params() != &self.params => {
+                Err("the damper's parameters are not the declared ones".into())
+            }
+            _ => Ok(()),
+        }
+    }
+
     fn report_clamp(&mut self, diag: &mut Diagnostics) {
         if self.out.command_clamped && !self.clamp_active {
             diag.warn(format!(
@@ -117,6 +127,10 @@ macro_rules! delegate_to_shell {
 
         fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
             self.s.update_outputs::<Self>()
+        }
+
+        fn check_restored(&self) -> Result<(), String> {
+            self.s.check_restored()
         }
 
         fn do_step(
