@@ -192,3 +192,13 @@ class System:
 
     def __repr__(self) -> str:
         return f"<System {self.file}: {', '.join(self.instances)}>"
+
+    def __reduce__(self):
+        # the loaded FMUs live in this process; say what to send instead of pickle's own
+        # "cannot pickle 'PreparedSystem'"
+        raise TypeError(
+            "a railfmu.System holds FMUs loaded in this process and does not pickle: send its "
+            "description (System.description, a dict) or its file and load it where it runs "
+            "(System.from_dict, System.load), or run a set on a Dask cluster with "
+            "railfmu.run_set(..., client=...)"
+        )

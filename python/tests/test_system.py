@@ -444,6 +444,12 @@ def test_arguments_of_the_wrong_type_raise_type_errors_naming_them(passive_file)
     with pytest.raises(TypeError, match="progress must be True, False, None or a callable"):
         s.run(stop_time=0.01, progress=5)
     assert s.stop_time == 1.0
+    # a stop time whose results would pass the recorded-values limit: refused when set, as
+    # System.load refuses it, not when the run starts
+    for attempt in (lambda: setattr(s, "stop_time", 99999.0), lambda: s.run(stop_time=99999.0)):
+        with pytest.raises(railfmu.SystemDescriptionError, match="more than the 500000000 allowed"):
+            attempt()
+    assert s.stop_time == 1.0
     # NumPy numbers are numbers
     s.stop_time = np.float32(0.25)
     assert s.stop_time == 0.25
@@ -470,3 +476,8 @@ def test_errors_cross_process_boundaries_as_themselves(passive_file):
     for cls in (railfmu.Error, railfmu.FmuError, railfmu.SimulationError, railfmu.OutputError, railfmu.AssessmentError):
         assert cls.__module__ == "railfmu"
         assert type(pickle.loads(pickle.dumps(cls("x")))) is cls
+    # a System does not pickle, and says what to send instead; its description loads again
+    with pytest.raises(TypeError, match="send its description"):
+        pickle.dumps(s)
+    again = railfmu.System.from_dict(pickle.loads(pickle.dumps(s.description)))
+    assert np.array_equal(bits(again.run(stop_time=0.01).values), bits(s.run(stop_time=0.01).values))

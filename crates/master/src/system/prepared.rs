@@ -176,6 +176,16 @@ impl PreparedSystem {
                     SystemError::Invalid { field, reason, .. } => invalid(field, "", reason),
                     other => other,
                 })?;
+                // the recorded values of the longer run, refused now as a description's are,
+                // not when the run starts
+                let limits = crate::coupling::RunLimits::from_env()
+                    .map_err(|r| invalid("step".into(), "", r))?;
+                let steps = limits
+                    .steps(t - self.plan.start_time, self.plan.step)
+                    .map_err(|r| invalid("step".into(), "", r))?;
+                limits
+                    .recorded(steps, self.plan.record.len() + 1)
+                    .map_err(|r| invalid("stop_time".into(), "", r))?;
             }
         }
         Ok(RunChanges {
