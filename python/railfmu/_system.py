@@ -193,6 +193,16 @@ class System:
     def __repr__(self) -> str:
         return f"<System {self.file}: {', '.join(self.instances)}>"
 
+    def __copy__(self) -> "System":
+        # the loaded FMUs shared (runs never see each other's state), the settings its own
+        other = System(self._prepared)
+        other._parameters = dict(self._parameters)
+        other._stop_time = self._stop_time
+        return other
+
+    def __deepcopy__(self, memo: Dict[int, Any]) -> "System":
+        return self.__copy__()
+
     def __reduce__(self):
         # the loaded FMUs live in this process; say what to send instead of pickle's own
         # "cannot pickle 'PreparedSystem'"

@@ -476,6 +476,14 @@ def test_errors_cross_process_boundaries_as_themselves(passive_file):
     for cls in (railfmu.Error, railfmu.FmuError, railfmu.SimulationError, railfmu.OutputError, railfmu.AssessmentError):
         assert cls.__module__ == "railfmu"
         assert type(pickle.loads(pickle.dumps(cls("x")))) is cls
+    # copies share the loaded FMUs but not their settings
+    import copy
+
+    for twin in (copy.copy(s), copy.deepcopy(s)):
+        twin.stop_time = 0.5
+        twin.set_parameter("bogie.vehicle.speed", 60.0)
+        assert s.stop_time == 1.0 and s.parameters == {}
+        assert len(twin.run()) == 501
     # a System does not pickle, and says what to send instead; its description loads again
     with pytest.raises(TypeError, match="send its description"):
         pickle.dumps(s)

@@ -593,6 +593,13 @@ impl Actuator {
         })
     }
 
+    /// Whether this actuator is one [`Self::new`] can give with `params` (and steps since):
+    /// the same parameters, and valid. An actuator decoded from bytes someone altered is
+    /// refused by this before it steps.
+    pub fn is_built_from(&self, params: &ActuatorParams) -> bool {
+        self.params == *params && params.validate().is_ok()
+    }
+
     /// Parameters in use.
     pub fn params(&self) -> &ActuatorParams {
         &self.params

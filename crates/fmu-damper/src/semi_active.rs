@@ -415,6 +415,15 @@ impl SemiActiveDamper {
         Self::new(SemiActiveParams::passive_reference())
     }
 
+    /// Whether this damper is one [`Self::new`] can give with `params` (and steps since): the
+    /// same parameters, valid, and what was derived from them at construction. A damper
+    /// decoded from bytes someone altered is refused by this before it steps.
+    pub fn is_built_from(&self, params: &SemiActiveParams) -> bool {
+        self.params == *params
+            && params.validate().is_ok()
+            && self.velocity_ref_cbrt.to_bits() == params.velocity_ref_mps.cbrt().to_bits()
+    }
+
     /// Parameters in use.
     pub fn params(&self) -> &SemiActiveParams {
         &self.params

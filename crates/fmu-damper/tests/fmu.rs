@@ -734,19 +734,34 @@ fn a_forged_state_whose_physics_disagrees_with_its_parameters_is_refused() {
             .collect();
         // the declared value and the physics' copy
         assert_eq!(at.len(), 2, "{parameter}");
-        for k in at {
+        let forge = |at: &[usize], value: f64| {
             let mut forged = bytes.clone();
-            forged[k..k + 8].copy_from_slice(&(1.5 * marker).to_le_bytes());
+            for &k in at {
+                forged[k..k + 8].copy_from_slice(&value.to_le_bytes());
+            }
             model_description::testing::reseal_state(&mut forged);
+            forged
+        };
+        // one copy altered, or both set to 0 (in the declared range, which admits 0, but
+        // not a value the physics takes)
+        let cases = [
+            (&at[..1], 1.5 * marker),
+            (&at[1..], 1.5 * marker),
+            (&at[..], 0.0),
+        ];
+        for (copies, value) in cases {
+            let forged = forge(copies, value);
             assert!(
                 c.deserialize_fmu_state(&forged).is_err(),
-                "{parameter} at {k}"
+                "{parameter} {copies:?}"
             );
             assert!(
                 logged(&log.take(), Status::Error, "does not hold together"),
                 "{parameter}"
             );
         }
+        // both altered alike to another valid value: a state the parameters can give
+        assert!(c.deserialize_fmu_state(&forge(&at, 1.5 * marker)).is_ok());
     }
     check::<FullActiveActuator>("supply.pressure", 10.123_456_7e6);
     check::<SemiActiveDamper>("damper.bulk_modulus", 1.234_567_89e9);

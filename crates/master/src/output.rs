@@ -68,18 +68,19 @@ pub fn remove_stale_file(path: &Path) -> std::io::Result<()> {
 }
 
 /// Temporary files being written, not yet renamed onto their destination: a second Ctrl-C,
-/// which ends the process at once, removes them ([`remove_unfinished`]), so that an aborted
-/// write leaves no partial file behind.
-static UNFINISHED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// which ends the process at once, removes them ([`give_up_unfinished`]), so that an aborted
+/// write leaves no partial file behind. `None` once given up: no file is created after that.
+static UNFINISHED: Mutex<Option<Vec<PathBuf>>> = Mutex::new(Some(Vec::new()));
 
-fn unfinished_files() -> MutexGuard<'static, Vec<PathBuf>> {
+fn unfinished_files() -> MutexGuard<'static, Option<Vec<PathBuf>>> {
     UNFINISHED.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
-/// Removes every temporary file still being written ([`write_unfinished`]); for a process
-/// about to exit without unwinding.
-pub fn remove_unfinished() {
-    for path in unfinished_files().drain(..) {
+/// Removes every temporary file still being written ([`write_unfinished`]) and refuses to
+/// create any more; for a process about to exit without unwinding.
+pub fn give_up_unfinished() {
+    let files = unfinished_files().take().unwrap_or_default();
+    for path in files {
         let _ = std::fs::remove_file(path);
     }
 }
@@ -98,17 +99,28 @@ pub struct Unfinished {
 /// A temporary file's entry in [`UNFINISHED`], removed when dropped.
 struct Listed(PathBuf);
 
-impl Listed {
-    fn new(tmp: &Path) -> Self {
-        unfinished_files().push(tmp.to_path_buf());
-        Listed(tmp.to_path_buf())
+impl Drop for Listed {
+    fn drop(&mut self) {
+        if let Some(files) = unfinished_files().as_mut() {
+            files.retain(|p| p != &self.0);
+        }
     }
 }
 
-impl Drop for Listed {
-    fn drop(&mut self) {
-        unfinished_files().retain(|p| p != &self.0);
-    }
+/// A temporary file in `dir`, created and listed in [`UNFINISHED`] under its lock, so that
+/// [`give_up_unfinished`] sees every file created before it and none is created after it.
+fn listed_temporary_file(dir: &Path) -> std::io::Result<(tempfile::NamedTempFile, Listed)> {
+    let mut files = unfinished_files();
+    let Some(list) = files.as_mut() else {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::Interrupted,
+            "the process is ending (interrupted twice)",
+        ));
+    };
+    let tmp = tempfile::Builder::new().prefix(".tmp-").tempfile_in(dir)?;
+    list.push(tmp.path().to_path_buf());
+    let listed = Listed(tmp.path().to_path_buf());
+    Ok((tmp, listed))
 }
 
 impl Unfinished {
@@ -142,12 +154,8 @@ where
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let tmp = tempfile::Builder::new()
-        .prefix(".tmp-")
-        .tempfile_in(&dir)
-        .map_err(io_err(path))?;
-    // listed before it is filled, dropped (so removed) after it on an error
-    let listed = Listed::new(tmp.path());
+    // listed before it is filled; on an error both go (the entry first, then the file)
+    let (tmp, listed) = listed_temporary_file(&dir).map_err(io_err(path))?;
     {
         let mut w = std::io::BufWriter::new(tmp.as_file());
         fill(&mut w)?;

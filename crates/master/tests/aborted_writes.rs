@@ -3,7 +3,7 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)] // test code
 
-use master::output::{remove_unfinished, write_unfinished};
+use master::output::{give_up_unfinished, write_unfinished};
 
 fn temporary_files(dir: &std::path::Path) -> Vec<String> {
     std::fs::read_dir(dir)
@@ -18,19 +18,7 @@ fn files_being_written_are_removed_when_the_process_gives_up() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("r.csv");
     std::fs::write(&path, "earlier results\n").unwrap();
-    // interrupted while writing: the temporary file goes, the earlier results stay
-    let written = write_unfinished(&path, |w| {
-        w.write_all(b"half of the new ").unwrap();
-        assert_eq!(temporary_files(dir.path()).len(), 1);
-        remove_unfinished();
-        assert!(temporary_files(dir.path()).is_empty());
-        Ok(())
-    });
-    if let Ok(file) = written {
-        assert!(file.commit().is_err(), "renamed a removed file");
-    }
-    assert_eq!(std::fs::read_to_string(&path).unwrap(), "earlier results\n");
-    // written in full but not committed: listed until committed or dropped
+    // written in full but not committed: a temporary file until committed or dropped
     let file = write_unfinished(&path, |w| {
         w.write_all(b"new results\n").unwrap();
         Ok(())
@@ -40,14 +28,28 @@ fn files_being_written_are_removed_when_the_process_gives_up() {
     file.commit().unwrap();
     assert!(temporary_files(dir.path()).is_empty());
     assert_eq!(std::fs::read_to_string(&path).unwrap(), "new results\n");
-    // nothing listed any more: a later give-up removes nothing
-    let kept = write_unfinished(&dir.path().join("s.json"), |w| {
+    let dropped = write_unfinished(&dir.path().join("s.json"), |w| {
         w.write_all(b"{}").unwrap();
         Ok(())
     })
     .unwrap();
-    drop(kept);
-    remove_unfinished();
+    drop(dropped);
+    assert!(temporary_files(dir.path()).is_empty());
+    // interrupted while writing: the temporary file goes, the earlier results stay
+    let written = write_unfinished(&path, |w| {
+        w.write_all(b"half of the newest ").unwrap();
+        assert_eq!(temporary_files(dir.path()).len(), 1);
+        give_up_unfinished();
+        assert!(temporary_files(dir.path()).is_empty());
+        Ok(())
+    });
+    if let Ok(file) = written {
+        assert!(file.commit().is_err(), "renamed a removed file");
+    }
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "new results\n");
+    // and no file is begun after that (a worker thread still writing)
+    let e = write_unfinished(&path, |_| Ok(())).err().unwrap();
+    assert!(e.to_string().contains("the process is ending"), "{e}");
     assert!(temporary_files(dir.path()).is_empty());
     assert_eq!(std::fs::read_to_string(&path).unwrap(), "new results\n");
 }

@@ -181,8 +181,13 @@ pub fn dominant_frequency(x: &[f64], fs: f64, f_min: f64, f_max: f64) -> Result<
     let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let scaled: Vec<f64>;
     let x = if peak.is_finite() && peak > 0.0 && !(1e-100..=1e100).contains(&peak) {
-        let scale = (-peak.log2().round()).exp2();
-        scaled = x.iter().map(|v| v * scale).collect();
+        // in two factors: 2^1074 (a subnormal peak's) is beyond f64 on its own
+        let exponent = -peak.log2().round();
+        let (a, b) = (
+            (exponent / 2.0).floor().exp2(),
+            (exponent - (exponent / 2.0).floor()).exp2(),
+        );
+        scaled = x.iter().map(|v| v * a * b).collect();
         &scaled[..]
     } else {
         x
@@ -364,7 +369,7 @@ mod tests {
         };
         let f = at(1.0);
         assert!((f - 6.0).abs() < 0.1, "{f}");
-        for scale in [1e153, 1e300, 1e-150, 1e-300] {
+        for scale in [1e153, 1e300, 1e-150, 1e-300, 1e-310] {
             assert!((at(scale) - f).abs() < 1e-9, "{scale:e}: {} Hz", at(scale));
         }
     }

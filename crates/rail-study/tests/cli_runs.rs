@@ -372,7 +372,9 @@ fn a_study_checks_its_systems_first_and_holds_its_folder() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     std::fs::create_dir_all(&out).unwrap();
+    // an earlier study: its report beside its numbers
     std::fs::write(out.join("REPORT.md"), "the earlier report").unwrap();
+    std::fs::write(out.join("study.json"), r#"{"settings": {}, "configs": []}"#).unwrap();
     std::fs::write(out.join("notes.txt"), "the user's").unwrap();
     let systems = dir.path().join("systems");
     std::fs::create_dir_all(&systems).unwrap();
@@ -450,6 +452,7 @@ fn a_study_checks_its_systems_first_and_holds_its_folder() {
     let stderr = String::from_utf8_lossy(&r.stderr);
     assert_eq!(r.status.code(), Some(130), "{stderr}");
     assert!(!out.join("REPORT.md").exists(), "{stderr}");
+    assert!(!out.join("study.json").exists(), "{stderr}");
     assert_eq!(
         std::fs::read_to_string(out.join("notes.txt")).unwrap(),
         "the user's"
@@ -653,6 +656,10 @@ fn a_run_whose_outputs_cannot_all_be_written_changes_nothing() {
     std::fs::create_dir(d.join("s.json")).unwrap();
     let e = refused(&["-o", "r.csv", "--summary", "s.json"]);
     assert!(e.contains("s.json"), "{e}");
+    // a summary that passes the checks but cannot be written (no file can be created in
+    // /proc, not even by root): found after the run, before the results replace the earlier
+    let e = refused(&["-o", "r.csv", "--summary", "/proc/self/s.json"]);
+    assert!(e.contains("cannot write '/proc/self/s.json'"), "{e}");
     assert_eq!(before("r.csv"), csv);
     assert_eq!(before("r.meta.json"), meta);
     let mut names: Vec<_> = std::fs::read_dir(d)
@@ -661,4 +668,40 @@ fn a_run_whose_outputs_cannot_all_be_written_changes_nothing() {
         .collect();
     names.sort();
     assert_eq!(names, ["r.csv", "r.meta.json", "s.json", "system.json"]);
+}
+
+/// Under `nohup` (SIGHUP ignored) a hang-up does not stop a run: the handler that takes
+/// Ctrl-C and SIGTERM leaves SIGHUP as it found it.
+#[test]
+fn a_hang_up_under_nohup_does_not_stop_a_run() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("system.json"), system_json(2000.0)).unwrap();
+    let mut child = Command::new("nohup")
+        .arg(env!("CARGO_BIN_EXE_master"))
+        .args(["--quiet", "run"])
+        .arg(dir.path().join("system.json"))
+        .arg("-o")
+        .arg(dir.path().join("r.csv"))
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(800));
+    let pid = child.id().to_string();
+    let signal = |name: &str| {
+        let st = Command::new("kill").args([name, &pid]).status().unwrap();
+        assert!(st.success());
+    };
+    signal("-HUP");
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "the run ended on SIGHUP"
+    );
+    signal("-INT");
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("cancelled at t ="), "{stderr}");
 }

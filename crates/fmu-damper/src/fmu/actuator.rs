@@ -178,9 +178,11 @@ impl FmuModel for FullActiveActuator {
 
     fn check_restored(&self) -> Result<(), String> {
         match &self.actuator {
-            Some(a) if a.params() != &self.params => {
-                Err("the actuator's parameters are not the declared ones".into())
-            }
+            Some(a) if !a.is_built_from(&self.params) => Err(
+                "the actuator's physics is not the one its declared parameters give \
+                 (parameters altered, or not valid)"
+                    .into(),
+            ),
             _ => Ok(()),
         }
     }

@@ -96,9 +96,11 @@ impl SemiShell {
     /// A restored state's physics was built from the declared parameters.
     fn check_restored(&self) -> Result<(), String> {
         match &self.damper {
-            Some(d) if d.params() != &self.params => {
-                Err("the damper's parameters are not the declared ones".into())
-            }
+            Some(d) if !d.is_built_from(&self.params) => Err(
+                "the damper's physics is not the one its declared parameters give \
+                 (parameters altered, or not valid)"
+                    .into(),
+            ),
             _ => Ok(()),
         }
     }

@@ -90,6 +90,28 @@ impl GenericCommand {
 
 static CANCEL: AtomicBool = AtomicBool::new(false);
 
+/// Runs `install` (the Ctrl-C and SIGTERM handler) and gives SIGHUP back the disposition it
+/// had: the handler's crate takes SIGHUP with SIGTERM, which would turn a hang-up under
+/// `nohup` (SIGHUP ignored) into a cancelled run.
+#[cfg(unix)]
+fn keeping_sighup<T>(install: impl FnOnce() -> T) -> T {
+    // SAFETY: sigaction reads into / from a zero-initialised struct we own; no handler of
+    // ours is installed by these calls, only the earlier disposition put back.
+    let mut before: libc::sigaction = unsafe { std::mem::zeroed() };
+    let saved = unsafe { libc::sigaction(libc::SIGHUP, std::ptr::null(), &mut before) } == 0;
+    let out = install();
+    if saved {
+        // SAFETY: as above.
+        unsafe { libc::sigaction(libc::SIGHUP, &before, std::ptr::null_mut()) };
+    }
+    out
+}
+
+#[cfg(not(unix))]
+fn keeping_sighup<T>(install: impl FnOnce() -> T) -> T {
+    install()
+}
+
 /// The main of a `master` binary: installs the FMU logger at the requested level and the
 /// Ctrl-C handler (first Ctrl-C: stop at the next communication point; second: exit 130), runs
 /// `command`, prints an error with its chain of causes. Exit status 0 on success, 130 after
@@ -99,14 +121,19 @@ where
     F: FnOnce(&Context) -> Result<(), CommandError>,
 {
     crate::fmu::install_logger(global.log_level);
-    if let Err(e) = ctrlc::set_handler(|| {
-        if CANCEL.swap(true, Ordering::SeqCst) {
-            // second Ctrl-C: give up immediately, without the files half written
-            crate::output::remove_unfinished();
-            std::process::exit(130);
-        }
-        eprintln!("interrupt: stopping at the next communication point (Ctrl-C again to abort)");
-    }) {
+    let installed = keeping_sighup(|| {
+        ctrlc::set_handler(|| {
+            if CANCEL.swap(true, Ordering::SeqCst) {
+                // second Ctrl-C: give up immediately, without the files half written
+                crate::output::give_up_unfinished();
+                std::process::exit(130);
+            }
+            eprintln!(
+                "interrupt: stopping at the next communication point (Ctrl-C again to abort)"
+            );
+        })
+    });
+    if let Err(e) = installed {
         eprintln!("warning: cannot install the Ctrl-C handler: {e}");
     }
     let ctx = Context {
