@@ -314,7 +314,7 @@ fn force_bound_note_names_the_saturated_gains_from_the_runs() {
     ];
     let note = force_bound_note(&r.cv).unwrap();
     for s in [
-        "at most 25.2 kN",
+        "piston give 25.2 kN",
         "At c_v 210 / 390 kNs/m",
         "up to 32.3 / 21.4 kN",
         "delivered up to 22.3 / 19.0 kN",
