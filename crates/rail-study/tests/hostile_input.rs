@@ -464,9 +464,10 @@ fn archive_limits_and_unsafe_entries_are_refused_before_extraction() {
 
 /// An instance name that is no safe archive member name (a space, `#`, `%`) is exported as a
 /// safe member: the SSP runs (it referred to `resources/h #1%.ssv`, which the import reads as
-/// a URI with a fragment); what SSP cannot hold is named.
+/// a URI with a fragment); the coupling settings SSP has no place for travel in the master's
+/// annotation.
 #[test]
-fn an_exported_ssp_runs_whatever_its_instance_names_and_says_what_it_drops() {
+fn an_exported_ssp_runs_whatever_its_instance_names_and_keeps_its_coupling_settings() {
     let c = Case::new();
     hostile_fmu(&c, HOSTILE_MD);
     c.write(
@@ -481,13 +482,17 @@ fn an_exported_ssp_runs_whatever_its_instance_names_and_says_what_it_drops() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    assert!(
-        stdout.contains("no place for the master's init_sweeps (7)"),
-        "{stdout}"
-    );
-    let zip = zip::ZipArchive::new(std::fs::File::open(c.path("odd.ssp")).unwrap()).unwrap();
+    assert!(stdout.contains("the master's annotation"), "{stdout}");
+    let mut zip = zip::ZipArchive::new(std::fs::File::open(c.path("odd.ssp")).unwrap()).unwrap();
     let names: Vec<&str> = zip.file_names().collect();
     assert!(names.contains(&"resources/h__1_.ssv"), "{names:?}");
+    let mut ssd = String::new();
+    std::io::Read::read_to_string(&mut zip.by_name("SystemStructure.ssd").unwrap(), &mut ssd)
+        .unwrap();
+    assert!(
+        ssd.contains(r#"<rfm:Coupling algorithm="gauss-seidel" initSweeps="7""#),
+        "{ssd}"
+    );
     let out = c.master(&["run", "odd.ssp", "-o", "odd.csv"], &[]);
     assert!(
         out.status.success(),

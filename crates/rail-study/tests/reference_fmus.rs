@@ -310,6 +310,39 @@ fn feedthrough_records_sets_and_connects_every_type() {
             "{rows:?}"
         );
     }
+    // exported as an SSP: the Enumeration connectors' type is defined in ssd:Enumerations
+    // with the FMU's items (SSP 1.0 5.1), and the archive runs as the description did
+    let (ok, text) = master(&["export-ssp", "two.json", "two.ssp"], dir.path());
+    assert!(ok, "{text}");
+    let mut zip =
+        zip::ZipArchive::new(std::fs::File::open(dir.path().join("two.ssp")).unwrap()).unwrap();
+    let mut ssd = String::new();
+    std::io::Read::read_to_string(&mut zip.by_name("SystemStructure.ssd").unwrap(), &mut ssd)
+        .unwrap();
+    let connector = ssd
+        .split("<ssc:Enumeration name=\"")
+        .nth(1)
+        .and_then(|rest| rest.split('"').next())
+        .unwrap()
+        .to_string();
+    let defined = format!(
+        r#"<ssd:Enumerations>
+    <ssc:Enumeration name="{connector}"><ssc:Item name="Option 1" value="1"/><ssc:Item name="Option 2" value="2"/></ssc:Enumeration>"#
+    );
+    assert!(ssd.contains(&defined), "{ssd}");
+    let (ok, text) = master(&["run", "two.ssp", "-o", "two_ssp.csv"], dir.path());
+    assert!(ok, "{text}");
+    // (the SSP records every output: the description's columns compared)
+    let (sh, srows) = read_csv(&dir.path().join("two_ssp.csv"));
+    let at: Vec<usize> = h
+        .iter()
+        .map(|c| sh.iter().position(|s| s == c).unwrap())
+        .collect();
+    let picked: Vec<Vec<String>> = srows
+        .iter()
+        .map(|r| at.iter().map(|&k| r[k].clone()).collect())
+        .collect();
+    assert_eq!(picked, rows);
     std::fs::write(
         dir.path().join("bad.json"),
         system(r#", {"from": "a.String_output", "to": "b.Int32_input"}"#),

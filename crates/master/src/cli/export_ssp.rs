@@ -51,32 +51,13 @@ pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
     }
     let summary = crate::ssp::export(&sys, &args.output)?;
     println!("{}: {summary}", args.output.display());
-    // what SSP has no place for: `master run` on the archive takes its defaults
-    let defaults: crate::system::SystemDescription =
-        serde_json::from_str(r#"{"instances": [], "stop_time": 1, "step": 1}"#)
-            .map_err(|e| CommandError::Failed(format!("internal: defaults: {e}")))?;
-    for (field, value, default) in [
-        (
-            "init_sweeps",
-            sys.desc.init_sweeps as u64,
-            defaults.init_sweeps as u64,
-        ),
-        (
-            "max_step_halvings",
-            u64::from(sys.desc.max_step_halvings),
-            u64::from(defaults.max_step_halvings),
-        ),
-    ] {
-        if value != default {
-            println!(
-                "note: SSP has no place for the master's {field} ({value}); `master run` on the \
-                 archive takes its default ({default})"
-            );
-        }
-    }
+    // what SSP has no place for travels in the master's own annotation, which other hosts skip
     if sys.desc.algorithm == Algorithm::GaussSeidel {
         println!(
-            "note: SSP has no coupling algorithm; hosts reading it (libcosim, Ecos, fmpy) and `master run` on it exchange Jacobi-style (gauss-seidel with `master run --algorithm gauss-seidel`)"
+            "note: SSP has no coupling algorithm: `master run` on the archive couples \
+             gauss-seidel (in the order, sweeps and halvings of the description), as the \
+             master's annotation in it says; other hosts (libcosim, Ecos, fmpy) exchange \
+             Jacobi-style"
         );
     }
     Ok(())

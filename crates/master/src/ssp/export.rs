@@ -16,6 +16,8 @@ use crate::system::{split_ref, LoadedSystem};
 const NS_OSP: &str = "http://opensimulationplatform.com/SSP/OSPAnnotations";
 const NS_OMS: &str =
     "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd";
+/// The namespace of the master's own annotation ([`super::ssd::MASTER_ANNOTATION`]).
+const NS_MASTER: &str = "urn:rail-fmu:master:coupling";
 
 /// The name of every parameter set written. Ecos applies parameter sets only when its
 /// simulation is initialised with their name; one name for all makes one `init` apply all.
@@ -167,6 +169,8 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
     }
 
     let mut units_used: BTreeMap<String, Unit> = BTreeMap::new();
+    // the Enumeration types the connectors name, with their items (ssd:Enumerations)
+    let mut enums_used: BTreeMap<String, Vec<(i32, String)>> = BTreeMap::new();
     let mut ssd = String::new();
     let name = escape(
         Path::new(&sys.file)
@@ -177,7 +181,7 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
     let _ = writeln!(ssd, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
     let _ = writeln!(
         ssd,
-        r#"<ssd:SystemStructureDescription xmlns:ssd="{NS_SSD}" xmlns:ssc="{NS_SSC}" xmlns:ssv="{NS_SSV}" xmlns:osp="{NS_OSP}" xmlns:oms="{NS_OMS}" version="1.0" name="{name}" generationTool="master {}">"#,
+        r#"<ssd:SystemStructureDescription xmlns:ssd="{NS_SSD}" xmlns:ssc="{NS_SSC}" xmlns:ssv="{NS_SSV}" xmlns:osp="{NS_OSP}" xmlns:oms="{NS_OMS}" xmlns:rfm="{NS_MASTER}" version="1.0" name="{name}" generationTool="master {}">"#,
         env!("CARGO_PKG_VERSION")
     );
     let _ = writeln!(ssd, r#"  <ssd:System name="{name}">"#);
@@ -220,7 +224,26 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
                     VarType::Boolean => "<ssc:Boolean/>".to_string(),
                     VarType::String => "<ssc:String/>".to_string(),
                     VarType::Enumeration => match extras[i].enum_types.get(&v.name) {
-                        Some(t) => format!(r#"<ssc:Enumeration name="{}"/>"#, escape(t)),
+                        Some(t) => {
+                            let items: Vec<(i32, String)> = md
+                                .enum_items(v)
+                                .iter()
+                                .map(|it| (it.value, it.name.clone()))
+                                .collect();
+                            match enums_used.get(t) {
+                                Some(known) if *known != items => {
+                                    return Err(SspError::Export(format!(
+                                        "two FMUs declare the Enumeration type '{t}' with \
+                                         different items; an SSP names one type per name"
+                                    )))
+                                }
+                                Some(_) => {}
+                                None => {
+                                    enums_used.insert(t.clone(), items);
+                                }
+                            }
+                            format!(r#"<ssc:Enumeration name="{}"/>"#, escape(t))
+                        }
                         None => {
                             return Err(SspError::Export(format!(
                                 "'{}.{}' is an Enumeration without a declaredType",
@@ -282,10 +305,42 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
     }
     let _ = writeln!(
         ssd,
-        r#"    <ssd:Annotations><ssc:Annotation type="org.openmodelica"><oms:Annotations><oms:SimulationInformation><oms:FixedStepMaster description="oms-ma" stepSize="{}"/></oms:SimulationInformation></oms:Annotations></ssc:Annotation></ssd:Annotations>"#,
+        r#"    <ssd:Annotations><ssc:Annotation type="org.openmodelica"><oms:Annotations><oms:SimulationInformation><oms:FixedStepMaster description="oms-ma" stepSize="{}"/></oms:SimulationInformation></oms:Annotations></ssc:Annotation>"#,
         real(d.step)
     );
+    // what SSP has no place for, in an annotation of the master's that other tools skip:
+    // `master run` on the archive couples as the description said
+    let algorithm = match d.algorithm {
+        crate::coupling::Algorithm::Jacobi => "jacobi",
+        crate::coupling::Algorithm::GaussSeidel => "gauss-seidel",
+    };
+    let _ = write!(
+        ssd,
+        r#"      <ssc:Annotation type="{}"><rfm:Coupling algorithm="{algorithm}" initSweeps="{}" maxStepHalvings="{}">"#,
+        super::ssd::MASTER_ANNOTATION,
+        d.init_sweeps,
+        d.max_step_halvings
+    );
+    for name in d.order.iter().flatten() {
+        let _ = write!(ssd, r#"<rfm:Instance name="{}"/>"#, escape(name));
+    }
+    let _ = writeln!(ssd, "</rfm:Coupling></ssc:Annotation></ssd:Annotations>");
     let _ = writeln!(ssd, "  </ssd:System>");
+    if !enums_used.is_empty() {
+        let _ = writeln!(ssd, "  <ssd:Enumerations>");
+        for (name, items) in &enums_used {
+            let _ = write!(ssd, r#"    <ssc:Enumeration name="{}">"#, escape(name));
+            for (value, item) in items {
+                let _ = write!(
+                    ssd,
+                    r#"<ssc:Item name="{}" value="{value}"/>"#,
+                    escape(item)
+                );
+            }
+            let _ = writeln!(ssd, "</ssc:Enumeration>");
+        }
+        let _ = writeln!(ssd, "  </ssd:Enumerations>");
+    }
     if !units_used.is_empty() {
         let _ = writeln!(ssd, "  <ssd:Units>");
         for (n, u) in &units_used {

@@ -1,7 +1,7 @@
 //! An SSD (with its FMUs, parameter sets and mappings) converted into the master's
 //! [`SystemDescription`].
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
 use serde_json::Value as Json;
@@ -143,17 +143,23 @@ pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, S
             instances[i].step_multiple = m as u32;
         }
     }
+    let coupling = &ssd.system.coupling;
     let desc = SystemDescription {
         instances,
         connections,
         start_time,
         stop_time,
         step,
-        algorithm: opts.algorithm.unwrap_or(Algorithm::Jacobi),
-        order: None,
+        // the master's own settings where its export kept them (annotation), else what
+        // libcosim, Ecos and fmpy do: Jacobi
+        algorithm: opts
+            .algorithm
+            .or(coupling.algorithm)
+            .unwrap_or(Algorithm::Jacobi),
+        order: coupling.order.clone(),
         record: None,
-        init_sweeps: 3,
-        max_step_halvings: 0,
+        init_sweeps: coupling.init_sweeps.unwrap_or(3),
+        max_step_halvings: coupling.max_step_halvings.unwrap_or(0),
     };
     Ok(ImportedSsp {
         system: LoadedSystem::from_description(desc, &base_dir, &imp.pkg.label()),
@@ -275,31 +281,51 @@ impl Importer {
                     ),
                 });
             };
-            let end_of = |e: &str, k: &str| -> Result<(usize, Causality), SspError> {
-                let Some(i) = self.component_index(e) else {
-                    return Err(
-                        self.invalid(c.line, format!("connection: no component named '{e}'"))
-                    );
+            let end_of =
+                |e: &str, k: &str| -> Result<(usize, Causality, Option<String>), SspError> {
+                    let Some(i) = self.component_index(e) else {
+                        return Err(
+                            self.invalid(c.line, format!("connection: no component named '{e}'"))
+                        );
+                    };
+                    let md = &self.models[i];
+                    match md.variable(k) {
+                        // the connector's unit where it declares one (checked against the FMU's
+                        // in check_connectors), else the FMU variable's
+                        Some((_, v)) => Ok((
+                            i,
+                            v.causality,
+                            connector_unit(ssd, i, k).or_else(|| v.unit.clone()),
+                        )),
+                        None => Err(self.invalid(
+                            c.line,
+                            format!(
+                                "connection: component '{e}' (model '{}') has no variable '{k}'{}",
+                                md.model_name,
+                                md.suggest(k)
+                                    .map(|n| format!(" (did you mean '{n}'?)"))
+                                    .unwrap_or_default()
+                            ),
+                        )),
+                    }
                 };
-                let md = &self.models[i];
-                match md.variable(k) {
-                    Some((_, v)) => Ok((i, v.causality)),
-                    None => Err(self.invalid(
-                        c.line,
-                        format!(
-                            "connection: component '{e}' (model '{}') has no variable '{k}'{}",
-                            md.model_name,
-                            md.suggest(k)
-                                .map(|n| format!(" (did you mean '{n}'?)"))
-                                .unwrap_or_default()
-                        ),
-                    )),
-                }
-            };
-            let (_, sc) = end_of(se, &c.start_connector)?;
-            let (_, ec) = end_of(ee, &c.end_connector)?;
+            let (_, sc, su) = end_of(se, &c.start_connector)?;
+            let (_, ec, eu) = end_of(ee, &c.end_connector)?;
             let start = format!("{se}.{}", c.start_connector);
             let end = format!("{ee}.{}", c.end_connector);
+            if let (Some(su), Some(eu), false) = (&su, &eu, c.suppress_unit_conversion) {
+                if !same_unit(ssd, su, eu) {
+                    return Err(SspError::Unsupported {
+                        file: self.ssd_label.clone(),
+                        line: Some(c.line),
+                        what: format!(
+                            "unit conversion: connection '{start}' [{su}] -> '{end}' [{eu}]: \
+                             the master copies values unchanged (suppressUnitConversion=\"true\" \
+                             says to; the FMUs' own units must still agree)"
+                        ),
+                    });
+                }
+            }
             // SSP connections are directed start -> end; one written input -> output is
             // read the other way round.
             let (from, to) = if sc == Causality::Input && ec == Causality::Output {
@@ -364,9 +390,14 @@ impl Importer {
                         (ssv::parse_ssm(&l, &text)?, l)
                     }
                 };
+                // by name: a set of many parameters and a mapping of as many entries stay linear
+                let mut by_name: HashMap<&str, Vec<&Parameter>> = HashMap::new();
+                for (n, p) in &prefixed {
+                    by_name.entry(n.as_str()).or_default().push(p);
+                }
                 for e in &mapping.entries {
-                    let hits: Vec<&(String, &Parameter)> =
-                        prefixed.iter().filter(|(n, _)| *n == e.source).collect();
+                    let hits: &[&Parameter] =
+                        by_name.get(e.source.as_str()).map_or(&[], Vec::as_slice);
                     if hits.is_empty() {
                         return Err(SspError::Invalid {
                             file: mlabel.clone(),
@@ -377,7 +408,7 @@ impl Importer {
                             ),
                         });
                     }
-                    for (_, p) in hits {
+                    for &p in hits {
                         let v = match &e.transformation {
                             None => p.value.clone(),
                             Some(t) => t.apply(&p.value).map_err(|r| SspError::Invalid {
@@ -547,6 +578,18 @@ impl Importer {
 }
 
 /// Whether units `a` and `b` are the same: the same name, or identical definitions in the SSD.
+/// The unit a component's connector `name` declares (a Real connector's `unit`).
+fn connector_unit(ssd: &Ssd, component: usize, name: &str) -> Option<String> {
+    ssd.system.components[component]
+        .connectors
+        .iter()
+        .find(|k| k.name == name)
+        .and_then(|k| match &k.ty {
+            Some(ConnectorType::Real { unit }) => unit.clone(),
+            _ => None,
+        })
+}
+
 fn same_unit(ssd: &Ssd, a: &str, b: &str) -> bool {
     a == b
         || {

@@ -32,6 +32,9 @@ pub(super) struct Connection {
     pub start_connector: String,
     pub end_element: Option<String>,
     pub end_connector: String,
+    /// `suppressUnitConversion="true"`: values pass unconverted between connectors of
+    /// different units (SSP 1.0, 5.3.2); otherwise such a connection needs a conversion.
+    pub suppress_unit_conversion: bool,
     pub line: usize,
 }
 
@@ -77,6 +80,64 @@ pub(super) struct System {
     pub bindings: Vec<Binding>,
     /// OMSimulator's `oms:FixedStepMaster stepSize` [s].
     pub step_s: Option<f64>,
+    /// The master's own coupling settings, if an annotation of [`MASTER_ANNOTATION`] holds
+    /// them (written by `master export-ssp`).
+    pub coupling: CouplingSettings,
+}
+
+/// The `type` of the annotation in which `master export-ssp` keeps what SSP has no place
+/// for: the coupling algorithm, the Gauss-Seidel order, the initial sweeps and the step
+/// halvings (other tools skip annotations of types they do not know, SSP 1.0 1.4.4).
+pub(super) const MASTER_ANNOTATION: &str = "org.rail-fmu.master";
+
+/// The settings an annotation of [`MASTER_ANNOTATION`] holds (each absent when not given).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(super) struct CouplingSettings {
+    pub algorithm: Option<crate::coupling::Algorithm>,
+    pub order: Option<Vec<String>>,
+    pub init_sweeps: Option<usize>,
+    pub max_step_halvings: Option<u32>,
+}
+
+/// `<rfm:Coupling algorithm=".." initSweeps=".." maxStepHalvings=".."><rfm:Instance
+/// name=".."/>...</rfm:Coupling>` inside an annotation of [`MASTER_ANNOTATION`].
+fn parse_coupling(ctx: Ctx, a: Node) -> Result<CouplingSettings, SspError> {
+    let mut out = CouplingSettings::default();
+    let Some(c) = find_local(a, "Coupling").next() else {
+        return Ok(out);
+    };
+    out.algorithm = match c.attribute("algorithm") {
+        None => None,
+        Some("jacobi") => Some(crate::coupling::Algorithm::Jacobi),
+        Some("gauss-seidel") => Some(crate::coupling::Algorithm::GaussSeidel),
+        Some(other) => {
+            return Err(ctx.err(
+                c,
+                format!(
+                    "coupling algorithm '{}': expected 'jacobi' or 'gauss-seidel'",
+                    show::text(other)
+                ),
+            ))
+        }
+    };
+    let whole = |attr: &str| -> Result<Option<u64>, SspError> {
+        match c.attribute(attr) {
+            None => Ok(None),
+            Some(v) => v.trim().parse::<u64>().map(Some).map_err(|_| {
+                ctx.err(
+                    c,
+                    format!("{attr} = '{}': not a whole number >= 0", show::text(v)),
+                )
+            }),
+        }
+    };
+    out.init_sweeps = whole("initSweeps")?.map(|n| n as usize);
+    out.max_step_halvings = whole("maxStepHalvings")?.map(|n| n.min(u64::from(u32::MAX)) as u32);
+    let order: Vec<String> = find_local(c, "Instance")
+        .map(|i| ctx.req(i, "name").map(str::to_string))
+        .collect::<Result<_, _>>()?;
+    out.order = (!order.is_empty()).then_some(order);
+    Ok(out)
 }
 
 /// `ssc:Unit`: SI exponents (kg, m, s, A, K, mol, cd, rad), factor, offset.
@@ -225,6 +286,7 @@ fn parse_system(ctx: Ctx, n: Node) -> Result<System, SspError> {
         connections: Vec::new(),
         bindings: Vec::new(),
         step_s: None,
+        coupling: CouplingSettings::default(),
     };
     for c in elements(n) {
         if c.tag_name().namespace() != Some(NS_SSD) {
@@ -270,6 +332,9 @@ fn parse_system(ctx: Ctx, n: Node) -> Result<System, SspError> {
             }
             "Annotations" => {
                 for a in annotations(n) {
+                    if a.attribute("type") == Some(MASTER_ANNOTATION) {
+                        s.coupling = parse_coupling(ctx, a)?;
+                    }
                     if a.attribute("type") == Some("org.openmodelica") {
                         for m in find_local(a, "FixedStepMaster") {
                             s.step_s = ctx.f64(m, "stepSize")?.or(s.step_s);
@@ -441,6 +506,11 @@ fn parse_connection(ctx: Ctx, e: Node) -> Result<Connection, SspError> {
         start_connector: ctx.req(e, "startConnector")?.to_string(),
         end_element: e.attribute("endElement").map(str::to_string),
         end_connector: ctx.req(e, "endConnector")?.to_string(),
+        // xs:boolean
+        suppress_unit_conversion: matches!(
+            e.attribute("suppressUnitConversion").map(str::trim),
+            Some("true" | "1")
+        ),
         line: line(e),
     })
 }

@@ -99,6 +99,8 @@ pub(super) fn parse_set(ctx: Ctx, n: Node) -> Result<ParameterSet, SspError> {
         parameters: Vec::new(),
         units: Vec::new(),
     };
+    // SSV 1.0 6: a parameter's name "MUST be unique within the parameter set"
+    let mut seen: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
     for c in elements(n) {
         match c.tag_name().name() {
             "Parameters" if is(c, NS_SSV, "Parameters") => {
@@ -106,7 +108,19 @@ pub(super) fn parse_set(ctx: Ctx, n: Node) -> Result<ParameterSet, SspError> {
                     if !is(p, NS_SSV, "Parameter") {
                         return Err(ctx.unexpected(p));
                     }
-                    set.parameters.push(parse_parameter(ctx, p)?);
+                    let parameter = parse_parameter(ctx, p)?;
+                    if let Some(first) = seen.insert(parameter.name.clone(), parameter.line) {
+                        return Err(ctx.err(
+                            p,
+                            format!(
+                                "parameter '{}' is given twice in set '{}' (first at line \
+                                 {first}): a name is unique within a parameter set",
+                                crate::show::text(&parameter.name),
+                                crate::show::text(&set.name)
+                            ),
+                        ));
+                    }
+                    set.parameters.push(parameter);
                 }
             }
             "Units" if is(c, NS_SSV, "Units") => {
@@ -210,6 +224,7 @@ pub(super) fn parse_mapping(ctx: Ctx, n: Node) -> Result<Mapping, SspError> {
     }
     check_version(ctx, n)?;
     let mut entries = Vec::new();
+    let mut targets: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
     for e in elements(n) {
         match e.tag_name().name() {
             "MappingEntry" if is(e, NS_SSM, "MappingEntry") => {
@@ -225,9 +240,21 @@ pub(super) fn parse_mapping(ctx: Ctx, n: Node) -> Result<Mapping, SspError> {
                     }
                     transformation = Some(parse_transformation(ctx, t)?);
                 }
+                let target = ctx.req(e, "target")?.to_string();
+                // SSM 1.0 7: multiple parameters MUST NOT be mapped to the same name
+                if let Some(first) = targets.insert(target.clone(), line(e)) {
+                    return Err(ctx.err(
+                        e,
+                        format!(
+                            "mapping target '{}' is mapped to twice (first at line {first}): \
+                             one parameter per target",
+                            crate::show::text(&target)
+                        ),
+                    ));
+                }
                 entries.push(MappingEntry {
                     source: ctx.req(e, "source")?.to_string(),
-                    target: ctx.req(e, "target")?.to_string(),
+                    target,
                     transformation,
                     line: line(e),
                 });

@@ -79,8 +79,8 @@ const OMS_SSD: &str = r#" name="oms" version="1.0">
       </ssd:Component>
     </ssd:Elements>
     <ssd:Connections>
-      <ssd:Connection startElement="ms1" startConnector="position" endElement="ms2" endConnector="force"/>
-      <ssd:Connection startElement="ms2" startConnector="velocity" endElement="ms1" endConnector="force" suppressUnitConversion="true"/>
+      <ssd:Connection startElement="ms1" startConnector="position" endElement="ms2" endConnector="force" suppressUnitConversion="true"/>
+      <ssd:Connection startElement="ms2" startConnector="velocity" endElement="ms1" endConnector="force" suppressUnitConversion="1"/>
     </ssd:Connections>
     <ssd:Annotations>
       <ssc:Annotation type="org.openmodelica">
@@ -209,7 +209,7 @@ const OSP_SSD: &str = r#" name="osp" version="1.0">
       </ssd:Component>
     </ssd:Elements>
     <ssd:Connections>
-      <ssd:Connection startElement="b" startConnector="force" endElement="a" endConnector="position"/>
+      <ssd:Connection startElement="b" startConnector="force" endElement="a" endConnector="position" suppressUnitConversion="true"/>
     </ssd:Connections>
   </ssd:System>
   <ssd:DefaultExperiment startTime="0.5" stopTime="1.5">
@@ -325,6 +325,49 @@ fn ssp2_prefix_mapping_and_precedence() {
     );
 }
 
+/// Names SSP says are unique: a parameter set's parameters, a mapping's targets. Given twice
+/// they are refused (the last one won).
+#[test]
+fn a_parameter_or_mapping_target_given_twice_is_refused() {
+    let ssd = format!("{HEAD}{V2_SSD}");
+    let import_with = |ssv: &str, ssm: &str| {
+        let d = tempfile::tempdir().unwrap();
+        let p = ssp(
+            d.path(),
+            &[
+                ("SystemStructure.ssd", &ssd),
+                ("resources/ms.fmu", ""),
+                ("resources/bare.ssv", ssv),
+                ("resources/map.ssm", ssm),
+            ],
+        );
+        let opts = ImportOptions {
+            step: Some(0.001),
+            ..Default::default()
+        };
+        import(&p, &opts).map(|_| ()).map_err(|e| e.to_string())
+    };
+    assert!(import_with(BARE_SSV, MAP_SSM).is_ok());
+    let twice = BARE_SSV.replace(r#"name="unused""#, r#"name="stiffness""#);
+    let e = import_with(&twice, MAP_SSM).unwrap_err();
+    assert!(
+        e.contains("parameter 'stiffness' is given twice in set 'bare' (first at line 3)"),
+        "{e}"
+    );
+    let entry = r#"<ssm:MappingEntry source="ms.stiffness" target="ms.k">"#;
+    let two_targets = MAP_SSM.replace(
+        "</ssm:ParameterMapping>",
+        r#"  <ssm:MappingEntry source="ms.unused" target="ms.k"/>
+</ssm:ParameterMapping>"#,
+    );
+    assert!(MAP_SSM.contains(entry));
+    let e = import_with(BARE_SSV, &two_targets).unwrap_err();
+    assert!(
+        e.contains("mapping target 'ms.k' is mapped to twice (first at line 2)"),
+        "{e}"
+    );
+}
+
 #[test]
 fn a_bare_ssd_next_to_its_fmus() {
     let d = tempfile::tempdir().unwrap();
@@ -393,10 +436,28 @@ fn unsupported_content_is_refused_by_name() {
             ),
             "startIndices",
         ),
+        // connectors of different units: a conversion the master does not make, unless the
+        // connection suppresses it
         (
             oms_with(
                 ssd,
-                r#"endConnector="force"/>"#,
+                r#"endConnector="force" suppressUnitConversion="true"/>"#,
+                r#"endConnector="force" />"#,
+            ),
+            "unit conversion: connection 'ms1.position' [m] -> 'ms2.force' [N]",
+        ),
+        (
+            oms_with(
+                ssd,
+                r#"endConnector="force" suppressUnitConversion="1"/>"#,
+                r#"endConnector="force" suppressUnitConversion="false"/>"#,
+            ),
+            "unit conversion: connection 'ms2.velocity' [m/s] -> 'ms1.force' [N]",
+        ),
+        (
+            oms_with(
+                ssd,
+                r#"endConnector="force" suppressUnitConversion="1"/>"#,
                 r#"endConnector="force"><ssc:LinearTransformation factor="2"/></ssd:Connection>"#,
             ),
             "connection transformation",
