@@ -88,7 +88,8 @@ class System:
         ``step``, the communication step [s]; ``stop_time`` [s]; ``algorithm``, the coupling
         algorithm, ``"jacobi"`` or ``"gauss-seidel"``: each replaces the description's (as
         ``master run --step --stop --algorithm``). An SSP's defaults: its libcosim or
-        OMSimulator step annotation, its DefaultExperiment's stop time, Jacobi."""
+        OMSimulator step annotation, its DefaultExperiment's stop time, and the coupling
+        ``master export-ssp`` kept in it (else Jacobi)."""
         return cls(
             _railfmu.PreparedSystem.load(
                 os.fspath(path),

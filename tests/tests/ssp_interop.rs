@@ -113,7 +113,8 @@ fn exported_systems_are_valid_and_import_back_bit_for_bit() {
 /// run` on the archive gives the description's results bit for bit (other hosts skip it).
 #[test]
 fn a_gauss_seidel_system_and_its_order_import_back_bit_for_bit() {
-    let Some(py) = rail_python() else { return };
+    // the schema check needs Python (scripts/test.sh sets RAIL_PYTHON); the round trip not
+    let py = rail_python();
     for name in ["skyhook_onoff.json", "full_active.json"] {
         let path = workspace_root().join("systems").join(name);
         let mut sys = LoadedSystem::load(&path).unwrap();
@@ -124,7 +125,9 @@ fn a_gauss_seidel_system_and_its_order_import_back_bit_for_bit() {
         assert!(sys.desc.order.is_some(), "{name} names its order");
         let dir = tempfile::tempdir().unwrap();
         let file = export(&sys, dir.path());
-        schema_valid(&py, &file);
+        if let Some(py) = &py {
+            schema_valid(py, &file);
+        }
         let imported = ssp::import(&file, &ImportOptions::default()).unwrap();
         let back = &imported.system.desc;
         assert_eq!(back.algorithm, Algorithm::GaussSeidel, "{name}");

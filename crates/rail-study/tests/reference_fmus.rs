@@ -343,6 +343,65 @@ fn feedthrough_records_sets_and_connects_every_type() {
         .map(|r| at.iter().map(|&k| r[k].clone()).collect())
         .collect();
     assert_eq!(picked, rows);
+    // connectors that declare units the (unitless) FMU variables lack: km/h into m/s would
+    // need a conversion the master does not make, so it is refused unless the connection
+    // suppresses conversion, and then the value passes as it is
+    let rewritten = |name: &str, edit: &dyn Fn(&str) -> String| {
+        let mut src =
+            zip::ZipArchive::new(std::fs::File::open(dir.path().join("two.ssp")).unwrap()).unwrap();
+        let mut out = zip::ZipWriter::new(std::fs::File::create(dir.path().join(name)).unwrap());
+        for k in 0..src.len() {
+            let mut entry = src.by_index(k).unwrap();
+            let member = entry.name().to_string();
+            let mut bytes = Vec::new();
+            std::io::Read::read_to_end(&mut entry, &mut bytes).unwrap();
+            if member == "SystemStructure.ssd" {
+                bytes = edit(std::str::from_utf8(&bytes).unwrap()).into_bytes();
+            }
+            out.start_file(member, zip::write::SimpleFileOptions::default())
+                .unwrap();
+            std::io::Write::write_all(&mut out, &bytes).unwrap();
+        }
+        out.finish().unwrap();
+    };
+    let in_units = |ssd: &str| {
+        assert!(ssd.contains(r#"name="Float64_continuous_input" kind="input"><ssc:Real/>"#));
+        ssd.replace(
+            r#"name="Float64_continuous_output" kind="output"><ssc:Real/>"#,
+            r#"name="Float64_continuous_output" kind="output"><ssc:Real unit="km/h"/>"#,
+        )
+        .replace(
+            r#"name="Float64_continuous_input" kind="input"><ssc:Real/>"#,
+            r#"name="Float64_continuous_input" kind="input"><ssc:Real unit="m/s"/>"#,
+        )
+    };
+    rewritten("units.ssp", &in_units);
+    let (ok, text) = master(&["run", "units.ssp", "-o", "units.csv"], dir.path());
+    assert!(!ok);
+    assert!(
+        text.contains(
+            "unit conversion: connection 'a.Float64_continuous_output' [km/h] -> \
+             'b.Float64_continuous_input' [m/s]"
+        ),
+        "{text}"
+    );
+    rewritten("suppressed.ssp", &|ssd: &str| {
+        in_units(ssd).replace(
+            r#"startConnector="Float64_continuous_output" endElement="b" endConnector="Float64_continuous_input""#,
+            r#"startConnector="Float64_continuous_output" endElement="b" endConnector="Float64_continuous_input" suppressUnitConversion="true""#,
+        )
+    });
+    let (ok, text) = master(
+        &["run", "suppressed.ssp", "-o", "suppressed.csv"],
+        dir.path(),
+    );
+    assert!(ok, "{text}");
+    let (sh, srows) = read_csv(&dir.path().join("suppressed.csv"));
+    let col = sh
+        .iter()
+        .position(|c| c == "b.Float64_continuous_output")
+        .unwrap();
+    assert!(srows.iter().all(|r| r[col] == "1.25"), "{srows:?}");
     std::fs::write(
         dir.path().join("bad.json"),
         system(r#", {"from": "a.String_output", "to": "b.Int32_input"}"#),

@@ -51,7 +51,8 @@ pub struct Args {
     #[arg(long, visible_alias = "stop-time", allow_negative_numbers = true)]
     pub stop: Option<f64>,
     /// Coupling algorithm, jacobi or gauss-seidel. Default: the description's (gauss-seidel
-    /// unless it says), jacobi for an SSP. Not for an FMU alone.
+    /// unless it says); for an SSP the one `master export-ssp` kept in it, else jacobi. Not
+    /// for an FMU alone.
     #[arg(long, value_parser = parse_algorithm)]
     pub algorithm: Option<Algorithm>,
     /// Start value of a parameter or input, NAME=VALUE (repeatable): NAME is

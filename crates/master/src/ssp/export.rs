@@ -225,24 +225,20 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
                     VarType::String => "<ssc:String/>".to_string(),
                     VarType::Enumeration => match extras[i].enum_types.get(&v.name) {
                         Some(t) => {
-                            let items: Vec<(i32, String)> = md
+                            let mut items: Vec<(i32, String)> = md
                                 .enum_items(v)
                                 .iter()
                                 .map(|it| (it.value, it.name.clone()))
                                 .collect();
-                            match enums_used.get(t) {
-                                Some(known) if *known != items => {
-                                    return Err(SspError::Export(format!(
-                                        "two FMUs declare the Enumeration type '{t}' with \
-                                         different items; an SSP names one type per name"
-                                    )))
-                                }
-                                Some(_) => {}
-                                None => {
-                                    enums_used.insert(t.clone(), items);
-                                }
-                            }
-                            format!(r#"<ssc:Enumeration name="{}"/>"#, escape(t))
+                            items.sort();
+                            // one type per name in an SSD: a type of the same name with other
+                            // items (another FMU's) is named after its instance
+                            let name = match enums_used.get(t) {
+                                Some(known) if *known != items => format!("{}.{t}", inst.name),
+                                _ => t.clone(),
+                            };
+                            enums_used.entry(name.clone()).or_insert(items);
+                            format!(r#"<ssc:Enumeration name="{}"/>"#, escape(&name))
                         }
                         None => {
                             return Err(SspError::Export(format!(

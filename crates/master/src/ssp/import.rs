@@ -1,7 +1,7 @@
 //! An SSD (with its FMUs, parameter sets and mappings) converted into the master's
 //! [`SystemDescription`].
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::Path;
 
 use serde_json::Value as Json;
@@ -144,19 +144,43 @@ pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, S
         }
     }
     let coupling = &ssd.system.coupling;
+    // the master's own settings where its export kept them (annotation), else what libcosim,
+    // Ecos and fmpy do: Jacobi
+    let algorithm = opts
+        .algorithm
+        .or(coupling.algorithm)
+        .unwrap_or(Algorithm::Jacobi);
+    let order = match &coupling.order {
+        Some(order) if algorithm == Algorithm::GaussSeidel => {
+            let names: BTreeSet<&str> = instances.iter().map(|i| i.name.as_str()).collect();
+            let listed: BTreeSet<&str> = order.iter().map(String::as_str).collect();
+            if listed == names && order.len() == names.len() {
+                Some(order.clone())
+            } else {
+                // components renamed, added or removed since the export (by hand, by another
+                // tool): the order is derived from the FMUs, as for any other SSP
+                log::warn!(
+                    target: "master",
+                    "{}: the Gauss-Seidel order in the master's annotation ({}) names {} \
+                     instead of this SSD's components; the order is derived from the FMUs' \
+                     direct feedthrough instead",
+                    imp.ssd_label,
+                    super::ssd::MASTER_ANNOTATION,
+                    order.join(", ")
+                );
+                None
+            }
+        }
+        _ => None,
+    };
     let desc = SystemDescription {
         instances,
         connections,
         start_time,
         stop_time,
         step,
-        // the master's own settings where its export kept them (annotation), else what
-        // libcosim, Ecos and fmpy do: Jacobi
-        algorithm: opts
-            .algorithm
-            .or(coupling.algorithm)
-            .unwrap_or(Algorithm::Jacobi),
-        order: coupling.order.clone(),
+        algorithm,
+        order,
         record: None,
         init_sweeps: coupling.init_sweeps.unwrap_or(3),
         max_step_halvings: coupling.max_step_halvings.unwrap_or(0),
@@ -281,39 +305,43 @@ impl Importer {
                     ),
                 });
             };
-            let end_of =
-                |e: &str, k: &str| -> Result<(usize, Causality, Option<String>), SspError> {
-                    let Some(i) = self.component_index(e) else {
-                        return Err(
-                            self.invalid(c.line, format!("connection: no component named '{e}'"))
-                        );
-                    };
-                    let md = &self.models[i];
-                    match md.variable(k) {
-                        // the connector's unit where it declares one (checked against the FMU's
-                        // in check_connectors), else the FMU variable's
-                        Some((_, v)) => Ok((
-                            i,
-                            v.causality,
-                            connector_unit(ssd, i, k).or_else(|| v.unit.clone()),
-                        )),
-                        None => Err(self.invalid(
-                            c.line,
-                            format!(
-                                "connection: component '{e}' (model '{}') has no variable '{k}'{}",
-                                md.model_name,
-                                md.suggest(k)
-                                    .map(|n| format!(" (did you mean '{n}'?)"))
-                                    .unwrap_or_default()
-                            ),
-                        )),
-                    }
+            // (component, causality, the FMU variable's unit, the connector's declared unit)
+            type End = (usize, Causality, Option<String>, Option<String>);
+            let end_of = |e: &str, k: &str| -> Result<End, SspError> {
+                let Some(i) = self.component_index(e) else {
+                    return Err(
+                        self.invalid(c.line, format!("connection: no component named '{e}'"))
+                    );
                 };
-            let (_, sc, su) = end_of(se, &c.start_connector)?;
-            let (_, ec, eu) = end_of(ee, &c.end_connector)?;
+                let md = &self.models[i];
+                match md.variable(k) {
+                    Some((_, v)) => Ok((i, v.causality, v.unit.clone(), connector_unit(ssd, i, k))),
+                    None => Err(self.invalid(
+                        c.line,
+                        format!(
+                            "connection: component '{e}' (model '{}') has no variable '{k}'{}",
+                            md.model_name,
+                            md.suggest(k)
+                                .map(|n| format!(" (did you mean '{n}'?)"))
+                                .unwrap_or_default()
+                        ),
+                    )),
+                }
+            };
+            let (_, sc, s_fmu, s_declared) = end_of(se, &c.start_connector)?;
+            let (_, ec, e_fmu, e_declared) = end_of(ee, &c.end_connector)?;
             let start = format!("{se}.{}", c.start_connector);
             let end = format!("{ee}.{}", c.end_connector);
-            if let (Some(su), Some(eu), false) = (&su, &eu, c.suppress_unit_conversion) {
+            // Two FMU variables with their own units are compared by the system's plan (a
+            // mismatch refused there, whatever the SSD says). A unit only a connector declares
+            // (its FMU variable has none; check_connectors makes a declared unit agree with
+            // the FMU's) would need a conversion the master does not make: refused, unless the
+            // connection suppresses conversion.
+            let both_from_fmus = s_fmu.is_some() && e_fmu.is_some();
+            let (su, eu) = (s_declared.or(s_fmu), e_declared.or(e_fmu));
+            if let (Some(su), Some(eu), false, false) =
+                (&su, &eu, both_from_fmus, c.suppress_unit_conversion)
+            {
                 if !same_unit(ssd, su, eu) {
                     return Err(SspError::Unsupported {
                         file: self.ssd_label.clone(),
@@ -321,7 +349,7 @@ impl Importer {
                         what: format!(
                             "unit conversion: connection '{start}' [{su}] -> '{end}' [{eu}]: \
                              the master copies values unchanged (suppressUnitConversion=\"true\" \
-                             says to; the FMUs' own units must still agree)"
+                             on the connection says to)"
                         ),
                     });
                 }
@@ -577,7 +605,6 @@ impl Importer {
     }
 }
 
-/// Whether units `a` and `b` are the same: the same name, or identical definitions in the SSD.
 /// The unit a component's connector `name` declares (a Real connector's `unit`).
 fn connector_unit(ssd: &Ssd, component: usize, name: &str) -> Option<String> {
     ssd.system.components[component]
@@ -590,6 +617,7 @@ fn connector_unit(ssd: &Ssd, component: usize, name: &str) -> Option<String> {
         })
 }
 
+/// Whether units `a` and `b` are the same: the same name, or identical definitions in the SSD.
 fn same_unit(ssd: &Ssd, a: &str, b: &str) -> bool {
     a == b
         || {

@@ -80,7 +80,8 @@ pub struct ImportOptions {
     pub step: Option<f64>,
     /// Stop time \[s\]; default: the DefaultExperiment's stopTime.
     pub stop_time: Option<f64>,
-    /// Default Jacobi (SSP does not say; libcosim, Ecos and fmpy exchange Jacobi-style).
+    /// Default: the algorithm the master's annotation keeps (an SSP `master export-ssp`
+    /// wrote), else Jacobi (SSP does not say; libcosim, Ecos and fmpy exchange Jacobi-style).
     pub algorithm: Option<Algorithm>,
 }
 

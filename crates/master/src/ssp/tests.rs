@@ -325,6 +325,57 @@ fn ssp2_prefix_mapping_and_precedence() {
     );
 }
 
+/// The master's own annotation (as `master export-ssp` writes it) sets the coupling of an
+/// import: algorithm, order, sweeps; an option overrides the algorithm, an order that does
+/// not name the SSD's components is not used, a bad algorithm is named.
+#[test]
+fn the_masters_coupling_annotation_is_read_and_checked() {
+    let with_coupling = |coupling: &str| {
+        let mut files = oms_files();
+        let annotation = format!(
+            r#"<ssd:Annotations>
+      <ssc:Annotation type="org.rail-fmu.master"><rfm:Coupling xmlns:rfm="urn:rail-fmu:master:coupling" {coupling}</rfm:Coupling></ssc:Annotation>"#
+        );
+        let ssd = &mut files[0].1;
+        let at = ssd
+            .find("    <ssd:Annotations>\n      <ssc:Annotation")
+            .unwrap();
+        ssd.replace_range(at + 4..at + 4 + "<ssd:Annotations>".len(), &annotation);
+        files
+    };
+    let opts = |algorithm| ImportOptions {
+        algorithm,
+        ..ImportOptions::default()
+    };
+    let desc = |coupling: &str, algorithm| {
+        let files = with_coupling(coupling);
+        let d = tempfile::tempdir().unwrap();
+        let p = ssp(d.path(), &refs(&files));
+        import(&p, &opts(algorithm)).map(|i| i.system.desc.clone())
+    };
+    let kept = r#"algorithm="gauss-seidel" initSweeps="4" maxStepHalvings="1"><rfm:Instance name="ms2"/><rfm:Instance name="ms1"/>"#;
+    let d = desc(kept, None).unwrap();
+    assert_eq!(d.algorithm, Algorithm::GaussSeidel);
+    assert_eq!(d.order, Some(vec!["ms2".to_string(), "ms1".to_string()]));
+    assert_eq!((d.init_sweeps, d.max_step_halvings), (4, 1));
+    // the command line's algorithm wins; Jacobi has no order
+    let d = desc(kept, Some(Algorithm::Jacobi)).unwrap();
+    assert_eq!((d.algorithm, d.order), (Algorithm::Jacobi, None));
+    // an order of components renamed since: derived from the FMUs instead
+    let stale = kept.replace(r#"name="ms1""#, r#"name="renamed""#);
+    let d = desc(&stale, None).unwrap();
+    assert_eq!((d.algorithm, d.order), (Algorithm::GaussSeidel, None));
+    let e = desc(r#"algorithm="seidel">"#, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("coupling algorithm 'seidel': expected 'jacobi' or 'gauss-seidel'"),
+        "{e}"
+    );
+    let e = desc(r#"initSweeps="-1">"#, None).unwrap_err().to_string();
+    assert!(e.contains("initSweeps = '-1': not a whole number"), "{e}");
+}
+
 /// Names SSP says are unique: a parameter set's parameters, a mapping's targets. Given twice
 /// they are refused (the last one won).
 #[test]
@@ -435,24 +486,6 @@ fn unsupported_content_is_refused_by_name() {
                 r#"<ssd:Connection startElement="ms1" startIndices="1""#,
             ),
             "startIndices",
-        ),
-        // connectors of different units: a conversion the master does not make, unless the
-        // connection suppresses it
-        (
-            oms_with(
-                ssd,
-                r#"endConnector="force" suppressUnitConversion="true"/>"#,
-                r#"endConnector="force" />"#,
-            ),
-            "unit conversion: connection 'ms1.position' [m] -> 'ms2.force' [N]",
-        ),
-        (
-            oms_with(
-                ssd,
-                r#"endConnector="force" suppressUnitConversion="1"/>"#,
-                r#"endConnector="force" suppressUnitConversion="false"/>"#,
-            ),
-            "unit conversion: connection 'ms2.velocity' [m/s] -> 'ms1.force' [N]",
         ),
         (
             oms_with(
