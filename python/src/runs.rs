@@ -7,7 +7,6 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use master::coupling::{ColumnInfo, SimOutput};
-use master::model_description::VarType;
 use master::output::{write_json_atomic, OutputError};
 use master::results::{constant_kinds, with_integer_kinds, ConstantKind, ResultsFormat};
 pub use master::runset::{completed, format_by_description};
@@ -47,20 +46,8 @@ pub fn integer_parameters<'a>(
     names: impl IntoIterator<Item = &'a String>,
 ) -> Result<BTreeSet<String>, SystemError> {
     let archives = system.open_fmus()?;
-    let instances = &system.desc.instances;
-    Ok(names
-        .into_iter()
-        .filter(|name| {
-            split_ref(name).is_some_and(|(inst, var)| {
-                instances
-                    .iter()
-                    .position(|s| s.name == inst)
-                    .and_then(|i| archives[i].model.variables.iter().find(|v| v.name == var))
-                    .is_some_and(|v| matches!(v.var_type, VarType::Integer | VarType::Enumeration))
-            })
-        })
-        .cloned()
-        .collect())
+    let models: Vec<_> = archives.iter().map(|a| &a.model).collect();
+    Ok(system.integer_parameters(&models, names))
 }
 
 /// What a run's table carries besides its numbers (each column's FMU variable, the texts of

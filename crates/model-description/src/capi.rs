@@ -829,23 +829,33 @@ pub unsafe fn do_step(c: fmi2Component, t: fmi2Real, h: fmi2Real) -> fmi2Status 
     with(c, "fmi2DoStep", |cc| cc.component.do_step(t, h))
 }
 
-/// A status kind this FMU does not provide (steps are never asynchronous; the models never
-/// end the simulation early): fmi2Discard in the states that allow the query, as FMI 2.0,
+/// A status query: a NULL value pointer is an error and the state must allow the query;
+/// `answer` gives the value, or `None` for a status kind this FMU does not provide (steps are
+/// never asynchronous; the models never end the simulation early): fmi2Discard, as FMI 2.0,
 /// 4.2.3, says, not fmi2Error, which would end the host's run.
-unsafe fn status_unavailable(
+unsafe fn status_query<T>(
     c: fmi2Component,
     call: &'static str,
-    value_is_null: bool,
-    why: &str,
+    value: *mut T,
+    unavailable: &str,
+    answer: impl FnOnce(&CComponent) -> Option<T>,
 ) -> fmi2Status {
     with(c, call, |cc| {
-        if value_is_null {
+        if value.is_null() {
             return null_arg(cc, call);
         }
         if let Err(s) = cc.component.check_status_query(call) {
             return s;
         }
-        cc.component.status_unavailable(&format!("{call}: {why}"))
+        match answer(cc) {
+            Some(v) => {
+                *value = v;
+                Status::Ok
+            }
+            None => cc
+                .component
+                .status_unavailable(&format!("{call}: {unavailable}")),
+        }
     })
 }
 
@@ -854,11 +864,12 @@ pub unsafe fn get_status(
     _kind: fmi2StatusKind,
     value: *mut fmi2Status,
 ) -> fmi2Status {
-    status_unavailable(
+    status_query(
         c,
         "fmi2GetStatus",
-        value.is_null(),
+        value,
         "no asynchronous step to report on (canRunAsynchronuously = false)",
+        |_| None,
     )
 }
 
@@ -867,11 +878,12 @@ pub unsafe fn get_integer_status(
     _kind: fmi2StatusKind,
     value: *mut fmi2Integer,
 ) -> fmi2Status {
-    status_unavailable(
+    status_query(
         c,
         "fmi2GetIntegerStatus",
-        value.is_null(),
+        value,
         "no Integer status is defined for co-simulation",
+        |_| None,
     )
 }
 
@@ -880,11 +892,12 @@ pub unsafe fn get_string_status(
     _kind: fmi2StatusKind,
     value: *mut fmi2String,
 ) -> fmi2Status {
-    status_unavailable(
+    status_query(
         c,
         "fmi2GetStringStatus",
-        value.is_null(),
+        value,
         "no pending status (canRunAsynchronuously = false)",
+        |_| None,
     )
 }
 
@@ -893,24 +906,16 @@ pub unsafe fn get_real_status(
     kind: fmi2StatusKind,
     value: *mut fmi2Real,
 ) -> fmi2Status {
-    if kind != ffi::fmi2StatusKind_fmi2LastSuccessfulTime {
-        return status_unavailable(
-            c,
-            "fmi2GetRealStatus",
-            value.is_null(),
-            "only fmi2LastSuccessfulTime is available",
-        );
-    }
-    with(c, "fmi2GetRealStatus", |cc| {
-        if value.is_null() {
-            return null_arg(cc, "fmi2GetRealStatus");
-        }
-        if let Err(s) = cc.component.check_status_query("fmi2GetRealStatus") {
-            return s;
-        }
-        *value = cc.component.last_successful_time();
-        Status::Ok
-    })
+    status_query(
+        c,
+        "fmi2GetRealStatus",
+        value,
+        "only fmi2LastSuccessfulTime is available",
+        |cc| {
+            (kind == ffi::fmi2StatusKind_fmi2LastSuccessfulTime)
+                .then(|| cc.component.last_successful_time())
+        },
+    )
 }
 
 pub unsafe fn get_boolean_status(
@@ -918,25 +923,14 @@ pub unsafe fn get_boolean_status(
     kind: fmi2StatusKind,
     value: *mut fmi2Boolean,
 ) -> fmi2Status {
-    if kind != ffi::fmi2StatusKind_fmi2Terminated {
-        return status_unavailable(
-            c,
-            "fmi2GetBooleanStatus",
-            value.is_null(),
-            "only fmi2Terminated is available",
-        );
-    }
-    with(c, "fmi2GetBooleanStatus", |cc| {
-        if value.is_null() {
-            return null_arg(cc, "fmi2GetBooleanStatus");
-        }
-        if let Err(s) = cc.component.check_status_query("fmi2GetBooleanStatus") {
-            return s;
-        }
-        // The models never ask to end the simulation early.
-        *value = 0;
-        Status::Ok
-    })
+    // the models never ask to end the simulation early
+    status_query(
+        c,
+        "fmi2GetBooleanStatus",
+        value,
+        "only fmi2Terminated is available",
+        |_| (kind == ffi::fmi2StatusKind_fmi2Terminated).then_some(0),
+    )
 }
 
 pub fn types_platform() -> *const c_char {

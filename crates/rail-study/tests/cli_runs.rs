@@ -124,8 +124,9 @@ fn sweep_runs_in_parallel_and_keeps_failures() {
     assert!(!dir.path().join("out/light").exists());
 }
 
-#[test]
-fn ctrl_c_stops_cleanly_without_result_file() {
+/// `master run` of a 2000 s system into `r.csv`, sent `signal` (a `kill` option) after
+/// 800 ms: its output, and the folder it ran in.
+fn interrupted_run(signal: &str) -> (std::process::Output, tempfile::TempDir) {
     let dir = tempfile::tempdir().unwrap();
     // long enough to be interrupted: 2000 s at 1 ms
     std::fs::write(dir.path().join("system.json"), system_json(2000.0)).unwrap();
@@ -139,11 +140,16 @@ fn ctrl_c_stops_cleanly_without_result_file() {
         .unwrap();
     std::thread::sleep(std::time::Duration::from_millis(800));
     let st = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args([signal, &child.id().to_string()])
         .status()
         .unwrap();
     assert!(st.success());
-    let out = child.wait_with_output().unwrap();
+    (child.wait_with_output().unwrap(), dir)
+}
+
+#[test]
+fn ctrl_c_stops_cleanly_without_result_file() {
+    let (out, dir) = interrupted_run("-INT");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{stderr}");
     assert!(stderr.contains("cancelled at t ="), "{stderr}");
@@ -597,23 +603,7 @@ fn the_description_in_the_metadata_runs_again_from_another_folder() {
 /// point, without a results file.
 #[test]
 fn sigterm_stops_cleanly_without_result_file() {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("system.json"), system_json(2000.0)).unwrap();
-    let child = Command::new(env!("CARGO_BIN_EXE_master"))
-        .args(["--quiet", "run"])
-        .arg(dir.path().join("system.json"))
-        .arg("-o")
-        .arg(dir.path().join("r.csv"))
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(800));
-    let st = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(st.success());
-    let out = child.wait_with_output().unwrap();
+    let (out, dir) = interrupted_run("-TERM");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{stderr}");
     assert!(stderr.contains("cancelled at t ="), "{stderr}");

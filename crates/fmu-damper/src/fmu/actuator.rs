@@ -7,7 +7,7 @@ use model_description::{
 };
 use serde::{Deserialize, Serialize};
 
-use super::{not_initialised, step_error, AUTHOR};
+use super::{not_initialised, restored_physics, step_error, AUTHOR};
 use crate::full_active::{
     Actuator, ActuatorInputs, ActuatorModel, ActuatorOutputs, ActuatorParams, RodMode,
     LEAKAGE_LITRE_READING_M3PS_PER_PA,
@@ -177,14 +177,12 @@ impl FmuModel for FullActiveActuator {
     }
 
     fn check_restored(&self) -> Result<(), String> {
-        match &self.actuator {
-            Some(a) if !a.is_built_from(&self.params) => Err(
-                "the actuator's physics is not the one its declared parameters give \
-                 (parameters altered, or not valid)"
-                    .into(),
-            ),
-            _ => Ok(()),
-        }
+        restored_physics(
+            self.actuator
+                .as_ref()
+                .map(|a| a.is_built_from(&self.params)),
+            "actuator",
+        )
     }
 
     fn update_outputs(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {

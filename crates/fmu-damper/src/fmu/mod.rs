@@ -110,6 +110,18 @@ macro_rules! declare_appended_parameters {
 }
 pub(crate) use declare_appended_parameters;
 
+/// [`model_description::FmuModel::check_restored`] of a shell whose physics (`what`, built
+/// or not yet) must be the one its declared parameters give.
+fn restored_physics(built_from_parameters: Option<bool>, what: &str) -> Result<(), String> {
+    match built_from_parameters {
+        Some(false) => Err(format!(
+            "the {what}'s physics is not the one its declared parameters give (parameters \
+             altered, or not valid)"
+        )),
+        _ => Ok(()),
+    }
+}
+
 fn not_initialised() -> StepError {
     StepError::Error(ModelError::Other(
         "the physics is built in fmi2ExitInitializationMode; no step before it".into(),

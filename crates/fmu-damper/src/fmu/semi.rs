@@ -7,7 +7,7 @@ use model_description::{
 };
 use serde::{Deserialize, Serialize};
 
-use super::{not_initialised, step_error, AUTHOR};
+use super::{not_initialised, restored_physics, step_error, AUTHOR};
 use crate::semi_active::{
     SemiActiveDamper as Physics, SemiActiveInputs, SemiActiveOutputs, SemiActiveParams,
 };
@@ -95,14 +95,10 @@ impl SemiShell {
 
     /// A restored state's physics was built from the declared parameters.
     fn check_restored(&self) -> Result<(), String> {
-        match &self.damper {
-            Some(d) if !d.is_built_from(&self.params) => Err(
-                "the damper's physics is not the one its declared parameters give \
-                 (parameters altered, or not valid)"
-                    .into(),
-            ),
-            _ => Ok(()),
-        }
+        restored_physics(
+            self.damper.as_ref().map(|d| d.is_built_from(&self.params)),
+            "damper",
+        )
     }
 
     fn report_clamp(&mut self, diag: &mut Diagnostics) {

@@ -290,24 +290,33 @@ const MAP_SSM: &str = r#"<ssm:ParameterMapping xmlns:ssm="http://ssp-standard.or
   <ssm:MappingEntry source="ms.stiffness" target="ms.k"><ssc:LinearTransformation factor="100" offset="5"/></ssm:MappingEntry>
 </ssm:ParameterMapping>"#;
 
-#[test]
-fn ssp2_prefix_mapping_and_precedence() {
+/// The SSP 2.0 archive (V2_SSD) in `dir` with these parameter set and mapping members.
+fn v2_archive(dir: &Path, ssv: &str, ssm: &str) -> PathBuf {
     let ssd = format!("{HEAD}{V2_SSD}");
-    let d = tempfile::tempdir().unwrap();
-    let p = ssp(
-        d.path(),
+    ssp(
+        dir,
         &[
             ("SystemStructure.ssd", &ssd),
             ("resources/ms.fmu", ""),
-            ("resources/bare.ssv", BARE_SSV),
-            ("resources/map.ssm", MAP_SSM),
+            ("resources/bare.ssv", ssv),
+            ("resources/map.ssm", ssm),
         ],
-    );
-    let opts = ImportOptions {
+    )
+}
+
+/// Import options giving the 1 ms step the V2 archive lacks.
+fn stepped() -> ImportOptions {
+    ImportOptions {
         step: Some(0.001),
         ..Default::default()
-    };
-    let imp = import(&p, &opts).unwrap();
+    }
+}
+
+#[test]
+fn ssp2_prefix_mapping_and_precedence() {
+    let d = tempfile::tempdir().unwrap();
+    let p = v2_archive(d.path(), BARE_SSV, MAP_SSM);
+    let imp = import(&p, &stepped()).unwrap();
     assert_eq!(imp.version, "2.0");
     let params = &imp.system.desc.instances[0].parameters;
     // the system binding (mapped: 100 * 2 + 5) wins over the component's k = 1; only mapped
@@ -380,23 +389,11 @@ fn the_masters_coupling_annotation_is_read_and_checked() {
 /// they are refused (the last one won).
 #[test]
 fn a_parameter_or_mapping_target_given_twice_is_refused() {
-    let ssd = format!("{HEAD}{V2_SSD}");
     let import_with = |ssv: &str, ssm: &str| {
         let d = tempfile::tempdir().unwrap();
-        let p = ssp(
-            d.path(),
-            &[
-                ("SystemStructure.ssd", &ssd),
-                ("resources/ms.fmu", ""),
-                ("resources/bare.ssv", ssv),
-                ("resources/map.ssm", ssm),
-            ],
-        );
-        let opts = ImportOptions {
-            step: Some(0.001),
-            ..Default::default()
-        };
-        import(&p, &opts).map(|_| ()).map_err(|e| e.to_string())
+        import(&v2_archive(d.path(), ssv, ssm), &stepped())
+            .map(|_| ())
+            .map_err(|e| e.to_string())
     };
     assert!(import_with(BARE_SSV, MAP_SSM).is_ok());
     let twice = BARE_SSV.replace(r#"name="unused""#, r#"name="stiffness""#);

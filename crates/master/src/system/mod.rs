@@ -365,6 +365,29 @@ impl LoadedSystem {
         d
     }
 
+    /// Of the parameter names `keys` (`instance.variable`), those that are Integers or
+    /// Enumerations in their FMUs' model descriptions `models` (one per instance; the others,
+    /// and names that are not the system's, are left out): the columns a run set's tables
+    /// hold as integers.
+    pub fn integer_parameters<'a>(
+        &self,
+        models: &[&ModelDescription],
+        keys: impl IntoIterator<Item = &'a String>,
+    ) -> std::collections::BTreeSet<String> {
+        keys.into_iter()
+            .filter(|key| {
+                split_ref(key).is_some_and(|(inst, var)| {
+                    self.instance_index(inst)
+                        .and_then(|i| models[i].variable(var))
+                        .is_some_and(|(_, v)| {
+                            matches!(v.var_type, VarType::Integer | VarType::Enumeration)
+                        })
+                })
+            })
+            .cloned()
+            .collect()
+    }
+
     /// Opens and checks every instance's FMU (no binary is loaded).
     pub fn open_fmus(&self) -> Result<Vec<FmuArchive>, SystemError> {
         let mut cache: HashMap<PathBuf, FmuArchive> = HashMap::new();

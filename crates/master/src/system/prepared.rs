@@ -11,7 +11,7 @@ use super::plan::start_value;
 use super::{split_ref, LoadedSystem, RunError, SystemError};
 use crate::coupling::{simulate, CouplingPlan, RunOptions, SimOutput};
 use crate::fmu::{FmuSlave, PreparedFmu};
-use crate::model_description::VarType;
+use crate::model_description::ModelDescription;
 use crate::show::text;
 use crate::slave::{Slave, VarRef};
 
@@ -102,22 +102,8 @@ impl PreparedSystem {
         &self,
         keys: impl IntoIterator<Item = &'a String>,
     ) -> BTreeSet<String> {
-        keys.into_iter()
-            .filter(|key| {
-                split_ref(key).is_some_and(|(inst, var)| {
-                    let instances = &self.system.desc.instances;
-                    instances
-                        .iter()
-                        .position(|s| s.name == inst)
-                        .is_some_and(|i| {
-                            self.fmus[i].model().variable(var).is_some_and(|(_, v)| {
-                                matches!(v.var_type, VarType::Integer | VarType::Enumeration)
-                            })
-                        })
-                })
-            })
-            .cloned()
-            .collect()
+        let models: Vec<&ModelDescription> = self.fmus.iter().map(|f| f.model()).collect();
+        self.system.integer_parameters(&models, keys)
     }
 
     /// Validates the start values of one run (`instance.variable` -> value, as in a run set)
