@@ -46,6 +46,9 @@ pub struct VehicleLocus {
     pub results: Vec<EigenResult>,
     /// Linear critical speed in [`CRITICAL_SEARCH_MPS`], or why there is none.
     pub critical: Result<CriticalSpeed, String>,
+    /// sqrt(lambda / (r0 s)) [rad/m]: times the speed, the angular frequency of a free
+    /// wheelset's kinematic (Klingel) oscillation, above which no hunting mode of the coach lies.
+    pub kinematic_rad_per_m: f64,
 }
 
 fn vehicle_err(e: EigenError) -> AnalysisError {
@@ -78,13 +81,27 @@ pub fn vehicle_root_locus(
             )),
             Err(e) => return Err(vehicle_err(e)),
         };
+    let kinematic_rad_per_m = (params.wheel_rail.conicity
+        / (params.wheelset.wheel_radius_m * params.wheelset.half_contact_gauge_m))
+        .sqrt();
     Ok(VehicleLocus {
         damper,
         mounting_n_per_m,
         speeds_kmh: speeds_kmh.to_vec(),
         results,
         critical,
+        kinematic_rad_per_m,
     })
+}
+
+/// -re / |lambda| of an eigenvalue (re, im).
+fn damping_ratio((re, im): (f64, f64)) -> f64 {
+    let n = re.hypot(im);
+    if n > 0.0 {
+        -re / n
+    } else {
+        0.0
+    }
 }
 
 /// Number of the mode kind in the CSV (0 car body, 1 front bogie, 2 rear bogie, 3 both).
@@ -108,11 +125,13 @@ impl VehicleLocus {
     }
 
     /// The hunting mode (re, im) at each speed of the grid, followed from the mode that
-    /// crosses at the critical speed (without one, from the least-damped mode at the highest
-    /// speed): each neighbouring speed takes its oscillatory eigenvalue nearest to the one
-    /// before. The least-damped mode is another one at low speeds (the passive coach: a 90 Hz
-    /// mode of the bogies below 215 km/h), which made the frequency figure jump from 90 to
-    /// 3.5 Hz.
+    /// crosses at the critical speed: each neighbouring speed takes its oscillatory eigenvalue
+    /// nearest to the one before. The least-damped mode is another one at low speeds (the
+    /// passive coach: a 90 Hz mode of the bogies below 215 km/h), which made the frequency
+    /// figure jump from 90 to 3.5 Hz. Without a crossing (a stiff damper) the start is the
+    /// least-damped oscillatory eigenvalue at the highest speed among those below the free
+    /// wheelset's kinematic frequency there (bogie and car-body hunting both lie below it;
+    /// the closed semi-active valve's least-damped mode overall is a 66 Hz one of the bogies).
     pub fn hunting_mode(&self) -> Vec<Option<(f64, f64)>> {
         let mut followed = vec![None; self.results.len()];
         let nearest = |k: usize, to: (f64, f64)| {
@@ -137,12 +156,14 @@ impl VehicleLocus {
                         .total_cmp(&(b.1 - c.speed_kmh).abs())
                 })
                 .and_then(|(k, _)| Some((k, nearest(k, (c.mode.re, c.mode.im))?))),
-            Err(_) => self
-                .results
-                .iter()
-                .enumerate()
-                .rev()
-                .find_map(|(k, r)| r.least_damped.map(|m| (k, (m.re, m.im)))),
+            Err(_) => self.results.iter().enumerate().rev().find_map(|(k, r)| {
+                let kinematic = self.kinematic_rad_per_m * self.speeds_kmh[k] / 3.6;
+                r.eigenvalues
+                    .iter()
+                    .filter(|e| e.1 > 0.0 && e.1 <= kinematic)
+                    .min_by(|a, b| damping_ratio(**a).total_cmp(&damping_ratio(**b)))
+                    .map(|e| (k, *e))
+            }),
         };
         let Some((k0, mode)) = start else {
             return followed;
@@ -168,7 +189,11 @@ impl VehicleLocus {
             model: "coach",
             damper: self.damper.describe(),
             mode: "hunting mode",
-            mode_column: "hunting mode (followed from the critical speed)",
+            mode_column: if self.critical.is_ok() {
+                "hunting mode (followed from the critical speed)"
+            } else {
+                "hunting mode (followed from the least-damped mode below the kinematic frequency at the highest speed)"
+            },
             frequency_title: "Frequency of the hunting mode vs speed (linear coach)".into(),
             speeds: LocusSpeed::over(
                 &self.speeds_kmh,
@@ -297,6 +322,29 @@ mod tests {
         .unwrap();
         let v_soft = soft.critical.as_ref().unwrap().speed_kmh;
         assert!((v_soft - 309.6).abs() < 3.0, "{v_soft} vs {}", c.speed_kmh);
+    }
+
+    #[test]
+    fn without_a_crossing_the_figures_follow_hunting_not_a_wheelset_mode() {
+        // the closed valve linearised at +-2 mm, 4 Hz (`--damper semi-active:0:2e-3`): stable
+        // to the end of the search; its least-damped mode is a 66 Hz one of the bogies
+        let speeds = speed_grid_kmh(100.0, 400.0, 50.0).unwrap();
+        let r = vehicle_root_locus(
+            &VehicleParams::default(),
+            DamperSpec::KelvinVoigt(6.43e6, 202.5e3),
+            None,
+            &speeds,
+        )
+        .unwrap();
+        assert!(r.critical.is_err(), "{:?}", r.critical);
+        let top = r.results.last().unwrap().least_damped.unwrap();
+        assert!(top.freq_hz > 50.0, "{top:?}");
+        for (v, m) in speeds.iter().zip(r.hunting_mode()) {
+            let f = m.unwrap().1 / (2.0 * std::f64::consts::PI);
+            // measured: 2.5 Hz at 100 km/h to 4.6 Hz at 400
+            assert!((1.5..=6.0).contains(&f), "{v} km/h: {f} Hz");
+        }
+        assert!(r.figures().mode_column.contains("kinematic frequency"));
     }
 
     #[test]
