@@ -18,7 +18,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::plot::{Chart, PlotError};
-use master::output::{csv_field, write_bytes_atomic, OutputError};
+use master::output::{bytes_unfinished, csv_field, OutputError, Unfinished};
 
 pub mod actuator;
 pub mod assess;
@@ -167,8 +167,10 @@ impl Artefacts {
         self.files.iter().map(|(n, _)| n.as_str()).collect()
     }
 
-    /// Creates `dir` (and parents) and writes every file atomically; returns the paths written.
-    pub fn write_all(&self, dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
+    /// Creates `dir` (and parents) and writes every file into a temporary file beside its
+    /// destination, none committed yet: a failed write (a full disk) removes the ones written
+    /// and leaves the folder as it was.
+    pub fn stage_all(&self, dir: &Path) -> Result<Vec<Unfinished>, OutputError> {
         std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
             path: dir.to_path_buf(),
             source,
@@ -177,14 +179,28 @@ impl Artefacts {
         // must not leave the others new and the rest from an earlier call
         let paths: Vec<PathBuf> = self.files.iter().map(|(name, _)| dir.join(name)).collect();
         master::output::check_outputs_apart(&[], &paths)?;
-        let mut written = Vec::with_capacity(self.files.len());
-        for (name, bytes) in &self.files {
-            let path = dir.join(name);
-            write_bytes_atomic(&path, bytes)?;
-            written.push(path);
-        }
-        Ok(written)
+        self.files
+            .iter()
+            .zip(&paths)
+            .map(|((_, bytes), path)| bytes_unfinished(path, bytes))
+            .collect()
     }
+
+    /// Writes every file ([`Self::stage_all`]) and only then renames them onto their names,
+    /// so that a failed write replaces none of the earlier files; returns the paths written.
+    pub fn write_all(&self, dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
+        commit_all(self.stage_all(dir)?)
+    }
+}
+
+/// Renames staged files onto their destinations, in order; returns their paths.
+pub fn commit_all(staged: Vec<Unfinished>) -> Result<Vec<PathBuf>, OutputError> {
+    let mut written = Vec::with_capacity(staged.len());
+    for file in staged {
+        written.push(file.path().to_path_buf());
+        file.commit()?;
+    }
+    Ok(written)
 }
 
 #[cfg(test)]
@@ -212,5 +228,41 @@ mod tests {
         assert_eq!(paths.len(), 1);
         assert_eq!(std::fs::read_to_string(&paths[0]).unwrap(), "a\n1\n");
         assert_eq!(a.names(), vec!["x.csv"]);
+    }
+
+    #[test]
+    fn a_set_that_cannot_be_written_in_full_replaces_none_of_the_earlier_files() {
+        let d = tempfile::tempdir().unwrap();
+        let mut a = Artefacts::default();
+        a.add_text("a.csv", "new a\n".into());
+        a.add_text("b.csv", "new b\n".into());
+        std::fs::write(d.path().join("a.csv"), "old a\n").unwrap();
+        std::fs::write(d.path().join("b.csv"), "old b\n").unwrap();
+        // staged, not committed: the earlier files stay until the whole set is written
+        let staged = a.stage_all(d.path()).unwrap();
+        assert_eq!(staged.len(), 2);
+        let read = |n: &str| std::fs::read_to_string(d.path().join(n)).unwrap();
+        assert_eq!(
+            (read("a.csv"), read("b.csv")),
+            ("old a\n".into(), "old b\n".into())
+        );
+        drop(staged);
+        let names = |d: &Path| {
+            let mut v: Vec<String> = std::fs::read_dir(d)
+                .unwrap()
+                .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect();
+            v.sort();
+            v
+        };
+        // dropped (a later file failed): no temporary file left, nothing replaced
+        assert_eq!(names(d.path()), vec!["a.csv", "b.csv"]);
+        assert_eq!(read("a.csv"), "old a\n");
+        let written = a.write_all(d.path()).unwrap();
+        assert_eq!(written.len(), 2);
+        assert_eq!(
+            (read("a.csv"), read("b.csv")),
+            ("new a\n".into(), "new b\n".into())
+        );
     }
 }

@@ -81,8 +81,26 @@ pub(crate) fn write_analysis(
         // a file read this time (a profile passed back in) stays
         .filter(|n| master::output::check_outputs_apart(inputs, &[out.join(n)]).is_ok())
         .collect();
-    files.write_all(out)?;
+    // the files and the list of them written in full before any replaces an earlier one (a
+    // full disk must not leave the folder holding two runs' files)
+    let manifest = |listed: &[String]| -> Result<Artefacts, CommandError> {
+        let json = serde_json::json!({
+            "command": command.name,
+            "summary": summary,
+            "files": listed,
+        });
+        let text = serde_json::to_string_pretty(&json)
+            .map_err(|e| CommandError::Failed(format!("{manifest_name}: {e}")))?;
+        let mut list = Artefacts::default();
+        list.add_text(&manifest_name, text + "\n");
+        Ok(list)
+    };
     let mut listed = written;
+    let mut list = manifest(&listed)?;
+    let mut staged = files.stage_all(out)?;
+    staged.extend(list.stage_all(out)?);
+    crate::analysis::commit_all(staged)?;
+    let mut kept = false;
     for name in stale {
         if let Err(e) = master::output::remove_stale_file(&out.join(&name)) {
             eprintln!(
@@ -91,18 +109,14 @@ pub(crate) fn write_analysis(
                 command.name
             );
             listed.push(name);
+            kept = true;
         }
     }
-    let manifest = serde_json::json!({
-        "command": command.name,
-        "summary": summary,
-        "files": listed,
-    });
-    let text = serde_json::to_string_pretty(&manifest)
-        .map_err(|e| CommandError::Failed(format!("{manifest_name}: {e}")))?;
-    let mut list = Artefacts::default();
-    list.add_text(&manifest_name, text + "\n");
-    list.write_all(out)?;
+    if kept {
+        // listed for the next run to try again
+        list = manifest(&listed)?;
+        list.write_all(out)?;
+    }
     files.files.extend(list.files);
     print_report(summary, &files, out);
     Ok(())
