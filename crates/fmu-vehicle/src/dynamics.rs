@@ -111,13 +111,17 @@ impl LinearContactConsts {
 impl Consts {
     /// Largest internal step the explicit RK4 needs for stability and accuracy \[s\]: 1.5 over
     /// the fastest creep-damping rate (lateral 2 kappa f22/(V m_w), yaw 2 kappa f11 s^2/(V I_w),
-    /// spin 2 kappa f11 r0^2/(V J_w)), and 1 over the highest frequency bound (Gershgorin bound
+    /// spin 2 kappa f11 r0^2/(V J_w); the suspension's damping, Gershgorin bound of M^-1 C),
+    /// and 1 over the highest frequency bound (Gershgorin bound
     /// of M^-1 K of the suspension, and the contact-angle stiffness P d tan(gamma)/dy of the
     /// table or k_g of the linear model, on one wheelset).
     pub fn stable_substep_s(&self, p: &VehicleParams, table: &GeometryTable) -> f64 {
         let w = &p.wheelset;
+        // creep damping, and the suspension's own (a large damping of a light body decays
+        // faster than an explicit step can follow)
         let mut rate = (2.0 * self.f22 / (self.v * w.mass_kg))
-            .max(2.0 * self.f11 * self.s * self.s / (self.v * w.yaw_inertia_kgm2));
+            .max(2.0 * self.f11 * self.s * self.s / (self.v * w.yaw_inertia_kgm2))
+            .max(self.suspension.damping_gershgorin_bound(&self.minv));
         let k_contact = if self.nonlinear {
             rate = rate.max(2.0 * self.f11 * self.r0 * self.r0 * self.jw_inv / self.v);
             self.load * table.max_tan_gamma_slope()

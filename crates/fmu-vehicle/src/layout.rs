@@ -330,6 +330,20 @@ pub struct SparseSuspension {
     c: Vec<f64>,
 }
 
+/// max_i sum_j |A_ij| / M_i of a matrix stored by column.
+fn row_sum_bound(a: &[f64], minv: &[f64; N_DOF]) -> f64 {
+    let mut rows = [0.0; N_DOF];
+    for col in a.chunks_exact(N_DOF) {
+        for (r, x) in rows.iter_mut().zip(col) {
+            *r += x.abs();
+        }
+    }
+    rows.iter()
+        .zip(minv)
+        .map(|(r, m)| r * m)
+        .fold(0.0, f64::max)
+}
+
 /// The serialised form of [`SparseSuspension`] before its check.
 #[derive(Deserialize)]
 struct SuspensionColumns {
@@ -384,16 +398,12 @@ impl SparseSuspension {
 
     /// Gershgorin bound of the largest eigenvalue of M^-1 K: max_i sum_j |K_ij| / M_i.
     pub fn gershgorin_bound(&self, minv: &[f64; N_DOF]) -> f64 {
-        let mut rows = [0.0; N_DOF];
-        for col in self.k.chunks_exact(N_DOF) {
-            for (r, k) in rows.iter_mut().zip(col) {
-                *r += k.abs();
-            }
-        }
-        rows.iter()
-            .zip(minv)
-            .map(|(r, m)| r * m)
-            .fold(0.0, f64::max)
+        row_sum_bound(&self.k, minv)
+    }
+
+    /// The same bound for M^-1 C [1/s]: the fastest decay rate the suspension's damping gives.
+    pub fn damping_gershgorin_bound(&self, minv: &[f64; N_DOF]) -> f64 {
+        row_sum_bound(&self.c, minv)
     }
 
     /// Number of non-zero entries of K or C.

@@ -25,7 +25,7 @@ use wheel_rail::{GeometryTable, SegmentHint, TableError};
 use crate::dynamics::{rhs, Consts, Eval, N_STATES, RATES};
 use crate::layout::{
     damper_bogie, damper_side, frame_roll, frame_y, frame_yaw, wheelset_y, wheelset_yaw, Positions,
-    CARBODY_ROLL, CARBODY_Y, CARBODY_YAW, N_BOGIES, N_DAMPERS, N_WHEELSETS,
+    Suspension, CARBODY_ROLL, CARBODY_Y, CARBODY_YAW, N_BOGIES, N_DAMPERS, N_WHEELSETS,
 };
 use crate::params::{ContactSource, ParamError, TrackSource, VehicleParams};
 use wheel_rail::track::{DelayLine, TrackGenerator};
@@ -68,6 +68,84 @@ pub enum ModelError {
         /// Range end on that side \[mm\].
         range_mm: f64,
     },
+    /// The suspension cannot hold the car body and frames upright on wheelsets held still:
+    /// gravity's overturning moment (heights of the centres of gravity above the springs)
+    /// exceeds the roll stiffness, and the small-angle model would let the body tip over.
+    #[error(
+        "the suspension cannot hold the car body and bogie frames upright: the stiffness of \
+         car body and frames on fixed wheelsets is not positive definite (smallest eigenvalue \
+         {smallest:.3e}, a {body} roll or sway); raise the vertical or anti-roll stiffness \
+         (secondary.*, primary.*) or their lateral spacing, or lower carbody.cg_height / \
+         frame.cg_height"
+    )]
+    StaticallyUnstable {
+        /// Smallest eigenvalue of that stiffness matrix (of mixed units).
+        smallest: f64,
+        /// The body with the largest share of that eigenvector.
+        body: &'static str,
+    },
+    /// A wheelset starts beyond the contact table's range (derailed before the first step).
+    #[error(
+        "the initial displacement puts wheelset {wheelset} {y_mm:.2} mm from the track centre, \
+         beyond the contact table's range ({lo_mm:.2} to {hi_mm:.2} mm): lower \
+         initial.lateral_displacement or initial.yaw_angle"
+    )]
+    StartsDerailed {
+        /// Wheelset number, 1 = leading.
+        wheelset: usize,
+        /// Its initial lateral displacement \[mm\].
+        y_mm: f64,
+        /// The table's range \[mm\].
+        lo_mm: f64,
+        hi_mm: f64,
+    },
+}
+
+/// The car body and frames rest statically stable on wheelsets held still: the stiffness
+/// matrix over their dofs (lateral, yaw, roll each; gravitational roll terms included) is
+/// positive definite.
+fn check_static_stability(params: &VehicleParams) -> Result<(), ModelError> {
+    let k = Suspension::new(params).k;
+    let dofs = [
+        CARBODY_Y,
+        CARBODY_YAW,
+        CARBODY_ROLL,
+        frame_y(0),
+        frame_yaw(0),
+        frame_roll(0),
+        frame_y(1),
+        frame_yaw(1),
+        frame_roll(1),
+    ];
+    // scaled to unit diagonal so that N/m and N m/rad compare
+    let scale: Vec<f64> = dofs
+        .iter()
+        .map(|&i| k[(i, i)].abs().sqrt().max(1e-300))
+        .collect();
+    let sub = nalgebra::DMatrix::from_fn(dofs.len(), dofs.len(), |r, c| {
+        0.5 * (k[(dofs[r], dofs[c])] + k[(dofs[c], dofs[r])]) / (scale[r] * scale[c])
+    });
+    let eigen = sub.symmetric_eigen();
+    let (at, &smallest) = eigen
+        .eigenvalues
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(b.1))
+        .unwrap_or((0, &1.0));
+    if smallest > 1e-9 {
+        return Ok(());
+    }
+    let v = eigen.eigenvectors.column(at);
+    let share = |range: std::ops::Range<usize>| range.map(|i| v[i] * v[i]).sum::<f64>();
+    let body = [
+        ("car-body", share(0..3)),
+        ("front frame", share(3..6)),
+        ("rear frame", share(6..9)),
+    ]
+    .into_iter()
+    .max_by(|a, b| a.1.total_cmp(&b.1))
+    .map_or("car-body", |b| b.0);
+    Err(ModelError::StaticallyUnstable { smallest, body })
 }
 
 /// Errors of a step or an output evaluation; the model is unchanged after any of them.
@@ -287,6 +365,18 @@ impl Vehicle {
             state[wheelset_y(j)] = params.initial.lateral_m - arm * params.initial.yaw_rad;
             state[wheelset_yaw(j)] = params.initial.yaw_rad;
         }
+        let (lo, hi) = table.y_range();
+        for j in 0..N_WHEELSETS {
+            let y = state[wheelset_y(j)];
+            if !(lo..=hi).contains(&y) {
+                return Err(ModelError::StartsDerailed {
+                    wheelset: j + 1,
+                    y_mm: y * 1e3,
+                    lo_mm: lo * 1e3,
+                    hi_mm: hi * 1e3,
+                });
+            }
+        }
         let longest = positions.wheelset_delay_m[N_WHEELSETS - 1];
         let track = match params.track {
             TrackSource::None => Track::None,
@@ -299,6 +389,8 @@ impl Vehicle {
             Consts::new(p, &table).stable_substep_s(p, &table)
         })?;
         let substep_s = params.solver_substep_s.min(stable_s);
+        // after the step check, which refuses stiffnesses too far apart to compare
+        check_static_stability(&params)?;
         Ok(Self {
             substep_s,
             table_range_m: table.y_range(),

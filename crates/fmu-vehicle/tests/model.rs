@@ -332,3 +332,77 @@ fn restored_damper_rows_must_index_the_dofs() {
     let e = serde_json::from_value::<Consts>(bad).unwrap_err();
     assert!(e.to_string().contains("beyond the"), "{e}");
 }
+
+#[test]
+fn a_car_body_the_suspension_cannot_hold_upright_is_refused() {
+    // a centre of gravity 6 m high without anti-roll bar: gravity's overturning moment beats
+    // the air springs' roll stiffness (it tipped over to 127 degrees in 30 s, every step OK)
+    let mut p = VehicleParams::default();
+    p.carbody.cg_height_m = 6.0;
+    p.secondary.anti_roll_bar_nm_per_rad = 0.0;
+    let e = Vehicle::new(p).unwrap_err();
+    assert!(matches!(e, ModelError::StaticallyUnstable { .. }), "{e}");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("upright") && msg.contains("car-body") && msg.contains("cg_height"),
+        "{msg}"
+    );
+    // the calibrated coach, and the same centre of gravity with its anti-roll bar, stand
+    assert!(Vehicle::new(VehicleParams::default()).is_ok());
+    let mut p = VehicleParams::default();
+    p.carbody.cg_height_m = 2.5;
+    assert!(Vehicle::new(p).is_ok());
+}
+
+#[test]
+fn a_start_beyond_the_contact_table_is_refused_before_the_first_step() {
+    let e = Vehicle::new(VehicleParams {
+        initial: Initial {
+            lateral_m: 12e-3,
+            yaw_rad: 0.0,
+        },
+        ..VehicleParams::default()
+    })
+    .unwrap_err();
+    assert!(
+        matches!(e, ModelError::StartsDerailed { wheelset: 1, .. }),
+        "{e}"
+    );
+    assert!(
+        e.to_string().contains("initial.lateral_displacement"),
+        "{e}"
+    );
+    // a yaw angle that puts the leading wheelset past the table's end
+    let e = Vehicle::new(VehicleParams {
+        initial: Initial {
+            lateral_m: 0.0,
+            yaw_rad: 0.009,
+        },
+        ..VehicleParams::default()
+    })
+    .unwrap_err();
+    assert!(matches!(e, ModelError::StartsDerailed { .. }), "{e}");
+}
+
+#[test]
+fn a_large_suspension_damping_shortens_the_internal_step_instead_of_diverging() {
+    // 3 MN s/m of lateral secondary damping: the explicit step of the default sub-step
+    // diverged (frame acceleration -1.2e8 m/s^2 with every step OK, then a "derailment")
+    let mut p = VehicleParams {
+        track: TrackSource::None,
+        ..VehicleParams::default()
+    };
+    p.secondary.lateral_damping_ns_per_m = 3e6;
+    let default_substep = Vehicle::new(VehicleParams::default()).unwrap().substep_s();
+    let mut v = Vehicle::new(p).unwrap();
+    assert!(v.substep_s() < default_substep, "{}", v.substep_s());
+    let mut peak: f64 = 0.0;
+    for _ in 0..500 {
+        let o = v.step(1e-3, &Inputs::default()).unwrap();
+        for f in &o.frame {
+            peak = peak.max(f.lateral_acc_leading_axle_mps2.abs());
+        }
+    }
+    // measured with a 0.1 ms sub-step: 9.2 m/s^2 at most
+    assert!(peak < 50.0, "{peak}");
+}
