@@ -30,8 +30,11 @@ impl FieldError for PhysicsModelError {
         match self {
             PhysicsModelError::Param(p) => p.field(),
             // The contact table is the shell's field `contact`.
-            PhysicsModelError::Contact(_) => Some("contact"),
+            PhysicsModelError::Contact(_) | PhysicsModelError::FlangeNotCovered(_) => {
+                Some("contact")
+            }
             PhysicsModelError::TooStiff(e) => e.parameter.as_deref(),
+            PhysicsModelError::StartsDerailed { .. } => Some("initial_lateral_m"),
         }
     }
 
@@ -40,6 +43,7 @@ impl FieldError for PhysicsModelError {
             PhysicsModelError::Param(p) => p.reason(),
             PhysicsModelError::Contact(c) => c.to_string(),
             PhysicsModelError::TooStiff(e) => e.reason(),
+            other => other.to_string(),
         }
     }
 }

@@ -884,3 +884,73 @@ fn outputs_for_new_damper_forces_equal_a_full_evaluation() {
         assert_eq!(b.step(1e-3, &i).unwrap(), fresh.step(1e-3, &i).unwrap());
     }
 }
+
+/// The non-linear model's derailment limit is its contact table's range, as the coach's: a
+/// table that stops short of the flange is refused, a start beyond the table is refused before
+/// the first step, and a wheelset pushed past the table's end is a derailment there (the table
+/// used to be extrapolated to a fixed 50 mm, 40 mm off the track with fmi2OK).
+#[test]
+fn the_contact_table_bounds_the_non_linear_model() {
+    let nonlinear = Params {
+        model: ModelKind::NonLinear,
+        track: TrackSource::None,
+        ..Params::default()
+    };
+    // a +-3 mm cone of 0.2 without flange
+    let tread = GeometryTable::parse_csv(
+        "y_m,delta_r_left_m,delta_r_right_m,tan_gamma_left,tan_gamma_right\n\
+         -0.003,-0.0006,0.0006,0.05,0.05\n0.003,0.0006,-0.0006,0.05,0.05\n",
+        "tread.csv",
+    )
+    .unwrap();
+    let e = Bogie::with_table(nonlinear.clone(), tread.clone()).unwrap_err();
+    assert!(matches!(e, ModelError::FlangeNotCovered(_)), "{e}");
+    assert!(e.to_string().contains("does not cover the flange"), "{e}");
+    // the linear model does not use the table
+    let linear = Params {
+        model: ModelKind::Linear,
+        ..nonlinear.clone()
+    };
+    assert!(Bogie::with_table(linear, tread).is_ok());
+
+    let table = default_table();
+    let (lo, hi) = table.y_range();
+    let e = Bogie::with_table(
+        Params {
+            initial_lateral_m: hi + 1e-3,
+            initial_yaw_rad: 0.0,
+            ..nonlinear.clone()
+        },
+        table.clone(),
+    )
+    .unwrap_err();
+    assert!(matches!(e, ModelError::StartsDerailed { .. }), "{e}");
+    assert!(
+        e.to_string().contains("initial.lateral_displacement"),
+        "{e}"
+    );
+
+    let mut b = Bogie::with_table(nonlinear, table).unwrap();
+    let push = Inputs {
+        damper_left_force_n: 2e5,
+        damper_right_force_n: -2e5,
+        ..Inputs::default()
+    };
+    let mut last = None;
+    for _ in 0..2000 {
+        match b.step(1e-3, &push) {
+            Ok(o) => {
+                for y in [o.wheelset_front_rel_track_m, o.wheelset_rear_rel_track_m] {
+                    assert!((lo..=hi).contains(&y), "{y} with fmi2OK");
+                }
+            }
+            Err(e) => {
+                last = Some(e);
+                break;
+            }
+        }
+    }
+    let e = last.expect("pushed past the flange");
+    assert!(matches!(e, StepError::Derailed { .. }), "{e}");
+    assert!(e.to_string().contains("contact table's range"), "{e}");
+}

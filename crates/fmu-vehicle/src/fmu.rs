@@ -44,9 +44,7 @@ impl FieldError for PhysicsModelError {
         match self {
             PhysicsModelError::Param(p) => p.field(),
             // The contact table is the shell's field `contact`.
-            PhysicsModelError::Table(_) | PhysicsModelError::FlangeNotCovered { .. } => {
-                Some("contact")
-            }
+            PhysicsModelError::Table(_) | PhysicsModelError::FlangeNotCovered(_) => Some("contact"),
             // the load and what follows it are calculated parameters of the masses
             PhysicsModelError::TooStiff(e) if from_the_masses(e) => Some("wheelset.wheel_load"),
             PhysicsModelError::TooStiff(e) => e.parameter.as_deref(),

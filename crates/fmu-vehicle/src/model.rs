@@ -20,7 +20,7 @@ use serde::{Deserialize, Serialize};
 use vehicle_elements::{check_inputs, check_step, stable_substep, substep_count, TooStiff};
 
 pub use vehicle_elements::InputError;
-use wheel_rail::{GeometryTable, SegmentHint, TableError};
+use wheel_rail::{FlangeNotCovered, GeometryTable, SegmentHint, TableError};
 
 use crate::dynamics::{rhs, Consts, Eval, N_STATES, RATES};
 use crate::layout::{
@@ -39,9 +39,6 @@ pub fn worn_surrogate_table() -> Result<GeometryTable, TableError> {
     GeometryTable::parse_csv(WORN_SURROGATE_CSV, "built-in wheel_rail_worn_surrogate.csv")
 }
 
-/// tan(gamma) a table must reach on each side to cover the flange.
-pub const FLANGE_TAN_GAMMA: f64 = 1.0;
-
 /// Errors when building the model.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ModelError {
@@ -55,19 +52,8 @@ pub enum ModelError {
     #[error(transparent)]
     TooStiff(#[from] TooStiff),
     /// The contact table does not reach flange contact on one side.
-    #[error(
-        "contact table does not cover the flange: on the {side} wheel tan(gamma) reaches only \
-         {max_tan_gamma:.3} within the table's range ({range_mm:.2} mm), flange contact needs \
-         at least {FLANGE_TAN_GAMMA}"
-    )]
-    FlangeNotCovered {
-        /// "left" or "right".
-        side: &'static str,
-        /// Largest tan(gamma) of that side.
-        max_tan_gamma: f64,
-        /// Range end on that side \[mm\].
-        range_mm: f64,
-    },
+    #[error(transparent)]
+    FlangeNotCovered(#[from] FlangeNotCovered),
     /// The suspension cannot hold the car body and frames upright on wheelsets held still:
     /// gravity's overturning moment (heights of the centres of gravity above the springs)
     /// exceeds the roll stiffness, and the small-angle model would let the body tip over.
@@ -319,26 +305,6 @@ enum Track {
     Internal(TrackGenerator),
 }
 
-/// Checks that the table reaches flange contact on both sides.
-fn check_flange(table: &GeometryTable) -> Result<(), ModelError> {
-    let (lo, hi) = table.y_range();
-    let (mut left, mut right) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
-    for [_, _, _, tl, tr] in table.rows() {
-        left = left.max(tl);
-        right = right.max(tr);
-    }
-    for (side, max_tan_gamma, range) in [("left", left, lo), ("right", right, hi)] {
-        if max_tan_gamma < FLANGE_TAN_GAMMA {
-            return Err(ModelError::FlangeNotCovered {
-                side,
-                max_tan_gamma,
-                range_mm: range * 1e3,
-            });
-        }
-    }
-    Ok(())
-}
-
 impl Vehicle {
     /// Validates the parameters and loads the contact table.
     pub fn new(params: VehicleParams) -> Result<Self, ModelError> {
@@ -352,7 +318,7 @@ impl Vehicle {
     /// As [`Self::new`] with an explicit contact table (`params.contact` is ignored).
     pub fn with_table(params: VehicleParams, table: GeometryTable) -> Result<Self, ModelError> {
         params.validate()?;
-        check_flange(&table)?;
+        table.check_flange()?;
         let consts = Consts::new(&params, &table);
         let positions = Positions::new(&params);
         let mut state = [0.0; N_STATES];

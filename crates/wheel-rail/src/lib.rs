@@ -119,6 +119,6 @@ pub use creep::{
 };
 pub use profile::{Profile, ProfileError, MIN_POINTS};
 pub use table::{
-    write_csv, ContactGeometry, CsvNumbers, CsvRow, GeometryTable, SegmentHint, TableError,
-    BOGIE_CSV_HEADER,
+    write_csv, ContactGeometry, CsvNumbers, CsvRow, FlangeNotCovered, GeometryTable, SegmentHint,
+    TableError, BOGIE_CSV_HEADER, FLANGE_TAN_GAMMA,
 };

@@ -130,6 +130,26 @@ pub enum CsvNumbers {
 /// One row of the format: y, delta_r_left, delta_r_right, tan_gamma_left, tan_gamma_right.
 pub type CsvRow = [f64; 5];
 
+/// tan(gamma) a table must reach on each side to cover the flange: beyond it the flange
+/// guides the wheelset, and the end of the table is where a wheel climbs it (derailment).
+pub const FLANGE_TAN_GAMMA: f64 = 1.0;
+
+/// A contact table that does not reach flange contact on one side.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error(
+    "contact table does not cover the flange: on the {side} wheel tan(gamma) reaches only \
+     {max_tan_gamma:.3} within the table's range ({range_mm:.2} mm), flange contact needs \
+     at least {FLANGE_TAN_GAMMA}"
+)]
+pub struct FlangeNotCovered {
+    /// "left" or "right".
+    pub side: &'static str,
+    /// Largest tan(gamma) of that side.
+    pub max_tan_gamma: f64,
+    /// Range end on that side \[mm\].
+    pub range_mm: f64,
+}
+
 /// Writes the CSV format: header line, then one line per row.
 pub fn write_csv(rows: impl IntoIterator<Item = CsvRow>, numbers: CsvNumbers) -> String {
     use std::fmt::Write;
@@ -447,6 +467,27 @@ impl GeometryTable {
     /// Range of y covered by the table \[m\].
     pub fn y_range(&self) -> (f64, f64) {
         (self.y[0], self.y[self.y.len() - 1])
+    }
+
+    /// The table reaches flange contact ([`FLANGE_TAN_GAMMA`]) on both sides, so that a
+    /// wheelset leaving its range has climbed a flange.
+    pub fn check_flange(&self) -> Result<(), FlangeNotCovered> {
+        let (lo, hi) = self.y_range();
+        let (mut left, mut right) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+        for [_, _, _, tl, tr] in self.rows() {
+            left = left.max(tl);
+            right = right.max(tr);
+        }
+        for (side, max_tan_gamma, range) in [("left", left, lo), ("right", right, hi)] {
+            if max_tan_gamma < FLANGE_TAN_GAMMA {
+                return Err(FlangeNotCovered {
+                    side,
+                    max_tan_gamma,
+                    range_mm: range * 1e3,
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Segment [i, i+1] used for y: the last row at or below y, clamped to the end segments
