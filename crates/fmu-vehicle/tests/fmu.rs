@@ -401,3 +401,26 @@ fn a_long_host_step_equals_its_sub_steps() {
     assert_eq!(run(&[2.5]), sub);
     assert!(sub.iter().any(|x| *x != 0.0));
 }
+
+/// One call computes a bounded number of internal sub-steps: a light wheelset (0.01 kg) needs
+/// a sub-step of about a microsecond, and a 30 s step took 284 s of one host call. Such a step
+/// is discarded at once with the reason; shorter steps run.
+#[test]
+fn a_step_needing_too_many_internal_sub_steps_is_discarded_at_once() {
+    let (mut c, log) = initialising::<M>();
+    assert_eq!(set::<M>(&mut c, "wheelset.mass", 0.01), Status::Ok);
+    assert_eq!(c.exit_initialization_mode(), Status::Ok, "{:?}", log.take());
+    let started = std::time::Instant::now();
+    assert_eq!(c.do_step(0.0, 30.0), Status::Discard);
+    let l = log.take();
+    assert!(
+        logged(&l, Status::Discard, "take shorter communication steps"),
+        "{l:?}"
+    );
+    // measured 0.1 ms: refused before computing (the test does not time anything else)
+    assert!(started.elapsed().as_secs_f64() < 5.0);
+    let (mut c, _log) = initialising::<M>();
+    assert_eq!(set::<M>(&mut c, "wheelset.mass", 0.01), Status::Ok);
+    assert_eq!(c.exit_initialization_mode(), Status::Ok);
+    assert_eq!(c.do_step(0.0, 1e-3), Status::Ok);
+}

@@ -5,7 +5,7 @@
 use model_description::{field_error, FieldError, FmuModel, ModelError, StepError};
 use serde::{Deserialize, Serialize};
 
-use crate::step::{host_step, InputError};
+use crate::step::{host_step, InputError, MAX_SUBSTEPS};
 
 /// A rail-vehicle model's physics as its FMU shell drives it.
 pub trait ShellPhysics: Clone + Sized {
@@ -33,6 +33,8 @@ pub trait ShellPhysics: Clone + Sized {
     fn input_error(e: &Self::StepError) -> Option<&InputError>;
     /// Whether `e` is a diverged state (which a smaller step may avoid).
     fn diverged(e: &Self::StepError) -> bool;
+    /// The largest internal sub-step of the integration \[s\].
+    fn substep_s(&self) -> f64;
 }
 
 /// Implements [`ShellPhysics`] in a model crate whose physics has the inherent `new(params)`,
@@ -82,6 +84,10 @@ macro_rules! shell_physics {
 
             fn diverged(e: &$step_error) -> bool {
                 matches!(e, $step_error::Diverged { .. })
+            }
+
+            fn substep_s(&self) -> f64 {
+                $physics::substep_s(self)
             }
         }
     };
@@ -181,6 +187,17 @@ impl<P: ShellPhysics> Shell<P> {
                 "the physics is built in fmi2ExitInitializationMode; no step before it".into(),
             )));
         };
+        // a bounded time per call: parameters that need a very short sub-step (a light body
+        // on stiff springs) would compute a long step for hours
+        let substeps = step_s / p.substep_s();
+        if substeps > MAX_SUBSTEPS as f64 {
+            return Err(StepError::Discard(format!(
+                "a step of {step_s:?} s takes {substeps:.2e} internal sub-steps of {:?} s, \
+                 more than the {MAX_SUBSTEPS} one call computes: take shorter communication \
+                 steps",
+                p.substep_s()
+            )));
+        }
         let inputs = &self.inputs;
         let map = |e: P::StepError| match P::input_error(&e) {
             _ if P::diverged(&e) => StepError::Discard(e.to_string()),
