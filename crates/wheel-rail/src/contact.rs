@@ -368,10 +368,19 @@ impl PreparedSide {
             y_m: y,
             reason,
         };
+        let rail = &self.rail;
+        // only the part of the wheel over the rail can touch it: a back face or rim beyond the
+        // rail head that folds over when the wheelset rolls does not matter (it cut a table
+        // short, taken for the flange limit)
+        let (rail_lo, rail_hi) = (rail[0].0, rail[rail.len() - 1].0);
+        let over = |p: &(f64, f64, f64)| p.0 >= rail_lo && p.0 <= rail_hi;
+        if let (Some(a), Some(b)) = (buf.iter().position(over), buf.iter().rposition(over)) {
+            buf.truncate((b + 1).min(n - 1) + 1);
+            buf.drain(..a.saturating_sub(1));
+        }
         if buf.windows(2).any(|w| w[1].0 <= w[0].0) {
             return Err(no_contact("rolled wheel profile is not single-valued"));
         }
-        let rail = &self.rail;
         let lo = buf[0].0.max(rail[0].0);
         let hi = buf[buf.len() - 1].0.min(rail[rail.len() - 1].0);
         if hi <= lo {

@@ -30,6 +30,20 @@ pub const MIN_POINTS: usize = 3;
 /// minutes.
 pub const MAX_POINTS: usize = 100_000;
 
+/// Lateral extent a wheel or rail profile in millimetres can have [mm]: a wheel spans about
+/// 140 mm, a rail head about 75 (a synthetic crown a few); outside, the file is in another
+/// unit (metres: 0.14, micrometres: 140 000).
+pub const PLAUSIBLE_SPAN_MM: (f64, f64) = (1.0, 1000.0);
+
+/// At most 80 characters of a field or line echoed in a message (a 10 MB line is not).
+fn clip(text: &str) -> String {
+    const MAX: usize = 80;
+    match text.char_indices().nth(MAX) {
+        Some((cut, _)) => format!("{}... ({} bytes)", &text[..cut], text.len()),
+        None => text.to_string(),
+    }
+}
+
 /// Errors of profile reading / construction.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ProfileError {
@@ -82,6 +96,17 @@ pub enum ProfileError {
         max: usize,
     },
     /// Not enough points.
+    #[error(
+        "{source_name}: the profile spans {span_mm} mm laterally; coordinates are read in \
+         millimetres (a wheel spans about 140 mm, a rail head about 75 mm): is the file in \
+         {unit}?"
+    )]
+    ImplausibleSpan {
+        source_name: String,
+        span_mm: f64,
+        /// "metres" or "micrometres".
+        unit: &'static str,
+    },
     #[error("{source_name}: only {count} point(s) (line {last_line} is the last), at least {min} needed")]
     TooFewPoints {
         /// File name.
@@ -153,8 +178,9 @@ impl Profile {
                 return Err(malformed(
                     line_no,
                     format!(
-                        "expected 2 fields (lateral vertical, mm), found {}: {content:?}",
-                        fields.len()
+                        "expected 2 fields (lateral vertical, mm), found {}: {:?}",
+                        fields.len(),
+                        clip(content)
                     ),
                 ));
             }
@@ -166,7 +192,7 @@ impl Profile {
                         let which = if k == 0 { "lateral" } else { "vertical" };
                         return Err(malformed(
                             line_no,
-                            format!("{which} coordinate {f:?} is not a finite number"),
+                            format!("{which} coordinate {:?} is not a finite number", clip(f)),
                         ));
                     }
                 }
@@ -211,6 +237,18 @@ impl Profile {
         }
         if !increasing {
             pts.reverse();
+        }
+        let span_mm = pts[pts.len() - 1].1 - pts[0].1;
+        if !(PLAUSIBLE_SPAN_MM.0..=PLAUSIBLE_SPAN_MM.1).contains(&span_mm) {
+            return Err(ProfileError::ImplausibleSpan {
+                source_name: source_name.to_string(),
+                span_mm,
+                unit: if span_mm < PLAUSIBLE_SPAN_MM.0 {
+                    "metres"
+                } else {
+                    "micrometres"
+                },
+            });
         }
         Ok(Self {
             name: source_name.to_string(),
@@ -314,16 +352,16 @@ mod tests {
 
     #[test]
     fn parses_whitespace_comma_comments_header() {
-        let txt = "# comment\ny_mm, z_mm\n-1.0 0.5 # tail\n\n0,0\r\n1;\t-0.5";
+        let txt = "# comment\ny_mm, z_mm\n-10.0 0.5 # tail\n\n0,0\r\n10;\t-0.5";
         let p = Profile::parse_str(txt, "t").unwrap();
         assert_eq!(p.len(), 3);
-        assert!((p.lateral_m[0] + 1e-3).abs() < 1e-15);
+        assert!((p.lateral_m[0] + 10e-3).abs() < 1e-15);
         assert!((p.vertical_m[2] + 0.5e-3).abs() < 1e-15);
     }
 
     #[test]
     fn decreasing_file_is_reversed() {
-        let p = Profile::parse_str("2 0\n1 1\n0 2\n", "t").unwrap();
+        let p = Profile::parse_str("20 0\n10 1\n0 2\n", "t").unwrap();
         assert!(p.lateral_m[0] < p.lateral_m[2]);
         assert!((p.vertical_m[0] - 2e-3).abs() < 1e-15);
     }

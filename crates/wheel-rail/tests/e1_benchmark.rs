@@ -236,3 +236,24 @@ fn rail_level_is_the_convention_of_the_e1_reference() {
     );
     assert!(rail < 0.05e-3 && axle > 3.0 * rail, "{rail} vs {axle}");
 }
+
+/// A wheel profile with a near-vertical back face far from the rail (0.02 mm across, 14.5 mm
+/// high) folds over when the wheelset rolls; only the part of the wheel over the rail can
+/// touch it, so the table is E1's. It used to stop at 3.5 mm, taken for the flange limit.
+#[test]
+fn a_back_face_beyond_the_rail_does_not_cut_the_table_short() {
+    let text = std::fs::read_to_string(format!("{DATA}/RUIC519A.dat")).unwrap();
+    let wheel = Profile::parse_str(&format!("-70.02 5\n{text}"), "back_face.dat").unwrap();
+    let rail = Profile::from_file(format!("{DATA}/SUIC519A.dat")).unwrap();
+    let folded = ContactSetup::symmetric(wheel, rail, 0.920 / 2.0, 1.43516);
+    let a = compute_table(&e1_setup(), -10e-3, 10e-3, 0.1e-3).unwrap();
+    let b = compute_table(&folded, -10e-3, 10e-3, 0.1e-3).unwrap();
+    assert_eq!(
+        (b.y_reachable_min_m, b.y_reachable_max_m),
+        (a.y_reachable_min_m, a.y_reachable_max_m)
+    );
+    assert!(b.y_reachable_max_m > 6e-3, "{}", b.y_reachable_max_m);
+    for (ra, rb) in a.rows.iter().zip(&b.rows) {
+        assert_eq!(ra.delta_r_m, rb.delta_r_m, "y = {}", ra.y_m);
+    }
+}

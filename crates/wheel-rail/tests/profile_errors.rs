@@ -84,3 +84,47 @@ fn benchmark_files_read() {
     assert!((w.lateral_m[0] + 0.070).abs() < 1e-12);
     assert!((r.lateral_m[1000] - 0.039).abs() < 1e-12);
 }
+
+/// A profile whose lateral extent is no wheel's or rail's in millimetres is in another unit: the
+/// E1 wheel in micrometres gave conicity 0.055 at every amplitude without a word.
+#[test]
+fn a_profile_in_another_unit_is_refused() {
+    let wheel =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/data/RUIC519A.dat")).unwrap();
+    let scaled = |factor: f64| -> String {
+        wheel
+            .lines()
+            .filter_map(|l| {
+                let mut it = l.split_whitespace().map(|f| f.parse::<f64>());
+                match (it.next(), it.next()) {
+                    (Some(Ok(y)), Some(Ok(z))) => Some(format!("{} {}\n", y * factor, z * factor)),
+                    _ => None,
+                }
+            })
+            .collect()
+    };
+    assert!(Profile::parse_str(&scaled(1.0), "mm.dat").is_ok());
+    for (factor, unit) in [(1e3, "micrometres"), (1e-3, "metres")] {
+        let e = Profile::parse_str(&scaled(factor), "w.dat").unwrap_err();
+        assert!(matches!(e, ProfileError::ImplausibleSpan { .. }), "{e:?}");
+        assert!(
+            e.to_string().contains(unit) && e.to_string().contains("w.dat"),
+            "{e}"
+        );
+    }
+}
+
+/// A 10 MB field is not echoed whole in the message.
+#[test]
+fn a_huge_field_is_clipped_in_the_message() {
+    let long = "x".repeat(10_000_000);
+    let e = Profile::parse_str(&format!("0 0\n1 {long}\n2 2\n"), "long.dat").unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        msg.len() < 300 && msg.contains("10000000 bytes"),
+        "{}",
+        &msg[..200]
+    );
+    let e = Profile::parse_str(&format!("0 0\n1 1 {long}\n2 2\n"), "long.dat").unwrap_err();
+    assert!(e.to_string().len() < 300);
+}
