@@ -461,7 +461,18 @@ fn contact_geometry_without_a_value_fails_and_writes_nothing() {
         ),
         (
             ["--gauge", "5"],
-            "invalid option --gauge = 5: must be a track gauge in (300, 3000) mm",
+            "invalid option --gauge = 5: must be a standard track gauge, tight to wide, in \
+             [1400, 1480] mm",
+        ),
+        // the wheelset's rolling circles are 1500 mm apart: Russian gauge found no flange
+        (
+            ["--gauge", "1520"],
+            "invalid option --gauge = 1520: must be a standard track gauge",
+        ),
+        // a table in whole steps with a row at 0 (9.99 in 0.1 mm steps ran to 10.01 mm)
+        (
+            ["--y-max", "9.99"],
+            "invalid option --y-max = 9.99: must be a whole number of --step",
         ),
         (
             ["--step", "-1"],
@@ -480,6 +491,48 @@ fn contact_geometry_without_a_value_fails_and_writes_nothing() {
         );
         assert!(!out.exists());
     }
+    // a failed contact search names the profiles (a mirrored wheel: no contact at y = 0)
+    let wheel = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../wheel-rail/data/RUIC519A.dat"
+    ))
+    .unwrap();
+    let mirrored: String = wheel
+        .lines()
+        .rev()
+        .filter_map(|l| {
+            let mut it = l.split_whitespace().map(|f| f.parse::<f64>());
+            match (it.next(), it.next()) {
+                (Some(Ok(y)), Some(Ok(z))) => Some(format!("{} {z}\n", -y)),
+                _ => None,
+            }
+        })
+        .collect();
+    let mirrored_path = d.path().join("mirrored_wheel.dat");
+    std::fs::write(&mirrored_path, mirrored).unwrap();
+    refused(
+        &[
+            "contact-geometry",
+            "--wheel",
+            mirrored_path.to_str().unwrap(),
+        ],
+        &[],
+        out.to_str().unwrap(),
+        "wheel ",
+    );
+    let r = master(&[
+        "contact-geometry",
+        "--wheel",
+        mirrored_path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        r.stderr.contains("mirrored_wheel.dat on rail") && r.stderr.contains("at y = 0 mm"),
+        "{}",
+        r.stderr
+    );
+    assert!(!out.exists());
     let r = master(&[
         "contact-geometry",
         "--radius",
@@ -540,7 +593,7 @@ fn contact_geometry_without_a_value_fails_and_writes_nothing() {
         ),
         (
             ["--gauge", "1e300"],
-            "--gauge = 1e300: must be a track gauge",
+            "--gauge = 1e300: must be a standard track gauge",
         ),
     ] {
         let r = master(&[

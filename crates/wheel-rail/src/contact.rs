@@ -83,7 +83,7 @@ pub enum ContactError {
         what: String,
     },
     /// The wheel and rail do not overlap laterally, or the rolled wheel is not single-valued.
-    #[error("no contact on {side} at y = {y_m} m: {reason}")]
+    #[error("no contact on {side} at y = {} mm: {reason}", short(*.y_m * 1e3))]
     NoContact {
         /// "the left side", "the right side" or "either side".
         side: &'static str,
@@ -93,7 +93,10 @@ pub enum ContactError {
         reason: &'static str,
     },
     /// The roll angle equation could not be solved.
-    #[error("roll angle not found at y = {y_m} m (searched up to |phi| = {limit_rad} rad)")]
+    #[error(
+        "roll angle not found at y = {} mm (searched up to |phi| = {limit_rad} rad)",
+        short(*.y_m * 1e3)
+    )]
     RollNotFound {
         /// Lateral displacement.
         y_m: f64,

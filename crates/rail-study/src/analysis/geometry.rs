@@ -251,11 +251,14 @@ pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
             ));
         }
     }
-    if !(inputs.gauge_m.is_finite() && inputs.gauge_m > 0.3 && inputs.gauge_m < 3.0) {
+    // the wheelset is a standard-gauge one (rolling circles 1500 mm apart): 1000, 1067 or
+    // 1668 mm track found no overlap, 1520 mm a wheel without flange contact
+    if !(inputs.gauge_m.is_finite() && inputs.gauge_m >= 1.4 && inputs.gauge_m <= 1.48) {
         return Err(bad(
             "--gauge",
             inputs.gauge_m * 1e3,
-            "must be a track gauge in (300, 3000) mm",
+            "must be a standard track gauge, tight to wide, in [1400, 1480] mm (the wheelset's \
+             rolling circles are 1500 mm apart)",
         ));
     }
     if !(inputs.step_m.is_finite() && inputs.step_m > 0.0) {
@@ -266,6 +269,19 @@ pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
             "--y-max",
             inputs.y_max_m * 1e3,
             "must be at least 3 steps",
+        ));
+    }
+    // a table from -y_max to y_max in whole steps, with a row at 0 (9.99 mm in 0.1 mm steps
+    // ran to 10.01 mm without one)
+    let steps = inputs.y_max_m / inputs.step_m;
+    if (steps - steps.round()).abs() > 1e-6 * steps.max(1.0) {
+        return Err(bad(
+            "--y-max",
+            inputs.y_max_m * 1e3,
+            &format!(
+                "must be a whole number of --step {} mm",
+                master::show::num(inputs.step_m * 1e3)
+            ),
         ));
     }
     // the table's rows, -y_max to y_max in steps (the contact search refuses more), refused
@@ -313,7 +329,23 @@ pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
 pub fn contact_geometry(inputs: &GeometryInputs) -> Result<GeometryResults, AnalysisError> {
     check_options(inputs)?;
     let setup = setup_of(inputs)?;
-    let table = compute_table(&setup, -inputs.y_max_m, inputs.y_max_m, inputs.step_m)?;
+    // a failed search names the profiles (the same message came for a swapped, mirrored or
+    // flangeless profile)
+    let profiles = |e: wheel_rail::ContactError| {
+        let pair = |w: &ProfileSource, r: &ProfileSource| {
+            format!("wheel {} on rail {}", w.describe(), r.describe())
+        };
+        let left = pair(&inputs.wheel_left, &inputs.rail_left);
+        let right = pair(&inputs.wheel_right, &inputs.rail_right);
+        let both = if left == right {
+            left
+        } else {
+            format!("left {left}, right {right}")
+        };
+        AnalysisError::Geometry(format!("{both}: {e}"))
+    };
+    let table =
+        compute_table(&setup, -inputs.y_max_m, inputs.y_max_m, inputs.step_m).map_err(profiles)?;
     let bogie_table = if setup.radius_convention == RadiusConvention::RigidRoll
         || setup.nominal_radius_left_m == setup.nominal_radius_right_m
     {
@@ -323,7 +355,7 @@ pub fn contact_geometry(inputs: &GeometryInputs) -> Result<GeometryResults, Anal
             radius_convention: RadiusConvention::RigidRoll,
             ..setup
         };
-        compute_table(&rigid, -inputs.y_max_m, inputs.y_max_m, inputs.step_m)?
+        compute_table(&rigid, -inputs.y_max_m, inputs.y_max_m, inputs.step_m).map_err(profiles)?
     };
     let d = DeltaR::from_table(&table);
     let conicity = curve_amplitudes(inputs.amplitude_max_m, inputs.conicity_step_m)

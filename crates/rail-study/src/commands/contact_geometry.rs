@@ -71,7 +71,8 @@ pub struct Args {
     /// Right rail profile, if different from the left.
     #[arg(long, value_name = "FILE")]
     pub rail_right: Option<PathBuf>,
-    /// Track gauge [mm], measured 14 mm below the top of rail.
+    /// Track gauge [mm], measured 14 mm below the top of rail: 1400-1480 (tight to wide standard
+    /// gauge; the wheelset's rolling circles are 1500 mm apart).
     #[arg(
         long,
         value_name = "MM",
@@ -94,7 +95,7 @@ pub struct Args {
     /// Nominal rolling radius of the right wheel [mm].
     #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     pub radius_right: Option<f64>,
-    /// The table covers y from -y_max to +y_max [mm].
+    /// The table covers y from -y_max to +y_max [mm], a whole number of --step.
     #[arg(
         long,
         value_name = "MM",
