@@ -8,6 +8,13 @@ use crate::contact::ContactTable;
 /// Relative tolerance on S for "equal levels" (plateaus of a flat Δr = 0 tread are exact).
 const LEVEL_REL_TOL: f64 = 1e-9;
 
+/// Δr a contact search resolves \[m\]: below it a computed Δr is taken as 0. On a wide gauge
+/// both wheels run on the flat of the tread over several millimetres, where the search gives
+/// |Δr| of 0.01-0.2 µm of either sign (the profiles' own resolution, far below the contact
+/// zone's 7.5 µm); that noise put the equilibrium of a wheelset without restoring force
+/// millimetres off centre and left no oscillation of 1 mm (1445 mm gauge).
+pub const DELTA_R_RESOLUTION_M: f64 = 1e-6;
+
 /// Piecewise-linear Δr(y) = r_right - r_left and its exact integral.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DeltaR {
@@ -31,14 +38,17 @@ pub(crate) struct Oscillation {
 }
 
 impl DeltaR {
-    /// From a contact table: every solved state ([`ContactTable::solved_states`]: reachable rows,
+    /// From a contact table (|Δr| below [`DELTA_R_RESOLUTION_M`] taken as 0): every solved state ([`ContactTable::solved_states`]: reachable rows,
     /// flange-climbing rows beyond the flange limit, and the states on both sides of each located
     /// contact-point jump), with e0 and the mean nominal radius of the table.
     pub fn from_table(table: &ContactTable) -> Self {
         let (y, dr): (Vec<f64>, Vec<f64>) = table
             .solved_states()
             .iter()
-            .map(|r| (r.y_m, r.delta_r_m))
+            .map(|r| {
+                let resolved = r.delta_r_m.abs() >= DELTA_R_RESOLUTION_M;
+                (r.y_m, if resolved { r.delta_r_m } else { 0.0 })
+            })
             .unzip();
         let mut d = Self::build(y, dr, table.e0_m, table.nominal_radius_mean_m());
         d.flange_limits_m = Some((table.y_reachable_min_m, table.y_reachable_max_m));
