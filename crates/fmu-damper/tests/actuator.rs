@@ -52,12 +52,13 @@ fn command_at_dead_zone_gives_no_motion() {
 #[test]
 fn r4_full_vs_reduced_frf() {
     let p = ActuatorParams::default();
-    // a dense grid up to 597 rad/s: a coarse one (1, 5, 20, 50, 80, 95 Hz) steps over the
-    // steep fall between 60 and 76 Hz, where the modulus drops two decades and the two models
-    // differ most
+    // a dense grid from 1 Hz up to 600 rad/s, the grid of `master characterise actuator`: a
+    // coarse one (1, 5, 20, 50, 80, 95 Hz) steps over the steep fall between 60 and 76 Hz,
+    // where the modulus drops two decades and the two models differ most
     let n = 300;
+    let top_hz = 600.0 / (2.0 * std::f64::consts::PI);
     let low: Vec<f64> = (0..n)
-        .map(|i| 10f64.powf((95f64).log10() * i as f64 / (n - 1) as f64))
+        .map(|i| 10f64.powf(top_hz.log10() * i as f64 / (n - 1) as f64))
         .collect();
     let full = actuator_frf(&p, ActuatorModel::FullOrder, p.alpha_m, &low).unwrap();
     let red = actuator_frf(&p, ActuatorModel::ReducedOrder, p.alpha_m, &low).unwrap();
