@@ -946,6 +946,36 @@ fn root_locus_damper_options() {
     );
     let r = master(&["root-locus", "--from", "300", "--to", "200"]);
     assert!(!r.ok && r.stderr.contains("--to"), "{}", r.stderr);
+    // a small damping is shown as it is (5 N s/m was "0.0 kN s/m")
+    let small = run("viscous:5");
+    assert!(
+        small.ok && small.stdout.contains("viscous 0.005 kN s/m"),
+        "{}",
+        small.stdout
+    );
+    // negative numbers reach the range checks (they were taken for options); a grid of one
+    // speed draws no line; the models' common floor; a linearisation at 1e-300 Hz
+    for (options, expected) in [
+        (
+            vec!["--from", "-10"],
+            "invalid option --from = -10: must be at least 3.6 km/h",
+        ),
+        (vec!["--from", "0.5"], "invalid option --from = 0.5"),
+        (
+            vec!["--step", "1000"],
+            "invalid option --step = 1000: must leave at least two speeds",
+        ),
+        (
+            vec!["--conicity", "-0.2"],
+            "`wheel_rail.conicity`: must be within [0, 1]",
+        ),
+        (
+            vec!["--damper", "semi-active:0:1e-3:1e-300"],
+            "frequency 1e-300 Hz: must be at least 0.1",
+        ),
+    ] {
+        refused(&["root-locus"], &options, out.to_str().unwrap(), expected);
+    }
 }
 
 /// `master root-locus` on the coach (the default model): R15 and the mode named, a soft

@@ -74,24 +74,40 @@ pub const MAX_LINEARISATION_STROKE_M: f64 = 0.05;
 /// bogie (R6: 3-4 Hz) and of the coach at its critical speed (4.0 Hz).
 pub const DEFAULT_LINEARISATION_FREQ_HZ: f64 = 4.0;
 
+/// `x` to four significant digits, in its shortest form (5 N s/m is 0.005 kN s/m, not 0.0).
+fn sig(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return master::show::num(x).to_string();
+    }
+    let digits = 3 - x.abs().log10().floor() as i32;
+    let scale = 10f64.powi(digits);
+    master::show::num((x * scale).round() / scale).to_string()
+}
+
 impl LinearisedDamper {
-    /// Measures the damper at `opening` (0..1), stroke amplitude `stroke_m` (0 < X <= 5 cm) and
-    /// `freq_hz` (0 < f <= 50 Hz).
+    /// Measures the damper at `opening` (0..1), stroke amplitude `stroke_m` (1 um <= X <= 5 cm)
+    /// and `freq_hz` (0.1 <= f <= 50 Hz: hunting lies at a few Hz; far below, a period of the
+    /// periodic steady state would take hours to compute, and the damper's first harmonic
+    /// vanishes to rounding).
     pub fn measure(opening: f64, stroke_m: f64, freq_hz: f64) -> Result<Self, String> {
+        let num = master::show::num;
         if !(opening.is_finite() && (0.0..=1.0).contains(&opening)) {
             return Err(format!(
-                "opening {opening}: must be within 0 (closed) and 1"
+                "opening {}: must be within 0 (closed) and 1",
+                num(opening)
             ));
         }
-        if !(stroke_m.is_finite() && stroke_m > 0.0 && stroke_m <= MAX_LINEARISATION_STROKE_M) {
+        if !(stroke_m.is_finite() && (1e-6..=MAX_LINEARISATION_STROKE_M).contains(&stroke_m)) {
             return Err(format!(
-                "stroke {stroke_m} m: must be > 0 and at most {MAX_LINEARISATION_STROKE_M} m \
-                 (an amplitude in metres, e.g. 3e-3)"
+                "stroke {} m: must be at least 1e-6 m and at most {MAX_LINEARISATION_STROKE_M} m \
+                 (an amplitude in metres, e.g. 3e-3)",
+                num(stroke_m)
             ));
         }
-        if !(freq_hz.is_finite() && freq_hz > 0.0 && freq_hz <= 50.0) {
+        if !(freq_hz.is_finite() && (0.1..=50.0).contains(&freq_hz)) {
             return Err(format!(
-                "frequency {freq_hz} Hz: must be > 0 and at most 50 Hz"
+                "frequency {} Hz: must be at least 0.1 and at most 50 Hz",
+                num(freq_hz)
             ));
         }
         let (k, c) =
@@ -99,8 +115,10 @@ impl LinearisedDamper {
                 .map_err(|e| format!("the damper model cannot be linearised there: {e}"))?;
         if !(k.is_finite() && c.is_finite() && k >= 0.0 && c >= 0.0) {
             return Err(format!(
-                "the damper's first harmonic gives k = {k} N/m, c = {c} N s/m: not a \
-                 Kelvin-Voigt element"
+                "the damper's first harmonic gives k = {} N/m, c = {} N s/m: not a \
+                 Kelvin-Voigt element",
+                master::show::num(k),
+                master::show::num(c)
             ));
         }
         Ok(Self {
@@ -200,26 +218,26 @@ impl DamperSpec {
                 PASSIVE_MAXWELL_K_N_PER_M * 1e-6,
                 PASSIVE_MAXWELL_C_NS_PER_M * 1e-3
             ),
-            DamperSpec::Viscous(c) => format!("viscous {:.1} kN s/m per damper", c * 1e-3),
+            DamperSpec::Viscous(c) => format!("viscous {} kN s/m per damper", sig(c * 1e-3)),
             DamperSpec::Maxwell(k, c) => format!(
-                "Maxwell {:.2} MN/m in series with {:.1} kN s/m per damper",
-                k * 1e-6,
-                c * 1e-3
+                "Maxwell {} MN/m in series with {} kN s/m per damper",
+                sig(k * 1e-6),
+                sig(c * 1e-3)
             ),
             DamperSpec::KelvinVoigt(k, c) => format!(
-                "Kelvin-Voigt {:.2} MN/m parallel to {:.1} kN s/m per damper",
-                k * 1e-6,
-                c * 1e-3
+                "Kelvin-Voigt {} MN/m parallel to {} kN s/m per damper",
+                sig(k * 1e-6),
+                sig(c * 1e-3)
             ),
             DamperSpec::Linearised(l) => format!(
-                "semi-active damper at {:.0} % opening linearised at +-{:.2} mm, {:.2} Hz \
-                 (first harmonic of the fmu-damper model): Kelvin-Voigt {:.2} MN/m parallel \
-                 to {:.1} kN s/m per damper",
-                l.opening * 100.0,
-                l.stroke_m * 1e3,
-                l.freq_hz,
-                l.k_n_per_m * 1e-6,
-                l.c_ns_per_m * 1e-3
+                "semi-active damper at {} % opening linearised at +-{} mm, {} Hz \
+                 (first harmonic of the fmu-damper model): Kelvin-Voigt {} MN/m parallel \
+                 to {} kN s/m per damper",
+                sig(l.opening * 100.0),
+                sig(l.stroke_m * 1e3),
+                sig(l.freq_hz),
+                sig(l.k_n_per_m * 1e-6),
+                sig(l.c_ns_per_m * 1e-3)
             ),
             DamperSpec::None => "no yaw dampers".into(),
         }
@@ -235,8 +253,9 @@ pub fn speed_grid_kmh(from: f64, to: f64, step: f64) -> Result<Vec<f64>, Analysi
         reason: reason.to_string(),
     };
     let max = CRITICAL_SEARCH_MPS.1 * 3.6;
-    if !(from.is_finite() && from > 0.0) {
-        return Err(bad("--from", from, "must be > 0 km/h"));
+    // both linear models divide the creepages by V; the coach accepts 1 m/s and more
+    if !(from.is_finite() && from >= 3.6) {
+        return Err(bad("--from", from, "must be at least 3.6 km/h (1 m/s)"));
     }
     if !(to.is_finite() && to > from && to <= max) {
         return Err(bad(
@@ -251,6 +270,13 @@ pub fn speed_grid_kmh(from: f64, to: f64, step: f64) -> Result<Vec<f64>, Analysi
     let n = ((to - from) / step + 1e-9).floor();
     if n > 20_000.0 {
         return Err(bad("--step", step, "gives more than 20 000 speeds"));
+    }
+    if n < 1.0 {
+        return Err(bad(
+            "--step",
+            step,
+            "must leave at least two speeds between --from and --to (the figures draw lines)",
+        ));
     }
     Ok((0..=n as usize).map(|i| from + i as f64 * step).collect())
 }

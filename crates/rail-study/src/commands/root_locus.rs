@@ -36,13 +36,28 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "vehicle")]
     pub model: VehicleModel,
     /// First speed [km/h].
-    #[arg(long, value_name = "KMH", default_value_t = 100.0)]
+    #[arg(
+        long,
+        value_name = "KMH",
+        default_value_t = 100.0,
+        allow_negative_numbers = true
+    )]
     pub from: f64,
     /// Last speed [km/h] (at most 716).
-    #[arg(long, value_name = "KMH", default_value_t = 400.0)]
+    #[arg(
+        long,
+        value_name = "KMH",
+        default_value_t = 400.0,
+        allow_negative_numbers = true
+    )]
     pub to: f64,
     /// Speed step [km/h].
-    #[arg(long, value_name = "KMH", default_value_t = 5.0)]
+    #[arg(
+        long,
+        value_name = "KMH",
+        default_value_t = 5.0,
+        allow_negative_numbers = true
+    )]
     pub step: f64,
     /// Yaw damper (each of them): `passive` (the calibrated Maxwell representation of the
     /// coupled 30 % passive damper), `viscous:C`, `maxwell:K:C`, `kelvin:K:C` (N/m, N s/m;
@@ -56,10 +71,10 @@ pub struct Args {
     pub damper: DamperSpec,
     /// Mounting (series) stiffness of each yaw damper's installation [N/m], 1 kN/m .. 10 GN/m,
     /// coach only [default: rigid].
-    #[arg(long, value_name = "N_PER_M")]
+    #[arg(long, value_name = "N_PER_M", allow_negative_numbers = true)]
     pub mounting_stiffness: Option<f64>,
     /// Equivalent conicity of the linear model [default: the calibrated value].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub conicity: Option<f64>,
     /// Output folder (created if needed; files are written only once everything is computed).
     #[arg(
