@@ -77,6 +77,22 @@ fn split_fields(line: &str, sep: Option<char>) -> Vec<String> {
         .collect()
 }
 
+/// A whitespace-separated header's ` [unit]` fields joined to the name before them
+/// (`time [s] a [m/s2]` is two columns, as with the other separators).
+fn units_to_names(fields: Vec<String>) -> Vec<String> {
+    let mut names: Vec<String> = Vec::with_capacity(fields.len());
+    for f in fields {
+        match names.last_mut() {
+            Some(name) if f.starts_with('[') && f.ends_with(']') && !name.ends_with(']') => {
+                name.push(' ');
+                name.push_str(&f);
+            }
+            _ => names.push(f),
+        }
+    }
+    names
+}
+
 /// `name [unit]` -> (`name`, `Some(unit)`).
 fn split_unit(name: &str) -> (&str, Option<&str>) {
     match (name.rfind(" ["), name.ends_with(']')) {
@@ -129,8 +145,12 @@ impl ResultsTable {
         } else {
             std::iter::once((1, header))
                 .chain(lines)
-                .map(|(no, line)| {
-                    let fields = split_fields(line, sep);
+                .enumerate()
+                .map(|(k, (no, line))| {
+                    let mut fields = split_fields(line, sep);
+                    if k == 0 && sep.is_none() {
+                        fields = units_to_names(fields);
+                    }
                     let quoted = vec![false; fields.len()];
                     (no, fields, quoted)
                 })
@@ -223,7 +243,24 @@ impl ResultsTable {
         let meta = read_metadata(path).map_err(|e| input(&e))?;
         table.described = meta.is_some();
         table.sampling = meta.and_then(|m| m.sampling);
-        Ok(table)
+        table.check_recorded_rate()
+    }
+
+    /// The rate the metadata records is the time column's: metadata of another recording (a
+    /// CSV replaced beside its `.meta.json`) would set the band check wrong.
+    fn check_recorded_rate(self) -> Result<Self, AnalysisError> {
+        if let (Some(s), Ok(fs)) = (&self.sampling, self.sampling_rate_hz()) {
+            if (s.rate_hz - fs).abs() > 1e-3 * fs {
+                return Err(AnalysisError::Input(format!(
+                    "{}: its metadata records a sampling rate of {} Hz, but its time column is \
+                     sampled at {} Hz: the metadata is another recording's",
+                    self.path.display(),
+                    master::show::num(s.rate_hz),
+                    master::show::num(fs)
+                )));
+            }
+        }
+        Ok(self)
     }
 
     /// A Parquet file's numeric columns without nulls (texts and empty parameters left out).
@@ -263,14 +300,15 @@ impl ResultsTable {
                 path.display()
             )));
         }
-        Ok(ResultsTable {
+        ResultsTable {
             path: path.to_path_buf(),
             names,
             columns: values,
             described: meta.is_some(),
             sampling: meta.and_then(|m| m.sampling),
             text_columns,
-        })
+        }
+        .check_recorded_rate()
     }
 
     /// Index of a column by full name or by name without its ` [unit]`.
@@ -894,6 +932,28 @@ mod tests {
         assert_eq!(t.columns[2], vec![2.0, 4.0]);
         let t = ResultsTable::parse("time;a\n0;1\n", p).unwrap();
         assert_eq!(t.names, vec!["time", "a"]);
+        // metadata of another recording: 10 Hz recorded beside a 1 kHz time column
+        let mut t = ResultsTable::parse("time,a\n0,1\n0.001,2\n0.002,3\n", p).unwrap();
+        t.sampling = Some(Sampling {
+            rate_hz: 10.0,
+            passband_hz: 5.0,
+            decimation: None,
+        });
+        let e = t.clone().check_recorded_rate().unwrap_err().to_string();
+        assert!(
+            e.contains("records a sampling rate of 10 Hz") && e.contains("1000 Hz"),
+            "{e}"
+        );
+        t.sampling = Some(Sampling {
+            rate_hz: 1000.0,
+            passband_hz: 500.0,
+            decimation: None,
+        });
+        assert!(t.check_recorded_rate().is_ok());
+        // a whitespace-separated header carries units as the others do
+        let t = ResultsTable::parse("time [ms]   a [m/s2]\n0 1\n1 3\n", p).unwrap();
+        assert_eq!(t.names, vec!["time [ms]", "a [m/s2]"]);
+        assert_eq!(t.columns[1], vec![1.0, 3.0]);
         // unknown signal lists the available ones
         let e = t.find("b").unwrap_err();
         assert!(e.to_string().contains("the signals are: a"), "{e}");
