@@ -36,7 +36,7 @@ pub use setup::{
     ContactSetup, LateralReference, RadiusConvention, RailPlacement, WheelPlacement,
     CONTACT_ZONE_DEPTH_M,
 };
-pub use sweep::{compute_table, ContactJump, ContactTable, MAX_TABLE_ROWS};
+pub use sweep::{compute_table, compute_table_until, ContactJump, ContactTable, MAX_TABLE_ROWS};
 
 /// Half width of the central difference used for the contact-angle slope [m].
 const SLOPE_HALF_WINDOW_M: f64 = 0.25e-3;
@@ -92,6 +92,9 @@ pub enum ContactError {
         /// Reason.
         reason: &'static str,
     },
+    /// The caller asked the computation to stop.
+    #[error("stopped before the table was complete")]
+    Stopped,
     /// The roll angle equation could not be solved.
     #[error(
         "roll angle not found at y = {} mm (searched up to |phi| = {limit_rad} rad)",

@@ -110,9 +110,9 @@ pub use conicity::{
     DeltaR, LinearRegression,
 };
 pub use contact::{
-    compute_table, solve_contact, ContactError, ContactJump, ContactRow, ContactSetup,
-    ContactTable, LateralReference, RadiusConvention, RailPlacement, WheelContact, WheelPlacement,
-    WheelSide, CONTACT_ZONE_DEPTH_M,
+    compute_table, compute_table_until, solve_contact, ContactError, ContactJump, ContactRow,
+    ContactSetup, ContactTable, LateralReference, RadiusConvention, RailPlacement, WheelContact,
+    WheelPlacement, WheelSide, CONTACT_ZONE_DEPTH_M,
 };
 pub use creep::{
     hertz_kalker, saturated_wheelset_creep, saturation_factor, HertzKalker, WheelsetCreepForces,

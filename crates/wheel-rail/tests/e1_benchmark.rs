@@ -278,3 +278,20 @@ fn a_wide_gauge_gives_a_conicity_curve_from_zero() {
     let (c3, c5, c7) = (at(3.0), at(5.0), at(7.0));
     assert!(0.0 < c3 && c3 < c5 && c5 < c7 && c7 < 0.1, "{c3} {c5} {c7}");
 }
+
+/// The table computation asks its caller before each row and stops when told (Ctrl-C in the
+/// command: a fine grid on a dense profile took minutes to notice it).
+#[test]
+fn the_table_computation_stops_when_asked() {
+    let asked = std::cell::Cell::new(0usize);
+    let stop = || {
+        asked.set(asked.get() + 1);
+        asked.get() > 10
+    };
+    let e = wheel_rail::compute_table_until(&e1_setup(), -10e-3, 10e-3, 0.01e-3, &stop)
+        .unwrap_err();
+    assert_eq!(e, wheel_rail::ContactError::Stopped);
+    assert_eq!(asked.get(), 11, "asked once per row until told to stop");
+    let full = wheel_rail::compute_table_until(&e1_setup(), -10e-3, 10e-3, 0.1e-3, &|| false);
+    assert_eq!(full.unwrap().rows.len(), 201);
+}

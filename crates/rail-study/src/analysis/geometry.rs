@@ -15,9 +15,10 @@
 //! profiles into one table.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use wheel_rail::{
-    compute_table, ContactRow, ContactSetup, ContactTable, DeltaR, Profile, RadiusConvention,
+    compute_table_until, ContactRow, ContactSetup, ContactTable, DeltaR, Profile, RadiusConvention,
     WheelSide,
 };
 
@@ -324,9 +325,20 @@ pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
     Ok(())
 }
 
+/// A contact search stopped by the caller is the command's cancellation.
+pub(crate) fn stopped(e: wheel_rail::ContactError) -> AnalysisError {
+    match e {
+        wheel_rail::ContactError::Stopped => AnalysisError::Cancelled,
+        e => e.into(),
+    }
+}
+
 /// Reads the profiles, computes the tables and the conicity curve. Profile errors name the
 /// file and line; an amplitude without a conicity is an error; nothing is written here.
-pub fn contact_geometry(inputs: &GeometryInputs) -> Result<GeometryResults, AnalysisError> {
+pub fn contact_geometry(
+    inputs: &GeometryInputs,
+    cancel: &AtomicBool,
+) -> Result<GeometryResults, AnalysisError> {
     check_options(inputs)?;
     let setup = setup_of(inputs)?;
     // a failed search names the profiles (the same message came for a swapped, mirrored or
@@ -342,10 +354,20 @@ pub fn contact_geometry(inputs: &GeometryInputs) -> Result<GeometryResults, Anal
         } else {
             format!("left {left}, right {right}")
         };
-        AnalysisError::Geometry(format!("{both}: {e}"))
+        match e {
+            wheel_rail::ContactError::Stopped => AnalysisError::Cancelled,
+            e => AnalysisError::Geometry(format!("{both}: {e}")),
+        }
     };
-    let table =
-        compute_table(&setup, -inputs.y_max_m, inputs.y_max_m, inputs.step_m).map_err(profiles)?;
+    let stop = || cancel.load(Ordering::SeqCst);
+    let table = compute_table_until(
+        &setup,
+        -inputs.y_max_m,
+        inputs.y_max_m,
+        inputs.step_m,
+        &stop,
+    )
+    .map_err(profiles)?;
     let bogie_table = if setup.radius_convention == RadiusConvention::RigidRoll
         || setup.nominal_radius_left_m == setup.nominal_radius_right_m
     {
@@ -355,7 +377,14 @@ pub fn contact_geometry(inputs: &GeometryInputs) -> Result<GeometryResults, Anal
             radius_convention: RadiusConvention::RigidRoll,
             ..setup
         };
-        compute_table(&rigid, -inputs.y_max_m, inputs.y_max_m, inputs.step_m).map_err(profiles)?
+        compute_table_until(
+            &rigid,
+            -inputs.y_max_m,
+            inputs.y_max_m,
+            inputs.step_m,
+            &stop,
+        )
+        .map_err(profiles)?
     };
     let d = DeltaR::from_table(&table);
     let conicity = curve_amplitudes(inputs.amplitude_max_m, inputs.conicity_step_m)
@@ -676,7 +705,7 @@ mod tests {
             step_m: 0.0,
             ..GeometryInputs::default()
         };
-        let e = contact_geometry(&i).unwrap_err();
+        let e = contact_geometry(&i, &AtomicBool::new(false)).unwrap_err();
         assert!(e.to_string().contains("--step"), "{e}");
     }
 }

@@ -185,7 +185,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             r.add_artefacts(f)
         });
     }
-    let r = contact_geometry(&inputs).map_err(failed)?;
+    let r = contact_geometry(&inputs, ctx.cancel).map_err(failed)?;
     write_analysis(&COMMAND, &args.out, &read, ctx.cancel, &r.summary(), |f| {
         r.add_artefacts(f)
     })

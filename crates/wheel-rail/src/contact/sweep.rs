@@ -167,6 +167,19 @@ pub fn compute_table(
     y_max_m: f64,
     step_m: f64,
 ) -> Result<ContactTable, ContactError> {
+    compute_table_until(setup, y_min_m, y_max_m, step_m, &|| false)
+}
+
+/// [`compute_table`] that asks `stop` before each row and ends with [`ContactError::Stopped`]
+/// when it says so (a command interrupted by Ctrl-C: a fine grid on a dense profile takes
+/// minutes).
+pub fn compute_table_until(
+    setup: &ContactSetup,
+    y_min_m: f64,
+    y_max_m: f64,
+    step_m: f64,
+    stop: &dyn Fn() -> bool,
+) -> Result<ContactTable, ContactError> {
     let bad = |name, value, reason| ContactError::Param {
         name,
         value,
@@ -213,6 +226,9 @@ pub fn compute_table(
         let mut clamped = false;
         let mut climbing = true;
         for i in range {
+            if stop() {
+                return Err(ContactError::Stopped);
+            }
             if !clamped || climbing {
                 match solve_at(&p, ys[i], last_solved.roll_rad) {
                     Ok(s) if !clamped && !s.beyond => {
