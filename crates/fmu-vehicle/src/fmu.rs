@@ -49,7 +49,9 @@ impl FieldError for PhysicsModelError {
             PhysicsModelError::TooStiff(e) if from_the_masses(e) => Some("wheelset.wheel_load"),
             PhysicsModelError::TooStiff(e) => e.parameter.as_deref(),
             // the message names every parameter that holds the bodies upright
-            PhysicsModelError::StaticallyUnstable { .. } => Some("carbody.cg_height_m"),
+            PhysicsModelError::StaticallyUnstable { parameter, .. } => {
+                Some(parameter.as_deref().unwrap_or("carbody.cg_height_m"))
+            }
             PhysicsModelError::StartsDerailed { .. } => Some("initial.lateral_m"),
         }
     }

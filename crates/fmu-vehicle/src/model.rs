@@ -17,7 +17,7 @@
 //! acceleration at once. [`Vehicle::outputs`] evaluates them without stepping.
 
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{check_inputs, check_step, stable_substep, substep_count, TooStiff};
+use vehicle_elements::{blame, check_inputs, check_step, stable_substep, substep_count, TooStiff};
 
 pub use vehicle_elements::InputError;
 use wheel_rail::{FlangeNotCovered, GeometryTable, SegmentHint, TableError};
@@ -65,10 +65,13 @@ pub enum ModelError {
          frame.cg_height"
     )]
     StaticallyUnstable {
-        /// Smallest eigenvalue of that stiffness matrix (of mixed units).
+        /// Smallest eigenvalue of that stiffness matrix (scaled to a unit diagonal).
         smallest: f64,
         /// The body with the largest share of that eigenvector.
         body: &'static str,
+        /// The changed parameter whose default alone steadies the bodies most (its path in
+        /// [`VehicleParams`]), if one does.
+        parameter: Option<String>,
     },
     /// A wheelset starts beyond the contact table's range (derailed before the first step).
     #[error(
@@ -87,10 +90,11 @@ pub enum ModelError {
     },
 }
 
-/// The car body and frames rest statically stable on wheelsets held still: the stiffness
-/// matrix over their dofs (lateral, yaw, roll each; gravitational roll terms included) is
-/// positive definite.
-fn check_static_stability(params: &VehicleParams) -> Result<(), ModelError> {
+/// The smallest eigenvalue of the stiffness matrix over the car body's and frames' dofs
+/// (lateral, yaw, roll each; gravitational roll terms included) on wheelsets held still,
+/// scaled to a unit diagonal so that N/m and N m/rad compare, and the body that moves most in
+/// its mode.
+fn static_stability(params: &VehicleParams) -> (f64, &'static str) {
     let k = Suspension::new(params).k;
     let dofs = [
         CARBODY_Y,
@@ -103,7 +107,6 @@ fn check_static_stability(params: &VehicleParams) -> Result<(), ModelError> {
         frame_yaw(1),
         frame_roll(1),
     ];
-    // scaled to unit diagonal so that N/m and N m/rad compare
     let scale: Vec<f64> = dofs
         .iter()
         .map(|&i| k[(i, i)].abs().sqrt().max(1e-300))
@@ -112,15 +115,14 @@ fn check_static_stability(params: &VehicleParams) -> Result<(), ModelError> {
         0.5 * (k[(dofs[r], dofs[c])] + k[(dofs[c], dofs[r])]) / (scale[r] * scale[c])
     });
     let eigen = sub.symmetric_eigen();
-    let (at, &smallest) = eigen
+    let Some((at, &smallest)) = eigen
         .eigenvalues
         .iter()
         .enumerate()
         .min_by(|a, b| a.1.total_cmp(b.1))
-        .unwrap_or((0, &1.0));
-    if smallest > 1e-9 {
-        return Ok(());
-    }
+    else {
+        return (f64::NAN, "car-body");
+    };
     let v = eigen.eigenvectors.column(at);
     let share = |range: std::ops::Range<usize>| range.map(|i| v[i] * v[i]).sum::<f64>();
     let body = [
@@ -131,7 +133,22 @@ fn check_static_stability(params: &VehicleParams) -> Result<(), ModelError> {
     .into_iter()
     .max_by(|a, b| a.1.total_cmp(&b.1))
     .map_or("car-body", |b| b.0);
-    Err(ModelError::StaticallyUnstable { smallest, body })
+    (smallest, body)
+}
+
+/// The car body and frames rest statically stable on wheelsets held still
+/// ([`static_stability`] positive); else the error, with the parameter to blame.
+fn check_static_stability(params: &VehicleParams) -> Result<(), ModelError> {
+    let (smallest, body) = static_stability(params);
+    if smallest > 1e-9 {
+        return Ok(());
+    }
+    let parameter = blame(params, &VehicleParams::default(), |p| static_stability(p).0);
+    Err(ModelError::StaticallyUnstable {
+        smallest,
+        body,
+        parameter,
+    })
 }
 
 /// Errors of a step or an output evaluation; the model is unchanged after any of them.

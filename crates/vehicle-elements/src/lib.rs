@@ -41,5 +41,5 @@ pub use step::{
     check_inputs, check_step, host_step, substep_count, InputError, MAX_HOST_STEP_S, MAX_STEP_S,
     MAX_SUBSTEPS,
 };
-pub use substep::{blame_substep, check_substep, stable_substep, TooStiff, MIN_SUBSTEP_S};
+pub use substep::{blame, blame_substep, check_substep, stable_substep, TooStiff, MIN_SUBSTEP_S};
 pub use track::{TrackChoiceSource, TrackLevel, TrackSetting};

@@ -40,6 +40,19 @@ pub fn blame_substep<P: Serialize + DeserializeOwned>(
     defaults: &P,
     substep_s: impl Fn(&P) -> f64,
 ) -> Option<String> {
+    blame(params, defaults, substep_s)
+}
+
+/// The parameter to blame for a condition measured by `score` (larger is better): of the
+/// numbers in `params` that differ from `defaults`, the one whose default value alone gives the
+/// largest finite score (its path in the parameter struct). Only on an error path: it
+/// evaluates `score` once per changed number.
+pub fn blame<P: Serialize + DeserializeOwned>(
+    params: &P,
+    defaults: &P,
+    score: impl Fn(&P) -> f64,
+) -> Option<String> {
+    let substep_s = score;
     let given = serde_json::to_value(params).ok()?;
     let default = serde_json::to_value(defaults).ok()?;
     let mut changed = Vec::new();

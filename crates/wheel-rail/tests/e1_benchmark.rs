@@ -288,8 +288,8 @@ fn the_table_computation_stops_when_asked() {
         asked.set(asked.get() + 1);
         asked.get() > 10
     };
-    let e = wheel_rail::compute_table_until(&e1_setup(), -10e-3, 10e-3, 0.01e-3, &stop)
-        .unwrap_err();
+    let e =
+        wheel_rail::compute_table_until(&e1_setup(), -10e-3, 10e-3, 0.01e-3, &stop).unwrap_err();
     assert_eq!(e, wheel_rail::ContactError::Stopped);
     assert_eq!(asked.get(), 11, "asked once per row until told to stop");
     let full = wheel_rail::compute_table_until(&e1_setup(), -10e-3, 10e-3, 0.1e-3, &|| false);
