@@ -462,7 +462,7 @@ fn contact_geometry_without_a_value_fails_and_writes_nothing() {
         (
             ["--gauge", "5"],
             "invalid option --gauge = 5: must be a standard track gauge, tight to wide, in \
-             [1400, 1480] mm",
+             [1425, 1480] mm",
         ),
         // the wheelset's rolling circles are 1500 mm apart: Russian gauge found no flange
         (
@@ -967,7 +967,7 @@ fn root_locus_damper_options() {
         ),
         (
             vec!["--conicity", "-0.2"],
-            "`wheel_rail.conicity`: must be within [0, 1]",
+            "invalid option --conicity = -0.2: must be an equivalent conicity within [0, 1]",
         ),
         (
             vec!["--damper", "semi-active:0:1e-3:1e-300"],

@@ -6,6 +6,7 @@ use model_description::{field_error, FieldError, FmuModel, ModelError, StepError
 use serde::{Deserialize, Serialize};
 
 use crate::step::{host_step, InputError, MAX_SUBSTEPS};
+use crate::substep::MIN_SUBSTEP_S;
 
 /// A rail-vehicle model's physics as its FMU shell drives it.
 pub trait ShellPhysics: Clone + Sized {
@@ -189,6 +190,15 @@ impl<P: ShellPhysics> Shell<P> {
         };
         // a bounded time per call: parameters that need a very short sub-step (a light body
         // on stiff springs) would compute a long step for hours
+        // a model refuses parameters that need a sub-step below MIN_SUBSTEP_S: a shorter one
+        // comes from a corrupted FMU state, which a shorter communication step does not mend
+        if p.substep_s().is_nan() || p.substep_s() < MIN_SUBSTEP_S {
+            return Err(StepError::Error(ModelError::Other(format!(
+                "internal sub-step {:?} s is below the shortest a model builds ({MIN_SUBSTEP_S} \
+                 s): the internal sub-step comes from a corrupted FMU state",
+                p.substep_s()
+            ))));
+        }
         let substeps = step_s / p.substep_s();
         if substeps > MAX_SUBSTEPS as f64 {
             return Err(StepError::Discard(format!(

@@ -252,14 +252,15 @@ pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
             ));
         }
     }
-    // the wheelset is a standard-gauge one (rolling circles 1500 mm apart): 1000, 1067 or
-    // 1668 mm track found no overlap, 1520 mm a wheel without flange contact
-    if !(inputs.gauge_m.is_finite() && inputs.gauge_m >= 1.4 && inputs.gauge_m <= 1.48) {
+    // the wheelset is a standard-gauge one (rolling circles 1500 mm apart, flanges about
+    // 1425 mm across): 1000, 1067 or 1668 mm track found no overlap, 1520 mm a wheel without
+    // flange contact, 1420 mm a wheelset already on its flanges
+    if !(inputs.gauge_m.is_finite() && inputs.gauge_m >= 1.425 && inputs.gauge_m <= 1.48) {
         return Err(bad(
             "--gauge",
             inputs.gauge_m * 1e3,
-            "must be a standard track gauge, tight to wide, in [1400, 1480] mm (the wheelset's \
-             rolling circles are 1500 mm apart)",
+            "must be a standard track gauge, tight to wide, in [1425, 1480] mm (the wheelset's \
+             rolling circles are 1500 mm apart, its flanges about 1425 mm)",
         ));
     }
     if !(inputs.step_m.is_finite() && inputs.step_m > 0.0) {

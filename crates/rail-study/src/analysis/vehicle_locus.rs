@@ -156,14 +156,27 @@ impl VehicleLocus {
                         .total_cmp(&(b.1 - c.speed_kmh).abs())
                 })
                 .and_then(|(k, _)| Some((k, nearest(k, (c.mode.re, c.mode.im))?))),
-            Err(_) => self.results.iter().enumerate().rev().find_map(|(k, r)| {
-                let kinematic = self.kinematic_rad_per_m * self.speeds_kmh[k] / 3.6;
-                r.eigenvalues
-                    .iter()
-                    .filter(|e| e.1 > 0.0 && e.1 <= kinematic)
-                    .min_by(|a, b| damping_ratio(**a).total_cmp(&damping_ratio(**b)))
-                    .map(|e| (k, *e))
-            }),
+            Err(_) => {
+                let top = self.results.len().checked_sub(1);
+                let kinematic = |k: usize| self.kinematic_rad_per_m * self.speeds_kmh[k] / 3.6;
+                top.and_then(|k| {
+                    self.results[k]
+                        .eigenvalues
+                        .iter()
+                        .filter(|e| e.1 > 0.0 && e.1 <= kinematic(k))
+                        .min_by(|a, b| damping_ratio(**a).total_cmp(&damping_ratio(**b)))
+                        .map(|e| (k, *e))
+                })
+                // no oscillation below it (conicity 0: no kinematic oscillation at all): the
+                // least-damped mode at the highest speed
+                .or_else(|| {
+                    self.results
+                        .iter()
+                        .enumerate()
+                        .rev()
+                        .find_map(|(k, r)| r.least_damped.map(|m| (k, (m.re, m.im))))
+                })
+            }
         };
         let Some((k0, mode)) = start else {
             return followed;
@@ -345,6 +358,11 @@ mod tests {
             assert!((1.5..=6.0).contains(&f), "{v} km/h: {f} Hz");
         }
         assert!(r.figures().mode_column.contains("kinematic frequency"));
+        // conicity 0: no kinematic oscillation, no eigenvalue below it: the least-damped mode
+        let mut flat = VehicleParams::default();
+        flat.wheel_rail.conicity = 0.0;
+        let r = vehicle_root_locus(&flat, DamperSpec::Passive, None, &speeds).unwrap();
+        assert!(r.hunting_mode().iter().all(|m| m.is_some()));
     }
 
     #[test]

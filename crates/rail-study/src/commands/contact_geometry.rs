@@ -71,8 +71,8 @@ pub struct Args {
     /// Right rail profile, if different from the left.
     #[arg(long, value_name = "FILE")]
     pub rail_right: Option<PathBuf>,
-    /// Track gauge [mm], measured 14 mm below the top of rail: 1400-1480 (tight to wide standard
-    /// gauge; the wheelset's rolling circles are 1500 mm apart).
+    /// Track gauge [mm], measured 14 mm below the top of rail: 1425-1480 (tight to wide standard
+    /// gauge; the wheelset's rolling circles are 1500 mm apart, its flanges about 1425 mm).
     #[arg(
         long,
         value_name = "MM",

@@ -95,25 +95,26 @@ pub(crate) fn write_analysis(
         list.add_text(&manifest_name, text + "\n");
         Ok(list)
     };
+    // the staged list also names the earlier files still to be removed, so that a process
+    // ended in between leaves them listed for the next run; rewritten once they are gone
     let mut listed = written;
-    let mut list = manifest(&listed)?;
+    let with_stale: Vec<String> = listed.iter().chain(&stale).cloned().collect();
+    let mut list = manifest(&with_stale)?;
     let mut staged = files.stage_all(out)?;
     staged.extend(list.stage_all(out)?);
     crate::analysis::commit_all(staged)?;
-    let mut kept = false;
-    for name in stale {
-        if let Err(e) = master::output::remove_stale_file(&out.join(&name)) {
+    for name in &stale {
+        if let Err(e) = master::output::remove_stale_file(&out.join(name)) {
             eprintln!(
                 "warning: cannot remove '{}', a file of the previous {} run: {e}",
-                out.join(&name).display(),
+                out.join(name).display(),
                 command.name
             );
-            listed.push(name);
-            kept = true;
+            // listed for the next run to try again
+            listed.push(name.clone());
         }
     }
-    if kept {
-        // listed for the next run to try again
+    if !stale.is_empty() {
         list = manifest(&listed)?;
         list.write_all(out)?;
     }

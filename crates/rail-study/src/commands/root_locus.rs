@@ -96,6 +96,14 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             )));
         }
     }
+    if let Some(c) = args.conicity {
+        if !(c.is_finite() && (0.0..=1.0).contains(&c)) {
+            return Err(CommandError::Failed(format!(
+                "invalid option --conicity = {}: must be an equivalent conicity within [0, 1]",
+                master::show::num(c)
+            )));
+        }
+    }
     match args.model {
         VehicleModel::Coach => {
             let mut params = VehicleParams::default();
