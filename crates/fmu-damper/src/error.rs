@@ -39,6 +39,14 @@ pub enum StepError {
     /// A state or output became non-finite (never returned as a number).
     #[error("non-finite value in `{name}`")]
     NonFinite { name: &'static str },
+    /// The actuator's rod left its cylinder: the model has no end stops, so beyond the
+    /// stroke it has no meaning (the model is unchanged).
+    #[error(
+        "the rod would be at {rod_mm:.1} mm, beyond the cylinder's half stroke of \
+         {half_stroke_mm:.1} mm (the elongation, less the mounting's extension, must stay \
+         within the stroke)"
+    )]
+    BeyondStroke { rod_mm: f64, half_stroke_mm: f64 },
     /// The parameters held by the model are invalid.
     #[error(transparent)]
     Param(#[from] ParamError),

@@ -736,6 +736,13 @@ impl Actuator {
                 name: "actuator state",
             });
         }
+        // an elongation of 100 m gave a normal-looking force with fmi2OK
+        if y[4].abs() > self.params.half_stroke_m {
+            return Err(StepError::BeyondStroke {
+                rod_mm: y[4] * 1e3,
+                half_stroke_mm: self.params.half_stroke_m * 1e3,
+            });
+        }
         self.y = y;
         self.mount_extension_m = e;
         self.h_internal_s = h_int;

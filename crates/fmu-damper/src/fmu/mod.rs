@@ -67,6 +67,7 @@ impl FieldError for PhysicsStepError {
     fn field(&self) -> Option<&str> {
         match self {
             PhysicsStepError::BadInput { name, .. } => Some(name),
+            PhysicsStepError::BeyondStroke { .. } => Some("elongation_m"),
             PhysicsStepError::Param(p) => p.field(),
             _ => None,
         }
