@@ -50,7 +50,7 @@ const ZONE_MAX_STEPS: f64 = 3000.0;
 
 /// A number for a message: as written below 1e16 (and above 1e-4), in scientific notation
 /// beyond (a gauge of 1e300 m printed 300 digits).
-fn short(v: f64) -> String {
+pub(crate) fn short(v: f64) -> String {
     if v == 0.0 || !v.is_finite() || (1e-4..1e16).contains(&v.abs()) {
         format!("{v}")
     } else {

@@ -30,7 +30,7 @@ pub const MIN_POINTS: usize = 3;
 /// minutes.
 pub const MAX_POINTS: usize = 100_000;
 
-/// Lateral extent a wheel or rail profile in millimetres can have [mm]: a wheel spans about
+/// Lateral extent a wheel or rail profile in millimetres can have \[mm\]: a wheel spans about
 /// 140 mm, a rail head about 75 (a synthetic crown a few); outside, the file is in another
 /// unit (metres: 0.14, micrometres: 140 000).
 pub const PLAUSIBLE_SPAN_MM: (f64, f64) = (1.0, 1000.0);
@@ -95,18 +95,22 @@ pub enum ProfileError {
         /// The limit.
         max: usize,
     },
-    /// Not enough points.
+    /// The lateral extent is no wheel's or rail's in millimetres ([`PLAUSIBLE_SPAN_MM`]).
     #[error(
-        "{source_name}: the profile spans {span_mm} mm laterally; coordinates are read in \
+        "{source_name}: the profile spans {} mm laterally; coordinates are read in \
          millimetres (a wheel spans about 140 mm, a rail head about 75 mm): is the file in \
-         {unit}?"
+         {unit}?",
+        crate::contact::short(*.span_mm)
     )]
     ImplausibleSpan {
+        /// File name.
         source_name: String,
+        /// Lateral extent as read \[mm\].
         span_mm: f64,
         /// "metres" or "micrometres".
         unit: &'static str,
     },
+    /// Not enough points.
     #[error("{source_name}: only {count} point(s) (line {last_line} is the last), at least {min} needed")]
     TooFewPoints {
         /// File name.

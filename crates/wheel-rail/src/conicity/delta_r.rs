@@ -38,7 +38,7 @@ pub(crate) struct Oscillation {
 }
 
 impl DeltaR {
-    /// From a contact table (|Δr| below [`DELTA_R_RESOLUTION_M`] taken as 0): every solved state ([`ContactTable::solved_states`]: reachable rows,
+    /// From a contact table (|Δr| below `DELTA_R_RESOLUTION_M`, 1 µm, taken as 0): every solved state ([`ContactTable::solved_states`]: reachable rows,
     /// flange-climbing rows beyond the flange limit, and the states on both sides of each located
     /// contact-point jump), with e0 and the mean nominal radius of the table.
     pub fn from_table(table: &ContactTable) -> Self {
