@@ -326,6 +326,17 @@ pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
     Ok(())
 }
 
+/// The contact table of `setup` over the grid of `inputs`, stopping between rows once `cancel`
+/// is set (Ctrl-C).
+pub(crate) fn table_over_grid(
+    setup: &ContactSetup,
+    inputs: &GeometryInputs,
+    cancel: &AtomicBool,
+) -> Result<ContactTable, wheel_rail::ContactError> {
+    let stop = || cancel.load(Ordering::SeqCst);
+    compute_table_until(setup, -inputs.y_max_m, inputs.y_max_m, inputs.step_m, &stop)
+}
+
 /// A contact search stopped by the caller is the command's cancellation.
 pub(crate) fn stopped(e: wheel_rail::ContactError) -> AnalysisError {
     match e {
@@ -360,15 +371,7 @@ pub fn contact_geometry(
             e => AnalysisError::Geometry(format!("{both}: {e}")),
         }
     };
-    let stop = || cancel.load(Ordering::SeqCst);
-    let table = compute_table_until(
-        &setup,
-        -inputs.y_max_m,
-        inputs.y_max_m,
-        inputs.step_m,
-        &stop,
-    )
-    .map_err(profiles)?;
+    let table = table_over_grid(&setup, inputs, cancel).map_err(profiles)?;
     let bogie_table = if setup.radius_convention == RadiusConvention::RigidRoll
         || setup.nominal_radius_left_m == setup.nominal_radius_right_m
     {
@@ -378,14 +381,7 @@ pub fn contact_geometry(
             radius_convention: RadiusConvention::RigidRoll,
             ..setup
         };
-        compute_table_until(
-            &rigid,
-            -inputs.y_max_m,
-            inputs.y_max_m,
-            inputs.step_m,
-            &stop,
-        )
-        .map_err(profiles)?
+        table_over_grid(&rigid, inputs, cancel).map_err(profiles)?
     };
     let d = DeltaR::from_table(&table);
     let conicity = curve_amplitudes(inputs.amplitude_max_m, inputs.conicity_step_m)

@@ -12,10 +12,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use rayon::prelude::*;
-use wheel_rail::{compute_table_until, DeltaR};
+use wheel_rail::DeltaR;
 
 use super::{
-    check_options, conicity_at, setup_of, stopped, ConicityPoint, GeometryInputs, ProfileSource,
+    check_options, conicity_at, setup_of, stopped, table_over_grid, ConicityPoint, GeometryInputs,
+    ProfileSource,
 };
 use crate::analysis::{AnalysisError, Artefacts};
 use crate::plot::{
@@ -171,15 +172,7 @@ pub fn fleet(
                 ..inputs.clone()
             };
             let setup = setup_of(&single)?;
-            let stop = || cancel.load(Ordering::SeqCst);
-            let table = compute_table_until(
-                &setup,
-                -inputs.y_max_m,
-                inputs.y_max_m,
-                inputs.step_m,
-                &stop,
-            )
-            .map_err(stopped)?;
+            let table = table_over_grid(&setup, inputs, cancel).map_err(stopped)?;
             let d = DeltaR::from_table(&table);
             let conicity = amplitudes_m
                 .iter()
