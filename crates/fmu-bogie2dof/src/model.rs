@@ -8,7 +8,9 @@
 //! * the flange contact, omega_f = sqrt(2 P max d tan(gamma)/dy (1/m + p^2/J)):
 //!   h_sub <= 1 / omega_f (RK4's imaginary-axis stability ends at 2.8);
 //! * the internal track's shortest wavelength, omega_t = 2 pi V / lambda_min:
-//!   h_sub <= 1 / omega_t.
+//!   h_sub <= 1 / omega_t;
+//! * the secondary suspension, sqrt(2 k_ssy / m) and sqrt(2 k_ssx b^2 / J): far below the
+//!   flange for any real bogie, it governs only a suspension made nearly rigid.
 //!
 //! For the default bogie the flange bound governs: h_sub = 1.08 ms at any speed, so a 1 ms
 //! communication step is one RK4 step (0.1 ms sub-steps before). The convergence study
@@ -586,10 +588,14 @@ fn substep_bound(c: &Consts, table: &GeometryTable, generator: Option<&TrackGene
         c.kg
     };
     let w_flange = (2.0 * k_flange * (1.0 / c.m + c.p * c.p / c.j)).sqrt();
+    // the secondary suspension: lateral on the mass, longitudinal at arm b on the yaw inertia
+    let w_suspension = (2.0 * c.k_ssy / c.m)
+        .sqrt()
+        .max((2.0 * c.k_ssx * c.b * c.b / c.j).sqrt());
     let w_track = generator.map_or(0.0, |g| c.v * g.omega_hi);
     SUBSTEP_CAP_S
         .min(MAX_DECAY_PER_SUBSTEP / rate.max(1e-9))
-        .min(MAX_PHASE_PER_SUBSTEP_RAD / w_flange.max(w_track).max(1e-9))
+        .min(MAX_PHASE_PER_SUBSTEP_RAD / w_flange.max(w_suspension).max(w_track).max(1e-9))
 }
 
 /// Upper bound of the RK4 sub-step whatever the dynamics (the largest step of the

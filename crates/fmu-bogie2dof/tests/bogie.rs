@@ -954,3 +954,41 @@ fn the_contact_table_bounds_the_non_linear_model() {
     assert!(matches!(e, StepError::Derailed { .. }), "{e}");
     assert!(e.to_string().contains("contact table's range"), "{e}");
 }
+
+/// A stiff secondary suspension shortens the internal step instead of diverging: 1e11 N/m
+/// (laterally or longitudinally) gave a "derailment" at the first step, the sub-step following
+/// only the contact and creep. Stiffer than any step can follow is refused, naming it.
+#[test]
+fn a_stiff_suspension_shortens_the_internal_step() {
+    let base = Bogie::new(Params::default()).unwrap().substep_s();
+    for stiff in [
+        Params {
+            k_ssy_n_per_m: 1e11,
+            ..Params::default()
+        },
+        Params {
+            k_ssx_n_per_m: 1e11,
+            ..Params::default()
+        },
+    ] {
+        let mut b = Bogie::new(Params {
+            initial_lateral_m: 1e-3,
+            ..stiff
+        })
+        .unwrap();
+        assert!(b.substep_s() < base / 2.0, "{} s", b.substep_s());
+        let mut peak = 0.0f64;
+        for _ in 0..200 {
+            let o = b.step(1e-3, &Inputs::default()).unwrap();
+            peak = peak.max(o.wheelset_front_rel_track_m.abs());
+        }
+        assert!(peak < 0.02, "{peak} m");
+    }
+    let e = Bogie::new(Params {
+        k_ssy_n_per_m: 1e25,
+        ..Params::default()
+    })
+    .unwrap_err();
+    assert!(matches!(e, ModelError::TooStiff(_)), "{e}");
+    assert!(e.to_string().contains("k_ssy_n_per_m"), "{e}");
+}
