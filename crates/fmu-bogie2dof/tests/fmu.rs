@@ -286,3 +286,59 @@ fn start_values_and_contact_tables() {
     assert!((worn_file - worn).abs() <= 1e-6 * worn.abs().max(1.0));
     assert!((worn - aa_kw).abs() > 1.0);
 }
+
+/// A restored state whose internal sub-step was forged (checksum resealed) cannot make a step
+/// run for ever: a sub-step below the shortest any parameter set builds is reported as a
+/// corrupted state (fmi2Error), and one that would take more sub-steps than a call computes
+/// discards the step (the state unchanged).
+#[test]
+fn a_forged_internal_sub_step_is_refused_at_the_step() {
+    let substep = Bogie::new(Params::default()).unwrap().substep_s();
+    let forged = |value: f64| {
+        let (mut c, log) = initialising::<M>();
+        assert_eq!(c.exit_initialization_mode(), Status::Ok);
+        let state = c.get_fmu_state().unwrap();
+        let mut bytes = c.serialize_fmu_state(&state).unwrap();
+        let at: Vec<usize> = bytes
+            .windows(8)
+            .enumerate()
+            .filter(|(_, w)| *w == substep.to_le_bytes())
+            .map(|(k, _)| k)
+            .collect();
+        assert_eq!(at.len(), 1, "the sub-step {substep} s once in the state");
+        bytes[at[0]..at[0] + 8].copy_from_slice(&value.to_le_bytes());
+        model_description::testing::reseal_state(&mut bytes);
+        let restored = c
+            .deserialize_fmu_state(&bytes)
+            .unwrap_or_else(|_| panic!("{value}: {:?}", log.take()));
+        assert_eq!(c.set_fmu_state(&restored), Status::Ok);
+        log.take();
+        (c, log)
+    };
+    // (a NaN is refused when the state is read)
+    for corrupted in [1e-12, 0.0, -1e-3] {
+        let (mut c, log) = forged(corrupted);
+        assert_eq!(c.do_step(0.0, 1e-3), Status::Error, "{corrupted}");
+        assert!(
+            logged(&log.take(), Status::Error, "corrupted FMU state"),
+            "{corrupted}"
+        );
+    }
+    // 2e-7 s is above the shortest sub-step: a 1 ms step runs, a 10 s one is discarded at once
+    let (mut c, log) = forged(2e-7);
+    assert_eq!(c.do_step(0.0, 1e-3), Status::Ok);
+    let before = get::<M>(&mut c, "wheelset_front.lateral_displacement");
+    assert_eq!(c.do_step(1e-3, 10.0), Status::Discard);
+    assert!(
+        logged(
+            &log.take(),
+            Status::Discard,
+            "take shorter communication steps"
+        ),
+        "discard reason"
+    );
+    assert_eq!(
+        get::<M>(&mut c, "wheelset_front.lateral_displacement").to_bits(),
+        before.to_bits()
+    );
+}
