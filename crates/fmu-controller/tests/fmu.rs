@@ -865,3 +865,29 @@ fn fmu_state_save_restore_and_serialise() {
         &|t| vec![0.05 * (25.0 * t).cos(), 8e3 * (25.0 * t).sin()],
     );
 }
+
+/// Finite inputs whose products overflow (1e200 m/s from a broken sensor) end the run with the
+/// output named as the FMU names it (`control.condition`), not as the physics field.
+#[test]
+fn an_overflowing_output_is_named_by_its_fmi_name() {
+    type S = SkyHookController;
+    let (mut c, log) = init::<S>();
+    assert_eq!(c.exit_initialization_mode(), Status::Ok);
+    assert_eq!(set_r::<S>(&mut c, "sensor.velocity", 1e200), Status::Ok);
+    assert_eq!(set_r::<S>(&mut c, "sensor.acceleration", 1e200), Status::Ok);
+    assert_eq!(
+        set_r::<S>(&mut c, "damper.elongation_velocity", -1e200),
+        Status::Ok
+    );
+    let mut status = Status::Ok;
+    for k in 0..100 {
+        status = c.do_step(k as f64 * 1e-3, 1e-3);
+        if status != Status::Ok {
+            break;
+        }
+    }
+    assert_eq!(status, Status::Error);
+    let text = format!("{:?}", log.take());
+    assert!(text.contains("`control.condition`"), "{text}");
+    assert!(!text.contains("`condition`"), "{text}");
+}

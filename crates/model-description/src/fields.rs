@@ -59,9 +59,9 @@ pub fn variable_for_field<'a>(metas: &'a [VarMeta], field: &str) -> Option<&'a V
 }
 
 /// `text` with every physics field name in it (an identifier token containing '_', optionally
-/// dotted or indexed: `area_b_m2`, `valve.time_constant_s`, `table_opening[2]`) replaced by the FMI name of the variable bound
-/// to it, so messages such as "must exceed area_b_m2 * half_stroke_m" speak the FMU's language.
-/// Plain words stay as they are.
+/// dotted or indexed: `area_b_m2`, `valve.time_constant_s`, `table_opening[2]`, or any token in
+/// backticks) replaced by the FMI name of the variable bound to it, so messages such as "must
+/// exceed area_b_m2 * half_stroke_m" speak the FMU's language. Plain words stay as they are.
 pub fn rename_fields(text: &str, metas: &[VarMeta]) -> String {
     let is_ident = |c: char| c.is_ascii_alphanumeric() || matches!(c, '_' | '.' | '[' | ']');
     let mut out = String::with_capacity(text.len() + 16);
@@ -77,8 +77,9 @@ pub fn rename_fields(text: &str, metas: &[VarMeta]) -> String {
         } else {
             trimmed
         };
-        let renamed = token
-            .contains('_')
+        // a name in backticks is a field even without '_' (`cost`, `condition`)
+        let quoted = out.ends_with('`') && tail[token.len()..].starts_with('`');
+        let renamed = (token.contains('_') || quoted)
             .then(|| variable_for_field(metas, token))
             .flatten();
         out.push_str(renamed.map_or(token, |m| m.name.as_str()));
@@ -110,6 +111,13 @@ pub fn field_error_in(metas: &[VarMeta], e: &dyn FieldError) -> ModelError {
             None => ModelError::Other(reason),
         },
     }
+}
+
+/// [`rename_fields`] with the declaration of model `M` (on error paths only: the declaration is
+/// built on each call).
+pub fn rename_fields_of<M: FmuModel>(text: &str) -> String {
+    let metas: Vec<VarMeta> = M::variables().into_iter().map(|v| v.meta).collect();
+    rename_fields(text, &metas)
 }
 
 /// [`field_error_in`] with the declaration of model `M` (errors are rare: the declaration is
@@ -159,6 +167,7 @@ mod tests {
             meta("a.x", "p.x_m", Causality::Parameter),
             meta("b.x", "q.x_m", Causality::Parameter),
             meta("table.x[3]", "table_x[2]", Causality::Parameter),
+            meta("cost.value", "board.out.cost", Causality::Output),
         ]
     }
 
@@ -194,6 +203,11 @@ mod tests {
             "`x` must be > cylinder.area_b * cylinder.half_stroke. area_b_m2x contact ..."
         );
         assert_eq!(rename_fields("", &m), "");
+        // a plain word is a field only in backticks
+        assert_eq!(
+            rename_fields("non-finite output `cost` = inf: the cost is lost", &m),
+            "non-finite output `cost.value` = inf: the cost is lost"
+        );
         assert_eq!(
             rename_fields("must exceed table_x[2] = 1 (in [0, 1])", &m),
             "must exceed table.x[3] = 1 (in [0, 1])"

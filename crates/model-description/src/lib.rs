@@ -38,7 +38,7 @@ pub mod xml;
 pub use codec::{AlwaysSome, Codec, FmiValue, Native, Sign, ZeroIsNone};
 pub use component::{CollectLog, Component, FmiState, Status};
 pub use enumeration::{EnumItem, EnumType, FmiEnum};
-pub use fields::{field_error, FieldError};
+pub use fields::{field_error, rename_fields_of, FieldError};
 pub use files::{read_parameter_file, ParameterFileError, MAX_PARAMETER_FILE_BYTES};
 pub use model::{
     DefaultExperiment, Diagnostics, FmuModel, InstanceContext, ModelError, ModelInfo, StepError,

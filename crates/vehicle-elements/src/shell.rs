@@ -2,7 +2,9 @@
 //! physics at initialisation (previewing its outputs before), evaluate its outputs and take a
 //! host step on it, with the physics' errors in the FMU's language.
 
-use model_description::{field_error, FieldError, FmuModel, ModelError, StepError};
+use model_description::{
+    field_error, rename_fields_of, FieldError, FmuModel, ModelError, StepError,
+};
 use serde::{Deserialize, Serialize};
 
 use crate::step::{host_step, InputError, MAX_SUBSTEPS};
@@ -210,7 +212,7 @@ impl<P: ShellPhysics> Shell<P> {
         }
         let inputs = &self.inputs;
         let map = |e: P::StepError| match P::input_error(&e) {
-            _ if P::diverged(&e) => StepError::Discard(e.to_string()),
+            _ if P::diverged(&e) => StepError::Discard(rename_fields_of::<M>(&e.to_string())),
             Some(InputError::InvalidStep { .. }) => StepError::Discard(e.to_string()),
             Some(InputError::TooManySubsteps { .. }) => StepError::Error(ModelError::Other(
                 format!("{e} (the internal sub-step comes from a corrupted FMU state)"),
@@ -218,7 +220,7 @@ impl<P: ShellPhysics> Shell<P> {
             Some(InputError::NonFiniteInput { .. }) => {
                 StepError::Error(field_error::<M>(&StepFault::<P>(&e)))
             }
-            None => StepError::Error(ModelError::Other(e.to_string())),
+            None => StepError::Error(ModelError::Other(rename_fields_of::<M>(&e.to_string()))),
         };
         self.out = host_step(p, step_s, |p, h| p.step(h, inputs)).map_err(map)?;
         Ok(())

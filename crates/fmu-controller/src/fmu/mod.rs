@@ -101,7 +101,9 @@ pub use idf::IdealDamperForceController;
 pub use mppt::MpptController;
 pub use skyhook::SkyHookController;
 
-use model_description::{field_error, Diagnostics, FieldError, FmuModel, ModelError, StepError};
+use model_description::{
+    field_error, rename_fields_of, Diagnostics, FieldError, FmuModel, ModelError, StepError,
+};
 use serde::{Deserialize, Serialize};
 
 use crate::{ParamError, StepError as PhysicsStepError};
@@ -230,7 +232,9 @@ impl FieldError for PhysicsStepError {
 /// (fmi2Error).
 fn step_error<M: FmuModel>(e: &PhysicsStepError) -> StepError {
     match e {
-        PhysicsStepError::TooManySamples { .. } => StepError::Discard(e.to_string()),
+        PhysicsStepError::TooManySamples { .. } => {
+            StepError::Discard(rename_fields_of::<M>(&e.to_string()))
+        }
         _ => StepError::Error(field_error::<M>(e)),
     }
 }

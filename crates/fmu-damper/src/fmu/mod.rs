@@ -43,7 +43,9 @@ mod semi;
 pub use actuator::FullActiveActuator;
 pub use semi::{PassiveYawDamper, SemiActiveDamper};
 
-use model_description::{field_error, FieldError, FmuModel, ModelError, StepError};
+use model_description::{
+    field_error, rename_fields_of, FieldError, FmuModel, ModelError, StepError,
+};
 
 use crate::error::{ParamError, StepError as PhysicsStepError};
 
@@ -86,7 +88,7 @@ impl FieldError for PhysicsStepError {
 fn step_error<M: FmuModel>(e: &PhysicsStepError) -> StepError {
     match e {
         PhysicsStepError::Integration { .. } | PhysicsStepError::NonFinite { .. } => {
-            StepError::Discard(e.to_string())
+            StepError::Discard(rename_fields_of::<M>(&e.to_string()))
         }
         other => StepError::Error(field_error::<M>(other)),
     }
