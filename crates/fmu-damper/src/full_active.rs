@@ -202,7 +202,23 @@ impl Default for ActuatorParams {
     }
 }
 
+/// Stiffest mounting behind which the rod mode runs smoothly with a Stribeck drop
+/// (F_s > F_c) \[N/m\]: stiffer, the negative friction slope at a few mm/s makes the rod mode
+/// chatter (see the module docs and tests/mounting.rs).
+pub const SMOOTH_MOUNTING_LIMIT_N_PER_M: f64 = 1e8;
+
 impl ActuatorParams {
+    /// Whether the imposed rod sits behind a mounting stiffer than
+    /// [`SMOOTH_MOUNTING_LIMIT_N_PER_M`] with a friction that drops with speed: its force then
+    /// chatters and is not a rigid mounting's (the caller warns; rigid is `None`).
+    pub fn mounting_chatters(&self) -> bool {
+        self.rod == RodMode::Imposed
+            && self.stribeck_friction_n > self.coulomb_friction_n
+            && self
+                .mounting_stiffness_n_per_m
+                .is_some_and(|k| k > SMOOTH_MOUNTING_LIMIT_N_PER_M)
+    }
+
     /// Checks every parameter; the error names the first bad one.
     pub fn validate(&self) -> Result<(), ParamError> {
         positive("alpha_m", self.alpha_m)?;

@@ -240,3 +240,53 @@ fn through_the_fmu_zero_is_rigid_and_a_stiffness_changes_the_force() {
         f[0]
     }
 }
+
+/// The largest second difference of a force history relative to its peak: a smooth 4 Hz force
+/// in 0.1 ms steps stays far below 1e-3, a chattering one does not.
+fn roughness(f: &[f64]) -> f64 {
+    f.windows(3)
+        .map(|w| (w[0] - 2.0 * w[1] + w[2]).abs())
+        .fold(0.0, f64::max)
+        / peak(f)
+}
+
+/// Behind a mounting stiffer than the smooth limit, Table 3-2's friction makes the rod chatter
+/// and the FMU says so at initialisation (fmi2Warning naming the parameter); at or below the
+/// limit, or without the Stribeck drop, it is silent.
+#[test]
+fn a_mounting_stiffer_than_the_smooth_limit_chatters_and_the_fmu_warns() {
+    use fmu_damper::fmu::FullActiveActuator as A;
+    use fmu_damper::full_active::SMOOTH_MOUNTING_LIMIT_N_PER_M;
+    let f_s = ActuatorParams::default().stribeck_friction_n;
+    let f_c = ActuatorParams::default().coulomb_friction_n;
+    let rough: Vec<f64> = [1e7, SMOOTH_MOUNTING_LIMIT_N_PER_M, 1e10]
+        .iter()
+        .map(|&k| roughness(&actuator_force(Some(k), f_s)))
+        .collect();
+    eprintln!("roughness at 1e7, limit, 1e10 N/m: {rough:?}");
+    assert!(rough[0] < 1e-3 && rough[1] < 1e-2, "{rough:?}");
+    assert!(rough[2] > 10.0 * rough[1], "{rough:?}");
+
+    let exit = |k_m: f64, stribeck: f64| {
+        let (mut c, log) = rust_component::<A>(InstanceContext::default()).unwrap();
+        let set = |c: &mut model_description::Component, name: &str, x: f64| {
+            c.set_real(&[value_reference::<A>(name).unwrap()], &[x])
+        };
+        assert_eq!(set(&mut c, "damper.mounting_stiffness", k_m), Status::Ok);
+        assert_eq!(set(&mut c, "friction.stribeck", stribeck), Status::Ok);
+        assert_eq!(c.setup_experiment(0.0, None), Status::Ok);
+        assert_eq!(c.enter_initialization_mode(), Status::Ok);
+        let status = c.exit_initialization_mode();
+        (status, format!("{:?}", log.take()))
+    };
+    let (status, log) = exit(1e10, f_s);
+    assert_eq!(status, Status::Warning, "{log}");
+    assert!(
+        log.contains("damper.mounting_stiffness = 1e10 N/m"),
+        "{log}"
+    );
+    for (k_m, stribeck) in [(1e7, f_s), (0.0, f_s), (1e10, f_c)] {
+        let (status, log) = exit(k_m, stribeck);
+        assert_eq!(status, Status::Ok, "k_m {k_m}, F_s {stribeck}: {log}");
+    }
+}

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use super::{not_initialised, restored_physics, step_error, AUTHOR};
 use crate::full_active::{
     Actuator, ActuatorInputs, ActuatorModel, ActuatorOutputs, ActuatorParams, RodMode,
-    LEAKAGE_LITRE_READING_M3PS_PER_PA,
+    LEAKAGE_LITRE_READING_M3PS_PER_PA, SMOOTH_MOUNTING_LIMIT_N_PER_M,
 };
 
 fmi_enum! {
@@ -167,8 +167,17 @@ impl FmuModel for FullActiveActuator {
         })
     }
 
-    fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
+    fn exit_initialization(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError> {
         let mut a = Actuator::new(self.params).map_err(|e| field_error::<Self>(&e))?;
+        if self.params.mounting_chatters() {
+            diag.warn(format!(
+                "damper.mounting_stiffness = {:e} N/m is stiffer than {:e} N/m: with \
+                 friction.stribeck above friction.coulomb the rod chatters behind so stiff a \
+                 mounting and damper.force is not a rigid mounting's; 0 is rigid",
+                self.params.mounting_stiffness_n_per_m.unwrap_or(f64::NAN),
+                SMOOTH_MOUNTING_LIMIT_N_PER_M
+            ));
+        }
         a.set_inputs(&self.inputs)
             .map_err(|e| field_error::<Self>(&e))?;
         self.out = a.outputs().map_err(|e| field_error::<Self>(&e))?;
@@ -314,7 +323,9 @@ extra state, and <code>damper.force</code> is the spring's tension k_m e (no dir
 any more; the declaration keeps the rigid case's). The run starts quasi-static. Table 3-2's
 Stribeck drop (F_s &gt; F_c) gives the friction a negative slope at a few mm/s; behind a mounting
 stiffer than about 1e8 N/m the rod mode then chatters, so do not use k_m as a "nearly rigid"
-switch: 0 is rigid. At 10 MN/m the rod mode (about 900 rad/s) is smooth.</p>
+switch: 0 is rigid. fmi2ExitInitializationMode returns fmi2Warning, with the reason, for a
+mounting above 1e8 N/m while friction.stribeck exceeds friction.coulomb. At 10 MN/m the rod
+mode (about 900 rad/s) is smooth.</p>
 
 <h2>Direct feedthrough</h2>
 <p><code>damper.force</code>, <code>damper.friction_force</code> and <code>damper.power</code> depend on
