@@ -489,6 +489,45 @@ fn out_of_range_command_is_clamped_with_one_warning() {
     assert_eq!(c.do_step(0.0, h), Status::Ok);
 }
 
+/// An elongation velocity beyond what a yaw damper sees (100 m/s: mm/s given as m/s) warns on
+/// the step entering it, once, and again after it returned into range; the model goes on.
+#[test]
+fn an_implausible_velocity_warns_once() {
+    use fmu_damper::fmu::PLAUSIBLE_VELOCITY_MPS;
+    type P = PassiveYawDamper;
+    let (mut c, log) = init::<P>(&[]);
+    let h = 1e-3;
+    let mut t = 0.0;
+    let mut step = |c: &mut Component| {
+        let s = c.do_step(t, h);
+        t += h;
+        s
+    };
+    assert_eq!(step(&mut c), Status::Ok);
+    let v = "damper.elongation_velocity";
+    assert_eq!(set::<P>(&mut c, v, PLAUSIBLE_VELOCITY_MPS), Status::Ok);
+    assert_eq!(step(&mut c), Status::Ok);
+    assert_eq!(set::<P>(&mut c, v, 100.0), Status::Ok);
+    assert_eq!(step(&mut c), Status::Warning);
+    let msgs = log.take();
+    assert!(
+        logged(
+            &msgs,
+            Status::Warning,
+            "damper.elongation_velocity = 100 m/s"
+        ),
+        "{msgs:?}"
+    );
+    assert!(get::<P>(&mut c, "damper.force").is_finite());
+    assert_eq!(set::<P>(&mut c, v, -100.0), Status::Ok);
+    assert_eq!(step(&mut c), Status::Ok);
+    assert!(log.take().is_empty());
+    assert_eq!(set::<P>(&mut c, v, 0.1), Status::Ok);
+    assert_eq!(step(&mut c), Status::Ok);
+    assert_eq!(set::<P>(&mut c, v, -100.0), Status::Ok);
+    assert_eq!(step(&mut c), Status::Warning);
+}
+
 /// 4 Hz, +-3 mm, 0 % opening (the stiffest case): communication steps 1e-4, 1e-3, 5e-3 s agree
 /// within the physics crate's stated 0.5 % of the peak force (input sampled at mid-step), and
 /// the steady peak with a plain zero-order hold within 0.5 %.

@@ -41,7 +41,7 @@ mod actuator;
 mod semi;
 
 pub use actuator::FullActiveActuator;
-pub use semi::{PassiveYawDamper, SemiActiveDamper};
+pub use semi::{PassiveYawDamper, SemiActiveDamper, PLAUSIBLE_VELOCITY_MPS};
 
 use model_description::{
     field_error, rename_fields_of, FieldError, FmuModel, ModelError, StepError,

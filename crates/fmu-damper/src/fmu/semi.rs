@@ -30,7 +30,16 @@ pub struct SemiShell {
     out: SemiActiveOutputs,
     /// The command was clamped at the last step: warn only on entry into the clamped state.
     clamp_active: bool,
+    /// The elongation velocity was beyond [`PLAUSIBLE_VELOCITY_MPS`] at the last step: warn
+    /// only on entry.
+    #[serde(default)]
+    overspeed_active: bool,
 }
+
+/// Largest elongation velocity a yaw damper plausibly sees \[m/s\]: hunting at 4 Hz and
+/// +-6 mm at the damper is 0.15 m/s. Beyond it the model still computes (its orifice laws hold),
+/// but the input is more likely a unit slip (mm/s for m/s) or a broken signal, so the step warns.
+pub const PLAUSIBLE_VELOCITY_MPS: f64 = 5.0;
 
 impl SemiShell {
     fn new(params: SemiActiveParams, inputs: SemiActiveInputs) -> Self {
@@ -45,6 +54,7 @@ impl SemiShell {
             damper: None,
             out,
             clamp_active: false,
+            overspeed_active: false,
         }
     }
 
@@ -90,7 +100,21 @@ impl SemiShell {
         let out = d.step(h, &self.inputs).map_err(|e| step_error::<M>(&e))?;
         self.out = out;
         self.report_clamp(diag);
+        self.report_overspeed(diag);
         Ok(())
+    }
+
+    fn report_overspeed(&mut self, diag: &mut Diagnostics) {
+        let v = self.inputs.elongation_velocity_mps;
+        let over = v.abs() > PLAUSIBLE_VELOCITY_MPS;
+        if over && !self.overspeed_active {
+            diag.warn(format!(
+                "damper.elongation_velocity = {v} m/s is beyond the {PLAUSIBLE_VELOCITY_MPS} m/s \
+                 a yaw damper plausibly sees (a velocity in mm/s?); the model goes on \
+                 (further such steps are not reported until the velocity returns into range)"
+            ));
+        }
+        self.overspeed_active = over;
     }
 
     /// A restored state's physics was built from the declared parameters.
