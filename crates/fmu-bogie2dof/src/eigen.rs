@@ -89,12 +89,11 @@ pub struct HuntingMode {
 
 impl HuntingMode {
     fn from_eig(l: Complex<f64>) -> Self {
-        let n = l.norm();
         Self {
             re: l.re,
             im: l.im,
             freq_hz: l.im / (2.0 * std::f64::consts::PI),
-            damping_ratio: if n > 0.0 { -l.re / n } else { 0.0 },
+            damping_ratio: vehicle_elements::eigenvalues::damping_ratio(l),
         }
     }
 }

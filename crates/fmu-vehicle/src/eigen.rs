@@ -321,12 +321,11 @@ fn kind_of(s: &EnergyShares) -> ModeKind {
 fn mode(p: &VehicleParams, a: &DMatrix<f64>, l: Complex<f64>) -> Mode {
     let v = eigenvector(a, l);
     let shares = shares_of(p, &v);
-    let n = l.norm();
     Mode {
         re: l.re,
         im: l.im,
         freq_hz: l.im / (2.0 * std::f64::consts::PI),
-        damping_ratio: if n > 0.0 { -l.re / n } else { 0.0 },
+        damping_ratio: vehicle_elements::eigenvalues::damping_ratio(l),
         shares,
         kind: kind_of(&shares),
     }

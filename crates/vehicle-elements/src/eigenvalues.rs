@@ -9,6 +9,16 @@ use nalgebra::{Complex, DMatrix};
 /// running for ever).
 const QR_ITERATIONS_PER_EIGENVALUE: usize = 100;
 
+/// Damping ratio -re / |lambda| of an eigenvalue (negative = unstable; 0 at lambda = 0).
+pub fn damping_ratio(l: Complex<f64>) -> f64 {
+    let n = l.norm();
+    if n > 0.0 {
+        -l.re / n
+    } else {
+        0.0
+    }
+}
+
 /// Eigenvalues of a real square matrix, `None` when the QR iteration does not converge (or the
 /// matrix holds a value that is not finite). The matrix is balanced first (diagonal scaling by
 /// powers of two, as LAPACK's `dgebal` does, so no rounding is introduced): a state matrix with

@@ -14,7 +14,7 @@ use fmu_vehicle::eigen::{
 use fmu_vehicle::VehicleParams;
 
 use super::locus::DamperSpec;
-use super::locus_figures::{speeds_line, LocusFigures, LocusSpeed};
+use super::locus_figures::{damping_ratio, speeds_line, LocusFigures, LocusSpeed};
 use super::{AnalysisError, Artefacts, Table};
 
 /// Seed R15: linear critical speed of the coach with the passive reference damper [km/h].
@@ -94,16 +94,6 @@ pub fn vehicle_root_locus(
     })
 }
 
-/// -re / |lambda| of an eigenvalue (re, im).
-fn damping_ratio((re, im): (f64, f64)) -> f64 {
-    let n = re.hypot(im);
-    if n > 0.0 {
-        -re / n
-    } else {
-        0.0
-    }
-}
-
 /// Number of the mode kind in the CSV (0 car body, 1 front bogie, 2 rear bogie, 3 both).
 fn kind_code(m: &Mode) -> f64 {
     use fmu_vehicle::eigen::ModeKind::*;
@@ -164,7 +154,7 @@ impl VehicleLocus {
                         .eigenvalues
                         .iter()
                         .filter(|e| e.1 > 0.0 && e.1 <= kinematic(k))
-                        .min_by(|a, b| damping_ratio(**a).total_cmp(&damping_ratio(**b)))
+                        .min_by(|a, b| damping_ratio(a.0, a.1).total_cmp(&damping_ratio(b.0, b.1)))
                         .map(|e| (k, *e))
                 })
                 // no oscillation below it (conicity 0: no kinematic oscillation at all): the
