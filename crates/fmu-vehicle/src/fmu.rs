@@ -290,11 +290,12 @@ impl FmuModel for RailVehicle {
             /// Elongation velocity of the front left yaw damper
             output "damper_front_left.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[0].elongation_velocity_mps;
             /// Absolute velocity of the car-body end of the front left damper along its axis, positive
-            /// forward (towards the car-body end); for a sky-hook
+            /// forward (towards the car-body end)
             output "damper_front_left.carbody_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[0].carbody_end_velocity_mps;
             /// Absolute acceleration of the car-body end of the front left damper along its axis
             output "damper_front_left.carbody_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[0].carbody_end_acc_mps2;
             /// Absolute velocity of the frame end of the front left damper along its axis, positive forward
+            /// (a textbook sky-hook's x', (3.6), with sensor.sign = -1)
             output "damper_front_left.frame_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[0].frame_end_velocity_mps;
             /// Absolute acceleration of the frame end of the front left damper along its axis
             output "damper_front_left.frame_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[0].frame_end_acc_mps2;
@@ -303,11 +304,12 @@ impl FmuModel for RailVehicle {
             /// Elongation velocity of the front right yaw damper
             output "damper_front_right.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[1].elongation_velocity_mps;
             /// Absolute velocity of the car-body end of the front right damper along its axis, positive
-            /// forward (towards the car-body end); for a sky-hook
+            /// forward (towards the car-body end)
             output "damper_front_right.carbody_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[1].carbody_end_velocity_mps;
             /// Absolute acceleration of the car-body end of the front right damper along its axis
             output "damper_front_right.carbody_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[1].carbody_end_acc_mps2;
             /// Absolute velocity of the frame end of the front right damper along its axis, positive forward
+            /// (a textbook sky-hook's x', (3.6), with sensor.sign = -1)
             output "damper_front_right.frame_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[1].frame_end_velocity_mps;
             /// Absolute acceleration of the frame end of the front right damper along its axis
             output "damper_front_right.frame_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[1].frame_end_acc_mps2;
@@ -316,11 +318,12 @@ impl FmuModel for RailVehicle {
             /// Elongation velocity of the rear left yaw damper
             output "damper_rear_left.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[2].elongation_velocity_mps;
             /// Absolute velocity of the car-body end of the rear left damper along its axis, positive
-            /// forward (towards the car-body end); for a sky-hook
+            /// forward (towards the car-body end)
             output "damper_rear_left.carbody_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[2].carbody_end_velocity_mps;
             /// Absolute acceleration of the car-body end of the rear left damper along its axis
             output "damper_rear_left.carbody_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[2].carbody_end_acc_mps2;
             /// Absolute velocity of the frame end of the rear left damper along its axis, positive forward
+            /// (a textbook sky-hook's x', (3.6), with sensor.sign = -1)
             output "damper_rear_left.frame_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[2].frame_end_velocity_mps;
             /// Absolute acceleration of the frame end of the rear left damper along its axis
             output "damper_rear_left.frame_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[2].frame_end_acc_mps2;
@@ -329,11 +332,12 @@ impl FmuModel for RailVehicle {
             /// Elongation velocity of the rear right yaw damper
             output "damper_rear_right.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[3].elongation_velocity_mps;
             /// Absolute velocity of the car-body end of the rear right damper along its axis, positive
-            /// forward (towards the car-body end); for a sky-hook
+            /// forward (towards the car-body end)
             output "damper_rear_right.carbody_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[3].carbody_end_velocity_mps;
             /// Absolute acceleration of the car-body end of the rear right damper along its axis
             output "damper_rear_right.carbody_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[3].carbody_end_acc_mps2;
             /// Absolute velocity of the frame end of the rear right damper along its axis, positive forward
+            /// (a textbook sky-hook's x', (3.6), with sensor.sign = -1)
             output "damper_rear_right.frame_end_velocity" [unit = "m/s", display_unit = "mm/s"] => shell.out.damper[3].frame_end_velocity_mps;
             /// Absolute acceleration of the frame end of the rear right damper along its axis
             output "damper_rear_right.frame_end_acceleration" [unit = "m/s2", depends_on = FT_DAMPERS] => shell.out.damper[3].frame_end_acc_mps2;

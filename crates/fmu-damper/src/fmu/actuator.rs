@@ -338,7 +338,8 @@ order they are states, the declaration covers both. The pressures have no feedth
 <p>Pressure states with the regularised orifices and the regularised Coulomb friction are stiff;
 each communication step is integrated with the linearly implicit, L-stable Rosenbrock pair of
 Shampine and Reichelt (1997, MATLAB's ode23s), second order with a third-order error estimate,
-relative tolerance 1e-6 (absolute 10 Pa on pressures, 1e-9 m on the spool), allocation-free, the
+relative tolerance 1e-6 (absolute tolerances scaled from it: 10 Pa on pressures, 1e-8 m and
+1.2e-5 m/s on the spool, 1e-9 m and 1e-7 m/s on the rod), allocation-free, the
 internal step chosen by error control. Inputs are held over a communication step (zero-order
 hold).</p>
 

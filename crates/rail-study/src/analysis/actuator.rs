@@ -331,8 +331,9 @@ impl ActuatorResults {
             p.cylinder_damping_ratio()
         );
         s.push_str(&format!(
-            "   (leakage C_L = {:e} m^3/(s Pa), dead zone beta = {:e} m = {} alpha)\n",
+            "   (leakage C_L = {:e} m^3/(s Pa): Table 3-2's number in m^3, the physics' default; the FMU's default is the litre reading, {:e}; dead zone beta = {:e} m = {} alpha)\n",
             p.leakage_coeff_m3ps_per_pa,
+            fmu_damper::full_active::LEAKAGE_LITRE_READING_M3PS_PER_PA,
             p.beta_m,
             round_sig(p.beta_m / p.alpha_m)
         ));
