@@ -223,6 +223,7 @@ pub fn collapse(table: &Table, columns: &[ColumnMetadata]) -> Result<SimOutput, 
             wall_time_s: 0.0,
             realtime_ratio: 0.0,
             terminated: None,
+            failed: None,
         },
         columns: infos,
         strings,
@@ -420,6 +421,7 @@ mod tests {
                 wall_time_s: 0.0,
                 realtime_ratio: 0.0,
                 terminated: None,
+                failed: None,
             },
             columns: labels
                 .iter()

@@ -149,6 +149,7 @@ mod tests {
                 wall_time_s: 1e-4,
                 realtime_ratio: 20.0,
                 terminated: None,
+                failed: None,
             },
             columns: vec![],
             strings: vec![],

@@ -46,8 +46,8 @@ mod plan;
 
 pub use plan::{
     check_plan, step_below_resolution, topological_order, Algorithm, ColumnInfo, CouplingPlan,
-    PlanConnection, PlanInstance, Recorded, RunLimits, SimError, SimOutput, Summary, Terminated,
-    MAX_RECORDED_VALUES_VAR, MAX_STEPS_VAR,
+    Failure, PlanConnection, PlanInstance, Recorded, RunLimits, SimError, SimOutput, Summary,
+    Terminated, MAX_RECORDED_VALUES_VAR, MAX_STEPS_VAR,
 };
 
 /// Options of one run.
@@ -92,6 +92,43 @@ pub fn simulate(
     slaves: &mut [&mut dyn Slave],
     opts: &RunOptions,
 ) -> Result<SimOutput, SimError> {
+    simulate_with(plan, slaves, opts, !opts.general_engine).map_err(|f| f.error)
+}
+
+/// A run that failed: its error, and the history recorded before the failure (up to the last
+/// communication point every instance completed, its summary's `failed` set); `None` when
+/// the run failed before its first row.
+#[derive(Debug)]
+pub struct FailedRun<E> {
+    pub error: E,
+    pub history: Option<Box<SimOutput>>,
+}
+
+impl<E> FailedRun<E> {
+    /// The same failure with the error converted.
+    pub fn map<F>(self, f: impl FnOnce(E) -> F) -> FailedRun<F> {
+        FailedRun {
+            error: f(self.error),
+            history: self.history,
+        }
+    }
+}
+
+impl<E> From<E> for FailedRun<E> {
+    fn from(error: E) -> Self {
+        FailedRun {
+            error,
+            history: None,
+        }
+    }
+}
+
+/// [`simulate`], keeping the history of a run that fails.
+pub fn simulate_keeping_history(
+    plan: &CouplingPlan,
+    slaves: &mut [&mut dyn Slave],
+    opts: &RunOptions,
+) -> Result<SimOutput, FailedRun<SimError>> {
     simulate_with(plan, slaves, opts, !opts.general_engine)
 }
 
@@ -100,46 +137,95 @@ fn simulate_with(
     slaves: &mut [&mut dyn Slave],
     opts: &RunOptions,
     fast: bool,
-) -> Result<SimOutput, SimError> {
+) -> Result<SimOutput, FailedRun<SimError>> {
     let n_steps = check_plan(plan, slaves.len())?;
     check_step_sizes(plan, slaves, n_steps)?;
     let started = Instant::now();
     let exchange = Exchange::new(plan);
     let mut eng = Engine::new(plan, &exchange, slaves, opts, n_steps, fast);
-    let res = eng.run();
+    let mut data = Vec::new();
+    let res = eng.run(&mut data);
     let term = eng.terminate_all();
-    let data = res?;
-    term?;
-    let terminated = eng.terminated().map(|(i, t)| Terminated {
-        instance: plan.instances[i].name.clone(),
-        time_s: t,
+    let width = plan.record.len() + 1;
+    let last_row_time = |data: &[f64]| data.len().checked_sub(width).map(|k| data[k]);
+    let error = match (res, term) {
+        (Err(e), _) | (Ok(()), Err(e)) => e,
+        (Ok(()), Ok(())) => {
+            let terminated = eng.terminated().map(|(i, t)| Terminated {
+                instance: plan.instances[i].name.clone(),
+                time_s: t,
+            });
+            let end = terminated.as_ref().map_or(plan.stop_time, |t| t.time_s);
+            let strings = eng.take_strings();
+            let rejected = eng.rejected();
+            let summary = summary(plan, n_steps, end, started, rejected, terminated, None);
+            return Ok(output(plan, data, strings, summary));
+        }
+    };
+    let history = last_row_time(&data).map(|end| {
+        let failure = Failure {
+            time_s: end,
+            error: error.to_string(),
+        };
+        let strings = eng.take_strings();
+        let summary = summary(
+            plan,
+            n_steps,
+            end,
+            started,
+            eng.rejected(),
+            None,
+            Some(failure),
+        );
+        Box::new(output(plan, data, strings, summary))
     });
-    let strings = eng.take_strings();
+    Err(FailedRun { error, history })
+}
+
+/// The statistics of a run that ended at `end` \[s\].
+fn summary(
+    plan: &CouplingPlan,
+    n_steps: u64,
+    end: f64,
+    started: Instant,
+    rejected_steps: u64,
+    terminated: Option<Terminated>,
+    failed: Option<Failure>,
+) -> Summary {
     let wall = started.elapsed().as_secs_f64();
-    let end = terminated.as_ref().map_or(plan.stop_time, |t| t.time_s);
     let sim = end - plan.start_time;
+    let steps = (sim / plan.step).round() as u64;
+    Summary {
+        terminated,
+        failed,
+        steps: steps.min(n_steps),
+        rejected_steps,
+        simulated_time_s: sim,
+        wall_time_s: wall,
+        realtime_ratio: if wall > 0.0 {
+            sim / wall
+        } else {
+            f64::INFINITY
+        },
+    }
+}
+
+fn output(
+    plan: &CouplingPlan,
+    data: Vec<f64>,
+    strings: Vec<String>,
+    summary: Summary,
+) -> SimOutput {
     let mut header = vec!["time [s]".to_string()];
     header.extend(plan.record.iter().map(|r| r.label.clone()));
-    let steps = ((end - plan.start_time) / plan.step).round() as u64;
-    Ok(SimOutput {
+    SimOutput {
         header,
         data,
         columns: plan.record.iter().map(|r| r.info.clone()).collect(),
         strings,
         decimation: None,
-        summary: Summary {
-            terminated,
-            steps: steps.min(n_steps),
-            rejected_steps: eng.rejected(),
-            simulated_time_s: sim,
-            wall_time_s: wall,
-            realtime_ratio: if wall > 0.0 {
-                sim / wall
-            } else {
-                f64::INFINITY
-            },
-        },
-    })
+        summary,
+    }
 }
 
 #[cfg(test)]

@@ -200,6 +200,7 @@ mod tests {
                 wall_time_s: 0.0,
                 realtime_ratio: 0.0,
                 terminated: None,
+                failed: None,
             },
             columns: vec![
                 ColumnInfo::default(),

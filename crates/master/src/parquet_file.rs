@@ -562,6 +562,7 @@ mod tests {
                 wall_time_s: 0.25,
                 realtime_ratio: 4.0,
                 terminated: None,
+                failed: None,
             },
             columns: vec![
                 col(ScalarType::Real, Some("m"), vec![]),

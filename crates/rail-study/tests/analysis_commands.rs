@@ -1428,6 +1428,7 @@ fn assess_reads_parquet_and_checks_the_recorded_band() {
             wall_time_s: 0.1,
             realtime_ratio: 200.0,
             terminated: None,
+            failed: None,
         },
         columns: vec![],
         strings: vec![],

@@ -695,3 +695,67 @@ fn a_hang_up_under_nohup_does_not_stop_a_run() {
     assert_eq!(out.status.code(), Some(130), "{stderr}");
     assert!(stderr.contains("cancelled at t ="), "{stderr}");
 }
+
+/// A run that fails midway (a bogie without secondary suspension derails at 150 m/s) writes
+/// its history up to the failure in place of the results, with the failure in its metadata,
+/// and says where: an earlier run's results do not stay under its name.
+#[test]
+fn a_failed_run_writes_its_history_up_to_the_failure() {
+    let dir = tempfile::tempdir().unwrap();
+    let system = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../systems/passive.json");
+    let out = dir.path().join("r.csv");
+    let run = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_master"))
+            .args(["--quiet", "run"])
+            .arg(&system)
+            .arg("-o")
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let ok = run(&["--stop", "0.1"]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let failed = run(&[
+        "--stop",
+        "2",
+        "--set",
+        "bogie.vehicle.speed=150",
+        "--set",
+        "bogie.suspension.lateral_stiffness=0",
+        "--set",
+        "bogie.suspension.longitudinal_stiffness=0",
+    ]);
+    let stderr = String::from_utf8_lossy(&failed.stderr);
+    assert_eq!(failed.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("derailment"), "{stderr}");
+    assert!(
+        stderr.contains(&format!("is in {}", out.display())),
+        "{stderr}"
+    );
+    let csv = std::fs::read_to_string(&out).unwrap();
+    let last: f64 = csv
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(last > 0.1 && last < 2.0, "last row at {last} s");
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.meta.json")).unwrap())
+            .unwrap();
+    let failure = &meta["summary"]["failed"];
+    assert_eq!(failure["time_s"].as_f64(), Some(last), "{meta}");
+    assert!(
+        failure["error"].as_str().unwrap().contains("derailment"),
+        "{failure}"
+    );
+    assert!(stderr.contains(&format!("up to t = {last} s")), "{stderr}");
+}

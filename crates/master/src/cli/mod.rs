@@ -42,6 +42,15 @@ pub enum CommandError {
     Ssp(#[from] crate::ssp::SspError),
     #[error("{0}")]
     Failed(String),
+    /// A run failed after recording a history, which was written.
+    #[error(
+        "{error}\nthe history up to t = {time_s} s is in {path} (its metadata records the failure)"
+    )]
+    FailedWithHistory {
+        error: Box<crate::system::RunError>,
+        time_s: f64,
+        path: String,
+    },
     /// An error of a subcommand defined outside this crate (its source chain is printed).
     #[error(transparent)]
     Other(Box<dyn std::error::Error + Send + Sync>),

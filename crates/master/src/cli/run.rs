@@ -5,13 +5,13 @@
 use std::path::PathBuf;
 
 use super::{CommandError, Context};
-use crate::coupling::{Algorithm, RunOptions};
+use crate::coupling::{Algorithm, FailedRun, RunOptions, SimError};
 use crate::output::{check_outputs_apart, json_unfinished};
 use crate::results::{
     csv_metadata_path, prepare_results, remove_results, ResultsFormat, RunContext,
 };
 use crate::ssp::{self, ImportOptions};
-use crate::system::{LoadedSystem, OverridesFrom, SingleFmuOptions, SystemOverrides};
+use crate::system::{LoadedSystem, OverridesFrom, RunError, SingleFmuOptions, SystemOverrides};
 
 /// Run one system description, or one FMU alone, and write the recorded variables as CSV or
 /// Parquet.
@@ -207,9 +207,21 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         progress: Some(&progress),
         general_engine: false,
     };
-    let out = sys.run(&opts);
+    let out = sys.run_keeping_history(&opts);
     bar.finish_and_clear();
-    let out = out?;
+    // a run that fails (not one stopped by Ctrl-C) writes its history up to the failure in
+    // place of the results, marked in its metadata, so that it can be looked into and no
+    // earlier run's results stay under its name
+    let (out, failure) = match out {
+        Ok(out) => (out, None),
+        Err(FailedRun {
+            error,
+            history: Some(history),
+        }) if !matches!(error, RunError::Sim(SimError::Cancelled { .. })) => {
+            (*history, Some(error))
+        }
+        Err(failed) => return Err(failed.error.into()),
+    };
     let format = chosen.unwrap_or_else(|| {
         ResultsFormat::by_size(out.rows().count() as u64, out.header.len() as u64)
     });
@@ -251,6 +263,13 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         if ours && check_outputs_apart(&inputs, &written(&other, format.other())).is_ok() {
             remove_results(&other, format.other())?;
         }
+    }
+    if let Some(error) = failure {
+        return Err(CommandError::FailedWithHistory {
+            error: Box::new(error),
+            time_s: out.summary.failed.as_ref().map_or(f64::NAN, |f| f.time_s),
+            path: output.display().to_string(),
+        });
     }
     println!("{}: {}", output.display(), out.summary);
     if let Some(t) = &out.summary.terminated {

@@ -515,6 +515,8 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             };
             if let Err(e) = read {
                 self.recorded = values;
+                // the rows before stay a history; this one is not complete
+                out.truncate(row);
                 return Err(self.slave_err(time, g.instance, e));
             }
         }
@@ -523,10 +525,12 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
             return Ok(());
         }
         if let Some(k) = out[row + 1..].iter().position(|x| !x.is_finite()) {
+            let value = out[row + 1 + k];
+            out.truncate(row);
             return Err(SimError::NonFinite {
                 time,
                 label: self.plan.record[k].label.clone(),
-                value: out[row + 1 + k],
+                value,
             });
         }
         Ok(())
@@ -922,15 +926,17 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         }
     }
 
-    pub(super) fn run(&mut self) -> Result<Vec<f64>, SimError> {
+    /// Runs the plan, recording into `data` (which keeps the rows recorded before a failure).
+    pub(super) fn run(&mut self, data: &mut Vec<f64>) -> Result<(), SimError> {
         // Reserved up to 32 MiB at first, then grown (fallibly, see `record`): the limits of
         // check_plan bound the total, the memory actually free is only known while growing.
         let total = (self.n_steps as usize)
             .saturating_add(1)
             .saturating_mul(self.plan.record.len() + 1);
-        let mut data = Vec::with_capacity(total.min(1 << 22));
+        data.clear();
+        data.reserve(total.min(1 << 22));
         self.initialise()?;
-        self.record(self.plan.start_time, &mut data)?;
+        self.record(self.plan.start_time, data)?;
         for k in 0..self.n_steps {
             if let Some(c) = self.opts.cancel {
                 if c.load(Ordering::Relaxed) {
@@ -941,19 +947,19 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                 // the FMU ends the run: the results stop at the last completed point
                 let t = if completed { self.t(k + 1) } else { self.t(k) };
                 if completed {
-                    self.record(t, &mut data)?;
+                    self.record(t, data)?;
                 }
                 log::info!(target: "master", "instance '{}' asked to end the simulation at t = {t} s", self.slaves[i].name());
                 self.terminated = Some((i, t));
                 break;
             }
             let t = self.t(k + 1);
-            self.record(t, &mut data)?;
+            self.record(t, data)?;
             if let Some(p) = self.opts.progress {
                 p(k + 1, self.n_steps);
             }
         }
-        Ok(data)
+        Ok(())
     }
 
     /// fmi2Terminate on every slave that reached step mode and did not return fmi2Error or

@@ -112,6 +112,19 @@ pub struct Summary {
     /// Set when an FMU asked to end the simulation before the stop time.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub terminated: Option<Terminated>,
+    /// Set on the history of a run that failed: the results stop at the last communication
+    /// point every instance completed, before the failure.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub failed: Option<Failure>,
+}
+
+/// The run failed after its history up to `time_s` was recorded.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Failure {
+    /// The last recorded communication point \[s\].
+    pub time_s: f64,
+    /// What failed (the run's error).
+    pub error: String,
 }
 
 /// An FMU ended the run: its step returned fmi2Discard with fmi2Terminated true (FMI 2.0
@@ -141,6 +154,9 @@ impl std::fmt::Display for Summary {
                 "; terminated by instance '{}' at t = {} s",
                 t.instance, t.time_s
             )?;
+        }
+        if let Some(x) = &self.failed {
+            write!(f, "; failed after t = {} s", x.time_s)?;
         }
         Ok(())
     }

@@ -477,6 +477,60 @@ fn an_instance_that_returned_an_error_is_not_terminated() {
     }
 }
 
+/// A run that fails keeps its history: every row up to the last point both instances
+/// completed, the summary saying where and why; the plain `simulate` gives the same error. A
+/// failure before the first row has no history.
+#[test]
+fn a_failed_run_keeps_its_history_up_to_the_failure() {
+    use crate::slave::FailStatus;
+    for fast in [true, false] {
+        let plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.2);
+        let opts = RunOptions {
+            general_engine: !fast,
+            ..RunOptions::default()
+        };
+        let full = {
+            let (mut a, mut b) = slaves();
+            simulate(&plan, &mut [&mut a, &mut b], &opts).unwrap()
+        };
+        let (mut a, mut b) = slaves();
+        b.hooks.fail_step_from = Some((0.1, FailStatus::Error));
+        let failed = simulate_keeping_history(&plan, &mut [&mut a, &mut b], &opts).unwrap_err();
+        assert!(
+            failed.error.to_string().contains("fmi2DoStep"),
+            "{}",
+            failed.error
+        );
+        let history = failed.history.expect("rows before the failure");
+        let width = history.header.len();
+        let rows = history.data.len() / width;
+        assert_eq!(history.header, full.header);
+        let last_t = history.data[(rows - 1) * width];
+        assert!((last_t - 0.1).abs() < 1e-9, "last row at {last_t}");
+        assert_eq!(history.data[..], full.data[..rows * width], "fast {fast}");
+        let f = history.summary.failed.as_ref().unwrap();
+        assert_eq!(
+            (f.time_s, f.error.clone()),
+            (last_t, failed.error.to_string())
+        );
+        assert_eq!(history.summary.steps, 100);
+        assert!(history.summary.to_string().contains("failed after t = 0.1"));
+        let (mut a, mut b) = slaves();
+        b.hooks.fail_step_from = Some((0.1, FailStatus::Error));
+        let e = simulate(&plan, &mut [&mut a, &mut b], &opts).unwrap_err();
+        assert_eq!(e.to_string(), failed.error.to_string());
+    }
+    let plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.2);
+    let (mut a, mut b) = slaves();
+    b.hooks.fail_step_from = Some((0.0, FailStatus::Error));
+    let failed =
+        simulate_keeping_history(&plan, &mut [&mut a, &mut b], &RunOptions::default()).unwrap_err();
+    // the start row was recorded before the first step failed
+    let history = failed.history.unwrap();
+    assert_eq!(history.data.len(), history.header.len());
+    assert_eq!(history.summary.steps, 0);
+}
+
 #[test]
 fn discard_without_state_support_or_retry_is_an_error_and_terminates() {
     let mut plan = two_mass_plan(Algorithm::Jacobi, vec![0, 1], 4e-3, 0.2);

@@ -471,6 +471,15 @@ impl LoadedSystem {
     pub fn run(&self, opts: &RunOptions) -> Result<SimOutput, RunError> {
         PreparedSystem::prepare(self)?.run(&RunChanges::default(), opts)
     }
+
+    /// [`Self::run`], keeping the history of a run that fails (see
+    /// [`FailedRun`](crate::coupling::FailedRun)).
+    pub fn run_keeping_history(
+        &self,
+        opts: &RunOptions,
+    ) -> Result<SimOutput, crate::coupling::FailedRun<RunError>> {
+        PreparedSystem::prepare(self)?.run_keeping_history(&RunChanges::default(), opts)
+    }
 }
 
 mod overrides;

@@ -9,7 +9,7 @@ use serde_json::Value;
 
 use super::plan::start_value;
 use super::{split_ref, LoadedSystem, RunError, SystemError};
-use crate::coupling::{simulate, CouplingPlan, RunOptions, SimOutput};
+use crate::coupling::{simulate_keeping_history, CouplingPlan, FailedRun, RunOptions, SimOutput};
 use crate::fmu::{FmuSlave, PreparedFmu};
 use crate::model_description::ModelDescription;
 use crate::show::text;
@@ -190,14 +190,26 @@ impl PreparedSystem {
     /// One run: instantiates every instance (sharing the prepared FMUs), simulates, frees the
     /// instances (also on error).
     pub fn run(&self, changes: &RunChanges, opts: &RunOptions) -> Result<SimOutput, RunError> {
+        self.run_keeping_history(changes, opts).map_err(|f| f.error)
+    }
+
+    /// [`Self::run`], keeping the history of a run that fails (see [`FailedRun`]).
+    pub fn run_keeping_history(
+        &self,
+        changes: &RunChanges,
+        opts: &RunOptions,
+    ) -> Result<SimOutput, FailedRun<RunError>> {
         let plan = self.plan_for(changes);
         let mut slaves: Vec<FmuSlave> = Vec::with_capacity(self.fmus.len());
         for (fmu, inst) in self.fmus.iter().zip(&self.system.desc.instances) {
-            slaves.push(fmu.instantiate(&inst.name, inst.logging)?);
+            let slave = fmu
+                .instantiate(&inst.name, inst.logging)
+                .map_err(RunError::from)?;
+            slaves.push(slave);
         }
         let mut refs: Vec<&mut dyn Slave> =
             slaves.iter_mut().map(|s| s as &mut dyn Slave).collect();
-        Ok(simulate(&plan, &mut refs, opts)?)
+        simulate_keeping_history(&plan, &mut refs, opts).map_err(|f| f.map(RunError::from))
     }
 }
 

@@ -285,6 +285,7 @@ pub(crate) fn recorded(header: Vec<String>, data: Vec<f64>) -> SimOutput {
             wall_time_s: 1.0,
             realtime_ratio: span_s,
             terminated: None,
+            failed: None,
         },
         columns: vec![],
         strings: vec![],
