@@ -32,6 +32,19 @@ pub enum OutputError {
     NotAFile { path: PathBuf },
     #[error("cannot write '{path}': the folder '{folder}' does not exist")]
     NoFolder { path: PathBuf, folder: PathBuf },
+    #[error("cannot write '{path}': '{folder}' is not a folder")]
+    NotAFolder { path: PathBuf, folder: PathBuf },
+    #[error(
+        "cannot write '{path}': its name is {bytes} bytes long, more than the {NAME_MAX_BYTES} \
+         a file name may have"
+    )]
+    NameTooLong { path: PathBuf, bytes: usize },
+    #[error("cannot write into the folder '{folder}' (for '{path}'): {source}")]
+    FolderNotWritable {
+        path: PathBuf,
+        folder: PathBuf,
+        source: std::io::Error,
+    },
     #[error("cannot write '{output}': it is the same file as {what} '{other}'")]
     SameFile {
         output: PathBuf,
@@ -185,20 +198,47 @@ where
     write_unfinished(path, fill)?.commit()
 }
 
-/// The folders the outputs go into exist: checked before a command computes anything, so
-/// that a mistyped folder is named at once, not after a long run.
+/// The longest file name (in bytes) the master writes: Linux's NAME_MAX, which the common
+/// file systems share.
+pub const NAME_MAX_BYTES: usize = 255;
+
+/// The outputs can be written: their folders exist, are folders and take a new file (a file is
+/// created and removed again in each), and their names are not too long. Checked before a
+/// command computes anything, so that a mistyped, read-only or full folder is named at once,
+/// not after a long run.
 pub fn check_folders_exist(outputs: &[PathBuf]) -> Result<(), OutputError> {
     for out in outputs {
         let folder = match out.parent() {
             Some(p) if !p.as_os_str().is_empty() => p,
             _ => Path::new("."),
         };
+        let (path, folder_buf) = (out.clone(), folder.to_path_buf());
         if !folder.is_dir() {
-            return Err(OutputError::NoFolder {
-                path: out.clone(),
-                folder: folder.to_path_buf(),
+            return Err(if folder.exists() {
+                OutputError::NotAFolder {
+                    path,
+                    folder: folder_buf,
+                }
+            } else {
+                OutputError::NoFolder {
+                    path,
+                    folder: folder_buf,
+                }
             });
         }
+        let bytes = out.file_name().map_or(0, |n| n.as_encoded_bytes().len());
+        if bytes > NAME_MAX_BYTES {
+            return Err(OutputError::NameTooLong { path, bytes });
+        }
+        // a probe file, removed when dropped
+        tempfile::Builder::new()
+            .prefix(".master-probe-")
+            .tempfile_in(folder)
+            .map_err(|source| OutputError::FolderNotWritable {
+                path,
+                folder: folder_buf,
+                source,
+            })?;
     }
     Ok(())
 }
@@ -409,6 +449,26 @@ pub fn results_csv_unfinished(path: &Path, out: &SimOutput) -> Result<Unfinished
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Before a run: a folder that is a file, a name longer than a file system takes, and a
+    /// folder that is missing are each named; a writable folder passes and keeps no probe.
+    #[test]
+    fn outputs_are_checked_writable_before_a_run() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("afile");
+        std::fs::write(&file, b"x").unwrap();
+        let e = check_folders_exist(&[file.join("x.csv")]).unwrap_err();
+        assert!(matches!(e, OutputError::NotAFolder { .. }), "{e}");
+        assert!(e.to_string().contains("is not a folder"), "{e}");
+        let e = check_folders_exist(&[dir.path().join("no/x.csv")]).unwrap_err();
+        assert!(matches!(e, OutputError::NoFolder { .. }), "{e}");
+        let long = dir.path().join(format!("{}.meta.json", "x".repeat(250)));
+        let e = check_folders_exist(&[long]).unwrap_err();
+        assert!(e.to_string().contains("260 bytes long"), "{e}");
+        check_folders_exist(&[dir.path().join("r.csv"), PathBuf::from("r.csv")]).unwrap();
+        let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert_eq!(left.len(), 1, "{left:?}");
+    }
 
     #[test]
     fn csv_round_trip_and_quoting() {

@@ -275,3 +275,36 @@ fn sweep_refuses_local_jobs_on_a_dask_cluster() {
     );
     assert!(!c.path("out").exists());
 }
+
+/// A dimensionless bound is printed without its unit "1" ("2 is above its maximum 1", not
+/// "2 1 is above its maximum 1 1"); a unit that is one keeps it.
+#[test]
+fn a_dimensionless_bound_is_printed_without_the_unit_one() {
+    let md = MS_MD.replace(
+        r#"<Real start="1" unit="kg"/>"#,
+        r#"<Real start="0.5" unit="1" min="0" max="1"/>"#,
+    );
+    let c = Case::new(SYSTEM);
+    fake_fmu(c.dir.path(), "MassSpring.fmu", "MassSpring", &md);
+    let e = c.run_fails();
+    assert!(
+        e.contains("mass: 2 is above its maximum 1 (declared"),
+        "{e}"
+    );
+}
+
+/// An output path under a file is named as such before anything runs.
+#[test]
+fn an_output_folder_that_is_a_file_is_named() {
+    let c = Case::new(SYSTEM);
+    std::fs::write(c.path("afile"), b"x").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .args(["--quiet", "run", "system.json", "-o", "afile/x.csv"])
+        .current_dir(c.dir.path())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("'afile' is not a folder"), "{e}");
+    assert_eq!(std::fs::read(c.path("afile")).unwrap(), b"x");
+}

@@ -759,3 +759,25 @@ fn a_failed_run_writes_its_history_up_to_the_failure() {
     );
     assert!(stderr.contains(&format!("up to t = {last} s")), "{stderr}");
 }
+
+/// A sweep whose output folder is a file names it, and leaves the file as it was.
+#[test]
+fn a_sweep_into_a_file_names_it() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("system.json"), system_json(0.01)).unwrap();
+    std::fs::write(
+        dir.path().join("set.json"),
+        r#"{"base": "system.json", "runs": [{"name": "a", "parameters": {}}]}"#,
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("afile"), b"x").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .args(["--quiet", "sweep", "set.json", "-o", "afile"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(e.contains("'afile' is a file, not a folder"), "{e}");
+    assert_eq!(std::fs::read(dir.path().join("afile")).unwrap(), b"x");
+}

@@ -384,6 +384,11 @@ pub fn lock_output_folder(outdir: &Path) -> Result<OutputFolderLock, SweepError>
         path: outdir.to_path_buf(),
         source,
     };
+    if outdir.exists() && !outdir.is_dir() {
+        return Err(SweepError::NotAFolder {
+            path: outdir.to_path_buf(),
+        });
+    }
     std::fs::create_dir_all(outdir).map_err(dir_err)?;
     let folder = std::fs::File::open(outdir).map_err(dir_err)?;
     if !crate::fmu::extract::try_lock(&folder) {

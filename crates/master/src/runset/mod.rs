@@ -79,6 +79,8 @@ pub enum SweepError {
     System(#[from] SystemError),
     #[error(transparent)]
     Output(#[from] OutputError),
+    #[error("the output folder '{path}' is a file, not a folder")]
+    NotAFolder { path: PathBuf },
     #[error("cannot create '{path}': {source}")]
     Dir {
         path: PathBuf,

@@ -414,7 +414,12 @@ pub(super) fn start_value(
     let x = json_value_for(md, v, value, strings).map_err(|r| invalid(field.clone(), name, r))?;
     if matches!(v.var_type, VarType::Real | VarType::Integer) {
         // the FMU refuses such a value at fmi2SetXXX, in every run: said here, before one
-        let unit = v.unit.as_deref().map_or(String::new(), |u| format!(" {u}"));
+        // a dimensionless "1" is no unit to print after a number ("2 1 is above ... 1 1")
+        let unit = v
+            .unit
+            .as_deref()
+            .filter(|u| !u.trim().is_empty() && u.trim() != "1")
+            .map_or(String::new(), |u| format!(" {u}"));
         let outside = match (v.min, v.max) {
             (Some(lo), _) if x < lo => Some(format!("below its minimum {}{unit}", num(lo))),
             (_, Some(hi)) if x > hi => Some(format!("above its maximum {}{unit}", num(hi))),
