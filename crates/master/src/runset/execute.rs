@@ -1,7 +1,7 @@
 //! Executing a run set: one job on the prepared system, the jobs in parallel, each run's
 //! results written into a temporary folder and moved into place whole.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -272,6 +272,7 @@ pub fn not_finished(job: &Job, outdir: &Path, error: &str) -> RunReport {
         error: Some(error.to_string()),
         summary: None,
         results: None,
+        fmu_digests: BTreeMap::new(),
     }
 }
 
@@ -535,6 +536,7 @@ where
         error: None,
         summary: None,
         results: None,
+        fmu_digests: fmu_digests(&job.system),
     };
     let partial = match tempfile::Builder::new()
         .prefix(&format!("{PARTIAL_PREFIX}{}-", job.name))
@@ -619,10 +621,53 @@ where
     report
 }
 
+/// The SHA-1 (hex) of the file at `path`, `None` if it cannot be read. Kept per path, size and
+/// modification time, so that the runs of a set sharing an FMU read it once.
+pub fn file_digest(path: &Path) -> Option<String> {
+    type Cache = HashMap<PathBuf, (u64, std::time::SystemTime, String)>;
+    static CACHE: std::sync::Mutex<Option<Cache>> = std::sync::Mutex::new(None);
+    let meta = std::fs::metadata(path).ok()?;
+    let key = (meta.len(), meta.modified().ok()?);
+    if let Ok(cache) = CACHE.lock() {
+        if let Some((len, time, digest)) = cache.as_ref().and_then(|c| c.get(path)) {
+            if (*len, *time) == key {
+                return Some(digest.clone());
+            }
+        }
+    }
+    let mut hasher = sha1_smol::Sha1::new();
+    let mut file = std::fs::File::open(path).ok()?;
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        let n = std::io::Read::read(&mut file, &mut buf).ok()?;
+        if n == 0 {
+            break;
+        }
+        hasher.update(&buf[..n]);
+    }
+    let digest = hasher.digest().to_string();
+    if let Ok(mut cache) = CACHE.lock() {
+        cache
+            .get_or_insert_with(HashMap::new)
+            .insert(path.to_path_buf(), (key.0, key.1, digest.clone()));
+    }
+    Some(digest)
+}
+
+/// [`file_digest`] of every FMU of `system`, by its path as the description gives it (a file
+/// that cannot be read is left out, and its run fails on its own).
+pub fn fmu_digests(system: &SystemDescription) -> BTreeMap<String, String> {
+    system
+        .instances
+        .iter()
+        .filter_map(|i| Some((i.fmu.to_string_lossy().into_owned(), file_digest(&i.fmu)?)))
+        .collect()
+}
+
 /// The report of `job` in `outdir` if that run is complete in `format` and is the same run:
 /// its `summary.json` says ok, its results are there in `format` (and not in the other
-/// format) and its `system.json` is the job's resolved system (same FMUs, start values,
-/// timing). A failed, unfinished or changed run, or one whose results are in the other format,
+/// format), its `system.json` is the job's resolved system (same FMUs, start values, timing)
+/// and the FMU files are the ones it ran (same digests). A failed, unfinished or changed run, or one whose results are in the other format,
 /// gives `None` and is run again: a resumed run set stays in one format, so the Parquet folder
 /// (or the CSV files) hold every run. The sweep decides `format` before (explicit, else
 /// [`format_by_description`] over all its jobs, as a fresh sweep does).
@@ -638,6 +683,8 @@ pub fn completed(outdir: &Path, job: &Job, format: ResultsFormat) -> Option<RunR
         && report.name == job.name
         && report.parameters == job.parameters
         && system == job.system
+        // the same FMU files: a rebuilt or replaced FMU at the same path is another model
+        && report.fmu_digests == fmu_digests(&job.system)
         && report.results.as_deref().and_then(Path::file_name) == results.file_name()
         && results.is_file()
         && other.symlink_metadata().is_err()

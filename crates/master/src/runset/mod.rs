@@ -71,6 +71,10 @@ pub struct RunReport {
     pub error: Option<String>,
     pub summary: Option<Summary>,
     pub results: Option<PathBuf>,
+    /// The SHA-1 of each FMU file the run loaded, by its path: a resumed run set runs again a
+    /// run whose FMU changed since (see [`completed`]).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub fmu_digests: BTreeMap<String, String>,
 }
 
 #[derive(Debug, thiserror::Error)]

@@ -456,3 +456,33 @@ fn a_run_set_resumed_in_the_other_format_reruns_every_run_into_one_format() {
     assert_eq!(resume(&j, out, ResultsFormat::Csv), ["run-000"]);
     assert!(!out.join("results").exists());
 }
+
+/// A resumed set runs again a run whose FMU file changed at the same path (a rebuilt or
+/// replaced model): its report holds the digest of every FMU it loaded.
+#[test]
+fn a_run_whose_fmu_changed_since_is_not_complete() {
+    let fmus = tempfile::tempdir().unwrap();
+    let (ms, sdm) = (
+        fmus.path().join("MassSpring.fmu"),
+        fmus.path().join("SDM.fmu"),
+    );
+    std::fs::write(&ms, b"first build").unwrap();
+    std::fs::write(&sdm, b"damper").unwrap();
+    let base = LoadedSystem::from_json_str(BASE, fmus.path(), "base.json").unwrap();
+    let set: RunSet = serde_json::from_str(r#"{"product": {"ms.k": [50]}}"#).unwrap();
+    let j = set.expand(&base, "set.json").unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let runner = |_: &Job| -> Result<SimOutput, String> {
+        let plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.01);
+        let mut a = Mock::new("ms", MassSpring::new(1.0, 1.0, 1.0, 0.0));
+        let mut b = Mock::new("sdm", SpringDamperMass::new(1.0, 1.0, 1.0));
+        simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).map_err(|e| e.to_string())
+    };
+    let reports = execute(&j, dir.path(), 1, false, runner).unwrap();
+    assert_eq!(reports[0].fmu_digests.len(), 2, "{:?}", reports[0]);
+    assert!(completed(dir.path(), &j[0], ResultsFormat::Csv).is_some());
+    std::fs::write(&ms, b"second build").unwrap();
+    assert!(completed(dir.path(), &j[0], ResultsFormat::Csv).is_none());
+    std::fs::write(&ms, b"first build").unwrap();
+    assert!(completed(dir.path(), &j[0], ResultsFormat::Csv).is_some());
+}
