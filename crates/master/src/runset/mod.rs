@@ -40,7 +40,7 @@ pub struct RunSet {
     /// Inline base system (FMU paths relative to the run-set file).
     #[serde(default)]
     pub system: Option<SystemDescription>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::input::unique_keys")]
     pub product: BTreeMap<String, Vec<Value>>,
     #[serde(default)]
     pub runs: Vec<RunSpec>,
@@ -51,6 +51,7 @@ pub struct RunSet {
 pub struct RunSpec {
     #[serde(default)]
     pub name: Option<String>,
+    #[serde(deserialize_with = "crate::input::unique_keys")]
     pub parameters: BTreeMap<String, Value>,
 }
 

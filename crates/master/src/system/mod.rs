@@ -103,7 +103,7 @@ pub struct InstanceSpec {
     pub fmu: PathBuf,
     /// Start values by variable name: numbers for Real/Integer, true/false for Boolean, text
     /// for String, an item name (or its integer) for Enumeration.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::input::unique_keys")]
     pub parameters: BTreeMap<String, Value>,
     /// This instance steps every `step_multiple` communication steps.
     #[serde(default = "one")]

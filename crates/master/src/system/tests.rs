@@ -226,3 +226,25 @@ fn missing_fmu_names_the_field() {
         PathBuf::from("/nonexistent/MassSpring.fmu")
     );
 }
+
+/// A start value given twice in one instance is refused with its name and line, as a field
+/// given twice is (serde_json would keep the last silently); so is a parameter given twice in a
+/// run set's product or run.
+#[test]
+fn a_start_value_given_twice_is_refused() {
+    let twice = SYS.replace(
+        r#""parameters": {"k": 200.0, "mode": 1}"#,
+        r#""parameters": {"k": 500.0, "mode": 1, "k": 200.0}"#,
+    );
+    assert_ne!(twice, SYS);
+    let e = LoadedSystem::from_json_str(&twice, Path::new("/d"), "sys.json").unwrap_err();
+    let e = e.to_string();
+    assert!(e.contains("`k` is given twice") && e.contains("line 3"), "{e}");
+    for set in [
+        r#"{"product": {"ms.k": [1], "ms.k": [2]}}"#,
+        r#"{"runs": [{"parameters": {"ms.k": 1, "ms.k": 2}}]}"#,
+    ] {
+        let e = serde_json::from_str::<crate::runset::RunSet>(set).unwrap_err();
+        assert!(e.to_string().contains("`ms.k` is given twice"), "{e}");
+    }
+}
