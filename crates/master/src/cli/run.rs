@@ -239,16 +239,24 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     } else {
         sys.resolved()
     };
-    let ctx = RunContext {
+    let cancel = ctx.cancel;
+    let run_context = RunContext {
         system: serde_json::to_value(&described).ok(),
         ..RunContext::default()
     };
     // every file written before any earlier one is replaced
-    let results = prepare_results(&output, &out, format, &ctx)?;
+    let results = prepare_results(&output, &out, format, &run_context)?;
     let summary = match &args.summary {
         Some(p) => Some(json_unfinished(p, &out.summary)?),
         None => None,
     };
+    // Ctrl-C or SIGTERM while the files were written: nothing replaces the earlier ones (the
+    // unfinished files are removed when dropped), exit status 130 as after a cancelled run
+    if cancel.load(std::sync::atomic::Ordering::SeqCst) {
+        return Err(CommandError::Failed(
+            "interrupted while writing the results: nothing written".into(),
+        ));
+    }
     results.commit()?;
     if let Some(summary) = summary {
         summary.commit()?;
