@@ -120,6 +120,47 @@ impl Drop for Listed {
     }
 }
 
+/// The name prefix of the temporary files results are written to before they are renamed.
+pub const UNFINISHED_PREFIX: &str = ".master-unfinished-";
+
+/// How old an unlocked temporary file must be before another master removes it \[s\]: a file
+/// just created is locked a moment later.
+const ABANDONED_AFTER_S: u64 = 60;
+
+/// Removes the temporary files in `dir` that a master killed while writing left behind
+/// (SIGKILL, a closed terminal's SIGHUP): ours by their prefix, unlocked (no live process
+/// writes them) and older than [`ABANDONED_AFTER_S`]. Returns how many.
+pub fn remove_abandoned_files(dir: &Path) -> usize {
+    if !cfg!(unix) {
+        return 0;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    let mut removed = 0;
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        if !name.to_string_lossy().starts_with(UNFINISHED_PREFIX) {
+            continue;
+        }
+        let Ok(meta) = entry.metadata() else { continue };
+        let old = meta
+            .modified()
+            .ok()
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|age| age.as_secs() >= ABANDONED_AFTER_S);
+        if !(meta.is_file() && old) {
+            continue;
+        }
+        let path = entry.path();
+        let unlocked = std::fs::File::open(&path).is_ok_and(|f| crate::fmu::extract::try_lock(&f));
+        if unlocked && std::fs::remove_file(&path).is_ok() {
+            removed += 1;
+        }
+    }
+    removed
+}
+
 /// A temporary file in `dir`, created and listed in [`UNFINISHED`] under its lock, so that
 /// [`give_up_unfinished`] sees every file created before it and none is created after it.
 fn listed_temporary_file(dir: &Path) -> std::io::Result<(tempfile::NamedTempFile, Listed)> {
@@ -130,7 +171,12 @@ fn listed_temporary_file(dir: &Path) -> std::io::Result<(tempfile::NamedTempFile
             "the process is ending (interrupted twice)",
         ));
     };
-    let tmp = tempfile::Builder::new().prefix(".tmp-").tempfile_in(dir)?;
+    remove_abandoned_files(dir);
+    let tmp = tempfile::Builder::new()
+        .prefix(UNFINISHED_PREFIX)
+        .tempfile_in(dir)?;
+    // held while the file is written: another master tells it from one a dead master left
+    crate::fmu::extract::try_lock(tmp.as_file());
     list.push(tmp.path().to_path_buf());
     let listed = Listed(tmp.path().to_path_buf());
     Ok((tmp, listed))
@@ -449,6 +495,45 @@ pub fn results_csv_unfinished(path: &Path, out: &SimOutput) -> Result<Unfinished
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A temporary file a killed master left (old, unlocked) is removed by the next write into
+    /// its folder; one a live master writes (locked) or one just created stays, and so do a
+    /// user's files.
+    #[cfg(unix)]
+    #[test]
+    fn a_killed_masters_unfinished_files_are_removed_by_the_next() {
+        let dir = tempfile::tempdir().unwrap();
+        let hour_ago = std::time::SystemTime::now() - std::time::Duration::from_secs(3600);
+        let file = |name: &str, age: Option<std::time::SystemTime>| {
+            let f = std::fs::File::create(dir.path().join(name)).unwrap();
+            if let Some(t) = age {
+                f.set_modified(t).unwrap();
+            }
+            f
+        };
+        file(&format!("{UNFINISHED_PREFIX}dead"), Some(hour_ago));
+        let live = file(&format!("{UNFINISHED_PREFIX}live"), Some(hour_ago));
+        assert!(crate::fmu::extract::try_lock(&live));
+        file(&format!("{UNFINISHED_PREFIX}new"), None);
+        file(".tmp-users", Some(hour_ago));
+        write_atomic(&dir.path().join("r.csv"), |w| {
+            w.write_all(b"x").map_err(io_err(Path::new("r.csv")))
+        })
+        .unwrap();
+        let mut names: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        let expected = [
+            ".master-unfinished-live",
+            ".master-unfinished-new",
+            ".tmp-users",
+            "r.csv",
+        ];
+        assert_eq!(names, expected);
+        drop(live);
+    }
 
     /// Before a run: a folder that is a file, a name longer than a file system takes, and a
     /// folder that is missing are each named; a writable folder passes and keeps no probe.

@@ -9,7 +9,7 @@ fn temporary_files(dir: &std::path::Path) -> Vec<String> {
     std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .filter(|n| n.starts_with(".tmp-"))
+        .filter(|n| n.starts_with(master::output::UNFINISHED_PREFIX))
         .collect()
 }
 

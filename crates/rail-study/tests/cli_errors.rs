@@ -91,7 +91,7 @@ impl Case {
             .unwrap()
             .filter_map(|e| e.ok())
             .map(|e| e.file_name().to_string_lossy().to_string())
-            .filter(|n| n.starts_with(".tmp"))
+            .filter(|n| n.starts_with(master::output::UNFINISHED_PREFIX))
             .collect();
         assert!(leftovers.is_empty(), "{leftovers:?}");
         stderr

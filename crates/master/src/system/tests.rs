@@ -239,7 +239,10 @@ fn a_start_value_given_twice_is_refused() {
     assert_ne!(twice, SYS);
     let e = LoadedSystem::from_json_str(&twice, Path::new("/d"), "sys.json").unwrap_err();
     let e = e.to_string();
-    assert!(e.contains("`k` is given twice") && e.contains("line 3"), "{e}");
+    assert!(
+        e.contains("`k` is given twice") && e.contains("line 3"),
+        "{e}"
+    );
     for set in [
         r#"{"product": {"ms.k": [1], "ms.k": [2]}}"#,
         r#"{"runs": [{"parameters": {"ms.k": 1, "ms.k": 2}}]}"#,
