@@ -323,11 +323,12 @@ impl LoadedSystem {
         }
     }
 
-    /// Line of the first occurrence of `"needle"` in the JSON text.
-    fn line_of(&self, needle: &str) -> Option<usize> {
+    /// Line of the value at `field` (`instances[3].name`) in the JSON text, else of the first
+    /// occurrence of `"needle"` (a field the text does not hold as named).
+    fn line_of(&self, field: &str, needle: &str) -> Option<usize> {
         let text = self.text.as_ref()?;
-        let quoted = format!("\"{needle}\"");
-        let pos = text.find(&quoted)?;
+        let pos =
+            locate::value_offset(text, field).or_else(|| text.find(&format!("\"{needle}\"")))?;
         Some(text[..pos].matches('\n').count() + 1)
     }
 
@@ -337,10 +338,11 @@ impl LoadedSystem {
         needle: &str,
         reason: impl Into<String>,
     ) -> SystemError {
+        let field = field.into();
         SystemError::Invalid {
             file: self.file.clone(),
-            line: self.line_of(needle),
-            field: field.into(),
+            line: self.line_of(&field, needle),
+            field,
             reason: reason.into(),
         }
     }
@@ -482,6 +484,7 @@ impl LoadedSystem {
     }
 }
 
+mod locate;
 mod overrides;
 mod plan;
 mod prepared;

@@ -174,9 +174,10 @@ fn causality_type_and_unit_checks() {
         "{\"from\": \"ms.velocity\", \"to\": \"sdm.input_velocity\"}",
         "{\"from\": \"ms.position\", \"to\": \"sdm.input_position\"}",
     );
+    // the line is the second connection's, not the first holding the same text
     assert!(err_of(&t).contains(
-        "connections[1].to: input 'sdm.input_position' is already driven by connections[0]"
-    ));
+        "line 8: connections[1].to: input 'sdm.input_position' is already driven by connections[0]"
+    ), "{}", err_of(&t));
 }
 
 #[test]
@@ -200,7 +201,7 @@ fn malformed_json_and_timing() {
     assert!(err_of(&SYS.replace("\"stop_time\": 1.0", "\"stop_time\": 0.0")).contains("stop_time"));
     let e = err_of(&SYS.replace("\"name\": \"ms\"", "\"name\": \"sdm\""));
     assert!(
-        e.contains("instances[1].name: instance name 'sdm' is used twice"),
+        e.contains("line 4: instances[1].name: instance name 'sdm' is used twice"),
         "{e}"
     );
     let e = err_of(&SYS.replace("\"name\": \"ms\"", "\"name\": \"m.s\""));
