@@ -22,7 +22,10 @@ pub enum SignalError {
         needed: usize,
         what: &'static str,
     },
-    #[error("signal contains a non-finite value at sample {index}")]
+    #[error(
+        "sample {index} is not finite, or the signal's values are too large to filter (beyond \
+         about 1e150)"
+    )]
     NonFinite { index: usize },
     #[error(
         "no spectral peak between {} and {} Hz",

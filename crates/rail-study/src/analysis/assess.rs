@@ -698,7 +698,9 @@ pub fn assess_table(
                 static_wheel_load_n,
             } => assess_guiding_forces(&x, fs, speed_kmh / 3.6, static_wheel_load_n, settings),
         }
-        .map_err(|e: AssessError| AnalysisError::Input(format!("signal '{name}': {e}")))?;
+        .map_err(|e: AssessError| {
+            AnalysisError::Input(format!("{}: signal '{name}': {e}", table.path.display()))
+        })?;
         out.push((name.clone(), a));
     }
     Ok(AssessReport {
