@@ -1206,3 +1206,42 @@ fn a_study_option_out_of_range_is_refused_before_anything_is_touched() {
         "the previous report"
     );
 }
+
+/// An SSP whose libcosim and OMSimulator annotations give different communication steps runs
+/// with libcosim's and says so (it was taken silently).
+#[test]
+fn an_ssp_with_two_different_steps_says_which_it_takes() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    let out = c.master(&["export-ssp", "system.json", "ok.ssp"], &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut src = zip::ZipArchive::new(std::fs::File::open(c.path("ok.ssp")).unwrap()).unwrap();
+    let mut z = zip::ZipWriter::new(std::fs::File::create(c.path("two.ssp")).unwrap());
+    let o = zip::write::SimpleFileOptions::default();
+    let mut changed = false;
+    for i in 0..src.len() {
+        let mut e = src.by_index(i).unwrap();
+        let mut data = Vec::new();
+        std::io::Read::read_to_end(&mut e, &mut data).unwrap();
+        if e.name() == "SystemStructure.ssd" {
+            let text = String::from_utf8(data).unwrap();
+            let at = text.find("baseStepSize=\"").unwrap() + "baseStepSize=\"".len();
+            let end = at + text[at..].find('"').unwrap();
+            let step: f64 = text[at..end].parse().unwrap();
+            data = format!("{}{}{}", &text[..at], 2.0 * step, &text[end..]).into_bytes();
+            changed = true;
+        }
+        z.start_file(e.name(), o).unwrap();
+        z.write_all(&data).unwrap();
+    }
+    z.finish().unwrap();
+    assert!(changed);
+    let out = c.master(&["run", "two.ssp", "-o", "two.csv"], &[]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("gives two communication steps"), "{stderr}");
+}

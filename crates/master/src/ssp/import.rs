@@ -117,6 +117,18 @@ pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, S
                 .into(),
         )
     })?;
+    if let (None, Some(osp), Some(oms)) = (opts.step, ssd.base_step_s, ssd.system.step_s) {
+        if (osp - oms).abs() > 1e-9 * osp.abs().max(oms.abs()) {
+            // two tools' annotations that disagree: libcosim's is taken, and the user told
+            log::warn!(
+                target: "master",
+                "{}: the SSD gives two communication steps, libcosim's osp:FixedStepAlgorithm \
+                 baseStepSize {osp} s and OMSimulator's oms:FixedStepMaster stepSize {oms} s; \
+                 using {osp} s (give --step to choose)",
+                imp.ssd_label
+            );
+        }
+    }
     let step = opts
         .step
         .or(ssd.base_step_s)
