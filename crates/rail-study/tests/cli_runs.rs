@@ -781,3 +781,33 @@ fn a_sweep_into_a_file_names_it() {
     assert!(e.contains("'afile' is a file, not a folder"), "{e}");
     assert_eq!(std::fs::read(dir.path().join("afile")).unwrap(), b"x");
 }
+
+/// An Enumeration parameter given by item name in one run and by number in another is refused
+/// before anything runs (its Parquet column mixed 'high' and '0' as texts).
+#[test]
+fn an_enumeration_given_both_ways_in_a_set_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let system = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../systems/passive.json");
+    std::fs::write(
+        dir.path().join("set.json"),
+        format!(
+            r#"{{"base": "{}", "product": {{"bogie.track.level": ["high", 0]}}}}"#,
+            system.display()
+        ),
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .args([
+            "--quiet", "sweep", "set.json", "-o", "out", "--format", "parquet",
+        ])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("bogie.track.level") && e.contains("give it one way in every run"),
+        "{e}"
+    );
+    assert!(!dir.path().join("out").join("sweep.json").exists());
+}

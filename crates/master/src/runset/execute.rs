@@ -19,10 +19,35 @@ use crate::system::{LoadedSystem, PreparedSystem, SystemDescription, SystemError
 /// The start values and stop time of every job, checked against the prepared system's FMUs
 /// as each run would check them (variable names, types, declared ranges): a run set with a
 /// misspelt variable is refused before anything runs or is removed, not failed run by run.
+/// An Enumeration given by item name in some runs and by number in others is refused too: its
+/// results column would mix texts and numbers.
 pub fn check_jobs(system: &PreparedSystem, jobs: &[Job]) -> Result<(), SystemError> {
     for job in jobs {
         let run = format!("run '{}'", job.name);
         system.changes(&job.parameters, Some(job.system.stop_time), &run)?;
+    }
+    let integers = system.integer_parameters(jobs.iter().flat_map(|j| j.parameters.keys()));
+    for key in &integers {
+        let given = |text: bool| {
+            jobs.iter().find_map(|j| {
+                j.parameters
+                    .get(key)
+                    .filter(|v| v.is_string() == text)
+                    .map(|v| (j.name.as_str(), v))
+            })
+        };
+        if let (Some((a, name)), Some((b, number))) = (given(true), given(false)) {
+            return Err(SystemError::Invalid {
+                file: format!("run '{b}'"),
+                line: None,
+                field: key.clone(),
+                reason: format!(
+                    "given as the number {number} here and as the item name {name} in run \
+                     '{a}': give it one way in every run, so that its results column has one \
+                     type"
+                ),
+            });
+        }
     }
     Ok(())
 }
