@@ -106,6 +106,7 @@ fn sweep_err(e: &SweepError) -> PyErr {
         SweepError::System(s) => system_err(s),
         SweepError::Output(_)
         | SweepError::Dir { .. }
+        | SweepError::NotAFolder { .. }
         | SweepError::NotARunFolder { .. }
         | SweepError::NotARunTable { .. }
         | SweepError::NoOutputFolder

@@ -145,11 +145,16 @@ fn simulate_with(
     let mut eng = Engine::new(plan, &exchange, slaves, opts, n_steps, fast);
     let mut data = Vec::new();
     let res = eng.run(&mut data);
-    let term = eng.terminate_all();
     let width = plan.record.len() + 1;
     let last_row_time = |data: &[f64]| data.len().checked_sub(width).map(|k| data[k]);
+    let term = eng.terminate_all(last_row_time(&data).unwrap_or(plan.start_time));
     let error = match (res, term) {
-        (Err(e), _) | (Ok(()), Err(e)) => e,
+        (Err(e), Err(t)) => {
+            // the run's error is the one reported; the other is not lost
+            log::warn!(target: "master", "after the run failed, {t}");
+            e
+        }
+        (Err(e), Ok(())) | (Ok(()), Err(e)) => e,
         (Ok(()), Ok(())) => {
             let terminated = eng.terminated().map(|(i, t)| Terminated {
                 instance: plan.instances[i].name.clone(),
@@ -174,7 +179,11 @@ fn simulate_with(
             end,
             started,
             eng.rejected(),
-            None,
+            // an FMU that ended the run before fmi2Terminate failed: said too
+            eng.terminated().map(|(i, t)| Terminated {
+                instance: plan.instances[i].name.clone(),
+                time_s: t,
+            }),
             Some(failure),
         );
         Box::new(output(plan, data, strings, summary))

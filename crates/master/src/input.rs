@@ -80,3 +80,52 @@ where
     }
     d.deserialize_map(Keys(std::marker::PhantomData))
 }
+
+/// What tells a file's content changed without reading it: size, modification time and, on
+/// Unix, inode and status-change time (which a copy that keeps the modification time, `cp -p`,
+/// still sets).
+fn file_stamp(meta: &std::fs::Metadata) -> Option<(u64, std::time::SystemTime, u64, i64, i64)> {
+    #[cfg(unix)]
+    let (ino, ctime, ctime_ns) = {
+        use std::os::unix::fs::MetadataExt;
+        (meta.ino(), meta.ctime(), meta.ctime_nsec())
+    };
+    #[cfg(not(unix))]
+    let (ino, ctime, ctime_ns) = (0, 0, 0);
+    Some((meta.len(), meta.modified().ok()?, ino, ctime, ctime_ns))
+}
+
+/// The SHA-1 (hex) of the file at `path`, `None` if it cannot be read. Kept per path and
+/// its size, modification time, inode and status-change time, so that the runs of a set sharing
+/// an FMU read it once.
+pub fn file_digest(path: &Path) -> Option<String> {
+    type Stamp = (u64, std::time::SystemTime, u64, i64, i64);
+    type Cache = std::collections::HashMap<std::path::PathBuf, (Stamp, String)>;
+    static CACHE: std::sync::Mutex<Option<Cache>> = std::sync::Mutex::new(None);
+    let meta = std::fs::metadata(path).ok()?;
+    let key = file_stamp(&meta)?;
+    if let Ok(cache) = CACHE.lock() {
+        if let Some((stamp, digest)) = cache.as_ref().and_then(|c| c.get(path)) {
+            if *stamp == key {
+                return Some(digest.clone());
+            }
+        }
+    }
+    let mut hasher = sha1_smol::Sha1::new();
+    let mut file = std::fs::File::open(path).ok()?;
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        let n = std::io::Read::read(&mut file, &mut buf).ok()?;
+        if n == 0 {
+            break;
+        }
+        hasher.update(&buf[..n]);
+    }
+    let digest = hasher.digest().to_string();
+    if let Ok(mut cache) = CACHE.lock() {
+        cache
+            .get_or_insert_with(std::collections::HashMap::new)
+            .insert(path.to_path_buf(), (key, digest.clone()));
+    }
+    Some(digest)
+}

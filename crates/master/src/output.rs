@@ -125,7 +125,7 @@ pub const UNFINISHED_PREFIX: &str = ".master-unfinished-";
 
 /// How old an unlocked temporary file must be before another master removes it \[s\]: a file
 /// just created is locked a moment later.
-const ABANDONED_AFTER_S: u64 = 60;
+pub const ABANDONED_AFTER_S: u64 = 60;
 
 /// Removes the temporary files in `dir` that a master killed while writing left behind
 /// (SIGKILL, a closed terminal's SIGHUP): ours by their prefix, unlocked (no live process
@@ -153,7 +153,10 @@ pub fn remove_abandoned_files(dir: &Path) -> usize {
             continue;
         }
         let path = entry.path();
-        let unlocked = std::fs::File::open(&path).is_ok_and(|f| crate::fmu::extract::try_lock(&f));
+        // opened without blocking and without following a link: a FIFO or link put there in
+        // the meantime is neither waited on nor followed
+        let unlocked =
+            crate::input::open_regular_file(&path).is_ok_and(|f| crate::fmu::extract::try_lock(&f));
         if unlocked && std::fs::remove_file(&path).is_ok() {
             removed += 1;
         }
@@ -164,6 +167,20 @@ pub fn remove_abandoned_files(dir: &Path) -> usize {
 /// A temporary file in `dir`, created and listed in [`UNFINISHED`] under its lock, so that
 /// [`give_up_unfinished`] sees every file created before it and none is created after it.
 fn listed_temporary_file(dir: &Path) -> std::io::Result<(tempfile::NamedTempFile, Listed)> {
+    // once per folder and process, outside the list's lock: a sweep writes a file per run into
+    // one folder, and a second Ctrl-C must not wait for a scan
+    static SCANNED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+    let first = {
+        let mut scanned = SCANNED.lock().unwrap_or_else(PoisonError::into_inner);
+        let first = !scanned.iter().any(|d| d == dir);
+        if first {
+            scanned.push(dir.to_path_buf());
+        }
+        first
+    };
+    if first {
+        remove_abandoned_files(dir);
+    }
     let mut files = unfinished_files();
     let Some(list) = files.as_mut() else {
         return Err(std::io::Error::new(
@@ -171,7 +188,6 @@ fn listed_temporary_file(dir: &Path) -> std::io::Result<(tempfile::NamedTempFile
             "the process is ending (interrupted twice)",
         ));
     };
-    remove_abandoned_files(dir);
     let tmp = tempfile::Builder::new()
         .prefix(UNFINISHED_PREFIX)
         .tempfile_in(dir)?;

@@ -646,10 +646,13 @@ fn a_run_whose_outputs_cannot_all_be_written_changes_nothing() {
     std::fs::create_dir(d.join("s.json")).unwrap();
     let e = refused(&["-o", "r.csv", "--summary", "s.json"]);
     assert!(e.contains("s.json"), "{e}");
-    // a summary that passes the checks but cannot be written (no file can be created in
-    // /proc, not even by root): found after the run, before the results replace the earlier
+    // a summary in a folder that takes no new file (/proc, not even for root): found before
+    // the run by the probe file, and the earlier results stay
     let e = refused(&["-o", "r.csv", "--summary", "/proc/self/s.json"]);
-    assert!(e.contains("cannot write '/proc/self/s.json'"), "{e}");
+    assert!(
+        e.contains("cannot write into the folder '/proc/self' (for '/proc/self/s.json')"),
+        "{e}"
+    );
     assert_eq!(before("r.csv"), csv);
     assert_eq!(before("r.meta.json"), meta);
     let mut names: Vec<_> = std::fs::read_dir(d)
@@ -810,4 +813,39 @@ fn an_enumeration_given_both_ways_in_a_set_is_refused() {
         "{e}"
     );
     assert!(!dir.path().join("out").join("sweep.json").exists());
+}
+
+/// A run whose FMU file was replaced after its set loaded the FMU fails, naming the file: its
+/// report would otherwise record the new file's digest for a run of the old model, and a
+/// resumed set would keep it.
+#[test]
+fn a_run_whose_fmu_changed_since_its_set_loaded_it_fails() {
+    use master::runset::{run_job, RunSet};
+    use master::system::{LoadedSystem, PreparedSystem};
+    let dir = tempfile::tempdir().unwrap();
+    for f in ["MassSpring.fmu", "SpringDamperMass.fmu"] {
+        std::fs::copy(dist().join(f), dir.path().join(f)).unwrap();
+    }
+    let text = system_json(0.01).replace(
+        &dist().display().to_string(),
+        &dir.path().display().to_string(),
+    );
+    let sys = LoadedSystem::from_json_str(&text, dir.path(), "system.json").unwrap();
+    let prepared = PreparedSystem::prepare(&sys).unwrap();
+    let set: RunSet =
+        serde_json::from_str(r#"{"runs": [{"name": "a", "parameters": {}}]}"#).unwrap();
+    let jobs = set.expand(&sys, "set.json").unwrap();
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    assert!(run_job(&prepared, &jobs[0], &cancel).is_ok());
+    // another build at the same path
+    std::fs::copy(
+        dist().join("SpringDamperMass.fmu"),
+        dir.path().join("MassSpring.fmu"),
+    )
+    .unwrap();
+    let e = run_job(&prepared, &jobs[0], &cancel).unwrap_err();
+    assert!(
+        e.contains("MassSpring.fmu' changed since the run set loaded it"),
+        "{e}"
+    );
 }

@@ -222,63 +222,77 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         }
         Err(failed) => return Err(failed.error.into()),
     };
-    let format = chosen.unwrap_or_else(|| {
-        ResultsFormat::by_size(out.rows().count() as u64, out.header.len() as u64)
-    });
-    let output = args
-        .output
-        .clone()
-        .unwrap_or_else(|| default_output(format));
-    if args.output.is_none() || (chosen.is_none() && format == ResultsFormat::Csv) {
-        check_outputs_apart(&inputs, &written(&output, format))?;
-    }
-    // FMU paths absolute, so that the description runs again from wherever it is saved (an
-    // SSP's FMUs lie in a temporary folder: its description is kept as imported)
-    let described = if imported.is_some() {
-        sys.desc.clone()
-    } else {
-        sys.resolved()
-    };
     let cancel = ctx.cancel;
-    let run_context = RunContext {
-        system: serde_json::to_value(&described).ok(),
-        ..RunContext::default()
-    };
-    // every file written before any earlier one is replaced
-    let results = prepare_results(&output, &out, format, &run_context)?;
-    let summary = match &args.summary {
-        Some(p) => Some(json_unfinished(p, &out.summary)?),
-        None => None,
-    };
-    // Ctrl-C or SIGTERM while the files were written: nothing replaces the earlier ones (the
-    // unfinished files are removed when dropped), exit status 130 as after a cancelled run
-    if cancel.load(std::sync::atomic::Ordering::SeqCst) {
-        return Err(CommandError::Failed(
-            "interrupted while writing the results: nothing written".into(),
-        ));
-    }
-    results.commit()?;
-    if let Some(summary) = summary {
-        summary.commit()?;
-    }
-    if args.output.is_none() {
-        // the default file of the other format, from an earlier run, would read as a result
-        // of this one (unless it is an input or the --summary file, which stay)
-        let other = default_output(format.other());
-        // only a results file of the master's (its metadata reads as such): a user's own
-        // results.csv or results.parquet stays
-        let ours = crate::results::written_by_master(&other, format.other());
-        if ours && check_outputs_apart(&inputs, &written(&other, format.other())).is_ok() {
-            remove_results(&other, format.other())?;
+    // the files of the run: its results, or a failed run's history
+    let write = || -> Result<PathBuf, CommandError> {
+        let format = chosen.unwrap_or_else(|| {
+            ResultsFormat::by_size(out.rows().count() as u64, out.header.len() as u64)
+        });
+        let output = args
+            .output
+            .clone()
+            .unwrap_or_else(|| default_output(format));
+        if args.output.is_none() || (chosen.is_none() && format == ResultsFormat::Csv) {
+            // the files the run's size decided, checked as the others were before the run
+            check_outputs_apart(&inputs, &written(&output, format))?;
+            crate::output::check_folders_exist(&written(&output, format))?;
         }
-    }
+        // FMU paths absolute, so that the description runs again from wherever it is saved (an
+        // SSP's FMUs lie in a temporary folder: its description is kept as imported)
+        let described = if imported.is_some() {
+            sys.desc.clone()
+        } else {
+            sys.resolved()
+        };
+        let run_context = RunContext {
+            system: serde_json::to_value(&described).ok(),
+            ..RunContext::default()
+        };
+        // every file written before any earlier one is replaced
+        let results = prepare_results(&output, &out, format, &run_context)?;
+        let summary = match &args.summary {
+            Some(p) => Some(json_unfinished(p, &out.summary)?),
+            None => None,
+        };
+        // Ctrl-C or SIGTERM while the files were written: nothing replaces the earlier ones (the
+        // unfinished files are removed when dropped), exit status 130 as after a cancelled run
+        if cancel.load(std::sync::atomic::Ordering::SeqCst) {
+            return Err(CommandError::Failed(
+                "interrupted while writing the results: nothing written".into(),
+            ));
+        }
+        results.commit()?;
+        if let Some(summary) = summary {
+            summary.commit()?;
+        }
+        if args.output.is_none() {
+            // the default file of the other format, from an earlier run, would read as a result
+            // of this one (unless it is an input or the --summary file, which stay)
+            let other = default_output(format.other());
+            // only a results file of the master's (its metadata reads as such): a user's own
+            // results.csv or results.parquet stays
+            let ours = crate::results::written_by_master(&other, format.other());
+            if ours && check_outputs_apart(&inputs, &written(&other, format.other())).is_ok() {
+                remove_results(&other, format.other())?;
+            }
+        }
+        Ok(output)
+    };
+    let written_to = write();
     if let Some(error) = failure {
-        return Err(CommandError::FailedWithHistory {
-            error: Box::new(error),
-            time_s: out.summary.failed.as_ref().map_or(f64::NAN, |f| f.time_s),
-            path: output.display().to_string(),
+        return Err(match written_to {
+            Ok(path) => CommandError::FailedWithHistory {
+                error: Box::new(error),
+                time_s: out.summary.failed.as_ref().map_or(f64::NAN, |f| f.time_s),
+                path: path.display().to_string(),
+            },
+            // the run's own error first: why it failed matters more than its history
+            Err(e) => CommandError::Failed(format!(
+                "{error}\nits history up to the failure was not written: {e}"
+            )),
         });
     }
+    let output = written_to?;
     println!("{}: {}", output.display(), out.summary);
     if let Some(t) = &out.summary.terminated {
         println!(

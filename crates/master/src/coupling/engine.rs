@@ -963,15 +963,15 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
     }
 
     /// fmi2Terminate on every slave that reached step mode and did not return fmi2Error or
-    /// fmi2Fatal.
-    pub(super) fn terminate_all(&mut self) -> Result<(), SimError> {
+    /// fmi2Fatal; `time` is where the run ended (the last recorded point), for the message.
+    pub(super) fn terminate_all(&mut self, time: f64) -> Result<(), SimError> {
         let mut first = None;
         for i in 0..self.slaves.len() {
             if self.initialised[i] && !self.failed[i] {
                 self.initialised[i] = false;
                 if let Err(e) = self.slaves[i].terminate() {
                     first.get_or_insert(SimError::Slave {
-                        time: self.plan.stop_time,
+                        time,
                         source: Box::new(e),
                     });
                 }

@@ -1,7 +1,7 @@
 //! Executing a run set: one job on the prepared system, the jobs in parallel, each run's
 //! results written into a temporary folder and moved into place whole.
 
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -19,13 +19,19 @@ use crate::system::{LoadedSystem, PreparedSystem, SystemDescription, SystemError
 /// The start values and stop time of every job, checked against the prepared system's FMUs
 /// as each run would check them (variable names, types, declared ranges): a run set with a
 /// misspelt variable is refused before anything runs or is removed, not failed run by run.
-/// An Enumeration given by item name in some runs and by number in others is refused too: its
-/// results column would mix texts and numbers.
+/// The jobs are also checked with [`check_given_one_way`].
 pub fn check_jobs(system: &PreparedSystem, jobs: &[Job]) -> Result<(), SystemError> {
     for job in jobs {
         let run = format!("run '{}'", job.name);
         system.changes(&job.parameters, Some(job.system.stop_time), &run)?;
     }
+    check_given_one_way(system, jobs)
+}
+
+/// An Enumeration given by item name in some runs and by number in others is refused: the
+/// set's results column would mix texts and numbers. `jobs`: the whole set (a resumed set's
+/// kept runs too).
+pub fn check_given_one_way(system: &PreparedSystem, jobs: &[Job]) -> Result<(), SystemError> {
     let integers = system.integer_parameters(jobs.iter().flat_map(|j| j.parameters.keys()));
     for key in &integers {
         let given = |text: bool| {
@@ -76,6 +82,19 @@ pub fn run_job(
         return Err(format!(
             "{run}: not a run of the prepared system '{}' (instances, FMUs or timing differ)",
             system.system().file
+        ));
+    }
+    // the report records the digests of the files now: a file replaced since the system was
+    // loaded would be recorded for a run of the model loaded before
+    let now = fmu_digests(&job.system);
+    if let Some((path, _)) = system
+        .fmu_digests()
+        .iter()
+        .find(|(path, digest)| now.get(*path) != Some(*digest))
+    {
+        return Err(format!(
+            "{run}: the FMU '{path}' changed since the run set loaded it: this run would be \
+             recorded for the new file; run the set again (a resumed set runs this run again)"
         ));
     }
     let changes = system
@@ -646,46 +665,18 @@ where
     report
 }
 
-/// The SHA-1 (hex) of the file at `path`, `None` if it cannot be read. Kept per path, size and
-/// modification time, so that the runs of a set sharing an FMU read it once.
-pub fn file_digest(path: &Path) -> Option<String> {
-    type Cache = HashMap<PathBuf, (u64, std::time::SystemTime, String)>;
-    static CACHE: std::sync::Mutex<Option<Cache>> = std::sync::Mutex::new(None);
-    let meta = std::fs::metadata(path).ok()?;
-    let key = (meta.len(), meta.modified().ok()?);
-    if let Ok(cache) = CACHE.lock() {
-        if let Some((len, time, digest)) = cache.as_ref().and_then(|c| c.get(path)) {
-            if (*len, *time) == key {
-                return Some(digest.clone());
-            }
-        }
-    }
-    let mut hasher = sha1_smol::Sha1::new();
-    let mut file = std::fs::File::open(path).ok()?;
-    let mut buf = vec![0u8; 1 << 16];
-    loop {
-        let n = std::io::Read::read(&mut file, &mut buf).ok()?;
-        if n == 0 {
-            break;
-        }
-        hasher.update(&buf[..n]);
-    }
-    let digest = hasher.digest().to_string();
-    if let Ok(mut cache) = CACHE.lock() {
-        cache
-            .get_or_insert_with(HashMap::new)
-            .insert(path.to_path_buf(), (key.0, key.1, digest.clone()));
-    }
-    Some(digest)
-}
-
-/// [`file_digest`] of every FMU of `system`, by its path as the description gives it (a file
+/// [`file_digest`](crate::input::file_digest) of every FMU of `system`, by its path as the description gives it (a file
 /// that cannot be read is left out, and its run fails on its own).
 pub fn fmu_digests(system: &SystemDescription) -> BTreeMap<String, String> {
     system
         .instances
         .iter()
-        .filter_map(|i| Some((i.fmu.to_string_lossy().into_owned(), file_digest(&i.fmu)?)))
+        .filter_map(|i| {
+            Some((
+                i.fmu.to_string_lossy().into_owned(),
+                crate::input::file_digest(&i.fmu)?,
+            ))
+        })
         .collect()
 }
 

@@ -46,6 +46,8 @@ pub struct PreparedSystem {
     /// The prepared FMU of each instance.
     fmus: Vec<Arc<PreparedFmu>>,
     plan: CouplingPlan,
+    /// The SHA-1 of each FMU file when it was loaded, by its absolute path.
+    fmu_digests: BTreeMap<String, String>,
 }
 
 impl PreparedSystem {
@@ -58,9 +60,13 @@ impl PreparedSystem {
         let mut by_path: HashMap<PathBuf, Arc<PreparedFmu>> = HashMap::new();
         let mut fmus = Vec::with_capacity(archives.len());
         let mut fmu_paths = Vec::with_capacity(archives.len());
+        let mut fmu_digests = BTreeMap::new();
         for (i, archive) in archives.into_iter().enumerate() {
             let path = system.fmu_path(i);
             let path = std::path::absolute(&path).unwrap_or(path);
+            if let Some(digest) = crate::input::file_digest(&path) {
+                fmu_digests.insert(path.to_string_lossy().into_owned(), digest);
+            }
             let fmu = match by_path.get(&path) {
                 Some(f) => Arc::clone(f),
                 None => {
@@ -78,6 +84,7 @@ impl PreparedSystem {
             fmu_paths,
             fmus,
             plan,
+            fmu_digests,
         })
     }
 
@@ -93,6 +100,11 @@ impl PreparedSystem {
     /// Absolute FMU path of each instance.
     pub fn fmu_paths(&self) -> &[PathBuf] {
         &self.fmu_paths
+    }
+
+    /// The SHA-1 of each FMU file as it was when loaded, by its absolute path.
+    pub fn fmu_digests(&self) -> &BTreeMap<String, String> {
+        &self.fmu_digests
     }
 
     /// Of the parameter names `keys` (`instance.variable`), those that are Integers or
