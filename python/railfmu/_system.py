@@ -180,15 +180,28 @@ class System:
 
         Raises :class:`SystemDescriptionError` for an invalid name or value,
         :class:`FmuError` when an FMU cannot be instantiated, :class:`SimulationError` when
-        the simulation fails.
+        the simulation fails; its ``history`` holds the :class:`Results` up to the last
+        communication point every instance completed (``summary["failed"]`` gives the time
+        and the error), or None when the run failed before its first row.
         """
         merged = {**self._parameters, **_plain_dict(parameters)}
         seconds = _seconds("stop_time", stop_time)
         stop = seconds if seconds is not None else self._stop_time
         from ._progress import bar
 
-        with bar(progress, "steps") as cb:
-            header, data, texts, summary, meta = self._prepared.run(merged, stop, cb)
+        try:
+            with bar(progress, "steps") as cb:
+                header, data, texts, summary, meta = self._prepared.run(merged, stop, cb)
+        except _railfmu.SimulationError as e:
+            history = None
+            if len(e.args) == 2 and isinstance(e.args[1], tuple):
+                h_header, h_data, h_texts, h_summary, h_meta = e.args[1]
+                history = Results._from_bytes(
+                    h_header, h_data, json.loads(h_summary), True, h_texts, json.loads(h_meta)
+                )
+                e.args = (e.args[0],)
+            e.history = history
+            raise
         return Results._from_bytes(header, data, json.loads(summary), True, texts, json.loads(meta))
 
     def __repr__(self) -> str:

@@ -17,7 +17,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyInt, PyString};
 use serde_json::Value;
 
-use master::coupling::{Algorithm, RunOptions, SimError, SimOutput, Summary};
+use master::coupling::{Algorithm, FailedRun, RunOptions, SimError, SimOutput, Summary};
 use master::output::check_outputs_apart;
 use master::results::{
     csv_metadata_path, write_results, ResultsFormat, ResultsMetadata, RunContext,
@@ -449,20 +449,31 @@ impl PySystem {
                     progress: Some(&report),
                     general_engine: false,
                 };
-                prepared.run(&changes, &opts)
+                prepared.run_keeping_history(&changes, &opts)
             },
             |py, ev| match (&progress, ev) {
                 (Some(cb), Event::Steps(k, n)) => cb.call1(py, (k, n)).map(|_| ()),
                 _ => Ok(()),
             },
         )?;
-        let out = out.map_err(|e| run_err(&e))?;
         // the metadata describe the system as run, as those of a run of a run set do
         let ctx = RunContext {
             system: Some(self.run_description(&params, stop_time)?),
             ..RunContext::default()
         };
-        table(py, out, &ctx)
+        match out {
+            Ok(out) => table(py, out, &ctx),
+            // a simulation that failed after its first row: the exception carries its history
+            // (the Python side makes it `SimulationError.history`)
+            Err(FailedRun {
+                error: e @ RunError::Sim(_),
+                history: Some(history),
+            }) if !matches!(e, RunError::Sim(SimError::Cancelled { .. })) => {
+                let history = pyo3::IntoPyObjectExt::into_py_any(table(py, *history, &ctx)?, py)?;
+                Err(SimulationError::new_err((error_message(&e), history)))
+            }
+            Err(failed) => Err(run_err(&failed.error)),
+        }
     }
 
     /// Runs one job of this system's run set (JSON, as from `load_run_set`), as a run set's

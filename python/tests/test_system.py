@@ -152,6 +152,25 @@ def test_bad_input_raises_with_the_masters_message_and_changes_nothing(passive_f
     with pytest.raises(railfmu.SimulationError, match=r"fmi2Error: .*'vehicle.speed': must be > 0, got 0"):
         sys.run({"bogie.vehicle.speed": 0.0}, stop_time=0.01)
     assert len(sys.run(stop_time=0.01)) == 11  # still usable
+    # that failure came at the start: no history
+    with pytest.raises(railfmu.SimulationError) as failed:
+        sys.run({"bogie.vehicle.speed": 0.0}, stop_time=0.01)
+    assert failed.value.history is None
+    # a failure midway (a bogie without secondary suspension derails at 150 m/s): the error
+    # carries the history up to it, its summary saying where and why
+    derail = {
+        "bogie.vehicle.speed": 150.0,
+        "bogie.suspension.lateral_stiffness": 0.0,
+        "bogie.suspension.longitudinal_stiffness": 0.0,
+    }
+    with pytest.raises(railfmu.SimulationError, match="derailment") as failed:
+        sys.run(derail, stop_time=2.0)
+    history = failed.value.history
+    assert "history" not in str(failed.value) and str(failed.value).count("derailment") >= 1
+    t = history.time
+    assert 0.1 < t[-1] < 2.0 and len(t) == round(t[-1] / 1e-3) + 1
+    assert history.summary["failed"]["time_s"] == t[-1]
+    assert "derailment" in history.summary["failed"]["error"]
     # files: missing, malformed JSON (line and column), broken FMU
     with pytest.raises(railfmu.SystemDescriptionError, match=r"cannot read"):
         railfmu.System.load(tmp_path / "nope.json")
