@@ -21,6 +21,9 @@ from ._runset import RunSet, run_set
 from ._system import System
 from .dask import SchedulerLostError
 
+# System.run sets it to the run's Results up to the failure; any other SimulationError has none
+SimulationError.history = None
+
 __all__ = [
     "AssessmentError",
     "Error",

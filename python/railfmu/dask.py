@@ -61,7 +61,7 @@ class SchedulerLostError(_railfmu.Error, ConnectionError):
     ``resume=True`` on a working cluster runs them."""
 
 
-_PREPARED: Dict[str, "_railfmu.PreparedSystem"] = {}
+_PREPARED: Dict[Any, "_railfmu.PreparedSystem"] = {}
 _PREPARED_LOCK = threading.Lock()
 _KEEP_PREPARED = 4
 
@@ -152,14 +152,34 @@ def _localise(description: Dict[str, Any], paths: Dict[str, str]) -> Dict[str, A
     return d
 
 
+def _fmu_stamps(base_json: str) -> tuple:
+    """What tells whether the system's FMU files changed since a worker loaded them (a rebuild
+    on a shared file system keeps the paths): size, modification and status-change times, inode."""
+    stamps = []
+    try:
+        instances = json.loads(base_json).get("instances", [])
+    except ValueError:
+        return ()
+    for inst in instances:
+        try:
+            st = os.stat(inst.get("fmu", ""))
+            stamps.append((st.st_size, st.st_mtime_ns, st.st_ctime_ns, st.st_ino))
+        except (OSError, TypeError, AttributeError):
+            stamps.append(None)
+    return tuple(stamps)
+
+
 def _prepared(base_json: str, label: str) -> "_railfmu.PreparedSystem":
+    # keyed on the FMU files' stamps too: a system whose FMUs were rebuilt is loaded again
+    # (its runs would otherwise fail as run on a changed FMU, for as long as the worker lives)
+    key = (base_json, _fmu_stamps(base_json))
     with _PREPARED_LOCK:
-        system = _PREPARED.get(base_json)
+        system = _PREPARED.get(key)
         if system is None:
             system = _railfmu.PreparedSystem.from_json(base_json, "", label)
             if len(_PREPARED) >= _KEEP_PREPARED:
                 _PREPARED.pop(next(iter(_PREPARED)))
-            _PREPARED[base_json] = system
+            _PREPARED[key] = system
         return system
 
 

@@ -156,6 +156,7 @@ def test_bad_input_raises_with_the_masters_message_and_changes_nothing(passive_f
     with pytest.raises(railfmu.SimulationError) as failed:
         sys.run({"bogie.vehicle.speed": 0.0}, stop_time=0.01)
     assert failed.value.history is None
+    assert railfmu.SimulationError("made by hand").history is None
     # a failure midway (a bogie without secondary suspension derails at 150 m/s): the error
     # carries the history up to it, its summary saying where and why
     derail = {

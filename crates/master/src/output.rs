@@ -153,8 +153,8 @@ pub fn remove_abandoned_files(dir: &Path) -> usize {
             continue;
         }
         let path = entry.path();
-        // opened without blocking and without following a link: a FIFO or link put there in
-        // the meantime is neither waited on nor followed
+        // opened without blocking (a FIFO put there in the meantime is not waited on); a link
+        // put there is removed itself, not its target
         let unlocked =
             crate::input::open_regular_file(&path).is_ok_and(|f| crate::fmu::extract::try_lock(&f));
         if unlocked && std::fs::remove_file(&path).is_ok() {
@@ -169,15 +169,12 @@ pub fn remove_abandoned_files(dir: &Path) -> usize {
 fn listed_temporary_file(dir: &Path) -> std::io::Result<(tempfile::NamedTempFile, Listed)> {
     // once per folder and process, outside the list's lock: a sweep writes a file per run into
     // one folder, and a second Ctrl-C must not wait for a scan
-    static SCANNED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
-    let first = {
-        let mut scanned = SCANNED.lock().unwrap_or_else(PoisonError::into_inner);
-        let first = !scanned.iter().any(|d| d == dir);
-        if first {
-            scanned.push(dir.to_path_buf());
-        }
-        first
-    };
+    static SCANNED: Mutex<Option<std::collections::HashSet<PathBuf>>> = Mutex::new(None);
+    let first = SCANNED
+        .lock()
+        .unwrap_or_else(PoisonError::into_inner)
+        .get_or_insert_with(Default::default)
+        .insert(dir.to_path_buf());
     if first {
         remove_abandoned_files(dir);
     }

@@ -86,16 +86,26 @@ pub fn run_job(
     }
     // the report records the digests of the files now: a file replaced since the system was
     // loaded would be recorded for a run of the model loaded before
-    let now = fmu_digests(&job.system);
-    if let Some((path, _)) = system
-        .fmu_digests()
-        .iter()
-        .find(|(path, digest)| now.get(*path) != Some(*digest))
-    {
-        return Err(format!(
-            "{run}: the FMU '{path}' changed since the run set loaded it: this run would be \
-             recorded for the new file; run the set again (a resumed set runs this run again)"
-        ));
+    for path in system.fmu_paths() {
+        let loaded = system.fmu_digests().get(path.to_string_lossy().as_ref());
+        match crate::input::file_digest(path) {
+            None => {
+                return Err(format!(
+                    "{run}: the FMU '{}' cannot be read any more: the run's report could not \
+                     name the model it ran",
+                    path.display()
+                ))
+            }
+            Some(now) if Some(&now) != loaded => {
+                return Err(format!(
+                    "{run}: the FMU '{}' changed since the run set loaded it: this run would \
+                     be recorded for the new file; run the set again (a resumed set runs this \
+                     run again)",
+                    path.display()
+                ))
+            }
+            Some(_) => {}
+        }
     }
     let changes = system
         .changes(&job.parameters, Some(job.system.stop_time), &run)
