@@ -53,6 +53,16 @@ fn init<M: FmuModel>(values: &[(&str, f64)]) -> (Component, CollectLog) {
     (c, log)
 }
 
+/// Steps of `h` from t = 0, one per call.
+fn stepper(h: f64) -> impl FnMut(&mut Component) -> Status {
+    let mut t = 0.0;
+    move |c: &mut Component| {
+        let s = c.do_step(t, h);
+        t += h;
+        s
+    }
+}
+
 fn real_outputs<M: FmuModel>() -> Vec<String> {
     M::variables()
         .iter()
@@ -446,13 +456,7 @@ fn invalid_parameters_are_rejected_by_name() {
 fn out_of_range_command_is_clamped_with_one_warning() {
     type S = SemiActiveDamper;
     let (mut c, log) = init::<S>(&[("damper.elongation_velocity", 0.02)]);
-    let h = 1e-3;
-    let mut t = 0.0;
-    let mut step = |c: &mut Component| {
-        let s = c.do_step(t, h);
-        t += h;
-        s
-    };
+    let mut step = stepper(1e-3);
     assert_eq!(step(&mut c), Status::Ok);
     assert_eq!(set::<S>(&mut c, "valve.command", 12.0), Status::Ok);
     // Ideal valve: the clamped opening shows at once.
@@ -486,7 +490,7 @@ fn out_of_range_command_is_clamped_with_one_warning() {
     set::<S>(&mut c, "valve.command", 11.0);
     assert_eq!(c.exit_initialization_mode(), Status::Warning);
     assert!(logged(&log.take(), Status::Warning, "valve.command = 11 V"));
-    assert_eq!(c.do_step(0.0, h), Status::Ok);
+    assert_eq!(c.do_step(0.0, 1e-3), Status::Ok);
 }
 
 /// An elongation velocity beyond what a yaw damper sees (100 m/s: mm/s given as m/s) warns on
@@ -496,13 +500,7 @@ fn an_implausible_velocity_warns_once() {
     use fmu_damper::fmu::PLAUSIBLE_VELOCITY_MPS;
     type P = PassiveYawDamper;
     let (mut c, log) = init::<P>(&[]);
-    let h = 1e-3;
-    let mut t = 0.0;
-    let mut step = |c: &mut Component| {
-        let s = c.do_step(t, h);
-        t += h;
-        s
-    };
+    let mut step = stepper(1e-3);
     assert_eq!(step(&mut c), Status::Ok);
     let v = "damper.elongation_velocity";
     assert_eq!(set::<P>(&mut c, v, PLAUSIBLE_VELOCITY_MPS), Status::Ok);

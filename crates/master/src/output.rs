@@ -144,11 +144,7 @@ pub fn remove_abandoned_files(dir: &Path) -> usize {
             continue;
         }
         let Ok(meta) = entry.metadata() else { continue };
-        let old = meta
-            .modified()
-            .ok()
-            .and_then(|t| t.elapsed().ok())
-            .is_some_and(|age| age.as_secs() >= ABANDONED_AFTER_S);
+        let old = crate::fmu::extract::age_s(&meta).is_some_and(|age| age >= ABANDONED_AFTER_S);
         if !(meta.is_file() && old) {
             continue;
         }

@@ -116,15 +116,18 @@ pub fn field_error_in(metas: &[VarMeta], e: &dyn FieldError) -> ModelError {
 /// [`rename_fields`] with the declaration of model `M` (on error paths only: the declaration is
 /// built on each call).
 pub fn rename_fields_of<M: FmuModel>(text: &str) -> String {
-    let metas: Vec<VarMeta> = M::variables().into_iter().map(|v| v.meta).collect();
-    rename_fields(text, &metas)
+    rename_fields(text, &metas_of::<M>())
+}
+
+/// The declared variables of model `M` (built on each call: for error paths).
+fn metas_of<M: FmuModel>() -> Vec<VarMeta> {
+    M::variables().into_iter().map(|v| v.meta).collect()
 }
 
 /// [`field_error_in`] with the declaration of model `M` (errors are rare: the declaration is
 /// built on the error path only).
 pub fn field_error<M: FmuModel>(e: &dyn FieldError) -> ModelError {
-    let metas: Vec<VarMeta> = M::variables().into_iter().map(|v| v.meta).collect();
-    field_error_in(&metas, e)
+    field_error_in(&metas_of::<M>(), e)
 }
 
 #[cfg(test)]

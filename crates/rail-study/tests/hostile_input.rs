@@ -521,24 +521,11 @@ fn an_ssps_fmus_unpack_within_the_fmu_limit() {
         String::from_utf8_lossy(&out.stderr)
     );
     // the same archive with its FMU replaced by 8 MB of zeros (a few kB compressed)
-    let mut src = zip::ZipArchive::new(std::fs::File::open(c.path("ok.ssp")).unwrap()).unwrap();
-    let mut entries: Vec<(String, Vec<u8>)> = Vec::new();
-    for i in 0..src.len() {
-        let mut e = src.by_index(i).unwrap();
-        let mut data = Vec::new();
-        std::io::Read::read_to_end(&mut e, &mut data).unwrap();
-        if e.name().ends_with(".fmu") {
-            data = vec![0u8; 8 << 20];
+    rewrite_zip(&c.path("ok.ssp"), &c.path("bomb.ssp"), |name, data| {
+        if name.ends_with(".fmu") {
+            *data = vec![0u8; 8 << 20];
         }
-        entries.push((e.name().to_string(), data));
-    }
-    let mut z = zip::ZipWriter::new(std::fs::File::create(c.path("bomb.ssp")).unwrap());
-    let o = zip::write::SimpleFileOptions::default();
-    for (name, data) in &entries {
-        z.start_file(name.as_str(), o).unwrap();
-        z.write_all(data).unwrap();
-    }
-    z.finish().unwrap();
+    });
     assert!(std::fs::metadata(c.path("bomb.ssp")).unwrap().len() < 200_000);
     let e = c.fails(
         &["run", "bomb.ssp", "-o", "bomb.csv"],
@@ -1219,29 +1206,38 @@ fn an_ssp_with_two_different_steps_says_which_it_takes() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let mut src = zip::ZipArchive::new(std::fs::File::open(c.path("ok.ssp")).unwrap()).unwrap();
-    let mut z = zip::ZipWriter::new(std::fs::File::create(c.path("two.ssp")).unwrap());
-    let o = zip::write::SimpleFileOptions::default();
     let mut changed = false;
-    for i in 0..src.len() {
-        let mut e = src.by_index(i).unwrap();
-        let mut data = Vec::new();
-        std::io::Read::read_to_end(&mut e, &mut data).unwrap();
-        if e.name() == "SystemStructure.ssd" {
-            let text = String::from_utf8(data).unwrap();
+    rewrite_zip(&c.path("ok.ssp"), &c.path("two.ssp"), |name, data| {
+        if name == "SystemStructure.ssd" {
+            let text = String::from_utf8(std::mem::take(data)).unwrap();
             let at = text.find("baseStepSize=\"").unwrap() + "baseStepSize=\"".len();
             let end = at + text[at..].find('"').unwrap();
             let step: f64 = text[at..end].parse().unwrap();
-            data = format!("{}{}{}", &text[..at], 2.0 * step, &text[end..]).into_bytes();
+            *data = format!("{}{}{}", &text[..at], 2.0 * step, &text[end..]).into_bytes();
             changed = true;
         }
-        z.start_file(e.name(), o).unwrap();
-        z.write_all(&data).unwrap();
-    }
-    z.finish().unwrap();
+    });
     assert!(changed);
     let out = c.master(&["run", "two.ssp", "-o", "two.csv"], &[]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(stderr.contains("gives two communication steps"), "{stderr}");
+}
+
+/// Copies the archive `src` to `dst`, each entry's bytes passed through `edit` (its name, its
+/// data to change in place).
+fn rewrite_zip(src: &Path, dst: &Path, mut edit: impl FnMut(&str, &mut Vec<u8>)) {
+    let mut src = zip::ZipArchive::new(std::fs::File::open(src).unwrap()).unwrap();
+    let mut z = zip::ZipWriter::new(std::fs::File::create(dst).unwrap());
+    let o = zip::write::SimpleFileOptions::default();
+    for i in 0..src.len() {
+        let mut e = src.by_index(i).unwrap();
+        let mut data = Vec::new();
+        std::io::Read::read_to_end(&mut e, &mut data).unwrap();
+        let name = e.name().to_string();
+        edit(&name, &mut data);
+        z.start_file(name.as_str(), o).unwrap();
+        z.write_all(&data).unwrap();
+    }
+    z.finish().unwrap();
 }

@@ -7,9 +7,9 @@ use super::{CommandError, Context};
 use crate::output::write_json_atomic;
 use crate::results::ResultsFormat;
 use crate::runset::{
-    check_given_one_way, check_jobs, completed, execute_with as run_all, format_by_description,
-    lock_output_folder, prepare_run_folder, run_job, Job, ResultsOptions, RunReport, RunSet,
-    NOT_STARTED,
+    check_given_one_way, check_start_values, completed, execute_with as run_all,
+    format_by_description, lock_output_folder, prepare_run_folder, run_job, Job, ResultsOptions,
+    RunReport, RunSet, NOT_STARTED,
 };
 use crate::system::PreparedSystem;
 
@@ -83,7 +83,8 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     // the FMUs loaded and every run's start values checked before anything is removed
     let system = if !todo.is_empty() || !args.resume {
         let system = PreparedSystem::prepare(&base)?;
-        check_jobs(&system, &todo)?;
+        // each run to be made; the enumerations over the whole set, kept runs too
+        check_start_values(&system, &todo)?;
         check_given_one_way(&system, &jobs)?;
         Some(system)
     } else {

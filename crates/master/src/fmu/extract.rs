@@ -278,6 +278,12 @@ pub(crate) fn try_lock(_file: &std::fs::File) -> bool {
     true
 }
 
+/// Whole seconds since the file was last modified (`None` if the system does not say, or the
+/// time lies ahead): how the leftovers of a dead master are told from files just created.
+pub(crate) fn age_s(meta: &std::fs::Metadata) -> Option<u64> {
+    Some(meta.modified().ok()?.elapsed().ok()?.as_secs())
+}
+
 /// Whether `name` is an extraction folder's: the prefix and the 6 random letters or digits
 /// `unpack` gives it.
 fn is_extraction_name(name: &str) -> bool {
@@ -313,10 +319,9 @@ pub fn remove_stale_extractions(root: &Path) -> usize {
                     && std::fs::read_dir(&dir).is_ok_and(|mut d| d.next().is_none())
                     && entry
                         .metadata()
-                        .and_then(|m| m.modified())
                         .ok()
-                        .and_then(|t| t.elapsed().ok())
-                        .is_some_and(|age| age.as_secs() > LOCKLESS_GRACE_S)
+                        .and_then(|m| age_s(&m))
+                        .is_some_and(|age| age > LOCKLESS_GRACE_S)
             }
         };
         if stale && std::fs::remove_dir_all(&dir).is_ok() {

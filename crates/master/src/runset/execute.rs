@@ -21,11 +21,17 @@ use crate::system::{LoadedSystem, PreparedSystem, SystemDescription, SystemError
 /// misspelt variable is refused before anything runs or is removed, not failed run by run.
 /// The jobs are also checked with [`check_given_one_way`].
 pub fn check_jobs(system: &PreparedSystem, jobs: &[Job]) -> Result<(), SystemError> {
+    check_start_values(system, jobs)?;
+    check_given_one_way(system, jobs)
+}
+
+/// The per-run part of [`check_jobs`]: each job's start values and stop time.
+pub fn check_start_values(system: &PreparedSystem, jobs: &[Job]) -> Result<(), SystemError> {
     for job in jobs {
         let run = format!("run '{}'", job.name);
         system.changes(&job.parameters, Some(job.system.stop_time), &run)?;
     }
-    check_given_one_way(system, jobs)
+    Ok(())
 }
 
 /// An Enumeration given by item name in some runs and by number in others is refused: the
@@ -590,7 +596,7 @@ where
         error: None,
         summary: None,
         results: None,
-        fmu_digests: fmu_digests(&job.system),
+        fmu_digests: job.system.fmu_digests(),
     };
     let partial = match tempfile::Builder::new()
         .prefix(&format!("{PARTIAL_PREFIX}{}-", job.name))
@@ -675,21 +681,6 @@ where
     report
 }
 
-/// [`file_digest`](crate::input::file_digest) of every FMU of `system`, by its path as the description gives it (a file
-/// that cannot be read is left out, and its run fails on its own).
-pub fn fmu_digests(system: &SystemDescription) -> BTreeMap<String, String> {
-    system
-        .instances
-        .iter()
-        .filter_map(|i| {
-            Some((
-                i.fmu.to_string_lossy().into_owned(),
-                crate::input::file_digest(&i.fmu)?,
-            ))
-        })
-        .collect()
-}
-
 /// The report of `job` in `outdir` if that run is complete in `format` and is the same run:
 /// its `summary.json` says ok, its results are there in `format` (and not in the other
 /// format), its `system.json` is the job's resolved system (same FMUs, start values, timing)
@@ -710,7 +701,7 @@ pub fn completed(outdir: &Path, job: &Job, format: ResultsFormat) -> Option<RunR
         && report.parameters == job.parameters
         && system == job.system
         // the same FMU files: a rebuilt or replaced FMU at the same path is another model
-        && report.fmu_digests == fmu_digests(&job.system)
+        && report.fmu_digests == job.system.fmu_digests()
         && report.results.as_deref().and_then(Path::file_name) == results.file_name()
         && results.is_file()
         && other.symlink_metadata().is_err()

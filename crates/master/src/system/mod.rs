@@ -82,6 +82,19 @@ pub enum StartValueError {
 }
 
 impl SystemDescription {
+    /// The SHA-1 ([`file_digest`](crate::input::file_digest)) of every FMU file, by its path
+    /// as the description gives it; a file that cannot be read is left out (its run fails on its
+    /// own).
+    pub fn fmu_digests(&self) -> BTreeMap<String, String> {
+        self.instances
+            .iter()
+            .filter_map(|i| {
+                let digest = crate::input::file_digest(&i.fmu)?;
+                Some((i.fmu.to_string_lossy().into_owned(), digest))
+            })
+            .collect()
+    }
+
     /// Sets the start value of `key` (`instance.variable`) in the description (its
     /// parameters; the variable itself is checked when the system is loaded).
     pub fn set_start_value(&mut self, key: &str, value: Value) -> Result<(), StartValueError> {

@@ -60,13 +60,11 @@ impl PreparedSystem {
         let mut by_path: HashMap<PathBuf, Arc<PreparedFmu>> = HashMap::new();
         let mut fmus = Vec::with_capacity(archives.len());
         let mut fmu_paths = Vec::with_capacity(archives.len());
-        let mut fmu_digests = BTreeMap::new();
+        // by the absolute paths the runs' descriptions give
+        let fmu_digests = system.resolved().fmu_digests();
         for (i, archive) in archives.into_iter().enumerate() {
             let path = system.fmu_path(i);
             let path = std::path::absolute(&path).unwrap_or(path);
-            if let Some(digest) = crate::input::file_digest(&path) {
-                fmu_digests.insert(path.to_string_lossy().into_owned(), digest);
-            }
             let fmu = match by_path.get(&path) {
                 Some(f) => Arc::clone(f),
                 None => {
