@@ -209,7 +209,8 @@ class Results:
 class RunSetResults(Mapping[str, Results]):
     """A run-set folder: ``sweep.json`` plus one folder per run (``system.json``,
     ``results.csv``, ``summary.json``; Parquet results in ``results/<run>.parquet``). A mapping
-    from run name to its :class:`Results` (read when first asked for; failed runs have none)."""
+    from run name to its :class:`Results` (read when first asked for; failed runs have none:
+    their rows up to the failure are :meth:`history`)."""
 
     def __init__(self, folder: PathLike, reports: Optional[List[Dict[str, Any]]] = None):
         self.folder: Path = Path(folder)
@@ -251,7 +252,8 @@ class RunSetResults(Mapping[str, Results]):
         for r in self.reports:
             if r["name"] == name:
                 if not r["ok"]:
-                    raise KeyError(f"run '{name}' failed: {r.get('error')}")
+                    more = f" (its history up to the failure: .history('{name}'))" if r.get("history") else ""
+                    raise KeyError(f"run '{name}' failed: {r.get('error')}{more}")
                 parquet = self.folder / "results" / f"{name}.parquet"
                 if parquet.is_file():
                     res = Results.read_parquet(parquet)
@@ -260,6 +262,24 @@ class RunSetResults(Mapping[str, Results]):
                 res.summary = dict(r.get("summary") or {})
                 self._cache[name] = res
                 return res
+        raise KeyError(f"no run '{name}' in {self.folder}")
+
+    def history(self, name: str) -> Optional[Results]:
+        """The rows of failed run ``name`` up to its failure (``history.csv`` or
+        ``history.parquet`` in its folder; ``summary["failed"]`` gives the time and the
+        error), or None when it failed before its first row. Raises KeyError for a run that
+        is not in the set or did not fail."""
+        for r in self.reports:
+            if r["name"] == name:
+                if r["ok"]:
+                    raise KeyError(f"run '{name}' did not fail: its results are [{name!r}]")
+                if not r.get("history"):
+                    return None
+                folder = self.folder / name
+                parquet = folder / "history.parquet"
+                if parquet.is_file():
+                    return Results.read_parquet(parquet)
+                return Results.read_csv(folder / "history.csv")
         raise KeyError(f"no run '{name}' in {self.folder}")
 
     def __repr__(self) -> str:

@@ -206,7 +206,8 @@ def run_task(
     a run still going then stops at its next communication point, instead of running to its end
     for nobody (a cancelled future does not stop a task already running). Returns the run's
     ``header``, ``data`` (float64 bytes), ``summary_json`` and ``columns_json`` (the columns'
-    units and FMU variables), or its ``error``."""
+    units and FMU variables), or its ``error`` (with a run that failed after its first row,
+    the others hold its history up to the failure)."""
     if fmus:
         paths = {p: _local_copy(digest, name, data) for p, (digest, name, data) in fmus.items()}
         base_json = json.dumps(_localise(json.loads(base_json), paths))

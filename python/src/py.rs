@@ -477,8 +477,10 @@ impl PySystem {
     }
 
     /// Runs one job of this system's run set (JSON, as from `load_run_set`), as a run set's
-    /// worker does; returns (header, data bytes, summary JSON, columns JSON, None) or (None,
-    /// None, None, None, error): a failed simulation is the run's result, not an exception.
+    /// worker does; returns (header, data bytes, summary JSON, columns JSON, None), or a
+    /// failed run's error last with its history up to the failure in the other four (None
+    /// when it failed before its first row): a failed simulation is the run's result, not an
+    /// exception.
     /// `should_stop()`, when given, is called about once a second while the run goes on; once
     /// it returns True the run stops at its next communication point (a cancelled run, an
     /// error). An exception of it is taken as False: a check that cannot be made stops
@@ -511,14 +513,18 @@ impl PySystem {
         )?;
         match out {
             Ok(out) => {
-                let summary = serde_json::to_string(&out.summary)
-                    .map_err(|e| Error::new_err(format!("internal: summary: {e}")))?;
-                let c = serde_json::to_string(&runs::ColumnsWire::of(&out))
-                    .map_err(|e| Error::new_err(format!("internal: columns: {e}")))?;
-                let d = f64_pybytes(py, &out.data)?;
-                Ok((Some(out.header), Some(d), Some(summary), Some(c), None))
+                let (header, d, summary, c) = wire(py, out)?;
+                Ok((Some(header), Some(d), Some(summary), Some(c), None))
             }
-            Err(e) => Ok((None, None, None, None, Some(e))),
+            // a run that failed after its first row: its history comes with its error
+            Err(FailedRun {
+                error,
+                history: Some(h),
+            }) => {
+                let (header, d, summary, c) = wire(py, *h)?;
+                Ok((Some(header), Some(d), Some(summary), Some(c), Some(error)))
+            }
+            Err(f) => Ok((None, None, None, None, Some(f.error))),
         }
     }
 
@@ -574,8 +580,8 @@ impl PySystem {
                     |job| {
                         let r = run_job(prepared, job, cancel_ref);
                         if let Ok(tx) = tx.lock() {
-                            let _ =
-                                tx.send(Event::Done(job.name.clone(), r.as_ref().err().cloned()));
+                            let error = r.as_ref().err().map(|f| f.error.clone());
+                            let _ = tx.send(Event::Done(job.name.clone(), error));
                         }
                         r
                     },
@@ -589,6 +595,20 @@ impl PySystem {
         let reports = reports.map_err(|e| sweep_err(&e))?;
         reports.iter().map(report_json).collect()
     }
+}
+
+/// A run's output as `PreparedSystem.run_job` hands it to Python: header, data bytes, summary
+/// JSON, columns JSON.
+fn wire(
+    py: Python<'_>,
+    out: SimOutput,
+) -> PyResult<(Vec<String>, Bound<'_, PyBytes>, String, String)> {
+    let summary = serde_json::to_string(&out.summary)
+        .map_err(|e| Error::new_err(format!("internal: summary: {e}")))?;
+    let c = serde_json::to_string(&runs::ColumnsWire::of(&out))
+        .map_err(|e| Error::new_err(format!("internal: columns: {e}")))?;
+    let d = f64_pybytes(py, &out.data)?;
+    Ok((out.header, d, summary, c))
 }
 
 /// Before a run set writes into `outdir`: refuses a run whose folder would replace a file or
@@ -783,8 +803,9 @@ impl PyRunWriter {
     }
 
     /// Writes the folder of a job from its results (header, data bytes, summary JSON,
-    /// columns JSON, as `PreparedSystem.run_job` returns them) or from its error; returns the
-    /// report as JSON.
+    /// columns JSON, as `PreparedSystem.run_job` returns them) or from its error (with the
+    /// others: the failed run's history, written into its folder); returns the report as
+    /// JSON.
     #[pyo3(signature = (job_json, header=None, data=None, summary_json=None, columns_json=None, error=None))]
     fn write(
         &self,
@@ -796,27 +817,37 @@ impl PyRunWriter {
         error: Option<String>,
     ) -> PyResult<String> {
         let job: Job = serde_json::from_str(job_json).map_err(|e| json_err("job", &e))?;
+        let output = |header: Vec<String>, data: &[u8], summary: &str| -> PyResult<SimOutput> {
+            let data = f64_from_bytes(data).map_err(OutputError::new_err)?;
+            let summary: Summary =
+                serde_json::from_str(summary).map_err(|e| json_err("summary", &e))?;
+            // without columns: every column Real, no FMU variable in the metadata
+            let wire: runs::ColumnsWire = match columns_json {
+                Some(c) => serde_json::from_str(c).map_err(|e| json_err("columns", &e))?,
+                None => runs::ColumnsWire::default(),
+            };
+            Ok(SimOutput {
+                header,
+                data,
+                summary,
+                columns: wire.columns,
+                strings: wire.strings,
+                decimation: None,
+            })
+        };
         let result = match (error, header, data, summary_json) {
-            (Some(e), ..) => Err(e),
-            (None, Some(header), Some(data), Some(summary)) => {
-                let data = f64_from_bytes(data).map_err(OutputError::new_err)?;
-                let summary: Summary =
-                    serde_json::from_str(summary).map_err(|e| json_err("summary", &e))?;
-                // without columns: every column Real, no FMU variable in the metadata
-                let wire: runs::ColumnsWire = match columns_json {
-                    Some(c) => serde_json::from_str(c).map_err(|e| json_err("columns", &e))?,
-                    None => runs::ColumnsWire::default(),
-                };
-                Ok(SimOutput {
-                    header,
-                    data,
-                    summary,
-                    columns: wire.columns,
-                    strings: wire.strings,
-                    decimation: None,
-                })
-            }
-            _ => Err("internal: a run came back with neither results nor an error".to_string()),
+            // a failed run with its history up to the failure
+            (Some(error), Some(header), Some(data), Some(summary)) => Err(FailedRun {
+                error,
+                history: Some(Box::new(output(header, data, summary)?)),
+            }),
+            (Some(e), ..) => Err(e.into()),
+            (None, Some(header), Some(data), Some(summary)) => Ok(output(header, data, summary)?),
+            _ => Err(
+                "internal: a run came back with neither results nor an error"
+                    .to_string()
+                    .into(),
+            ),
         };
         report_json(&self.writer.write(&job, result))
     }

@@ -6,7 +6,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-use master::coupling::{ColumnInfo, SimOutput};
+use master::coupling::{ColumnInfo, FailedRun, SimOutput};
 use master::output::{write_json_atomic, OutputError};
 use master::results::{constant_kinds, with_integer_kinds, ConstantKind, ResultsFormat};
 pub use master::runset::{completed, format_by_description};
@@ -104,14 +104,14 @@ impl RunSetWriter {
     }
 
     /// Writes the folder of `job` from its outcome `result`; returns its report.
-    pub fn write(&self, job: &Job, result: Result<SimOutput, String>) -> RunReport {
+    pub fn write(&self, job: &Job, result: Result<SimOutput, FailedRun<String>>) -> RunReport {
         let result = std::sync::Mutex::new(Some(result));
         run_one_with(job, &self.outdir, &self.results, &self.kinds, &|_: &Job| {
             result
                 .lock()
                 .ok()
                 .and_then(|mut r| r.take())
-                .unwrap_or_else(|| Err("internal: results handed over twice".into()))
+                .unwrap_or_else(|| Err("internal: results handed over twice".to_string().into()))
         })
     }
 }
@@ -234,7 +234,7 @@ mod tests {
             ResultsFormat::Csv,
             BTreeSet::new(),
         );
-        let report = writer.write(&j, Err("negative stiffness".into()));
+        let report = writer.write(&j, Err("negative stiffness".to_string().into()));
         assert!(!report.ok);
         assert_eq!(report.error.as_deref(), Some("negative stiffness"));
         assert!(dir.path().join("bad/summary.json").is_file());

@@ -164,6 +164,26 @@ def test_bad_input_fails_its_own_run_and_no_worker(dist, client, tmp_path):
     assert set(client.run(os.getpid).values()) == pids  # no worker crashed
 
 
+def test_a_run_that_fails_midway_on_the_cluster_keeps_the_local_history(dist, client, tmp_path):
+    rs = speed_set(dist, [60.0], stop_time=2.0)
+    rs["runs"] = [
+        {
+            "name": "derails",
+            "parameters": {
+                "bogie.vehicle.speed": 150.0,
+                "bogie.suspension.lateral_stiffness": 0.0,
+                "bogie.suspension.longitudinal_stiffness": 0.0,
+            },
+        }
+    ]
+    local = railfmu.run_set(rs, tmp_path / "local", threads=1)
+    remote = railfmu.run_set(rs, tmp_path / "dask", client=client)
+    assert remote.failed == local.failed and "derailment" in remote.failed["derails"]
+    a = (tmp_path / "local" / "derails" / "history.csv").read_bytes()
+    assert (tmp_path / "dask" / "derails" / "history.csv").read_bytes() == a
+    assert remote.history("derails").summary["failed"] == local.history("derails").summary["failed"]
+
+
 def test_a_killed_worker_does_not_lose_the_set_and_a_resumed_set_skips_finished_runs(dist, client, tmp_path):
     rs = eight_runs(dist, stop_time=1.0)
     local = rs.run(tmp_path / "local", threads=2)

@@ -67,6 +67,42 @@ def test_a_failed_run_is_kept_and_the_others_go_on(dist, tmp_path):
     sweep = json.loads((tmp_path / "out" / "sweep.json").read_text())
     assert [r["name"] for r in sweep] == ["run-000", "standstill", "slow"]
     assert not (tmp_path / "out" / "standstill" / "results.csv").exists()
+    # it failed before its first row: no history
+    assert res.history("standstill") is None
+    with pytest.raises(KeyError, match="did not fail"):
+        res.history("slow")
+
+
+DERAILS = {
+    "bogie.vehicle.speed": 150.0,
+    "bogie.suspension.lateral_stiffness": 0.0,
+    "bogie.suspension.longitudinal_stiffness": 0.0,
+}
+
+
+@pytest.mark.parametrize("format", ["csv", "parquet"])
+def test_a_run_that_fails_midway_keeps_its_history_in_its_folder(dist, master_cmd, tmp_path, format):
+    rs = speed_set(dist, [60.0], stop_time=2.0)
+    rs["runs"] = [{"name": "derails", "parameters": DERAILS}]
+    res = railfmu.run_set(rs, tmp_path / "py", threads=2, format=format)
+    assert set(res) == {"run-000"} and "derailment" in res.failed["derails"]
+    with pytest.raises(KeyError, match=r"\.history\('derails'\)"):
+        res["derails"]
+    history = res.history("derails")
+    t = history.time
+    assert 0.1 < t[-1] < 2.0 and len(t) == round(t[-1] / 1e-3) + 1
+    assert history.summary["failed"]["time_s"] == t[-1]
+    assert "derailment" in history.summary["failed"]["error"]
+    assert (tmp_path / "py" / "derails" / f"history.{format}").is_file()
+    # never in the results table, which holds completed runs only
+    assert not (tmp_path / "py" / "results" / "derails.parquet").exists()
+    # the command line writes the same history
+    set_file = tmp_path / "set.json"
+    set_file.write_text(json.dumps(rs))
+    r = run_master(master_cmd, "sweep", set_file, "-o", tmp_path / "cli", "--format", format)
+    assert r.returncode == 1 and "its history up to the failure is in" in r.stderr, r.stderr
+    cli = railfmu.read_results(tmp_path / "cli").history("derails")
+    assert np.array_equal(bits(cli.values), bits(history.values))
 
 
 def test_a_misspelt_variable_refuses_the_set_before_it_touches_the_folder(dist, tmp_path):

@@ -126,7 +126,9 @@ fn prepared_runs_equal_fresh_runs_and_unpack_each_fmu_once() {
         .collect();
     // a start value the model does not have fails that run only, naming it
     let bad = RunRequest::new("t-", b, c, 300.0, Some(1), 1.0).with("bogie.no_such", 1.into());
-    let e = run_job(&system, &bad.job(&base).unwrap(), &cancel).unwrap_err();
+    let e = run_job(&system, &bad.job(&base).unwrap(), &cancel)
+        .unwrap_err()
+        .error;
     assert!(e.contains("unknown variable 'no_such'"), "{e}");
     assert_eq!(
         extraction_count() - before,

@@ -763,6 +763,70 @@ fn a_failed_run_writes_its_history_up_to_the_failure() {
     assert!(stderr.contains(&format!("up to t = {last} s")), "{stderr}");
 }
 
+/// A sweep's run that fails midway (the derailing bogie above) keeps its history up to the
+/// failure in its own folder, says where, and the set's other runs complete.
+#[test]
+fn a_sweeps_failed_run_keeps_its_history_in_its_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let system = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../systems/passive.json");
+    std::fs::write(
+        dir.path().join("set.json"),
+        format!(
+            r#"{{"base": "{}", "runs": [
+  {{"name": "stable", "parameters": {{}}}},
+  {{"name": "derails", "parameters": {{"bogie.vehicle.speed": 150,
+    "bogie.suspension.lateral_stiffness": 0, "bogie.suspension.longitudinal_stiffness": 0}}}}]}}"#,
+            system.display()
+        ),
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .args(["sweep", "set.json", "-o", "out", "--format", "csv"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let history = Path::new("out").join("derails").join("history.csv");
+    assert!(
+        stderr.contains(&format!(
+            "its history up to the failure is in {}",
+            history.display()
+        )),
+        "{stderr}"
+    );
+    let folder = dir.path().join("out");
+    assert!(folder.join("stable/results.csv").is_file());
+    assert!(!folder.join("derails/results.csv").exists());
+    let csv = std::fs::read_to_string(dir.path().join(&history)).unwrap();
+    let last: f64 = csv
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(last > 0.1 && last < 2.0, "last row at {last} s");
+    let meta: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(folder.join("derails/history.meta.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(meta["summary"]["failed"]["time_s"].as_f64(), Some(last));
+    assert_eq!(meta["run"], "derails");
+    let report: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(folder.join("derails/summary.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(report["ok"], false);
+    assert!(
+        report["error"].as_str().unwrap().contains("derailment"),
+        "{report}"
+    );
+    assert_eq!(report["history"].as_str(), history.to_str());
+}
+
 /// A sweep whose output folder is a file names it, and leaves the file as it was.
 #[test]
 fn a_sweep_into_a_file_names_it() {
@@ -843,7 +907,7 @@ fn a_run_whose_fmu_changed_since_its_set_loaded_it_fails() {
         dir.path().join("MassSpring.fmu"),
     )
     .unwrap();
-    let e = run_job(&prepared, &jobs[0], &cancel).unwrap_err();
+    let e = run_job(&prepared, &jobs[0], &cancel).unwrap_err().error;
     assert!(
         e.contains("MassSpring.fmu' changed since the run set loaded it"),
         "{e}"

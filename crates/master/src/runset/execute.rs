@@ -9,12 +9,12 @@ use rayon::prelude::*;
 use serde_json::Value;
 
 use super::{Job, RunReport, SweepError, PARQUET_FOLDER};
-use crate::coupling::{CouplingPlan, RunOptions, SimOutput, Summary};
+use crate::coupling::{CouplingPlan, FailedRun, RunOptions, SimError, SimOutput, Summary};
 use crate::output::write_json_atomic;
 use crate::results::{
     constant_kinds, with_integer_kinds, write_results, ConstantKind, ResultsFormat, RunContext,
 };
-use crate::system::{LoadedSystem, PreparedSystem, SystemDescription, SystemError};
+use crate::system::{LoadedSystem, PreparedSystem, RunError, SystemDescription, SystemError};
 
 /// The start values and stop time of every job, checked against the prepared system's FMUs
 /// as each run would check them (variable names, types, declared ranges): a run set with a
@@ -71,7 +71,7 @@ pub fn run_job(
     system: &PreparedSystem,
     job: &Job,
     cancel: &AtomicBool,
-) -> Result<SimOutput, String> {
+) -> Result<SimOutput, FailedRun<String>> {
     let run = format!("run '{}'", job.name);
     let base = &system.system().desc;
     let same_fmus = job.system.instances.len() == base.instances.len()
@@ -88,7 +88,8 @@ pub fn run_job(
         return Err(format!(
             "{run}: not a run of the prepared system '{}' (instances, FMUs or timing differ)",
             system.system().file
-        ));
+        )
+        .into());
     }
     // the report records the digests of the files now: a file replaced since the system was
     // loaded would be recorded for a run of the model loaded before
@@ -100,7 +101,8 @@ pub fn run_job(
                     "{run}: the FMU '{}' cannot be read any more: the run's report could not \
                      name the model it ran",
                     path.display()
-                ))
+                )
+                .into())
             }
             Some(now) if Some(&now) != loaded => {
                 return Err(format!(
@@ -108,7 +110,8 @@ pub fn run_job(
                      be recorded for the new file; run the set again (a resumed set runs this \
                      run again)",
                     path.display()
-                ))
+                )
+                .into())
             }
             Some(_) => {}
         }
@@ -121,7 +124,13 @@ pub fn run_job(
         progress: None,
         general_engine: false,
     };
-    system.run(&changes, &opts).map_err(|e| e.to_string())
+    system
+        .run_keeping_history(&changes, &opts)
+        .map_err(|f| match f.error {
+            // a run its set stopped is not finished: no history, as `master run` on Ctrl-C
+            RunError::Sim(SimError::Cancelled { .. }) => f.error.to_string().into(),
+            _ => f.map(|e| e.to_string()),
+        })
 }
 
 /// How the runs of a run set write their results.
@@ -201,7 +210,7 @@ const REPLACED_PREFIX: &str = ".replaced-";
 /// `sweep.json` is removed first, so an interrupted sweep never leaves an old report looking
 /// current; hidden folders left by an interrupted sweep are removed at the start. A runner
 /// that panics fails its run (reported like any failure), never the sweep.
-pub fn execute<F>(
+pub fn execute<F, E>(
     jobs: &[Job],
     outdir: &Path,
     threads: usize,
@@ -209,7 +218,8 @@ pub fn execute<F>(
     runner: F,
 ) -> Result<Vec<RunReport>, SweepError>
 where
-    F: Fn(&Job) -> Result<SimOutput, String> + Sync,
+    F: Fn(&Job) -> Result<SimOutput, E> + Sync,
+    E: Into<FailedRun<String>>,
 {
     execute_with(
         jobs,
@@ -226,7 +236,7 @@ where
 /// starts: each run not started is reported as [`NOT_STARTED`] without a folder (an earlier
 /// set's folder and table of its name are removed), so that an interrupted set of 100 000
 /// runs ends at once and `sweep.json` still lists every run.
-pub fn execute_with<F>(
+pub fn execute_with<F, E>(
     jobs: &[Job],
     outdir: &Path,
     threads: usize,
@@ -236,7 +246,8 @@ pub fn execute_with<F>(
     runner: F,
 ) -> Result<Vec<RunReport>, SweepError>
 where
-    F: Fn(&Job) -> Result<SimOutput, String> + Sync,
+    F: Fn(&Job) -> Result<SimOutput, E> + Sync,
+    E: Into<FailedRun<String>>,
 {
     let kinds = with_integer_kinds(
         constant_kinds(jobs.iter().flat_map(|j| {
@@ -295,11 +306,20 @@ where
                 let r = run_one_with(job, outdir, results, &kinds, &runner);
                 bar.inc(1);
                 if !r.ok {
-                    bar.println(format!(
-                        "run '{}' failed: {}",
+                    let history = r.history.as_ref().map_or(String::new(), |h| {
+                        format!(" (its history up to the failure is in {})", h.display())
+                    });
+                    let message = format!(
+                        "run '{}' failed: {}{history}",
                         r.name,
                         r.error.as_deref().unwrap_or("")
-                    ));
+                    );
+                    // a hidden bar (--quiet, or not on a terminal) prints nothing
+                    if bar.is_hidden() {
+                        log::warn!(target: "master", "{message}");
+                    } else {
+                        bar.println(message);
+                    }
                 }
                 r
             })
@@ -332,18 +352,30 @@ pub fn not_finished(job: &Job, outdir: &Path, error: &str) -> RunReport {
         error: Some(error.to_string()),
         summary: None,
         results: None,
+        history: None,
         fmu_digests: BTreeMap::new(),
     }
 }
 
 /// The files a run folder holds (a folder is swapped into place only with its description
 /// and its report in it).
-const RUN_FOLDER_FILES: [&str; 4] = [
+const RUN_FOLDER_FILES: [&str; 7] = [
     "system.json",
     "summary.json",
     "results.csv",
     "results.meta.json",
+    "history.csv",
+    "history.meta.json",
+    "history.parquet",
 ];
+
+/// The file in a failed run's folder that holds its rows up to the failure.
+fn history_file(format: ResultsFormat) -> &'static str {
+    match format {
+        ResultsFormat::Csv => "history.csv",
+        ResultsFormat::Parquet => "history.parquet",
+    }
+}
 
 /// A run's `summary.json` larger than this is not one (a report is a few kilobytes).
 const MAX_RUN_REPORT_BYTES: u64 = 16 << 20;
@@ -556,14 +588,16 @@ fn swap_into_place(new: tempfile::TempDir, dest: &Path, outdir: &Path) -> Result
 }
 
 /// Runs one job with `runner` and writes its folder `<outdir>/<job>/`: `system.json`, then
-/// `results.csv` (if the run succeeded) and `summary.json` (each atomically) into a fresh
-/// hidden folder, which is swapped onto `<outdir>/<job>` when complete, so a run folder never
-/// mixes files of two runs and a run whose `summary.json` says ok has all its files. A runner
-/// may also hand over results computed elsewhere (another process or machine); a runner that
-/// panics fails the run.
-pub fn run_one<F>(job: &Job, outdir: &Path, runner: &F) -> RunReport
+/// `results.csv` (if the run succeeded; `history.csv` if it failed after its first row, from
+/// a runner whose error is a [`FailedRun`] with a history) and `summary.json` (each
+/// atomically) into a fresh hidden folder, which is swapped onto `<outdir>/<job>` when
+/// complete, so a run folder never mixes files of two runs and a run whose `summary.json`
+/// says ok has all its files. A runner may also hand over results computed elsewhere (another
+/// process or machine); a runner that panics fails the run.
+pub fn run_one<F, E>(job: &Job, outdir: &Path, runner: &F) -> RunReport
 where
-    F: Fn(&Job) -> Result<SimOutput, String>,
+    F: Fn(&Job) -> Result<SimOutput, E>,
+    E: Into<FailedRun<String>>,
 {
     run_one_with(
         job,
@@ -577,7 +611,7 @@ where
 /// [`run_one`] with results written as `results` says; `kinds` are the constant columns of
 /// the whole run set. Parquet results go to `<outdir>/results/<job>.parquet`: an earlier
 /// one is removed before the run, so a failed rerun leaves no stale results in the table.
-pub fn run_one_with<F>(
+pub fn run_one_with<F, E>(
     job: &Job,
     outdir: &Path,
     results: &ResultsOptions,
@@ -585,7 +619,8 @@ pub fn run_one_with<F>(
     runner: &F,
 ) -> RunReport
 where
-    F: Fn(&Job) -> Result<SimOutput, String>,
+    F: Fn(&Job) -> Result<SimOutput, E>,
+    E: Into<FailedRun<String>>,
 {
     let dest = outdir.join(&job.name);
     let table_file = results_path(outdir, &job.name, ResultsFormat::Parquet);
@@ -596,6 +631,7 @@ where
         error: None,
         summary: None,
         results: None,
+        history: None,
         fmu_digests: job.system.fmu_digests(),
     };
     let partial = match tempfile::Builder::new()
@@ -628,23 +664,43 @@ where
         let _ = std::fs::remove_dir(outdir.join(PARQUET_FOLDER));
     }
     let final_path = results_path(outdir, &job.name, results.format);
+    let ctx = RunContext {
+        run: Some(job.name.clone()),
+        parameters: job.parameters.clone(),
+        labels: results.labels.get(&job.name).cloned().unwrap_or_default(),
+        system: serde_json::to_value(&job.system).ok(),
+        kinds: kinds.clone(),
+    };
     let result = (|| -> Result<Summary, String> {
         write_json_atomic(&dir.join("system.json"), &job.system).map_err(|e| e.to_string())?;
-        let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| runner(job)))
-            .unwrap_or_else(|p| {
-                let what = p
-                    .downcast_ref::<&str>()
-                    .map(|s| s.to_string())
-                    .or_else(|| p.downcast_ref::<String>().cloned())
-                    .unwrap_or_default();
-                Err(format!("the run panicked: {what}"))
-            })?;
-        let ctx = RunContext {
-            run: Some(job.name.clone()),
-            parameters: job.parameters.clone(),
-            labels: results.labels.get(&job.name).cloned().unwrap_or_default(),
-            system: serde_json::to_value(&job.system).ok(),
-            kinds: kinds.clone(),
+        let ran = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            runner(job).map_err(Into::into)
+        }))
+        .unwrap_or_else(|p| {
+            let what = p
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| p.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            Err(format!("the run panicked: {what}").into())
+        });
+        let out = match ran {
+            Ok(out) => out,
+            Err(failed) => {
+                // the rows before the failure go into the run's folder, never into the
+                // results table, which holds completed runs only
+                if let Some(history) = failed.history {
+                    let name = history_file(results.format);
+                    if let Err(e) = write_results(&dir.join(name), &history, results.format, &ctx) {
+                        return Err(format!(
+                            "{}; also: its history could not be written: {e}",
+                            failed.error
+                        ));
+                    }
+                    report.history = Some(dest.join(name));
+                }
+                return Err(failed.error);
+            }
         };
         let path = match results.format {
             ResultsFormat::Csv => dir.join("results.csv"),
@@ -673,6 +729,7 @@ where
         let _ = std::fs::remove_file(&table_file);
         report.ok = false;
         report.results = None;
+        report.history = None;
         report.error = Some(match report.error.take() {
             Some(first) => format!("{first}; also: {e}"),
             None => e,

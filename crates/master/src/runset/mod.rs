@@ -72,6 +72,11 @@ pub struct RunReport {
     pub error: Option<String>,
     pub summary: Option<Summary>,
     pub results: Option<PathBuf>,
+    /// A failed run's rows up to its failure (`history.csv` or `history.parquet` in its
+    /// folder, never in the results table; its metadata's `summary.failed` says when and
+    /// why); none when the run failed before its first row.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub history: Option<PathBuf>,
     /// The SHA-1 of each FMU file the run loaded, by its path: a resumed run set runs again a
     /// run whose FMU changed since (see [`completed`]).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]

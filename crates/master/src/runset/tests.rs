@@ -1,6 +1,6 @@
 use super::*;
 use crate::coupling::tests::{two_mass_plan, MassSpring, Mock, SpringDamperMass};
-use crate::coupling::{simulate, Algorithm, RunOptions, SimOutput};
+use crate::coupling::{simulate, Algorithm, FailedRun, RunOptions, SimOutput};
 use crate::results::ResultsFormat;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -485,4 +485,89 @@ fn a_run_whose_fmu_changed_since_is_not_complete() {
     assert!(completed(dir.path(), &j[0], ResultsFormat::Csv).is_none());
     std::fs::write(&ms, b"first build").unwrap();
     assert!(completed(dir.path(), &j[0], ResultsFormat::Csv).is_some());
+}
+
+/// A run that fails after its first row keeps its history in its own folder (`history.csv`
+/// or `history.parquet`, its metadata saying when and why), never in the results table; a
+/// run that fails before its first row has none; a later set replaces such a folder.
+#[test]
+fn a_failed_run_keeps_its_history_in_its_folder() {
+    use crate::coupling::simulate_keeping_history;
+    use crate::slave::FailStatus;
+    let j = jobs(r#"{"product": {"ms.k": [50, 100, 200]}}"#).unwrap();
+    // run-001 fails from 0.03 s, run-002 before its first row
+    let runner = |fail: bool| {
+        move |job: &Job| -> Result<SimOutput, FailedRun<String>> {
+            if fail && job.name == "run-002" {
+                return Err("cannot instantiate".to_string().into());
+            }
+            let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.05);
+            plan.instances[0].parameters[1].1 = job.parameters["ms.k"].as_f64().unwrap();
+            let mut a = Mock::new("ms", MassSpring::new(1.0, 1.0, 1.0, 0.0));
+            let mut b = Mock::new("sdm", SpringDamperMass::new(1.0, 1.0, 1.0));
+            if fail && job.name == "run-001" {
+                b.hooks.fail_step_from = Some((0.03, FailStatus::Error));
+            }
+            simulate_keeping_history(&plan, &mut [&mut a, &mut b], &RunOptions::default())
+                .map_err(|f| f.map(|e| e.to_string()))
+        }
+    };
+    for format in [ResultsFormat::Csv, ResultsFormat::Parquet] {
+        let dir = tempfile::tempdir().unwrap();
+        let opts = ResultsOptions {
+            format,
+            ..ResultsOptions::default()
+        };
+        let reports = execute_with(&j, dir.path(), 2, false, &opts, None, runner(true)).unwrap();
+        assert_eq!(
+            reports.iter().map(|r| r.ok).collect::<Vec<_>>(),
+            [true, false, false]
+        );
+        let (file, other) = match format {
+            ResultsFormat::Csv => ("history.csv", "history.parquet"),
+            ResultsFormat::Parquet => ("history.parquet", "history.csv"),
+        };
+        let history = dir.path().join("run-001").join(file);
+        assert_eq!(reports[1].history.as_deref(), Some(history.as_path()));
+        assert!(reports[1].results.is_none() && reports[2].history.is_none());
+        assert!(!dir.path().join("run-001").join(other).exists());
+        assert!(!dir.path().join("run-002").join(file).exists());
+        // the table holds completed runs only
+        assert!(!results_path(dir.path(), "run-001", format).exists());
+        let (time, meta) = match format {
+            ResultsFormat::Csv => {
+                let text = std::fs::read_to_string(&history).unwrap();
+                let time: Vec<f64> = text
+                    .lines()
+                    .skip(1)
+                    .map(|l| l.split(',').next().unwrap().parse().unwrap())
+                    .collect();
+                (
+                    time,
+                    crate::results::read_metadata(&history).unwrap().unwrap(),
+                )
+            }
+            ResultsFormat::Parquet => {
+                let (out, meta) = crate::parquet_file::read_results_parquet(&history).unwrap();
+                (out.column("time").unwrap(), meta)
+            }
+        };
+        let last = *time.last().unwrap();
+        assert!((0.025..0.035).contains(&last), "history up to {last} s");
+        assert_eq!(time.len(), (last / 1e-3).round() as usize + 1);
+        let failed = meta.summary.failed.as_ref().expect("summary.failed");
+        assert_eq!(failed.time_s, last);
+        assert_eq!(Some(failed.error.as_str()), reports[1].error.as_deref());
+        // the report in the run's folder names it too
+        let report: RunReport = serde_json::from_str(
+            &std::fs::read_to_string(dir.path().join("run-001/summary.json")).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(report.history, reports[1].history);
+        // a set that completes the runs replaces the failed runs' folders whole
+        let again = execute_with(&j, dir.path(), 2, false, &opts, None, runner(false)).unwrap();
+        assert!(again.iter().all(|r| r.ok && r.history.is_none()));
+        assert!(!history.exists());
+        assert!(results_path(dir.path(), "run-001", format).exists());
+    }
 }

@@ -24,7 +24,7 @@ use crate::study::critical::{Critical, CurvePoint};
 use crate::study::metrics::{run_metrics, MetricSpec, RunMetrics, BOGIE_MASS_T};
 use crate::study::settings::StudySettings;
 use crate::study::vehicle::{Signals, VehicleModel};
-use master::coupling::SimOutput;
+use master::coupling::{FailedRun, SimOutput};
 use master::decimation::{decimate, factor_for_rate};
 use master::results::ResultsFormat;
 use master::runset::{execute_with, run_job, Job, ResultsOptions, SweepError};
@@ -394,22 +394,30 @@ impl Executor<'_> {
         let rate = self.settings.stored_rate_hz;
         let full_rate = self.settings.stored_format == ResultsFormat::Parquet;
         let signals = &self.signals;
-        let runner = |job: &Job| -> Result<SimOutput, String> {
-            let Some((spec, keep, system)) = specs.get(&job.name) else {
-                return Err(format!("internal: no metric spec for run '{}'", job.name));
-            };
-            let out = run_job(system, job, cancel)?;
-            let m = run_metrics(&out, spec, signals).map_err(|e| e.to_string());
-            lock(&metrics).insert(job.name.clone(), m);
-            let factor = factor_for_rate(&out, rate);
-            if *keep {
-                lock(&kept).insert(job.name.clone(), every_nth_row(&out, factor));
-                lock(&kept_tail).insert(job.name.clone(), last_rows(&out, HISTORY_DETAIL_S));
-            }
+        // the stored rate: full in Parquet, decimated in CSV
+        let stored = |out: SimOutput| -> Result<SimOutput, String> {
             if full_rate {
                 return Ok(out);
             }
-            decimate(&out, factor).map_err(|e| e.to_string())
+            decimate(&out, factor_for_rate(&out, rate)).map_err(|e| e.to_string())
+        };
+        let runner = |job: &Job| -> Result<SimOutput, FailedRun<String>> {
+            let Some((spec, keep, system)) = specs.get(&job.name) else {
+                return Err(format!("internal: no metric spec for run '{}'", job.name).into());
+            };
+            // a failed run's history is stored at the same rate, in its run folder
+            let out = run_job(system, job, cancel).map_err(|f| FailedRun {
+                history: f.history.and_then(|h| stored(*h).ok()).map(Box::new),
+                error: f.error,
+            })?;
+            let m = run_metrics(&out, spec, signals).map_err(|e| e.to_string());
+            lock(&metrics).insert(job.name.clone(), m);
+            if *keep {
+                let factor = factor_for_rate(&out, rate);
+                lock(&kept).insert(job.name.clone(), every_nth_row(&out, factor));
+                lock(&kept_tail).insert(job.name.clone(), last_rows(&out, HISTORY_DETAIL_S));
+            }
+            Ok(stored(out)?)
         };
         let dir = self.opts.out.join("runs").join(batch);
         // this batch's runs only (an earlier study's other runs would read as part of it)
