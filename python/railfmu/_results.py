@@ -379,7 +379,9 @@ def read_results(path: PathLike) -> Union[Results, RunSetResults]:
         try:
             s = json.loads(summary.read_text())
             # a run's report, or a run summary of its own; anything else is not the run's
-            if isinstance(s, dict):
+            # (a failed run's report has none: its history file keeps its own, which says
+            # when and why it failed)
+            if isinstance(s, dict) and csv.name == "results.csv":
                 inner = s.get("summary") if "ok" in s else s
                 if isinstance(inner, dict) or inner is None:
                     res.summary = dict(inner or {})

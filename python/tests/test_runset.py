@@ -94,13 +94,17 @@ def test_a_run_that_fails_midway_keeps_its_history_in_its_folder(dist, master_cm
     assert history.summary["failed"]["time_s"] == t[-1]
     assert "derailment" in history.summary["failed"]["error"]
     assert (tmp_path / "py" / "derails" / f"history.{format}").is_file()
+    # read as a file, beside the failed run's report (which has no summary), it keeps its own
+    alone = railfmu.read_results(tmp_path / "py" / "derails" / f"history.{format}")
+    assert alone.summary["failed"] == history.summary["failed"]
     # never in the results table, which holds completed runs only
     assert not (tmp_path / "py" / "results" / "derails.parquet").exists()
     # the command line writes the same history
     set_file = tmp_path / "set.json"
     set_file.write_text(json.dumps(rs))
     r = run_master(master_cmd, "sweep", set_file, "-o", tmp_path / "cli", "--format", format)
-    assert r.returncode == 1 and "its history up to the failure is in" in r.stderr, r.stderr
+    assert r.returncode == 1 and "derails: FAILED:" in r.stdout, r.stderr
+    assert f"(its history up to the failure is in {tmp_path / 'cli' / 'derails' / f'history.{format}'})" in r.stdout, r.stdout
     cli = railfmu.read_results(tmp_path / "cli").history("derails")
     assert np.array_equal(bits(cli.values), bits(history.values))
 

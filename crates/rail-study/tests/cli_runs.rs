@@ -787,13 +787,20 @@ fn a_sweeps_failed_run_keeps_its_history_in_its_folder() {
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
     let history = Path::new("out").join("derails").join("history.csv");
     assert!(
-        stderr.contains(&format!(
-            "its history up to the failure is in {}",
+        stdout
+            .lines()
+            .any(|l| l.starts_with("derails: FAILED:") && l.contains("derailment")),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains(&format!(
+            "(its history up to the failure is in {})",
             history.display()
         )),
-        "{stderr}"
+        "{stdout}"
     );
     let folder = dir.path().join("out");
     assert!(folder.join("stable/results.csv").is_file());
@@ -912,4 +919,68 @@ fn a_run_whose_fmu_changed_since_its_set_loaded_it_fails() {
         e.contains("MassSpring.fmu' changed since the run set loaded it"),
         "{e}"
     );
+}
+
+/// A study's run that fails midway (the derailing bogie above, in CSV, whose stored rate is
+/// decimated) keeps its history at the full rate, up to the row of the failure.
+#[test]
+fn a_studys_failed_run_keeps_its_full_rate_history() {
+    let dir = tempfile::tempdir().unwrap();
+    let systems = dir.path().join("systems");
+    std::fs::create_dir_all(&systems).unwrap();
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../systems");
+    for e in std::fs::read_dir(&shipped).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), systems.join(e.file_name())).unwrap();
+    }
+    let passive = std::fs::read_to_string(systems.join("passive.json")).unwrap();
+    let derailing = passive.replace(
+        "\"initial.yaw_angle\": 0.0",
+        "\"initial.yaw_angle\": 0.0, \"suspension.lateral_stiffness\": 0, \
+         \"suspension.longitudinal_stiffness\": 0",
+    );
+    assert_ne!(derailing, passive);
+    std::fs::write(systems.join("passive.json"), derailing).unwrap();
+    let out = dir.path().join("study");
+    let r = Command::new(env!("CARGO_BIN_EXE_master"))
+        .args([
+            "--quiet",
+            "study",
+            "--quick",
+            "--vehicle",
+            "bogie2dof",
+            "--fmus",
+        ])
+        .arg(dist())
+        .arg("--systems")
+        .arg(&systems)
+        .args([
+            "--configurations",
+            "passive",
+            "--speeds",
+            "522",
+            "--format",
+            "csv",
+        ])
+        .args(["--jobs", "2", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert!(stderr.contains("derailment"), "{stderr}");
+    let run = out.join("runs/main/sweep-passive_v522_s1");
+    let csv = std::fs::read_to_string(run.join("history.csv")).unwrap();
+    let time: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("history.meta.json")).unwrap())
+            .unwrap();
+    let failed = meta["summary"]["failed"]["time_s"].as_f64().unwrap();
+    assert_eq!(time.last().copied(), Some(failed), "{stderr}");
+    // every communication point of 1 ms, not the stored rate's
+    assert_eq!(time.len(), (failed / 1e-3).round() as usize + 1);
+    assert!(!run.join("results.csv").exists());
 }

@@ -140,7 +140,14 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     for r in &reports {
         match (&r.summary, &r.error) {
             (Some(s), _) => println!("{}: ok, {s}", r.name),
-            (None, Some(e)) if e != NOT_STARTED => println!("{}: FAILED: {e}", r.name),
+            (None, Some(e)) if e != NOT_STARTED => match &r.history {
+                Some(h) => println!(
+                    "{}: FAILED: {e} (its history up to the failure is in {})",
+                    r.name,
+                    h.display()
+                ),
+                None => println!("{}: FAILED: {e}", r.name),
+            },
             _ => {}
         }
     }

@@ -309,17 +309,11 @@ where
                     let history = r.history.as_ref().map_or(String::new(), |h| {
                         format!(" (its history up to the failure is in {})", h.display())
                     });
-                    let message = format!(
+                    bar.println(format!(
                         "run '{}' failed: {}{history}",
                         r.name,
                         r.error.as_deref().unwrap_or("")
-                    );
-                    // a hidden bar (--quiet, or not on a terminal) prints nothing
-                    if bar.is_hidden() {
-                        log::warn!(target: "master", "{message}");
-                    } else {
-                        bar.println(message);
-                    }
+                    ));
                 }
                 r
             })

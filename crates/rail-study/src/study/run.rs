@@ -394,30 +394,24 @@ impl Executor<'_> {
         let rate = self.settings.stored_rate_hz;
         let full_rate = self.settings.stored_format == ResultsFormat::Parquet;
         let signals = &self.signals;
-        // the stored rate: full in Parquet, decimated in CSV
-        let stored = |out: SimOutput| -> Result<SimOutput, String> {
-            if full_rate {
-                return Ok(out);
-            }
-            decimate(&out, factor_for_rate(&out, rate)).map_err(|e| e.to_string())
-        };
         let runner = |job: &Job| -> Result<SimOutput, FailedRun<String>> {
             let Some((spec, keep, system)) = specs.get(&job.name) else {
                 return Err(format!("internal: no metric spec for run '{}'", job.name).into());
             };
-            // a failed run's history is stored at the same rate, in its run folder
-            let out = run_job(system, job, cancel).map_err(|f| FailedRun {
-                history: f.history.and_then(|h| stored(*h).ok()).map(Box::new),
-                error: f.error,
-            })?;
+            // a failed run's history goes into its run folder at the full rate: decimated,
+            // it would lose the rows nearest the failure
+            let out = run_job(system, job, cancel)?;
             let m = run_metrics(&out, spec, signals).map_err(|e| e.to_string());
             lock(&metrics).insert(job.name.clone(), m);
+            let factor = factor_for_rate(&out, rate);
             if *keep {
-                let factor = factor_for_rate(&out, rate);
                 lock(&kept).insert(job.name.clone(), every_nth_row(&out, factor));
                 lock(&kept_tail).insert(job.name.clone(), last_rows(&out, HISTORY_DETAIL_S));
             }
-            Ok(stored(out)?)
+            if full_rate {
+                return Ok(out);
+            }
+            Ok(decimate(&out, factor).map_err(|e| e.to_string())?)
         };
         let dir = self.opts.out.join("runs").join(batch);
         // this batch's runs only (an earlier study's other runs would read as part of it)
