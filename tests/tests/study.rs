@@ -61,11 +61,11 @@ fn r8_passive_critical_speed() {
     }
 }
 
-/// R9: MPPT (both weightings) raises the critical speed by about 70 km/h (accepted 50-90).
-/// GAP (pinned): in our 2-dof bogie the closed semi-active valve (about 330 kNs/m at 4 Hz
-/// against about 100 kNs/m for the 30 % passive damper) keeps MPPT stable at 400 km/h in the
-/// quick study, a gain of >= 120 km/h. The lower bound of R9 is asserted, the measured gain
-/// is pinned (>= 100 km/h); see REPORT.md.
+/// R9: MPPT (both weightings) raises the critical speed by about 70 km/h. GAP (pinned, the
+/// 2-dof bogie is the HIL configuration): the closed semi-active valve (about 330 kNs/m at
+/// 4 Hz against about 100 kNs/m for the 30 % passive damper) keeps MPPT stable at 400 km/h in
+/// the quick study, a gain of >= 120 km/h. Asserted: at least +50 km/h, and the measured gain
+/// pinned at >= 100 km/h; no upper bound (the seed's +70 is not met here); see REPORT.md.
 #[test]
 fn r9_mppt_raises_critical_speed() {
     let p = STUDY.vcr("passive");
@@ -122,10 +122,13 @@ fn r10_mppt1_stays_closed_mppt2_reopens() {
 }
 
 /// R11: sky-hook with an ideal valve gives about the same curve as MPPT (seed Fig. 4.23).
-/// GAP (pinned): our ideal sky-hook gains about 30-40 km/h over passive (seed: about +70, like
-/// MPPT) while our MPPT gains > 120 km/h (R9 gap: nothing in the 2-dof bogie limits a closed
-/// valve), so the two are not within 20 km/h here. Asserted: the seed's qualitative ordering
-/// passive < ideal sky-hook <= MPPT, and the pinned gain (20-60 km/h); see REPORT.md.
+/// GAP (pinned): our ideal sky-hook gains far less over passive than MPPT (seed: about +70,
+/// like MPPT) while our MPPT gains > 120 km/h (R9 gap: nothing in the 2-dof bogie limits a
+/// closed valve), so the two are not within 20 km/h here. Asserted on the quick study: the
+/// seed's qualitative ordering passive < ideal sky-hook <= MPPT, and the pinned gain (20-60
+/// km/h). The full bogie study (its 2 km/h bisection, two seeds) measures +23.7 (on/off) and
+/// +17.5 km/h (continuous): the pin holds on the quick study's coarser grid only; see
+/// docs/VALIDATION.md.
 #[test]
 fn r11_ideal_skyhook_between_passive_and_mppt() {
     let p = STUDY.vcr("passive");

@@ -64,9 +64,10 @@ fn passive_critical_speed_280_to_310() {
     }
 }
 
-/// R9: MPPT raises the critical speed by about +70 km/h (accepted +40..+100). The lower bound
-/// holds for both weightings; the coach with MPPT stays within the limit to the end of the
-/// quick grid (420 km/h), so the measured gain is at least 420 - passive, more than +100. A
+/// R9: MPPT raises the critical speed by about +70 km/h (accepted +40..+100). NOT MET on the
+/// high side (docs/VALIDATION.md R9, full study +105..+140): the lower bound is asserted for
+/// both weightings, and the measured gain is pinned (stable to the end of the quick grid,
+/// 420 km/h, so at least 420 - passive, more than +100); nothing here asserts +100. A
 /// nearly closed valve gives about 330 kNs/m at 4 Hz against 100 for the 30 % passive damper,
 /// and our coach's critical speed rises more steeply with yaw damping than the seed's (the
 /// ideal 210 kNs/m damper keeps it within the limit at 380 km/h, the seed's exceeds it, Table
@@ -223,8 +224,8 @@ fn full_active_stable_to_380() {
 /// only the 390 one follows c_v v. Over the full study's two seeds the reference exceeds the
 /// bound at every c_v and the peak does not fall (tests/tests/vehicle_cv_table.rs). Asserted
 /// here: every peak in the seed's span 20-25 kN +-3 kN, seed 1's pinned shape (largest at 270
-/// kNs/m, the 390 value at most the 210 one + 1 kN), and every peak within 80-100 % of
-/// min(peak reference, bound).
+/// kNs/m, the 390 value at most the 210 one + 1 kN), and every peak at least 80 % of
+/// min(peak reference, bound) and at most the bound.
 #[test]
 fn cv_sensitivity_of_the_full_active_damper() {
     let bound_n = ActuatorBound::of_default_actuator().force_n;

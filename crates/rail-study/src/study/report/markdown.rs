@@ -386,7 +386,13 @@ pub fn report_markdown(r: &StudyResults, timing: &Timing, figures: &[(String, &s
     );
     if !r.failures.is_empty() {
         let _ = writeln!(m, "\n## Failed runs ({})\n", r.failures.len());
-        let _ = writeln!(m, "A failed sweep run counts as unstable at its speed.\n");
+        let _ = writeln!(
+            m,
+            "A failed sweep run counts as unstable at its speed. A run that failed after its \
+             first row keeps its history up to the failure, at the full rate, in its folder \
+             (`runs/<batch>/<run>/history.csv`, or `history.parquet`; the metadata's \
+             `summary.failed` gives the time and the error).\n"
+        );
         for (n, e) in &r.failures {
             let _ = writeln!(m, "* `{n}`: {e}");
         }
