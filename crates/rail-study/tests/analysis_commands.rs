@@ -1082,8 +1082,9 @@ fn root_locus_of_the_coach_gives_r15_and_the_mode() {
 /// first harmonic at one stroke and frequency; docs/VALIDATION.md R9): the 30 % passive damper
 /// at +-1 mm, 4 Hz gives R15 at a frequency that agrees with the linearisation's; a closed valve
 /// keeps the coach stable to the end of the search (716 km/h) at strokes up to 2 mm and gives
-/// 422 km/h only at +-5 mm (linearised at the 5.39 Hz of that crossing), far above the seed's
-/// MPPT (passive + 70, about 355 km/h), which the 10 % opening reaches at 5 mm (353 km/h).
+/// 422 km/h only at +-5 mm (linearised at the 5.39 Hz of that crossing, which the command finds
+/// itself without FREQ), far above the seed's MPPT (passive + 70, about 355 km/h), which the
+/// 10 % opening reaches at 5 mm (353 km/h).
 #[test]
 fn root_locus_with_the_linearised_semi_active_damper() {
     let d = tempfile::tempdir().unwrap();
@@ -1128,6 +1129,30 @@ fn root_locus_with_the_linearised_semi_active_damper() {
             "{damper}: {s}"
         );
     }
+    // without FREQ: linearised at the crossing mode's own frequency, which the command finds
+    // (at a fixed 4 Hz the closed valve at +-5 mm would cross at 499 km/h)
+    for (damper, range, freq) in [
+        ("semi-active:0:5e-3", 417.0..=427.0, 5.39),
+        ("semi-active:0:3e-3", 535.0..=545.0, 5.62),
+        ("semi-active:0.1:5e-3", 348.0..=358.0, 4.69),
+    ] {
+        let s = run(damper);
+        let v = number_after(&s, "linear critical speed:");
+        assert!(range.contains(&v), "{damper}: {v} km/h\n{s}");
+        let f = number_after(&s, "rad/s, frequency");
+        assert!((f - freq).abs() < 0.05, "{damper}: onset at {f} Hz\n{s}");
+        let used = number_after(&s, "linearised at the crossing mode's frequency,");
+        assert!(
+            (used - f).abs() < 0.02,
+            "{damper}: linearised at {used} Hz\n{s}"
+        );
+    }
+    let s = run("semi-active:0:2e-3");
+    assert!(
+        s.contains("no mode crosses with the damper linearised at 4 Hz")
+            && s.contains("stable up to 716 km/h"),
+        "{s}"
+    );
     let bad = master(&["root-locus", "--damper", "semi-active:0:3", "--out"]);
     assert!(!bad.ok, "{}", bad.stdout);
     let bad = master(&[

@@ -189,6 +189,71 @@ pub fn parse_damper(s: &str) -> Result<DamperSpec, String> {
     }
 }
 
+/// A `--damper` option: the spec, and whether a `semi-active:OPENING:STROKE` damper (no FREQ)
+/// is to be linearised at the frequency of the mode that crosses ([`linearise_at_crossing`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DamperArg {
+    pub spec: DamperSpec,
+    pub at_crossing: bool,
+}
+
+/// [`parse_damper`], noting a `semi-active` damper given without its frequency.
+pub fn parse_damper_arg(s: &str) -> Result<DamperArg, String> {
+    let spec = parse_damper(s)?;
+    let at_crossing = matches!(spec, DamperSpec::Linearised(_)) && s.trim().split(':').count() == 3;
+    Ok(DamperArg { spec, at_crossing })
+}
+
+/// Rounds of [`linearise_at_crossing`] at most (the crossing frequency settles to 0.01 Hz
+/// within three on the coach and the bogie).
+pub const MAX_LINEARISATION_ROUNDS: usize = 8;
+
+/// What [`linearise_at_crossing`] found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AtCrossing {
+    /// The damper linearised at the crossing mode's frequency (at its first frequency when
+    /// nothing crosses).
+    pub damper: LinearisedDamper,
+    /// Critical speeds computed.
+    pub rounds: usize,
+    /// Whether a mode crosses with it.
+    pub crossed: bool,
+}
+
+/// The damper `d` linearised again at the frequency of the mode that crosses with it, until
+/// that frequency moves by less than 0.01 Hz: a first-harmonic linearisation holds at one
+/// frequency, and the one that matters is the crossing mode's. `crossing` gives that mode's
+/// frequency \[Hz\] for a damper, `None` when nothing crosses (then `d` stays at its
+/// frequency). An error when the frequency has not settled after
+/// [`MAX_LINEARISATION_ROUNDS`].
+pub fn linearise_at_crossing(
+    mut d: LinearisedDamper,
+    mut crossing: impl FnMut(DamperSpec) -> Result<Option<f64>, String>,
+) -> Result<AtCrossing, String> {
+    for rounds in 1..=MAX_LINEARISATION_ROUNDS {
+        let Some(freq_hz) = crossing(DamperSpec::Linearised(d))? else {
+            return Ok(AtCrossing {
+                damper: d,
+                rounds,
+                crossed: false,
+            });
+        };
+        if (freq_hz - d.freq_hz).abs() < 0.01 {
+            return Ok(AtCrossing {
+                damper: d,
+                rounds,
+                crossed: true,
+            });
+        }
+        d = LinearisedDamper::measure(d.opening, d.stroke_m, freq_hz)?;
+    }
+    Err(format!(
+        "the crossing mode's frequency did not settle within {MAX_LINEARISATION_ROUNDS} \
+         linearisations (last {} Hz): give the frequency, semi-active:OPENING:STROKE:FREQ",
+        master::show::num(d.freq_hz)
+    ))
+}
+
 impl DamperSpec {
     pub fn representation(&self) -> DamperRepresentation {
         self.linear()
@@ -418,6 +483,35 @@ impl LocusResults {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A `semi-active` damper without FREQ is marked for the crossing frequency; the iteration
+    /// stops once the frequency settles, keeps the damper when nothing crosses, and refuses a
+    /// frequency that does not settle.
+    #[test]
+    fn linearisation_at_the_crossing_frequency() {
+        assert!(parse_damper_arg("semi-active:0:5e-3").unwrap().at_crossing);
+        assert!(
+            !parse_damper_arg("semi-active:0:5e-3:4")
+                .unwrap()
+                .at_crossing
+        );
+        assert!(!parse_damper_arg("passive").unwrap().at_crossing);
+        let d = LinearisedDamper::measure(0.0, 5e-3, 4.0).unwrap();
+        let settled = linearise_at_crossing(d, |_| Ok(Some(5.0))).unwrap();
+        assert!(settled.crossed && settled.rounds == 2);
+        assert_eq!(settled.damper.freq_hz, 5.0);
+        let none = linearise_at_crossing(d, |_| Ok(None)).unwrap();
+        assert!(!none.crossed && none.rounds == 1 && none.damper == d);
+        let mut flip = false;
+        let e = linearise_at_crossing(d, |_| {
+            flip = !flip;
+            Ok(Some(if flip { 5.0 } else { 6.0 }))
+        })
+        .unwrap_err();
+        assert!(e.contains("did not settle"), "{e}");
+        let e = linearise_at_crossing(d, |_| Err("no eigenvalues".into())).unwrap_err();
+        assert_eq!(e, "no eigenvalues");
+    }
 
     #[test]
     fn damper_spec_parsing() {

@@ -8,8 +8,11 @@ use fmu_bogie2dof::Params;
 use fmu_vehicle::VehicleParams;
 
 use super::{csv_or_svg_starting, failed, write_analysis, AnalysisCommand};
-use crate::analysis::locus::{parse_damper, root_locus, speed_grid_kmh, DamperSpec};
-use crate::analysis::vehicle_locus::vehicle_root_locus;
+use crate::analysis::locus::{
+    linearise_at_crossing, parse_damper_arg, root_locus, speed_grid_kmh, DamperArg, DamperSpec,
+    CRITICAL_SEARCH_MPS,
+};
+use crate::analysis::vehicle_locus::{damper_model, vehicle_root_locus};
 use crate::study::VehicleModel;
 use master::cli::{CommandError, Context};
 
@@ -63,12 +66,14 @@ pub struct Args {
     /// coupled 30 % passive damper), `viscous:C`, `maxwell:K:C`, `kelvin:K:C` (N/m, N s/m;
     /// 120k = 120e3), `none`, or `semi-active:OPENING:STROKE[:FREQ]`: the hydraulic
     /// semi-active damper model with its valve fixed at OPENING (0 closed .. 1), linearised by
-    /// its first harmonic at stroke amplitude STROKE [m] and FREQ [Hz, default 4], e.g.
-    /// `semi-active:0:3e-3:5.5` (a closed valve at +-3 mm, 5.5 Hz). A stiffness lies within
-    /// 1 kN/m .. 10 GN/m, a damping within 1 N s/m .. 100 MN s/m (or either is 0 where the law
-    /// allows): beyond them the eigenvalues cannot be trusted.
-    #[arg(long, default_value = "passive", value_parser = parse_damper)]
-    pub damper: DamperSpec,
+    /// its first harmonic at stroke amplitude STROKE [m] and FREQ [Hz], e.g.
+    /// `semi-active:0:3e-3:5.5` (a closed valve at +-3 mm, 5.5 Hz); without FREQ, at the
+    /// frequency of the mode that crosses (from 4 Hz, linearised again until it settles to
+    /// 0.01 Hz; 4 Hz when nothing crosses). A stiffness lies within 1 kN/m .. 10 GN/m, a
+    /// damping within 1 N s/m .. 100 MN s/m (or either is 0 where the law allows): beyond them
+    /// the eigenvalues cannot be trusted.
+    #[arg(long, default_value = "passive", value_parser = parse_damper_arg)]
+    pub damper: DamperArg,
     /// Mounting (series) stiffness of each yaw damper's installation [N/m], 1 kN/m .. 10 GN/m,
     /// coach only [default: rigid].
     #[arg(long, value_name = "N_PER_M", allow_negative_numbers = true)]
@@ -110,9 +115,20 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             if let Some(c) = args.conicity {
                 params.wheel_rail.conicity = c;
             }
-            let r = vehicle_root_locus(&params, args.damper, args.mounting_stiffness, &speeds)
+            let (damper, note) = resolve(args.damper, |spec| {
+                let model = damper_model(spec, args.mounting_stiffness);
+                let (lo, hi) = CRITICAL_SEARCH_MPS;
+                match fmu_vehicle::eigen::critical_speed(&params, &model, lo, hi) {
+                    Ok(c) => Ok(Some(c.mode.freq_hz)),
+                    Err(fmu_vehicle::eigen::EigenError::NoCrossing { .. })
+                    | Err(fmu_vehicle::eigen::EigenError::UnstableAtLowerEnd { .. }) => Ok(None),
+                    Err(e) => Err(e.to_string()),
+                }
+            })?;
+            let r = vehicle_root_locus(&params, damper, args.mounting_stiffness, &speeds)
                 .map_err(failed)?;
-            write_analysis(&COMMAND, &args.out, &[], ctx.cancel, &r.summary(), |f| {
+            let summary = format!("{note}{}", r.summary());
+            write_analysis(&COMMAND, &args.out, &[], ctx.cancel, &summary, |f| {
                 r.add_artefacts(f)
             })
         }
@@ -126,10 +142,53 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             if let Some(c) = args.conicity {
                 params.conicity = c;
             }
-            let r = root_locus(&params, args.damper, &speeds).map_err(failed)?;
-            write_analysis(&COMMAND, &args.out, &[], ctx.cancel, &r.summary(), |f| {
+            let (damper, note) = resolve(args.damper, |spec| {
+                let (lo, hi) = CRITICAL_SEARCH_MPS;
+                match fmu_bogie2dof::eigen::critical_speed(&params, &spec.representation(), lo, hi)
+                {
+                    Ok(c) => Ok(Some(c.hunting.freq_hz)),
+                    Err(fmu_bogie2dof::eigen::EigenError::NoCrossing { .. }) => Ok(None),
+                    Err(e) => Err(e.to_string()),
+                }
+            })?;
+            let r = root_locus(&params, damper, &speeds).map_err(failed)?;
+            let summary = format!("{note}{}", r.summary());
+            write_analysis(&COMMAND, &args.out, &[], ctx.cancel, &summary, |f| {
                 r.add_artefacts(f)
             })
         }
     }
+}
+
+/// The damper of `arg`, a `semi-active` one given without its frequency linearised at the
+/// crossing mode's ([`linearise_at_crossing`]; `crossing` gives that mode's frequency), and a
+/// line for the summary saying so (empty otherwise).
+fn resolve(
+    arg: DamperArg,
+    crossing: impl FnMut(DamperSpec) -> Result<Option<f64>, String>,
+) -> Result<(DamperSpec, String), CommandError> {
+    let DamperSpec::Linearised(d) = arg.spec else {
+        return Ok((arg.spec, String::new()));
+    };
+    if !arg.at_crossing {
+        return Ok((arg.spec, String::new()));
+    }
+    let found = linearise_at_crossing(d, crossing)
+        .map_err(|e| CommandError::Failed(format!("--damper: {e}")))?;
+    let d = found.damper;
+    let note = if found.crossed {
+        format!(
+            "damper linearised at the crossing mode's frequency, {} Hz (settled after {} \
+             critical speeds)\n",
+            master::show::num((d.freq_hz * 100.0).round() / 100.0),
+            found.rounds
+        )
+    } else {
+        format!(
+            "no mode crosses with the damper linearised at {} Hz: no crossing frequency to \
+             linearise it at\n",
+            master::show::num(d.freq_hz)
+        )
+    };
+    Ok((DamperSpec::Linearised(d), note))
 }
