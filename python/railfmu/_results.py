@@ -226,7 +226,8 @@ class RunSetResults(Mapping[str, Results]):
             if why:
                 raise _railfmu.OutputError(f"'{path}' is not a run-set summary: {why}")
         self.reports: List[Dict[str, Any]] = list(reports)
-        """Each run's report in job order: name, parameters, ok, error, summary, results."""
+        """Each run's report in job order: name, parameters, ok, error, summary, results (and
+        history, for a run that failed after its first row)."""
         self._cache: Dict[str, Results] = {}
         self._parameter_units: Optional[Dict[str, Optional[str]]] = None
 

@@ -243,11 +243,13 @@ pub fn split_label(label: &str) -> (&str, Option<&str>) {
 /// metadata, empty when it has none) tells which columns hold texts; every other field is a
 /// number.
 pub fn parse_csv(text: &str, file: &str, columns: &[ColumnMetadata]) -> Result<Table, String> {
-    // records, not lines: a quoted String may hold a line break
-    let records = master::csv_records::records(text, false).map_err(|e| format!("{file}: {e}"))?;
-    let mut records = records.into_iter();
+    // records, not lines: a quoted String may hold a line break; one at a time, so that a
+    // large file is held as its numbers, not also as the texts of its fields
+    let mut records = master::csv_records::Records::new(text, false);
     let header = records
         .next()
+        .transpose()
+        .map_err(|e| format!("{file}: {e}"))?
         .ok_or_else(|| format!("{file}: empty file (no header line)"))?
         .texts();
     let time = header.first().map_or("", String::as_str);
@@ -262,6 +264,7 @@ pub fn parse_csv(text: &str, file: &str, columns: &[ColumnMetadata]) -> Result<T
         .collect();
     let mut data = Vec::new();
     for record in records {
+        let record = record.map_err(|e| format!("{file}: {e}"))?;
         let n = record.line;
         if record.fields.len() != header.len() {
             return Err(format!(

@@ -39,37 +39,61 @@ pub struct CsvError {
 /// `skip_comments`, are lines starting with `#` (outside quotes). A line break inside quotes
 /// belongs to the field; `\r\n` ends a record as `\n` does.
 pub fn records(text: &str, skip_comments: bool) -> Result<Vec<Record>, CsvError> {
-    let mut out = Vec::new();
-    let mut chars = text.chars().peekable();
-    let mut line = 1usize;
-    loop {
-        // at the start of a record: skip empty and comment lines
-        match chars.peek() {
-            None => return Ok(out),
-            Some('\n') => {
-                chars.next();
-                line += 1;
-                continue;
-            }
-            Some('\r') => {
-                chars.next();
-                continue;
-            }
-            Some('#') if skip_comments => {
-                for c in chars.by_ref() {
-                    if c == '\n' {
-                        break;
-                    }
-                }
-                line += 1;
-                continue;
-            }
-            Some(_) => {}
+    Records::new(text, skip_comments).collect()
+}
+
+/// [`records`] one at a time, so that a reader keeps only what it converts them into (a large
+/// file's fields as texts take several times the file's size); after an error it ends.
+pub struct Records<'a> {
+    chars: std::iter::Peekable<std::str::Chars<'a>>,
+    line: usize,
+    skip_comments: bool,
+    failed: bool,
+}
+
+impl<'a> Records<'a> {
+    pub fn new(text: &'a str, skip_comments: bool) -> Self {
+        Records {
+            chars: text.chars().peekable(),
+            line: 1,
+            skip_comments,
+            failed: false,
         }
-        let start = line;
-        let err = |reason| CsvError {
-            line: start,
-            reason,
+    }
+
+    fn record(&mut self) -> Option<Result<Record, CsvError>> {
+        let chars = &mut self.chars;
+        loop {
+            // at the start of a record: skip empty and comment lines
+            match chars.peek() {
+                None => return None,
+                Some('\n') => {
+                    chars.next();
+                    self.line += 1;
+                    continue;
+                }
+                Some('\r') => {
+                    chars.next();
+                    continue;
+                }
+                Some('#') if self.skip_comments => {
+                    for c in chars.by_ref() {
+                        if c == '\n' {
+                            break;
+                        }
+                    }
+                    self.line += 1;
+                    continue;
+                }
+                Some(_) => break,
+            }
+        }
+        let start = self.line;
+        let err = |reason| {
+            Some(Err(CsvError {
+                line: start,
+                reason,
+            }))
         };
         let mut fields = Vec::new();
         let mut field = String::new();
@@ -79,7 +103,7 @@ pub fn records(text: &str, skip_comments: bool) -> Result<Vec<Record>, CsvError>
         loop {
             let Some(c) = chars.next() else {
                 if in_quotes {
-                    return Err(err("unterminated quoted field"));
+                    return err("unterminated quoted field");
                 }
                 break;
             };
@@ -89,7 +113,7 @@ pub fn records(text: &str, skip_comments: bool) -> Result<Vec<Record>, CsvError>
                     in_quotes = true;
                     at_start = false;
                 }
-                (false, '"') => return Err(err("a quote inside an unquoted field")),
+                (false, '"') => return err("a quote inside an unquoted field"),
                 (true, '"') => {
                     if chars.peek() == Some(&'"') {
                         chars.next();
@@ -97,7 +121,7 @@ pub fn records(text: &str, skip_comments: bool) -> Result<Vec<Record>, CsvError>
                     } else {
                         in_quotes = false;
                         if !matches!(chars.peek(), None | Some(',' | '\n' | '\r')) {
-                            return Err(err("text after a closing quote"));
+                            return err("text after a closing quote");
                         }
                     }
                 }
@@ -111,12 +135,12 @@ pub fn records(text: &str, skip_comments: bool) -> Result<Vec<Record>, CsvError>
                 }
                 (false, '\r') if chars.peek() == Some(&'\n') => {}
                 (false, '\n') => {
-                    line += 1;
+                    self.line += 1;
                     break;
                 }
                 (_, c) => {
                     if c == '\n' {
-                        line += 1;
+                        self.line += 1;
                     }
                     field.push(c);
                     at_start = false;
@@ -127,10 +151,23 @@ pub fn records(text: &str, skip_comments: bool) -> Result<Vec<Record>, CsvError>
             text: field,
             quoted,
         });
-        out.push(Record {
+        Some(Ok(Record {
             line: start,
             fields,
-        });
+        }))
+    }
+}
+
+impl Iterator for Records<'_> {
+    type Item = Result<Record, CsvError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.failed {
+            return None;
+        }
+        let r = self.record();
+        self.failed = matches!(r, Some(Err(_)));
+        r
     }
 }
 
@@ -166,6 +203,19 @@ mod tests {
             records("#a,b\n", false).unwrap()[0].texts(),
             vec!["#a", "b"]
         );
+    }
+
+    /// One record at a time, the same as the whole list; after a malformed record it ends.
+    #[test]
+    fn records_one_at_a_time_end_at_the_first_error() {
+        let text = "a,b\n1,\"x\ny\"\n2,3\n";
+        let one: Vec<Record> = Records::new(text, false).map(Result::unwrap).collect();
+        assert_eq!(one, records(text, false).unwrap());
+        assert_eq!(one.len(), 3);
+        let mut it = Records::new("a,b\n1,x\"y\n2,3\n", false);
+        assert!(it.next().unwrap().is_ok());
+        assert_eq!(it.next().unwrap().unwrap_err().line, 2);
+        assert!(it.next().is_none());
     }
 
     #[test]

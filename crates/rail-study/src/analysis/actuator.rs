@@ -207,7 +207,21 @@ pub fn characterise_actuator(
         .par_iter()
         .map(|&(a, m, f)| {
             check_cancel(cancel)?;
-            let v = actuator_frf(params, m, a * params.alpha_m, &[f])?;
+            let v = actuator_frf(params, m, a * params.alpha_m, &[f]).map_err(|e| match e {
+                // a free rod moves further the lower the frequency: name the option that
+                // asked for it
+                fmu_damper::StepError::BeyondStroke { .. } => option_err(
+                    "--actuator-f-min",
+                    master::show::num(opts.band_hz.0),
+                    &format!(
+                        "at {} Hz (spool amplitude {} alpha) the free rod leaves its stroke: \
+                         {e}; raise --actuator-f-min or lower the amplitude",
+                        master::show::num(f),
+                        master::show::num(a)
+                    ),
+                ),
+                e => e.into(),
+            })?;
             v.into_iter()
                 .next()
                 .ok_or(AnalysisError::Damper(fmu_damper::StepError::NonFinite {

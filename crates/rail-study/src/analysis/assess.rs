@@ -119,14 +119,15 @@ impl ResultsTable {
         } else {
             None
         };
-        // (line, fields, whether each was quoted): a comma-separated file by records (RFC
-        // 4180: our writer quotes names with commas and every String value, which may hold a
-        // line break), a host's semicolon- or space-separated export by lines
-        let records: Vec<(usize, Vec<String>, Vec<bool>)> = if sep == Some(',') {
-            master::csv_records::records(text, true)
-                .map_err(|e| bad_file(path, e.line, e.reason.into()))?
-                .into_iter()
-                .map(|r| {
+        // (line, fields, whether each was quoted), one record at a time (a large file's
+        // fields kept as texts would take several times its size): a comma-separated file by
+        // records (RFC 4180: our writer quotes names with commas and every String value, which
+        // may hold a line break), a host's semicolon- or space-separated export by lines
+        type Row = (usize, Vec<String>, Vec<bool>);
+        let mut records: Box<dyn Iterator<Item = Result<Row, AnalysisError>> + '_> =
+            if sep == Some(',') {
+                Box::new(master::csv_records::Records::new(text, true).map(|r| {
+                    let r = r.map_err(|e| bad_file(path, e.line, e.reason.into()))?;
                     let quoted = r.fields.iter().map(|f| f.quoted).collect();
                     let fields = r
                         .fields
@@ -139,25 +140,21 @@ impl ResultsTable {
                             }
                         })
                         .collect();
-                    (r.line, fields, quoted)
-                })
-                .collect()
-        } else {
-            std::iter::once((1, header))
-                .chain(lines)
-                .enumerate()
-                .map(|(k, (no, line))| {
-                    let mut fields = split_fields(line, sep);
-                    if k == 0 && sep.is_none() {
-                        fields = units_to_names(fields);
-                    }
-                    let quoted = vec![false; fields.len()];
-                    (no, fields, quoted)
-                })
-                .collect()
-        };
-        let mut records = records.into_iter();
-        let Some((_, names, _)) = records.next() else {
+                    Ok((r.line, fields, quoted))
+                }))
+            } else {
+                Box::new(std::iter::once((1, header)).chain(lines).enumerate().map(
+                    move |(k, (no, line))| {
+                        let mut fields = split_fields(line, sep);
+                        if k == 0 && sep.is_none() {
+                            fields = units_to_names(fields);
+                        }
+                        let quoted = vec![false; fields.len()];
+                        Ok((no, fields, quoted))
+                    },
+                ))
+            };
+        let Some((_, names, _)) = records.next().transpose()? else {
             return Err(bad_file(path, 1, "no header line".into()));
         };
         if names.len() < 2 {
@@ -171,7 +168,8 @@ impl ResultsTable {
         // the first field of a column that is quoted (a String), not a number or not finite
         // makes it a column that is left out
         let mut text: Vec<Option<(usize, String)>> = vec![None; names.len()];
-        for (no, fields, quoted) in records {
+        for record in records {
+            let (no, fields, quoted) = record?;
             if fields.len() != names.len() {
                 return Err(bad_file(
                     path,

@@ -234,9 +234,11 @@ pub fn setup_of(inputs: &GeometryInputs) -> Result<ContactSetup, AnalysisError> 
 
 /// Checks the numeric options shared by the single and the fleet run.
 pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
+    // the value as the user gave it in mm: 12 significant digits drop the round-off of its
+    // trip through metres (1400 mm, not 1400.0000000000002)
     let bad = |option: &'static str, v: f64, reason: &str| AnalysisError::Option {
         option,
-        value: master::show::num(v).to_string(),
+        value: master::show::num(format!("{v:.11e}").parse().unwrap_or(v)).to_string(),
         reason: reason.to_string(),
     };
     // the ranges of wheel_rail's ContactSetup::validate, in the options' millimetres
@@ -704,5 +706,12 @@ mod tests {
         };
         let e = contact_geometry(&i, &AtomicBool::new(false)).unwrap_err();
         assert!(e.to_string().contains("--step"), "{e}");
+        // a value is named as given in mm, without the round-off of its trip through metres
+        let i = GeometryInputs {
+            gauge_m: 1400.0 * 1e-3,
+            ..GeometryInputs::default()
+        };
+        let e = check_options(&i).unwrap_err().to_string();
+        assert!(e.contains("--gauge = 1400:"), "{e}");
     }
 }

@@ -133,8 +133,9 @@ impl LinearisedDamper {
 
 /// Parses `passive`, `none`, `viscous:C`, `maxwell:K:C`, `kelvin:K:C` (SI: N/m, N s/m;
 /// `120e3` or `120k` are both accepted) and `semi-active:OPENING:STROKE[:FREQ]` (valve opening
-/// 0..1, stroke amplitude in m, frequency in Hz, default 4), which measures the damper model
-/// there ([`LinearisedDamper::measure`]).
+/// 0..1, stroke amplitude in m, frequency in Hz; without it 4 Hz, the start of
+/// [`linearise_at_crossing`], which `master root-locus` then applies, see [`parse_damper_arg`]),
+/// which measures the damper model there ([`LinearisedDamper::measure`]).
 pub fn parse_damper(s: &str) -> Result<DamperSpec, String> {
     let num = |t: &str| -> Result<f64, String> {
         let t = t.trim();

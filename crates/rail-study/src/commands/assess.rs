@@ -112,6 +112,11 @@ pub struct AssessNumbers<'a> {
     pub wheel_load_kn: (&'a str, Option<f64>),
 }
 
+/// The highest speed `assess` takes [km/h]: beyond, a number is not a rail vehicle's speed in
+/// km/h (a speed in m/h, or a typing error), and the 10 m window step would be shorter than a
+/// sample.
+pub const MAX_SPEED_KMH: f64 = 1000.0;
+
 impl AssessNumbers<'_> {
     /// The numbers the computation would refuse, as `NAME = VALUE: reason` (the computation's
     /// own messages name its internal parameters, e.g. the wheel load in N).
@@ -122,6 +127,12 @@ impl AssessNumbers<'_> {
         let (_, speed) = self.speed_kmh;
         if !(speed.is_finite() && speed > 0.0) {
             return bad(self.speed_kmh, "must be a speed > 0 km/h");
+        }
+        if speed > MAX_SPEED_KMH {
+            return bad(
+                self.speed_kmh,
+                "must be a rail vehicle's speed in km/h, at most 1000 km/h",
+            );
         }
         let (_, skip) = self.skip_s;
         if !(skip.is_finite() && skip >= 0.0) {
@@ -169,6 +180,7 @@ fn check_options(args: &Args) -> Result<(), CommandError> {
 }
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
+    super::check_out_folder(&args.out)?;
     check_options(args)?;
     let criterion = args
         .quantity

@@ -70,7 +70,9 @@ pub struct Args {
     #[arg(long, default_value_t = 30, value_parser = frf_points)]
     pub actuator_freqs: usize,
     /// Lowest actuator FRF frequency [Hz] (at least 0.01 Hz: the full-order model is
-    /// integrated over whole periods within a bounded number of internal steps).
+    /// integrated over whole periods within a bounded number of internal steps; with the
+    /// spool at alpha the free rod leaves its stroke below about 0.35 Hz, which is refused
+    /// naming this option).
     #[arg(long, default_value_t = 1.0, value_parser = actuator_frequency_hz)]
     pub actuator_f_min: f64,
     /// Highest actuator FRF frequency [Hz] (at most 1e5 Hz).
@@ -113,6 +115,7 @@ fn frequency_within(text: &str, lowest_hz: f64) -> Result<f64, String> {
 }
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
+    super::check_out_folder(&args.out)?;
     let (mut damper, mut actuator) = (None, None);
     if matches!(args.target, Target::Damper | Target::All) {
         let opts = DamperOptions {

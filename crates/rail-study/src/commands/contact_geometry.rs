@@ -140,6 +140,7 @@ pub struct Args {
 }
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
+    super::check_out_folder(&args.out)?;
     let d = GeometryInputs::default();
     // the profile files read (those of --wheel-dir are found later)
     let mut read: Vec<PathBuf> = [&args.wheel, &args.rail, &args.wheel_right, &args.rail_right]

@@ -53,6 +53,18 @@ pub(crate) fn csv_or_svg_starting(name: &str, prefixes: &[&str]) -> bool {
 /// drawn only sometimes) is removed, so that the folder never mixes two runs' results;
 /// nothing else in the folder is touched. A file that cannot be removed is warned about and
 /// stays listed, for the next run to try again.
+/// An analysis command's output folder must be a folder or not exist yet: checked before the
+/// computation, so that a file in its place is named at once, not after the work.
+pub(crate) fn check_out_folder(out: &Path) -> Result<(), CommandError> {
+    match std::fs::metadata(out) {
+        Ok(m) if !m.is_dir() => Err(CommandError::Failed(format!(
+            "the output folder '{}' is a file, not a folder",
+            out.display()
+        ))),
+        _ => Ok(()),
+    }
+}
+
 pub(crate) fn write_analysis(
     command: &AnalysisCommand,
     out: &Path,
@@ -62,6 +74,7 @@ pub(crate) fn write_analysis(
     add: impl FnOnce(&mut Artefacts) -> Result<(), AnalysisError>,
 ) -> Result<(), CommandError> {
     check_cancel(cancel).map_err(failed)?;
+    check_out_folder(out)?;
     let mut files = Artefacts::default();
     add(&mut files).map_err(failed)?;
     let written: Vec<String> = files.names().iter().map(|n| n.to_string()).collect();

@@ -93,6 +93,7 @@ pub struct Args {
 }
 
 pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
+    super::check_out_folder(&args.out)?;
     let speeds = speed_grid_kmh(args.from, args.to, args.step).map_err(failed)?;
     if let Some(k) = args.mounting_stiffness {
         if !(k.is_finite() && k > 0.0) {
