@@ -1,8 +1,8 @@
 //! The coach's linear critical speed with the hydraulic semi-active damper itself, linearised by
 //! its first harmonic (`master root-locus --damper semi-active:OPENING:STROKE`), over valve
 //! openings and stroke amplitudes: each linearisation at the frequency of the mode that crosses
-//! with it ([`linearise_at_crossing`], as the command does without FREQ), so each row is
-//! self-consistent (docs/VALIDATION.md, R9).
+//! with it, or of the hunting mode at 716 km/h when nothing crosses ([`linearise_at_crossing`],
+//! as the command does without FREQ), so each row is self-consistent (docs/VALIDATION.md, R9).
 //!
 //! `cargo run --release -p rail-study --example linearised_damper_scan`
 use fmu_vehicle::eigen::critical_speed;
@@ -10,7 +10,7 @@ use fmu_vehicle::VehicleParams;
 use rail_study::analysis::locus::{
     linearise_at_crossing, DamperSpec, LinearisedDamper, DEFAULT_LINEARISATION_FREQ_HZ,
 };
-use rail_study::analysis::vehicle_locus::{damper_model, CRITICAL_SEARCH_MPS};
+use rail_study::analysis::vehicle_locus::{damper_model, vehicle_onset, CRITICAL_SEARCH_MPS};
 
 fn main() {
     let p = VehicleParams::default();
@@ -21,9 +21,7 @@ fn main() {
         for stroke_mm in [0.25, 0.5, 1.0, 2.0, 3.0, 5.0] {
             let found =
                 LinearisedDamper::measure(opening, stroke_mm * 1e-3, DEFAULT_LINEARISATION_FREQ_HZ)
-                    .and_then(|d| {
-                        linearise_at_crossing(d, |spec| Ok(v_cr(spec).ok().map(|c| c.mode.freq_hz)))
-                    });
+                    .and_then(|d| linearise_at_crossing(d, |spec| vehicle_onset(&p, spec, None)));
             let row = match found {
                 Ok(f) => {
                     let d = f.damper;

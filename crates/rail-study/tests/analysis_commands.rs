@@ -1168,9 +1168,14 @@ fn root_locus_with_the_linearised_semi_active_damper() {
             "{damper}: linearised at {used} Hz\n{s}"
         );
     }
+    // stable at 4 Hz, crossing at the frequency the coach hunts at (563 km/h at 5.65 Hz);
+    // stable at every frequency at +-2 mm, linearised at the hunting mode's at 716 km/h
+    let s = run("semi-active:0:2.8e-3");
+    let v = number_after(&s, "linear critical speed:");
+    assert!((558.0..=568.0).contains(&v), "{v} km/h\n{s}");
     let s = run("semi-active:0:2e-3");
     assert!(
-        s.contains("no mode crosses with the damper linearised at 4 Hz")
+        s.contains("no mode crosses: damper linearised at the hunting mode's frequency")
             && s.contains("stable up to 716 km/h"),
         "{s}"
     );
@@ -1568,4 +1573,22 @@ fn an_analysis_into_a_file_names_it() {
         );
         assert_eq!(std::fs::read(&file).unwrap(), b"x");
     }
+    // a file above the folder, a link to nothing in its place
+    let below = file.join("sub");
+    let r = master(&["root-locus", "-o", below.to_str().unwrap()]);
+    assert!(
+        !r.ok
+            && r.stderr
+                .contains(&format!("'{f}', on the way to the output folder")),
+        "{}",
+        r.stderr
+    );
+    let dangling = d.path().join("dangling");
+    std::os::unix::fs::symlink(d.path().join("nothing"), &dangling).unwrap();
+    let r = master(&["characterise", "-o", dangling.to_str().unwrap()]);
+    assert!(
+        !r.ok && r.stderr.contains("is a link to nothing, not a folder"),
+        "{}",
+        r.stderr
+    );
 }

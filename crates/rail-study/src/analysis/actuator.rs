@@ -215,7 +215,7 @@ pub fn characterise_actuator(
                     master::show::num(opts.band_hz.0),
                     &format!(
                         "at {} Hz (spool amplitude {} alpha) the free rod leaves its stroke: \
-                         {e}; raise --actuator-f-min or lower the amplitude",
+                         {e}; raise --actuator-f-min",
                         master::show::num(f),
                         master::show::num(a)
                     ),

@@ -234,11 +234,12 @@ pub fn setup_of(inputs: &GeometryInputs) -> Result<ContactSetup, AnalysisError> 
 
 /// Checks the numeric options shared by the single and the fleet run.
 pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
-    // the value as the user gave it in mm: 12 significant digits drop the round-off of its
-    // trip through metres (1400 mm, not 1400.0000000000002)
+    // the value as the user gave it in mm: 15 significant digits drop the round-off of its
+    // trip through metres (1400 mm, not 1400.0000000000002) and keep what was typed
+    // (1480.0000000001 stays out of range in the message too)
     let bad = |option: &'static str, v: f64, reason: &str| AnalysisError::Option {
         option,
-        value: master::show::num(format!("{v:.11e}").parse().unwrap_or(v)).to_string(),
+        value: master::show::num(format!("{v:.14e}").parse().unwrap_or(v)).to_string(),
         reason: reason.to_string(),
     };
     // the ranges of wheel_rail's ContactSetup::validate, in the options' millimetres
@@ -713,5 +714,11 @@ mod tests {
         };
         let e = check_options(&i).unwrap_err().to_string();
         assert!(e.contains("--gauge = 1400:"), "{e}");
+        let i = GeometryInputs {
+            gauge_m: 1480.0000000001 * 1e-3,
+            ..GeometryInputs::default()
+        };
+        let e = check_options(&i).unwrap_err().to_string();
+        assert!(e.contains("--gauge = 1480.0000000001:"), "{e}");
     }
 }

@@ -209,50 +209,97 @@ pub fn parse_damper_arg(s: &str) -> Result<DamperArg, String> {
 /// within three on the coach and the bogie).
 pub const MAX_LINEARISATION_ROUNDS: usize = 8;
 
+/// What the eigen-analysis says of one linearised damper, for [`linearise_at_crossing`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Onset {
+    /// A mode crosses in the search range; its frequency \[Hz\].
+    Crosses(f64),
+    /// Nothing crosses; the frequency of the hunting mode at the top of the search range
+    /// \[Hz\], if there is one.
+    Stable(Option<f64>),
+}
+
 /// What [`linearise_at_crossing`] found.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AtCrossing {
-    /// The damper linearised at the crossing mode's frequency (at its first frequency when
-    /// nothing crosses).
+    /// The damper linearised at the frequency it settled at.
     pub damper: LinearisedDamper,
-    /// Critical speeds computed.
+    /// Eigen-analyses made.
     pub rounds: usize,
-    /// Whether a mode crosses with it.
+    /// Whether a mode crosses with it (else it is linearised at the hunting mode's frequency
+    /// at the top of the search range; where it started when there is none, or when that
+    /// frequency hops between modes without settling).
     pub crossed: bool,
+    /// Whether the frequency settled (false: stable at every frequency tried, the damper
+    /// where it started).
+    pub settled: bool,
 }
 
 /// The damper `d` linearised again at the frequency of the mode that crosses with it, until
 /// that frequency moves by less than 0.01 Hz: a first-harmonic linearisation holds at one
-/// frequency, and the one that matters is the crossing mode's. `crossing` gives that mode's
-/// frequency \[Hz\] for a damper, `None` when nothing crosses (then `d` stays at its
-/// frequency). An error when the frequency has not settled after
-/// [`MAX_LINEARISATION_ROUNDS`].
+/// frequency, and the one that matters is the crossing mode's. When nothing crosses, at the
+/// hunting mode's frequency at the top of the search range: a damper that is stiff at 4 Hz
+/// may let the coach cross at the 5.7 Hz it hunts at. `onset` gives the eigen-analysis of a
+/// damper. An error when the frequency has not settled after [`MAX_LINEARISATION_ROUNDS`].
 pub fn linearise_at_crossing(
     mut d: LinearisedDamper,
-    mut crossing: impl FnMut(DamperSpec) -> Result<Option<f64>, String>,
+    mut onset: impl FnMut(DamperSpec) -> Result<Onset, String>,
 ) -> Result<AtCrossing, String> {
+    let first = d;
+    let mut ever_crossed = false;
     for rounds in 1..=MAX_LINEARISATION_ROUNDS {
-        let Some(freq_hz) = crossing(DamperSpec::Linearised(d))? else {
-            return Ok(AtCrossing {
-                damper: d,
-                rounds,
-                crossed: false,
-            });
+        let (target_hz, crossed) = match onset(DamperSpec::Linearised(d))? {
+            Onset::Crosses(f) => (Some(f), true),
+            Onset::Stable(f) => (f, false),
         };
-        if (freq_hz - d.freq_hz).abs() < 0.01 {
-            return Ok(AtCrossing {
+        ever_crossed |= crossed;
+        let settled = |d: LinearisedDamper| {
+            Ok(AtCrossing {
                 damper: d,
                 rounds,
-                crossed: true,
-            });
+                crossed,
+                settled: true,
+            })
+        };
+        // the linearisation's own range (0.1-50 Hz)
+        let Some(f) = target_hz.map(|f| f.clamp(0.1, 50.0)) else {
+            return settled(d);
+        };
+        if (f - d.freq_hz).abs() < 0.01 {
+            return settled(d);
         }
-        d = LinearisedDamper::measure(d.opening, d.stroke_m, freq_hz)?;
+        d = LinearisedDamper::measure(d.opening, d.stroke_m, f)?;
+    }
+    if !ever_crossed {
+        // stable at every frequency tried, the least-damped mode hopping between modes (a
+        // very stiff damper): stable, at the frequency it started from
+        return Ok(AtCrossing {
+            damper: first,
+            rounds: MAX_LINEARISATION_ROUNDS,
+            crossed: false,
+            settled: false,
+        });
     }
     Err(format!(
         "the crossing mode's frequency did not settle within {MAX_LINEARISATION_ROUNDS} \
          linearisations (last {} Hz): give the frequency, semi-active:OPENING:STROKE:FREQ",
-        master::show::num(d.freq_hz)
+        master::show::num((d.freq_hz * 100.0).round() / 100.0)
     ))
+}
+
+/// [`Onset`] of the linear 2-dof bogie with `spec` (the hunting mode at the top of
+/// [`CRITICAL_SEARCH_MPS`] when nothing crosses).
+pub fn bogie_onset(params: &Params, spec: DamperSpec) -> Result<Onset, String> {
+    let (lo, hi) = CRITICAL_SEARCH_MPS;
+    let rep = spec.representation();
+    match critical_speed(params, &rep, lo, hi) {
+        Ok(c) => Ok(Onset::Crosses(c.hunting.freq_hz)),
+        Err(EigenError::NoCrossing { .. }) => {
+            let top = analyse(params, hi, &rep).map_err(|e| e.to_string())?;
+            Ok(Onset::Stable(top.hunting.map(|h| h.freq_hz)))
+        }
+        Err(e) => Err(e.to_string()),
+    }
 }
 
 impl DamperSpec {
@@ -498,15 +545,30 @@ mod tests {
         );
         assert!(!parse_damper_arg("passive").unwrap().at_crossing);
         let d = LinearisedDamper::measure(0.0, 5e-3, 4.0).unwrap();
-        let settled = linearise_at_crossing(d, |_| Ok(Some(5.0))).unwrap();
+        let settled = linearise_at_crossing(d, |_| Ok(Onset::Crosses(5.0))).unwrap();
         assert!(settled.crossed && settled.rounds == 2);
         assert_eq!(settled.damper.freq_hz, 5.0);
-        let none = linearise_at_crossing(d, |_| Ok(None)).unwrap();
+        let none = linearise_at_crossing(d, |_| Ok(Onset::Stable(None))).unwrap();
         assert!(!none.crossed && none.rounds == 1 && none.damper == d);
+        // stable at 4 Hz, crossing once linearised at the hunting frequency
+        let found = linearise_at_crossing(d, |spec| match spec {
+            DamperSpec::Linearised(l) if l.freq_hz < 5.0 => Ok(Onset::Stable(Some(5.7))),
+            _ => Ok(Onset::Crosses(5.65)),
+        })
+        .unwrap();
+        assert!(found.crossed && found.rounds == 3 && found.damper.freq_hz == 5.65);
+        // stable at every frequency, the hunting candidate hopping: stable where it started
+        let mut hop = false;
+        let stable = linearise_at_crossing(d, |_| {
+            hop = !hop;
+            Ok(Onset::Stable(Some(if hop { 19.0 } else { 7.0 })))
+        })
+        .unwrap();
+        assert!(!stable.crossed && !stable.settled && stable.damper == d);
         let mut flip = false;
         let e = linearise_at_crossing(d, |_| {
             flip = !flip;
-            Ok(Some(if flip { 5.0 } else { 6.0 }))
+            Ok(Onset::Crosses(if flip { 5.0 } else { 6.0 }))
         })
         .unwrap_err();
         assert!(e.contains("did not settle"), "{e}");

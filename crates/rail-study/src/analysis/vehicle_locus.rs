@@ -13,7 +13,7 @@ use fmu_vehicle::eigen::{
 };
 use fmu_vehicle::VehicleParams;
 
-use super::locus::DamperSpec;
+use super::locus::{DamperSpec, Onset};
 use super::locus_figures::{damping_ratio, speeds_line, LocusFigures, LocusSpeed};
 use super::{AnalysisError, Artefacts, Table};
 
@@ -81,9 +81,7 @@ pub fn vehicle_root_locus(
             )),
             Err(e) => return Err(vehicle_err(e)),
         };
-    let kinematic_rad_per_m = (params.wheel_rail.conicity
-        / (params.wheelset.wheel_radius_m * params.wheelset.half_contact_gauge_m))
-        .sqrt();
+    let kinematic_rad_per_m = kinematic_rad_per_m(params);
     Ok(VehicleLocus {
         damper,
         mounting_n_per_m,
@@ -92,6 +90,42 @@ pub fn vehicle_root_locus(
         critical,
         kinematic_rad_per_m,
     })
+}
+
+/// [`Onset`] of the linear coach with `spec` behind `mounting_n_per_m`: when nothing crosses,
+/// the hunting mode at the top of [`CRITICAL_SEARCH_MPS`], the least-damped oscillation below
+/// the free wheelset's kinematic frequency (as [`VehicleLocus::hunting_mode`] starts).
+pub fn vehicle_onset(
+    params: &VehicleParams,
+    spec: DamperSpec,
+    mounting_n_per_m: Option<f64>,
+) -> Result<Onset, String> {
+    let model = damper_model(spec, mounting_n_per_m);
+    let (lo, hi) = CRITICAL_SEARCH_MPS;
+    match critical_speed(params, &model, lo, hi) {
+        Ok(c) => Ok(Onset::Crosses(c.mode.freq_hz)),
+        Err(EigenError::NoCrossing { .. }) => {
+            let top = analyse(params, hi, &model).map_err(|e| e.to_string())?;
+            let kinematic_rad_per_s = kinematic_rad_per_m(params) * hi;
+            let hunting = top
+                .eigenvalues
+                .iter()
+                .filter(|e| e.1 > 0.0 && e.1 <= kinematic_rad_per_s)
+                .min_by(|a, b| damping_ratio(a.0, a.1).total_cmp(&damping_ratio(b.0, b.1)));
+            Ok(Onset::Stable(
+                hunting.map(|e| e.1 / (2.0 * std::f64::consts::PI)),
+            ))
+        }
+        Err(EigenError::UnstableAtLowerEnd { .. }) => Ok(Onset::Stable(None)),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// The free wheelset's kinematic (Klingel) wavenumber [rad/m]: sqrt(conicity / (r0 b)).
+fn kinematic_rad_per_m(params: &VehicleParams) -> f64 {
+    (params.wheel_rail.conicity
+        / (params.wheelset.wheel_radius_m * params.wheelset.half_contact_gauge_m))
+        .sqrt()
 }
 
 /// Number of the mode kind in the CSV (0 car body, 1 front bogie, 2 rear bogie, 3 both).

@@ -43,6 +43,35 @@ pub(crate) fn csv_or_svg_starting(name: &str, prefixes: &[&str]) -> bool {
         && prefixes.iter().any(|p| name.starts_with(p))
 }
 
+/// An analysis command's output folder must be a folder or not exist yet, nor any folder
+/// above it be a file or a link to nothing: checked before the computation, so that such a
+/// path is named at once, not after the work.
+pub(crate) fn check_out_folder(out: &Path) -> Result<(), CommandError> {
+    // the nearest part of the path that exists decides (the rest is created)
+    let Some(existing) = out
+        .ancestors()
+        .filter(|p| !p.as_os_str().is_empty())
+        .find(|p| std::fs::symlink_metadata(p).is_ok())
+    else {
+        return Ok(());
+    };
+    let what = match std::fs::metadata(existing) {
+        Ok(m) if m.is_dir() => return Ok(()),
+        Ok(_) => "is a file, not a folder",
+        Err(_) => "is a link to nothing, not a folder",
+    };
+    let named = if existing == out {
+        format!("the output folder '{}'", out.display())
+    } else {
+        format!(
+            "'{}', on the way to the output folder '{}',",
+            existing.display(),
+            out.display()
+        )
+    };
+    Err(CommandError::Failed(format!("{named} {what}")))
+}
+
 /// Ends an analysis command: unless interrupted, collects its files (`add`), writes them into
 /// `out` (only now, after everything is computed, and none over one of the files it read,
 /// `inputs`) and prints `summary` with the file list.
@@ -53,18 +82,6 @@ pub(crate) fn csv_or_svg_starting(name: &str, prefixes: &[&str]) -> bool {
 /// drawn only sometimes) is removed, so that the folder never mixes two runs' results;
 /// nothing else in the folder is touched. A file that cannot be removed is warned about and
 /// stays listed, for the next run to try again.
-/// An analysis command's output folder must be a folder or not exist yet: checked before the
-/// computation, so that a file in its place is named at once, not after the work.
-pub(crate) fn check_out_folder(out: &Path) -> Result<(), CommandError> {
-    match std::fs::metadata(out) {
-        Ok(m) if !m.is_dir() => Err(CommandError::Failed(format!(
-            "the output folder '{}' is a file, not a folder",
-            out.display()
-        ))),
-        _ => Ok(()),
-    }
-}
-
 pub(crate) fn write_analysis(
     command: &AnalysisCommand,
     out: &Path,

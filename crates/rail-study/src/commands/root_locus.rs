@@ -9,10 +9,10 @@ use fmu_vehicle::VehicleParams;
 
 use super::{csv_or_svg_starting, failed, write_analysis, AnalysisCommand};
 use crate::analysis::locus::{
-    linearise_at_crossing, parse_damper_arg, root_locus, speed_grid_kmh, DamperArg, DamperSpec,
-    CRITICAL_SEARCH_MPS,
+    bogie_onset, linearise_at_crossing, parse_damper_arg, root_locus, speed_grid_kmh, DamperArg,
+    DamperSpec, Onset,
 };
-use crate::analysis::vehicle_locus::{damper_model, vehicle_root_locus};
+use crate::analysis::vehicle_locus::{vehicle_onset, vehicle_root_locus};
 use crate::study::VehicleModel;
 use master::cli::{CommandError, Context};
 
@@ -69,7 +69,8 @@ pub struct Args {
     /// its first harmonic at stroke amplitude STROKE [m] and FREQ [Hz], e.g.
     /// `semi-active:0:3e-3:5.5` (a closed valve at +-3 mm, 5.5 Hz); without FREQ, at the
     /// frequency of the mode that crosses (from 4 Hz, linearised again until it settles to
-    /// 0.01 Hz; 4 Hz when nothing crosses). A stiffness lies within 1 kN/m .. 10 GN/m, a
+    /// 0.01 Hz; when nothing crosses, at the hunting mode's frequency at the top of the
+    /// search). A stiffness lies within 1 kN/m .. 10 GN/m, a
     /// damping within 1 N s/m .. 100 MN s/m (or either is 0 where the law allows): beyond them
     /// the eigenvalues cannot be trusted.
     #[arg(long, default_value = "passive", value_parser = parse_damper_arg)]
@@ -117,14 +118,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
                 params.wheel_rail.conicity = c;
             }
             let (damper, note) = resolve(args.damper, |spec| {
-                let model = damper_model(spec, args.mounting_stiffness);
-                let (lo, hi) = CRITICAL_SEARCH_MPS;
-                match fmu_vehicle::eigen::critical_speed(&params, &model, lo, hi) {
-                    Ok(c) => Ok(Some(c.mode.freq_hz)),
-                    Err(fmu_vehicle::eigen::EigenError::NoCrossing { .. })
-                    | Err(fmu_vehicle::eigen::EigenError::UnstableAtLowerEnd { .. }) => Ok(None),
-                    Err(e) => Err(e.to_string()),
-                }
+                vehicle_onset(&params, spec, args.mounting_stiffness)
             })?;
             let r = vehicle_root_locus(&params, damper, args.mounting_stiffness, &speeds)
                 .map_err(failed)?;
@@ -143,15 +137,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             if let Some(c) = args.conicity {
                 params.conicity = c;
             }
-            let (damper, note) = resolve(args.damper, |spec| {
-                let (lo, hi) = CRITICAL_SEARCH_MPS;
-                match fmu_bogie2dof::eigen::critical_speed(&params, &spec.representation(), lo, hi)
-                {
-                    Ok(c) => Ok(Some(c.hunting.freq_hz)),
-                    Err(fmu_bogie2dof::eigen::EigenError::NoCrossing { .. }) => Ok(None),
-                    Err(e) => Err(e.to_string()),
-                }
-            })?;
+            let (damper, note) = resolve(args.damper, |spec| bogie_onset(&params, spec))?;
             let r = root_locus(&params, damper, &speeds).map_err(failed)?;
             let summary = format!("{note}{}", r.summary());
             write_analysis(&COMMAND, &args.out, &[], ctx.cancel, &summary, |f| {
@@ -162,11 +148,11 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
 }
 
 /// The damper of `arg`, a `semi-active` one given without its frequency linearised at the
-/// crossing mode's ([`linearise_at_crossing`]; `crossing` gives that mode's frequency), and a
+/// crossing mode's ([`linearise_at_crossing`]; `onset` is the model's eigen-analysis), and a
 /// line for the summary saying so (empty otherwise).
 fn resolve(
     arg: DamperArg,
-    crossing: impl FnMut(DamperSpec) -> Result<Option<f64>, String>,
+    onset: impl FnMut(DamperSpec) -> Result<Onset, String>,
 ) -> Result<(DamperSpec, String), CommandError> {
     let DamperSpec::Linearised(d) = arg.spec else {
         return Ok((arg.spec, String::new()));
@@ -174,21 +160,25 @@ fn resolve(
     if !arg.at_crossing {
         return Ok((arg.spec, String::new()));
     }
-    let found = linearise_at_crossing(d, crossing)
+    let found = linearise_at_crossing(d, onset)
         .map_err(|e| CommandError::Failed(format!("--damper: {e}")))?;
     let d = found.damper;
+    let hz = master::show::num((d.freq_hz * 100.0).round() / 100.0);
+    let rounds = match found.rounds {
+        1 => "1 eigen-analysis".to_string(),
+        n => format!("{n} eigen-analyses"),
+    };
     let note = if found.crossed {
+        format!("damper linearised at the crossing mode's frequency, {hz} Hz (settled after {rounds})\n")
+    } else if found.settled {
         format!(
-            "damper linearised at the crossing mode's frequency, {} Hz (settled after {} \
-             critical speeds)\n",
-            master::show::num((d.freq_hz * 100.0).round() / 100.0),
-            found.rounds
+            "no mode crosses: damper linearised at the hunting mode's frequency at the top of \
+             the search, {hz} Hz (settled after {rounds})\n"
         )
     } else {
         format!(
-            "no mode crosses with the damper linearised at {} Hz: no crossing frequency to \
-             linearise it at\n",
-            master::show::num(d.freq_hz)
+            "no mode crosses at any frequency tried (the least-damped mode at the top of the \
+             search hops between modes): damper linearised at {hz} Hz\n"
         )
     };
     Ok((DamperSpec::Linearised(d), note))
