@@ -110,6 +110,20 @@ pub enum ProfileError {
         /// "metres" or "micrometres".
         unit: &'static str,
     },
+    /// The vertical extent is no wheel's or rail's in millimetres (more than
+    /// [`PLAUSIBLE_SPAN_MM`]'s upper end).
+    #[error(
+        "{source_name}: the profile spans {} mm vertically; coordinates are read in \
+         millimetres (a wheel's flange is about 30 mm high, a whole rail about 170 mm): is the \
+         file in micrometres, or does it hold a value that is no coordinate?",
+        crate::contact::short(*.span_mm)
+    )]
+    ImplausibleHeight {
+        /// File name.
+        source_name: String,
+        /// Vertical extent as read \[mm\].
+        span_mm: f64,
+    },
     /// Not enough points.
     #[error("{source_name}: only {count} point(s) (line {last_line} is the last), at least {min} needed")]
     TooFewPoints {
@@ -252,6 +266,17 @@ impl Profile {
                 } else {
                     "micrometres"
                 },
+            });
+        }
+        let (low, high) = pts
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.2), hi.max(p.2))
+            });
+        if high - low > PLAUSIBLE_SPAN_MM.1 {
+            return Err(ProfileError::ImplausibleHeight {
+                source_name: source_name.to_string(),
+                span_mm: high - low,
             });
         }
         Ok(Self {

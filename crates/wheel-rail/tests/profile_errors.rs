@@ -114,6 +114,17 @@ fn a_profile_in_another_unit_is_refused() {
     }
 }
 
+/// A vertical extent no profile in millimetres has (a value of 1e300, or micrometres) is
+/// refused as such, not found later as a rolled wheel that is not single-valued.
+#[test]
+fn an_implausible_height_is_named() {
+    let e = Profile::parse_str("0 0\n10 1e300\n20 0\n", "tall.dat").unwrap_err();
+    assert!(matches!(e, ProfileError::ImplausibleHeight { .. }), "{e:?}");
+    assert!(e.to_string().contains("tall.dat: the profile spans"), "{e}");
+    // a flat crown spans nothing vertically: fine
+    assert!(Profile::parse_str("0 0\n10 0\n20 0\n", "flat.dat").is_ok());
+}
+
 /// A 10 MB field is not echoed whole in the message.
 #[test]
 fn a_huge_field_is_clipped_in_the_message() {

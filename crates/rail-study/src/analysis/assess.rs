@@ -334,6 +334,14 @@ impl ResultsTable {
                     list.join(", ")
                 )))
             }
+            // the full name given, and still several: the file has two columns of one name
+            hits if hits.iter().all(|&i| self.names[i] == name) => {
+                Err(AnalysisError::Input(format!(
+                    "{}: {} columns are named '{name}': the file must name each column once",
+                    self.path.display(),
+                    hits.len()
+                )))
+            }
             _ => Err(AnalysisError::Input(format!(
                 "{}: '{name}' matches several columns; give the full name with its unit",
                 self.path.display()
@@ -732,6 +740,22 @@ mod tests {
             s.push_str(&format!("{t},{},{}\n", amp * (2.0 * PI * f * t).sin(), 0.0));
         }
         s
+    }
+
+    /// A name given without its unit that fits several columns asks for the unit; a full name
+    /// that two columns share names the file's fault instead.
+    #[test]
+    fn a_column_is_found_by_its_name_and_ambiguity_is_named() {
+        let text = "time [s],a [m/s2],a [g],b [m],b [m]\n0,1,2,3,4\n0.1,1,2,3,4\n";
+        let t = ResultsTable::parse(text, Path::new("x.csv")).unwrap();
+        assert_eq!(t.find("a [g]").unwrap(), 2);
+        let e = t.find("a").unwrap_err().to_string();
+        assert!(e.contains("give the full name with its unit"), "{e}");
+        let e = t.find("b [m]").unwrap_err().to_string();
+        assert!(
+            e.contains("2 columns are named 'b [m]': the file must name each column once"),
+            "{e}"
+        );
     }
 
     #[test]

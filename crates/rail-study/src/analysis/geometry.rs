@@ -369,8 +369,21 @@ pub fn contact_geometry(
         } else {
             format!("left {left}, right {right}")
         };
+        // a reference point lost, or a rail no longer single-valued, once the rails are
+        // inclined: the option that inclined them is named
+        let inclined = inputs.inclination != 0.0
+            && matches!(
+                e,
+                wheel_rail::ContactError::ReferencePoint { .. }
+                    | wheel_rail::ContactError::Profile(_)
+            );
         match e {
             wheel_rail::ContactError::Stopped => AnalysisError::Cancelled,
+            e if inclined => AnalysisError::Option {
+                option: "--inclination",
+                value: master::show::num(inputs.inclination).to_string(),
+                reason: format!("the rails inclined by it give no contact geometry ({both}: {e})"),
+            },
             e => AnalysisError::Geometry(format!("{both}: {e}")),
         }
     };
@@ -707,6 +720,17 @@ mod tests {
         };
         let e = contact_geometry(&i, &AtomicBool::new(false)).unwrap_err();
         assert!(e.to_string().contains("--step"), "{e}");
+        // rails inclined the wrong way lose their gauge point: the option is named
+        let i = GeometryInputs {
+            inclination: -0.025,
+            ..GeometryInputs::default()
+        };
+        let e = contact_geometry(&i, &AtomicBool::new(false)).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("invalid option --inclination = -0.025"),
+            "{e}"
+        );
         // a value is named as given in mm, without the round-off of its trip through metres
         let i = GeometryInputs {
             gauge_m: 1400.0 * 1e-3,
