@@ -42,6 +42,26 @@ fn system_json(stop: f64) -> String {
     )
 }
 
+/// The times (first field) of a results CSV's rows after its header.
+fn csv_times(csv: &str) -> Vec<f64> {
+    csv.lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().parse().unwrap())
+        .collect()
+}
+
+/// `dir/systems`, a copy of the shipped system descriptions (to be changed by a test).
+fn copy_of_the_systems(dir: &Path) -> PathBuf {
+    let systems = dir.join("systems");
+    std::fs::create_dir_all(&systems).unwrap();
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../systems");
+    for e in std::fs::read_dir(&shipped).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), systems.join(e.file_name())).unwrap();
+    }
+    systems
+}
+
 #[test]
 fn sweep_runs_in_parallel_and_keeps_failures() {
     let dir = tempfile::tempdir().unwrap();
@@ -382,13 +402,7 @@ fn a_study_checks_its_systems_first_and_holds_its_folder() {
     std::fs::write(out.join("REPORT.md"), "the earlier report").unwrap();
     std::fs::write(out.join("study.json"), r#"{"settings": {}, "configs": []}"#).unwrap();
     std::fs::write(out.join("notes.txt"), "the user's").unwrap();
-    let systems = dir.path().join("systems");
-    std::fs::create_dir_all(&systems).unwrap();
-    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../systems");
-    for e in std::fs::read_dir(&shipped).unwrap() {
-        let e = e.unwrap();
-        std::fs::copy(e.path(), systems.join(e.file_name())).unwrap();
-    }
+    let systems = copy_of_the_systems(dir.path());
     let mppt2 = std::fs::read_to_string(systems.join("mppt2.json")).unwrap();
     let study = |extra: &[&str]| {
         let mut cmd = Command::new(env!("CARGO_BIN_EXE_master"));
@@ -741,15 +755,7 @@ fn a_failed_run_writes_its_history_up_to_the_failure() {
         "{stderr}"
     );
     let csv = std::fs::read_to_string(&out).unwrap();
-    let last: f64 = csv
-        .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let last = *csv_times(&csv).last().unwrap();
     assert!(last > 0.1 && last < 2.0, "last row at {last} s");
     let meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.meta.json")).unwrap())
@@ -806,15 +812,7 @@ fn a_sweeps_failed_run_keeps_its_history_in_its_folder() {
     assert!(folder.join("stable/results.csv").is_file());
     assert!(!folder.join("derails/results.csv").exists());
     let csv = std::fs::read_to_string(dir.path().join(&history)).unwrap();
-    let last: f64 = csv
-        .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let last = *csv_times(&csv).last().unwrap();
     assert!(last > 0.1 && last < 2.0, "last row at {last} s");
     let meta: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(folder.join("derails/history.meta.json")).unwrap(),
@@ -926,13 +924,7 @@ fn a_run_whose_fmu_changed_since_its_set_loaded_it_fails() {
 #[test]
 fn a_studys_failed_run_keeps_its_full_rate_history() {
     let dir = tempfile::tempdir().unwrap();
-    let systems = dir.path().join("systems");
-    std::fs::create_dir_all(&systems).unwrap();
-    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../systems");
-    for e in std::fs::read_dir(&shipped).unwrap() {
-        let e = e.unwrap();
-        std::fs::copy(e.path(), systems.join(e.file_name())).unwrap();
-    }
+    let systems = copy_of_the_systems(dir.path());
     let passive = std::fs::read_to_string(systems.join("passive.json")).unwrap();
     let derailing = passive.replace(
         "\"initial.yaw_angle\": 0.0",
@@ -969,12 +961,7 @@ fn a_studys_failed_run_keeps_its_full_rate_history() {
     let stderr = String::from_utf8_lossy(&r.stderr);
     assert!(stderr.contains("derailment"), "{stderr}");
     let run = out.join("runs/main/sweep-passive_v522_s1");
-    let csv = std::fs::read_to_string(run.join("history.csv")).unwrap();
-    let time: Vec<f64> = csv
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').next().unwrap().parse().unwrap())
-        .collect();
+    let time = csv_times(&std::fs::read_to_string(run.join("history.csv")).unwrap());
     let meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(run.join("history.meta.json")).unwrap())
             .unwrap();
