@@ -468,7 +468,7 @@ impl PySystem {
             Err(FailedRun {
                 error: e @ RunError::Sim(_),
                 history: Some(history),
-            }) if !matches!(e, RunError::Sim(SimError::Cancelled { .. })) => {
+            }) => {
                 let history = pyo3::IntoPyObjectExt::into_py_any(table(py, *history, &ctx)?, py)?;
                 Err(SimulationError::new_err((error_message(&e), history)))
             }

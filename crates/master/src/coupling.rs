@@ -97,7 +97,8 @@ pub fn simulate(
 
 /// A run that failed: its error, and the history recorded before the failure (up to the last
 /// communication point every instance completed, its summary's `failed` set); `None` when
-/// the run failed before its first row.
+/// the run failed before its first row, or was cancelled (stopped, not failed: Ctrl-C
+/// replaces no result with a history).
 #[derive(Debug)]
 pub struct FailedRun<E> {
     pub error: E,
@@ -167,7 +168,8 @@ fn simulate_with(
             return Ok(output(plan, data, strings, summary));
         }
     };
-    let history = last_row_time(&data).map(|end| {
+    let cancelled = matches!(error, SimError::Cancelled { .. });
+    let history = last_row_time(&data).filter(|_| !cancelled).map(|end| {
         let failure = Failure {
             time_s: end,
             error: error.to_string(),

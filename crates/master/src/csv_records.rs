@@ -35,15 +35,11 @@ pub struct CsvError {
     pub reason: &'static str,
 }
 
-/// The records of `text`, separated by `,`; empty lines are skipped and so, with
-/// `skip_comments`, are lines starting with `#` (outside quotes). A line break inside quotes
-/// belongs to the field; `\r\n` ends a record as `\n` does.
-pub fn records(text: &str, skip_comments: bool) -> Result<Vec<Record>, CsvError> {
-    Records::new(text, skip_comments).collect()
-}
-
-/// [`records`] one at a time, so that a reader keeps only what it converts them into (a large
-/// file's fields as texts take several times the file's size); after an error it ends.
+/// The records of a text, separated by `,`, one at a time, so that a reader keeps only what
+/// it converts them into (a large file's fields as texts take several times the file's size);
+/// after an error it ends. Empty lines are skipped and so, with `skip_comments`, are lines
+/// starting with `#` (outside quotes). A line break inside quotes belongs to the field;
+/// `\r\n` ends a record as `\n` does.
 pub struct Records<'a> {
     chars: std::iter::Peekable<std::str::Chars<'a>>,
     line: usize,
@@ -174,6 +170,11 @@ impl Iterator for Records<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every record of `text` at once.
+    fn records(text: &str, skip_comments: bool) -> Result<Vec<Record>, CsvError> {
+        Records::new(text, skip_comments).collect()
+    }
 
     fn texts(text: &str) -> Vec<(usize, Vec<String>)> {
         records(text, true)

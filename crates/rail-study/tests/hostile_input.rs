@@ -48,6 +48,16 @@ impl Case {
         std::fs::write(&p, text).unwrap();
         p
     }
+    /// [`Case::master`] without extra environment, which must succeed.
+    fn master_ok(&self, args: &[&str]) -> Output {
+        let out = self.master(args, &[]);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out
+    }
     /// Runs the master with `args` (paths relative to the case folder), TMPDIR in the case,
     /// extra environment `env`; kills it after 120 s (a hang fails the test).
     fn master(&self, args: &[&str], env: &[(&str, &str)]) -> Output {
@@ -508,12 +518,7 @@ fn an_exported_ssp_runs_whatever_its_instance_names_and_keeps_its_coupling_setti
 fn an_ssps_fmus_unpack_within_the_fmu_limit() {
     let c = Case::new();
     hostile_fmu(&c, HOSTILE_MD);
-    let out = c.master(&["export-ssp", "system.json", "ok.ssp"], &[]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    c.master_ok(&["export-ssp", "system.json", "ok.ssp"]);
     let out = c.master(&["run", "ok.ssp", "-o", "ok.csv"], &[]);
     assert!(
         out.status.success(),
@@ -1200,12 +1205,7 @@ fn a_study_option_out_of_range_is_refused_before_anything_is_touched() {
 fn an_ssp_with_two_different_steps_says_which_it_takes() {
     let c = Case::new();
     hostile_fmu(&c, HOSTILE_MD);
-    let out = c.master(&["export-ssp", "system.json", "ok.ssp"], &[]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    c.master_ok(&["export-ssp", "system.json", "ok.ssp"]);
     let mut changed = false;
     rewrite_zip(&c.path("ok.ssp"), &c.path("two.ssp"), |name, data| {
         if name == "SystemStructure.ssd" {

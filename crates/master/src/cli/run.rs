@@ -5,13 +5,13 @@
 use std::path::PathBuf;
 
 use super::{CommandError, Context};
-use crate::coupling::{Algorithm, FailedRun, RunOptions, SimError};
+use crate::coupling::{Algorithm, FailedRun, RunOptions};
 use crate::output::{check_outputs_apart, json_unfinished};
 use crate::results::{
     csv_metadata_path, prepare_results, remove_results, ResultsFormat, RunContext,
 };
 use crate::ssp::{self, ImportOptions};
-use crate::system::{LoadedSystem, OverridesFrom, RunError, SingleFmuOptions, SystemOverrides};
+use crate::system::{LoadedSystem, OverridesFrom, SingleFmuOptions, SystemOverrides};
 
 /// Run one system description, or one FMU alone, and write the recorded variables as CSV or
 /// Parquet.
@@ -217,9 +217,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         Err(FailedRun {
             error,
             history: Some(history),
-        }) if !matches!(error, RunError::Sim(SimError::Cancelled { .. })) => {
-            (*history, Some(error))
-        }
+        }) => (*history, Some(error)),
         Err(failed) => return Err(failed.error.into()),
     };
     let cancel = ctx.cancel;

@@ -9,12 +9,12 @@ use rayon::prelude::*;
 use serde_json::Value;
 
 use super::{Job, RunReport, SweepError, PARQUET_FOLDER};
-use crate::coupling::{CouplingPlan, FailedRun, RunOptions, SimError, SimOutput, Summary};
+use crate::coupling::{CouplingPlan, FailedRun, RunOptions, SimOutput, Summary};
 use crate::output::write_json_atomic;
 use crate::results::{
     constant_kinds, with_integer_kinds, write_results, ConstantKind, ResultsFormat, RunContext,
 };
-use crate::system::{LoadedSystem, PreparedSystem, RunError, SystemDescription, SystemError};
+use crate::system::{LoadedSystem, PreparedSystem, SystemDescription, SystemError};
 
 /// The start values and stop time of every job, checked against the prepared system's FMUs
 /// as each run would check them (variable names, types, declared ranges): a run set with a
@@ -126,11 +126,7 @@ pub fn run_job(
     };
     system
         .run_keeping_history(&changes, &opts)
-        .map_err(|f| match f.error {
-            // a run its set stopped is not finished: no history, as `master run` on Ctrl-C
-            RunError::Sim(SimError::Cancelled { .. }) => f.error.to_string().into(),
-            _ => f.map(|e| e.to_string()),
-        })
+        .map_err(|f| f.map(|e| e.to_string()))
 }
 
 /// How the runs of a run set write their results.

@@ -106,12 +106,7 @@ pub fn vehicle_onset(
         Ok(c) => Ok(Onset::Crosses(c.mode.freq_hz)),
         Err(EigenError::NoCrossing { .. }) => {
             let top = analyse(params, hi, &model).map_err(|e| e.to_string())?;
-            let kinematic_rad_per_s = kinematic_rad_per_m(params) * hi;
-            let hunting = top
-                .eigenvalues
-                .iter()
-                .filter(|e| e.1 > 0.0 && e.1 <= kinematic_rad_per_s)
-                .min_by(|a, b| damping_ratio(a.0, a.1).total_cmp(&damping_ratio(b.0, b.1)));
+            let hunting = hunting_candidate(&top, kinematic_rad_per_m(params) * hi);
             Ok(Onset::Stable(
                 hunting.map(|e| e.1 / (2.0 * std::f64::consts::PI)),
             ))
@@ -119,6 +114,18 @@ pub fn vehicle_onset(
         Err(EigenError::UnstableAtLowerEnd { .. }) => Ok(Onset::Stable(None)),
         Err(e) => Err(e.to_string()),
     }
+}
+
+/// The hunting mode where nothing crosses: the least-damped oscillatory eigenvalue of `r`
+/// below the free wheelset's kinematic frequency `kinematic_rad_per_s` (bogie and car-body
+/// hunting both lie below it; a stiff damper's least-damped mode overall may be a 66 Hz one of
+/// the bogies).
+fn hunting_candidate(r: &EigenResult, kinematic_rad_per_s: f64) -> Option<(f64, f64)> {
+    r.eigenvalues
+        .iter()
+        .filter(|e| e.1 > 0.0 && e.1 <= kinematic_rad_per_s)
+        .min_by(|a, b| damping_ratio(a.0, a.1).total_cmp(&damping_ratio(b.0, b.1)))
+        .copied()
 }
 
 /// The free wheelset's kinematic (Klingel) wavenumber [rad/m]: sqrt(conicity / (r0 b)).
@@ -183,23 +190,16 @@ impl VehicleLocus {
             Err(_) => {
                 let top = self.results.len().checked_sub(1);
                 let kinematic = |k: usize| self.kinematic_rad_per_m * self.speeds_kmh[k] / 3.6;
-                top.and_then(|k| {
-                    self.results[k]
-                        .eigenvalues
-                        .iter()
-                        .filter(|e| e.1 > 0.0 && e.1 <= kinematic(k))
-                        .min_by(|a, b| damping_ratio(a.0, a.1).total_cmp(&damping_ratio(b.0, b.1)))
-                        .map(|e| (k, *e))
-                })
-                // no oscillation below it (conicity 0: no kinematic oscillation at all): the
-                // least-damped mode at the highest speed
-                .or_else(|| {
-                    self.results
-                        .iter()
-                        .enumerate()
-                        .rev()
-                        .find_map(|(k, r)| r.least_damped.map(|m| (k, (m.re, m.im))))
-                })
+                top.and_then(|k| hunting_candidate(&self.results[k], kinematic(k)).map(|e| (k, e)))
+                    // no oscillation below it (conicity 0: no kinematic oscillation at all): the
+                    // least-damped mode at the highest speed
+                    .or_else(|| {
+                        self.results
+                            .iter()
+                            .enumerate()
+                            .rev()
+                            .find_map(|(k, r)| r.least_damped.map(|m| (k, (m.re, m.im))))
+                    })
             }
         };
         let Some((k0, mode)) = start else {

@@ -91,7 +91,6 @@ pub(crate) fn write_analysis(
     add: impl FnOnce(&mut Artefacts) -> Result<(), AnalysisError>,
 ) -> Result<(), CommandError> {
     check_cancel(cancel).map_err(failed)?;
-    check_out_folder(out)?;
     let mut files = Artefacts::default();
     add(&mut files).map_err(failed)?;
     let written: Vec<String> = files.names().iter().map(|n| n.to_string()).collect();
