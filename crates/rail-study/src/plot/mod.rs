@@ -22,8 +22,8 @@ use frame::{
     Frame, FrameSpec, MAX_PANEL_CHARS, PANEL_FONT_PX,
 };
 pub(crate) use frame::{
-    colour, draw_err, draw_legend, draw_limit, draw_lines, legend_width, longest, render_svg,
-    tick_label, LegendEntry, Swatch,
+    colour, draw_err, draw_guide, draw_legend, draw_limit, draw_lines, legend_width, longest,
+    render_svg, tick_label, LegendEntry, Swatch,
 };
 
 #[derive(Debug, thiserror::Error)]
@@ -71,6 +71,14 @@ pub struct Chart {
     pub panel_height: u32,
     /// Dots on the lines' points (a few measured points, e.g. the c_v table).
     pub markers: bool,
+    /// Grey dotted horizontal lines (value, label), e.g. the bounds of comfort classes; in
+    /// every panel.
+    pub guides: Vec<(f64, String)>,
+    /// The y axis reaches 0 (a quantity whose spread reads against its size, e.g. forces).
+    pub y_from_zero: bool,
+    /// Each panel scales its y axis to its own data (the x axis stays shared): runs whose
+    /// amplitudes differ tenfold, which one scale would flatten.
+    pub own_y_per_panel: bool,
 }
 
 impl Chart {
@@ -86,6 +94,9 @@ impl Chart {
             height: 560,
             panel_height: 230,
             markers: false,
+            guides: Vec::new(),
+            y_from_zero: false,
+            own_y_per_panel: false,
         }
     }
     /// Adds a series (to the first panel, if there are panels).
@@ -144,6 +155,21 @@ impl Chart {
         self.limit = Some((value, label.into()));
         self
     }
+    /// Adds a grey dotted horizontal line, listed in the legend.
+    pub fn with_guide(mut self, value: f64, label: &str) -> Self {
+        self.guides.push((value, label.into()));
+        self
+    }
+    /// Makes the y axis reach 0.
+    pub fn with_y_from_zero(mut self) -> Self {
+        self.y_from_zero = true;
+        self
+    }
+    /// Gives each panel a y axis of its own (see [`Chart::own_y_per_panel`]).
+    pub fn with_own_y_per_panel(mut self) -> Self {
+        self.own_y_per_panel = true;
+        self
+    }
 
     /// The series of panel `p`: the references first (drawn under the others).
     fn panel_series(&self, p: usize) -> Vec<&Series> {
@@ -174,6 +200,7 @@ impl Chart {
             .filter(|s| s.reference || captioned.is_none())
             .map(|s| s.name.as_str())
             .chain(self.limit.iter().map(|(_, l)| l.as_str()))
+            .chain(self.guides.iter().map(|(_, l)| l.as_str()))
             .collect()
     }
 
@@ -187,16 +214,24 @@ impl Chart {
     pub(crate) fn legend_px(&self) -> u32 {
         if self.panels.is_empty() {
             let names = self.series.iter().map(|s| s.name.as_str());
-            return legend_width(longest(
-                names.chain(self.limit.iter().map(|(_, l)| l.as_str())),
-            ));
+            let lines = self.limit.iter().chain(&self.guides);
+            return legend_width(longest(names.chain(lines.map(|(_, l)| l.as_str()))));
         }
         let names = (0..self.panels.len()).flat_map(|p| self.legend_names(p));
         legend_width(longest(names))
     }
 
     fn ranges(&self) -> Result<(Range, Range), PlotError> {
-        let pts = self.series.iter().flat_map(|s| s.points.iter());
+        self.ranges_of(self.series.iter())
+    }
+
+    /// The axes' ranges over `series`, the horizontal lines and, with
+    /// [`Chart::y_from_zero`], 0.
+    fn ranges_of<'a>(
+        &self,
+        series: impl Iterator<Item = &'a Series>,
+    ) -> Result<(Range, Range), PlotError> {
+        let pts = series.flat_map(|s| s.points.iter());
         let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
         let mut any = false;
         for &(x, y) in pts {
@@ -214,9 +249,13 @@ impl Chart {
                 reason: "no finite points".into(),
             });
         }
-        if let Some((v, _)) = &self.limit {
+        for (v, _) in self.limit.iter().chain(&self.guides) {
             y0 = y0.min(*v);
             y1 = y1.max(*v);
+        }
+        if self.y_from_zero {
+            y0 = y0.min(0.0);
+            y1 = y1.max(0.0);
         }
         let pad = |a: f64, b: f64| {
             let d = if b > a {
@@ -236,7 +275,8 @@ impl Chart {
     }
 
     /// Renders to an SVG string; `scatter` draws points instead of lines. With panels, they
-    /// are stacked under the title and share both axes' ranges, so that they compare.
+    /// are stacked under the title and share both axes' ranges, so that they compare (the y
+    /// range only without [`Chart::own_y_per_panel`]).
     pub fn to_svg(&self, scatter: bool) -> Result<String, PlotError> {
         let ((x0, x1), (y0, y1)) = self.ranges()?;
         let t = self.title.as_str();
@@ -264,6 +304,9 @@ impl Chart {
             if let Some((v, label)) = &self.limit {
                 entries.push(draw_limit(chart, t, (x0, x1), *v, label)?);
             }
+            for (v, label) in &self.guides {
+                entries.push(draw_guide(chart, t, (x0, x1), *v, label)?);
+            }
             Ok(entries)
         };
         if self.panels.is_empty() {
@@ -289,7 +332,12 @@ impl Chart {
                     legend_px,
                     legend: self.needs_legend(p),
                 };
-                draw_frame(area, t, &spec, (x0..x1, y0..y1), |c| body(p, c))?;
+                let (py0, py1) = if self.own_y_per_panel {
+                    self.ranges_of(self.panel_series(p).into_iter())?.1
+                } else {
+                    (y0, y1)
+                };
+                draw_frame(area, t, &spec, (x0..x1, py0..py1), |c| body(p, c))?;
             }
             if shared_y {
                 draw_shared_y_desc(panels, t, &self.y_label)?;

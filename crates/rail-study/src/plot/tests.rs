@@ -270,3 +270,33 @@ fn a_panel_captioned_with_its_line_lists_only_the_limit() {
     // a column wide enough for "limit", not for the signal's name
     assert_eq!(c.legend_px(), legend_width("limit".len()));
 }
+
+#[test]
+fn panels_scale_their_own_y_axes_on_request_and_guides_are_listed() {
+    let line = |a: f64| vec![(0.0, -a), (1.0, a), (2.0, -a)];
+    let two = Chart::new("histories", "time [s]", "acceleration [m/s^2]")
+        .with_series("passive", line(30.0))
+        .with_series("MPPT2", line(0.2))
+        .one_panel_per_series();
+    // shared: the small run's panel reaches the large one's ticks; its own: only its own
+    let tick_texts = |c: &Chart| -> Vec<String> {
+        texts(&c.to_svg(false).unwrap())
+            .into_iter()
+            .map(|t| t.2)
+            .collect()
+    };
+    let shared = tick_texts(&two);
+    assert_eq!(shared.iter().filter(|t| *t == "30").count(), 2, "{shared:?}");
+    let own = tick_texts(&two.clone().with_own_y_per_panel());
+    assert_eq!(own.iter().filter(|t| *t == "30").count(), 1, "{own:?}");
+    assert!(own.iter().any(|t| t == "0.2"), "{own:?}");
+    // a guide is drawn in every panel and listed in its legend; from zero, 0 is a tick
+    let c = Chart::new("comfort", "speed [km/h]", "N_y [-]")
+        .with_series("MPPT", vec![(200.0, 1.2), (300.0, 1.4)])
+        .with_guide(2.0, "N = 2: comfortable below")
+        .with_y_from_zero();
+    let all = tick_texts(&c);
+    assert!(all.iter().any(|t| t == "N = 2: comfortable below"), "{all:?}");
+    assert!(all.iter().any(|t| t == "0"), "{all:?}");
+    assert!(all.iter().any(|t| t == "2"), "{all:?}");
+}

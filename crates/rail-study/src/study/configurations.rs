@@ -94,7 +94,7 @@ macro_rules! system_json {
 pub const CONFIGURATIONS: &[Configuration] = &[
     Configuration {
         id: "passive",
-        label: "passive (30 %)",
+        label: "passive (valve 30 % open)",
         family: Family::Passive,
         valve: Valve::None,
         json: system_json!("passive"),

@@ -89,8 +89,35 @@ fn speed_curve(chart: Chart, id: &str, label: &str, points: Vec<(f64, f64)>) -> 
 }
 
 /// The caption of a time history's detail figure in the report.
-const HISTORY_DETAIL_CAPTION: &str =
-    "the same over the last 2 s at the full recorded rate, where its cycles and switchings show";
+const HISTORY_DETAIL_CAPTION: &str = "the same over the last 2 s at the full recorded rate, \
+     where its cycles and switchings show (each panel scaled to its own run)";
+
+/// A history's y axis: its description, and a grey line that says what its scale means.
+#[derive(Clone, Copy)]
+struct YAxis<'a> {
+    label: &'a str,
+    guide: Option<(f64, &'a str)>,
+}
+
+impl<'a> YAxis<'a> {
+    const fn plain(label: &'a str) -> Self {
+        YAxis { label, guide: None }
+    }
+}
+
+/// The valve command's axis: which end is closed (the controllers' 0-10 V, (3.1)).
+const COMMAND_AXIS: YAxis<'static> = YAxis {
+    label: "command [V]",
+    guide: Some((10.0, "10 V: valve fully open (0 V: closed, most damping)")),
+};
+
+/// The valve opening's axis.
+const OPENING_AXIS: YAxis<'static> = YAxis {
+    label: OPENING_LABEL,
+    guide: Some((1.0, "1: valve fully open (0: closed, most damping)")),
+};
+
+const OPENING_LABEL: &str = "opening [-]";
 
 /// (time, value) pairs of a series.
 type Points = Vec<(f64, f64)>;
@@ -105,12 +132,13 @@ fn history_chart(
     dir: &Path,
     stem: &str,
     title: &str,
-    y_label: &str,
+    y_axis: YAxis<'_>,
     runs: &[(&str, String)],
     column: &str,
     scale: f64,
     detail: Option<(&str, &str)>,
 ) -> Result<Option<(String, Option<String>)>, StudyError> {
+    let y_label = y_axis.label;
     // (panel label, CSV header, points) of each run that has the column
     let of = |get: &dyn Fn(&str) -> Option<Points>| -> Vec<(&str, String, Points)> {
         runs.iter()
@@ -121,7 +149,7 @@ fn history_chart(
     if found.is_empty() {
         return Ok(None);
     }
-    let mut views = vec![(stem, title.to_string(), found)];
+    let mut views = vec![(stem, title.to_string(), found, false)];
     let mut detail_written = None;
     if let Some((stem, title)) = detail {
         let tail = of(&|run| tail_series(r, run, column, scale));
@@ -134,12 +162,14 @@ fn history_chart(
             (span > 0.0).then(|| (s.len() - 1) as f64 / span)
         });
         if let (Some(rate_hz), true) = (rate_hz, same_grid) {
-            let title = format!("{title} ({rate_hz:.0} Hz samples, unfiltered)");
-            views.push((stem, title, tail));
+            let title = format!(
+                "{title} ({rate_hz:.0} Hz samples, unfiltered; each panel scaled to its run)"
+            );
+            views.push((stem, title, tail, true));
             detail_written = Some(stem.to_string());
         }
     }
-    for (stem, title, found) in views {
+    for (stem, title, found, own_scales) in views {
         let cols: Vec<(String, Points)> = found
             .iter()
             .map(|(_, header, s)| (header.clone(), s.clone()))
@@ -148,6 +178,15 @@ fn history_chart(
         let mut chart = Chart::new(&title, "time [s]", y_label);
         for ((label, _, _), (_, points)) in found.iter().zip(cols) {
             chart = chart.with_series(label, points);
+        }
+        if let Some((value, label)) = y_axis.guide {
+            chart = chart.with_guide(value, label);
+        }
+        if own_scales {
+            // the whole history compares the runs on one scale; the detail shows the shape of
+            // each, which one scale flattens where the passive damper hunts at 10 times the
+            // others' amplitude
+            chart = chart.with_own_y_per_panel();
         }
         chart
             .one_panel_per_series()
@@ -272,17 +311,24 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         "speed [km/h]",
         "max sliding rms, band-passed [m/s^2]",
     )
-    .with_limit(r.limit_mps2, &format!("a_lim = {:.2} m/s^2", r.limit_mps2));
+    .with_limit(r.limit_mps2, &format!("a_lim = {:.2} m/s^2", r.limit_mps2))
+    // a dot on each speed run: the sweep's steps and the bisection's refinements
+    .with_markers();
     let mut carbody_chart = Chart::new(
         "car-body floor lateral acceleration vs speed (largest of front, mid, rear)",
         "speed [km/h]",
         "rms [m/s^2]",
-    );
+    )
+    .with_markers();
     let mut comfort_chart = Chart::new(
-        "EN 12299 lateral ride comfort vs speed (W_d, largest of front, mid, rear)",
+        "EN 12299 lateral ride comfort vs speed (W_d, largest of front, mid, rear; indicative: \
+         5 s windows in 1 s steps over each run, not the standard's 5 minutes)",
         "speed [km/h]",
         "N_y = 6 a_YP95 [-]",
-    );
+    )
+    .with_markers()
+    .with_guide(1.0, "N = 1: very comfortable below")
+    .with_guide(2.0, "N = 2: comfortable below");
     let num = |v: Option<f64>| v.map_or("failed".into(), |v| format!("{v:.4}"));
     let (mut carbody_rows, mut comfort_rows) = (Vec::new(), Vec::new());
     for c in &r.configs {
@@ -417,24 +463,26 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
     let force = vehicle.first("damper", "damper.force");
     let command = vehicle.first("controller", "valve.command");
     let opening = vehicle.first("damper", "valve.opening");
-    let carbody_mid = signals.carbody.get(1).cloned().unwrap_or_default();
+    // above the front bogie, where the yaw dampers act: the mid-length point, between the
+    // bogies, moves least (sky-hook at 300 km/h: rms 0.20 front, 0.09 mid, 0.16 rear m/s^2)
+    let carbody_front = signals.carbody.first().cloned().unwrap_or_default();
     let command_what = if coach {
         "front-left damper's valve command"
     } else {
         "left damper's valve command"
     };
     let mut histories = vec![
-        ((stem::HISTORY_DISPLACEMENT, stem::HISTORY_DISPLACEMENT_DETAIL), "leading wheelset lateral displacement relative to the track", "displacement [mm]", ws_y, 1e3, &hist_runs, "wheelset displacement, passive / MPPT2 / sky-hook / full-active (Figs. 4.18, 4.21, 4.25)"),
-        ((stem::HISTORY_ACCELERATION, stem::HISTORY_ACCELERATION_DETAIL), acc_what, "acceleration [m/s^2]", acc, 1.0, &hist_runs, "the assessed acceleration as recorded (the EN 14363 rms band-passes it first; Figs. 4.18, 4.21, 4.26)"),
-        ((stem::HISTORY_FORCE, stem::HISTORY_FORCE_DETAIL), damper_what, "force [kN]", force.as_str(), 1e-3, &semi_runs, "damper force (Figs. 4.18, 4.21)"),
-        ((stem::HISTORY_COMMAND, stem::HISTORY_COMMAND_DETAIL), command_what, "command [V]", command.as_str(), 1.0, &semi_runs, "valve command MPPT2 vs sky-hook (Figs. 4.18, 4.21)"),
+        ((stem::HISTORY_DISPLACEMENT, stem::HISTORY_DISPLACEMENT_DETAIL), "leading wheelset lateral displacement relative to the track", YAxis::plain("displacement [mm]"), ws_y, 1e3, &hist_runs, "wheelset displacement, passive / MPPT2 / sky-hook / full-active (Figs. 4.18, 4.21, 4.25)"),
+        ((stem::HISTORY_ACCELERATION, stem::HISTORY_ACCELERATION_DETAIL), acc_what, YAxis::plain("acceleration [m/s^2]"), acc, 1.0, &hist_runs, "the assessed acceleration as recorded (the EN 14363 rms band-passes it first; Figs. 4.18, 4.21, 4.26)"),
+        ((stem::HISTORY_FORCE, stem::HISTORY_FORCE_DETAIL), damper_what, YAxis::plain("force [kN]"), force.as_str(), 1e-3, &semi_runs, "damper force (Figs. 4.18, 4.21)"),
+        ((stem::HISTORY_COMMAND, stem::HISTORY_COMMAND_DETAIL), command_what, COMMAND_AXIS, command.as_str(), 1.0, &semi_runs, "valve command MPPT2 vs sky-hook (Figs. 4.18, 4.21)"),
     ];
     if coach {
         histories.push((
             (stem::HISTORY_CARBODY, stem::HISTORY_CARBODY_DETAIL),
-            "car-body floor lateral acceleration at mid-length",
-            "acceleration [m/s^2]",
-            carbody_mid.as_str(),
+            "car-body floor lateral acceleration above the front bogie",
+            YAxis::plain("acceleration [m/s^2]"),
+            carbody_front.as_str(),
             1.0,
             &hist_runs,
             "what each damper concept transmits to the car body (the seed's future work)",
@@ -460,14 +508,36 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             }
         }
     }
-    // full-active force tracking (Fig. 4.27)
+    // full-active force tracking (Fig. 4.27): the last seconds at the full recorded rate
+    // (the actuator lags its reference by about one 100 Hz sample)
     let fa = scenario::history("full_active");
-    if let (Some(f), Some(fr)) = (
-        series(r, &fa, &vehicle.first("actuator", "damper.force"), 1e-3),
-        series(r, &fa, &vehicle.first("idf", "reference.force"), 1e-3),
-    ) {
+    let (fa_force, fa_reference) = (
+        vehicle.first("actuator", "damper.force"),
+        vehicle.first("idf", "reference.force"),
+    );
+    let full_rate = (
+        tail_series(r, &fa, &fa_force, 1e-3),
+        tail_series(r, &fa, &fa_reference, 1e-3),
+    );
+    let stored = || {
+        (
+            series(r, &fa, &fa_force, 1e-3),
+            series(r, &fa, &fa_reference, 1e-3),
+        )
+    };
+    let (tail, picked) = match full_rate {
+        (Some(f), Some(fr)) => (true, (Some(f), Some(fr))),
+        _ => (false, stored()),
+    };
+    if let (Some(f), Some(fr)) = picked {
         let t_end = f.last().map_or(0.0, |p| p.0);
-        let zoom = |s: &[(f64, f64)]| from_time(s, t_end - 2.0);
+        let zoom = |s: &[(f64, f64)]| from_time(s, t_end - HISTORY_DETAIL_S);
+        let rate_hz = if tail {
+            let span = f.last().map_or(0.0, |p| p.0) - f.first().map_or(0.0, |p| p.0);
+            (f.len().saturating_sub(1)) as f64 / span.max(f64::MIN_POSITIVE)
+        } else {
+            r.settings.stored_rate_hz
+        };
         write_series_csv(
             &out.join("full_active_force.csv"),
             &[
@@ -477,7 +547,13 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         )?;
         Chart::new(
             &format!(
-                "full-active: actuator force and IDF reference at {v_hist:.0} km/h (last 2 s)"
+                "full-active, {first}: actuator force and IDF reference c_v v at {v_hist:.0} \
+                 km/h, irregular track (last {HISTORY_DETAIL_S:.0} s, {rate_hz:.0} Hz samples)",
+                first = if coach {
+                    "front-left actuator"
+                } else {
+                    "left actuator"
+                }
             ),
             "time [s]",
             "force [kN]",
@@ -493,8 +569,13 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
 
     // ---- perturbation (Figs. 4.4-4.6, 5.11-5.13, 5.16-5.18; R7)
     let mut pert_cols = Vec::new();
+    let pert_title = format!(
+        "passive, ideal track, {:.1} mm initial lateral displacement of the {}",
+        r.settings.perturbation_lateral_m * 1e3,
+        if coach { "both bogies" } else { "bogie" }
+    );
     let mut chart = Chart::new(
-        "passive, ideal track, initial lateral displacement",
+        &pert_title,
         "time [s]",
         "leading wheelset lateral displacement relative to the track [mm]",
     );
@@ -541,7 +622,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         out,
         stem::MPPT_COMMAND_CLOSED_START,
         &format!("MPPT valve command of the {first_damper} from a closed valve at {v_low:.0} km/h, irregular track"),
-        "command [V]",
+        COMMAND_AXIS,
         &low_runs,
         &command,
         1.0,
@@ -569,7 +650,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             "MPPT valve command of the {first_damper} from {:.0} V, slow valve, {v_hil:.0} km/h, {}",
             r.settings.hil_initial_command_v, hil_what
         ),
-        "command [V]",
+        COMMAND_AXIS,
         &mppt_hil,
         &command,
         1.0,
@@ -588,7 +669,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             "leading wheelset displacement relative to the track at {v_hil:.0} km/h, {hil_what} \
              (each panel names its valve)"
         ),
-        "displacement [mm]",
+        YAxis::plain("displacement [mm]"),
         &hil_runs,
         ws_y,
         1e3,
@@ -607,7 +688,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             "actual valve opening of the {first_damper} at {v_hil:.0} km/h, {hil_what} (each \
              panel names its valve)"
         ),
-        "opening [-]",
+        OPENING_AXIS,
         &hil_runs,
         &opening,
         1.0,
@@ -621,30 +702,35 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
 
     // Fig. 5.25: zoom on the on/off sky-hook's command and the valve's actual opening
     let slow = scenario::hil("skyhook_onoff_slow");
-    if let (Some(cmd), Some(open)) = (
+    if let (Some(cmd), Some(open), Some(disp)) = (
         series(r, &slow, &command, 0.1),
         series(r, &slow, &opening, 1.0),
+        series(r, &slow, ws_y, 1e3),
     ) {
-        // the second where the command switches most: on the coach the sky-hook settles
-        // and its last second held only numerical noise (1e-20)
-        let t0 = busiest_second(&cmd);
+        // the second where the wheelset moves most: the sign law of (3.6) does not depend on
+        // the amplitude, so once the hunting has died out the command keeps switching on a
+        // motion of nanometres, and the second where it switches most shows nothing physical
+        let t0 = busiest_second(&disp);
         let zoom = |s: &[(f64, f64)]| between(s, t0, t0 + 1.0);
+        let peak_mm = zoom(&disp).iter().fold(0.0_f64, |m, p| m.max(p.1.abs()));
         write_series_csv(
             &out.join("skyhook_valve_zoom.csv"),
             &[
                 ("slow valve: command / 10 V [-]".into(), cmd.clone()),
                 ("slow valve: actual opening [-]".into(), open.clone()),
+                ("leading wheelset displacement [mm]".into(), disp.clone()),
             ],
         )?;
         Chart::new(
             &format!(
-                "on/off sky-hook, slow valve, {v_hil:.0} km/h: command and actual opening, \
-                 {t0:.0}-{:.0} s, the second where the command varies most ({:.0} Hz samples)",
+                "on/off sky-hook, slow valve, {v_hil:.0} km/h, {hil_what}: command and actual \
+                 opening over {t0:.0}-{:.0} s, the second where the leading wheelset moves most \
+                 (up to {peak_mm:.2} mm; {:.0} Hz samples)",
                 t0 + 1.0,
                 r.settings.stored_rate_hz
             ),
             "time [s]",
-            "opening [-]",
+            OPENING_LABEL,
         )
         .with_series("slow valve: command / 10 V", zoom(&cmd))
         .with_series("slow valve: actual opening", zoom(&open))
@@ -737,9 +823,10 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         .with_series(&ours_label, acceleration)
         // the seed in grey in both c_v figures (a colour there means one of ours)
         .with_reference(
-            "seed (Table 4-3)",
+            "seed (Table 4-3, speed not given)",
             SEED_TABLE_4_3.iter().map(|s| (s.0, s.1)).collect(),
         )
+        .with_limit(r.limit_mps2, &format!("a_lim = {:.2} m/s^2", r.limit_mps2))
         .write_lines(&out.join("cv_acceleration.svg"))?;
         figures.push((
             stem::CV_ACCELERATION.into(),
@@ -755,13 +842,15 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             "force [kN]",
         )
         .with_markers()
+        // from 0: the peaks' spread reads against their size (the seed's 81-98 % of the bound)
+        .with_y_from_zero()
         .with_series(&format!("{ours_label}: F_max"), peak);
         if reference.len() >= 2 {
             chart = chart.with_series(&format!("{ours_label}: peak reference c_v v"), reference);
         }
         chart
             .with_reference(
-                "seed (Table 4-3): F_max",
+                "seed (Table 4-3, speed not given): F_max",
                 SEED_TABLE_4_3.iter().map(|s| (s.0, s.2)).collect(),
             )
             .with_limit(

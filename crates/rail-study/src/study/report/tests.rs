@@ -128,7 +128,7 @@ fn report_has_the_tables_the_timing_and_the_failures() {
     assert_eq!(gain_over_passive(&r, "mppt2"), Some(110.0));
     let md = report_markdown(&r, &t, &[("rms_vs_speed".into(), "caption")]);
     for s in [
-        "| passive (30 %) | 290.0 (stable at 280.0) | - | - | 280-300 km/h | R8 |",
+        "| passive (valve 30 % open) | 290.0 (stable at 280.0) | - | - | 280-300 km/h | R8 |",
         "| MPPT2, ideal valve | > 400 | - | >= +110 |",
         "**10.0 simulated seconds per wall-clock second**",
         "| 210 | 7.00 | 20.0 | 5.00 | - | 0.250 | 8.00 | 7.08 | 20.4 | 0.357 |",
@@ -243,8 +243,8 @@ fn the_coach_report_has_the_car_body_beside_the_en14363_verdict() {
     for s in [
         "on the coach",
         "## Car body: lateral acceleration and ride comfort",
-        "| passive (30 %) | 280 | 3.00 | met | 0.250 | 1.50 | 1.50 |",
-        "| passive (30 %) | 290 | failed | run failed | failed | failed | - |",
+        "| passive (valve 30 % open) | 280 | 3.00 | met | 0.250 | 1.50 | 1.50 |",
+        "| passive (valve 30 % open) | 290 | failed | run failed | failed | failed | - |",
         "R16, Figs. 4.4-4.6",
         DIFFERENCES_COACH,
     ] {
@@ -272,7 +272,7 @@ fn the_coach_report_has_the_car_body_beside_the_en14363_verdict() {
         let svg = std::fs::read_to_string(d.path().join(f)).unwrap();
         for s in [
             ">\nMPPT\n<",
-            ">\npassive (30 %)\n<",
+            ">\npassive (valve 30 % open)\n<",
             ">\nMPPT2, ideal valve\n<",
         ] {
             assert!(svg.contains(s), "{f}: missing {s:?}");
@@ -337,7 +337,7 @@ fn force_bound_note_names_the_saturated_gains_from_the_runs() {
     let svg = std::fs::read_to_string(d.path().join("cv_force.svg")).unwrap();
     for s in [
         "force bound 25.2 kN (100 bar on 25.16 cm^2)",
-        "seed (Table 4-3): F_max",
+        "seed (Table 4-3, speed not given): F_max",
         "ours, 380 km/h: peak reference c_v v",
     ] {
         assert!(svg.contains(s), "cv_force.svg: missing {s:?}");
