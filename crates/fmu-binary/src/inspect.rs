@@ -4,7 +4,7 @@ use std::collections::BTreeSet;
 use std::fmt;
 
 use object::elf;
-use object::read::elf::{Dyn, ElfFile, FileHeader};
+use object::read::elf::{Dyn, ElfFile, FileHeader, ProgramHeader};
 use object::{FileKind, Object};
 
 use crate::version::SymbolVersion;
@@ -248,6 +248,63 @@ fn elf_image<'data, H: FileHeader<Endian = object::Endianness>>(
     let m = malformed("ELF");
     let endian = file.endian();
     let data = file.data();
+    // the loader maps each loadable segment from the file: one that reaches past the file's
+    // end (a truncated library) faults (SIGBUS) when touched, inside dlopen, before any error
+    // can be returned
+    let segments = file.elf_program_headers();
+    if !segments.iter().any(|p| p.p_type(endian) == elf::PT_LOAD) {
+        return Err(BinaryError::Malformed {
+            format: "ELF",
+            reason: "no loadable segment".into(),
+        });
+    }
+    for (k, p) in segments.iter().enumerate() {
+        if p.p_type(endian) != elf::PT_LOAD {
+            continue;
+        }
+        let (offset, size) = (p.p_offset(endian).into(), p.p_filesz(endian).into());
+        if offset
+            .checked_add(size)
+            .is_none_or(|end| end > data.len() as u64)
+        {
+            return Err(BinaryError::Malformed {
+                format: "ELF",
+                reason: format!(
+                    "loadable segment {k} (bytes {offset}..{}) reaches past the file's end \
+                     ({} bytes): a truncated library",
+                    offset.saturating_add(size),
+                    data.len()
+                ),
+            });
+        }
+    }
+    // a shared library's dynamic segment names its symbol and string tables, which the loader
+    // follows (a zeroed one, as in a damaged file of the right size, crashes it)
+    let mut dynamic_found = false;
+    for p in segments.iter() {
+        if let Some(entries) = p.dynamic(endian, data).map_err(&m)? {
+            dynamic_found = true;
+            let has = |tag: u32| {
+                entries
+                    .iter()
+                    .take_while(|e| e.tag32(endian) != Some(elf::DT_NULL))
+                    .any(|e| e.tag32(endian) == Some(tag))
+            };
+            if !has(elf::DT_SYMTAB) || !has(elf::DT_STRTAB) {
+                return Err(BinaryError::Malformed {
+                    format: "ELF",
+                    reason: "its dynamic segment names no symbol table (DT_SYMTAB, DT_STRTAB)"
+                        .into(),
+                });
+            }
+        }
+    }
+    if !dynamic_found {
+        return Err(BinaryError::Malformed {
+            format: "ELF",
+            reason: "no dynamic segment: not a shared library".into(),
+        });
+    }
     let sections = file.elf_section_table();
     let exports = file
         .exports()

@@ -172,3 +172,61 @@ fn what_is_no_shared_library_is_an_error() {
     assert!(inspect(b"not a binary at all").is_err());
     assert!(inspect(b"\x7fELF\x02\x01\x01").is_err());
 }
+
+/// The test executable (a position-independent ELF file, with a dynamic segment as a shared
+/// library has) without its section table, as a stripped library may come: what is left for a
+/// check is what the loader reads, the program headers.
+fn test_executable_without_sections() -> Vec<u8> {
+    let mut bytes = std::fs::read(std::env::current_exe().unwrap()).unwrap();
+    assert_eq!(&bytes[..5], b"\x7fELF\x02", "a 64-bit ELF file");
+    // e_shoff, e_shnum, e_shstrndx
+    bytes[0x28..0x30].fill(0);
+    bytes[0x3c..0x40].fill(0);
+    inspect(&bytes).unwrap();
+    bytes
+}
+
+/// (type, offset, size in the file) of each program header of a little-endian ELF64 file.
+fn program_headers(bytes: &[u8]) -> Vec<(u32, usize, usize)> {
+    let u = |at: usize, n: usize| {
+        bytes[at..at + n]
+            .iter()
+            .rev()
+            .fold(0usize, |v, b| (v << 8) | usize::from(*b))
+    };
+    let (phoff, phentsize, phnum) = (u(0x20, 8), u(0x36, 2), u(0x38, 2));
+    (0..phnum)
+        .map(|k| {
+            let h = phoff + k * phentsize;
+            (u(h, 4) as u32, u(h + 8, 8), u(h + 32, 8))
+        })
+        .collect()
+}
+
+#[test]
+fn a_truncated_library_is_malformed_before_a_loader_maps_past_its_end() {
+    let bytes = test_executable_without_sections();
+    let (_, offset, size) = program_headers(&bytes)
+        .into_iter()
+        .filter(|h| h.0 == 1) // PT_LOAD
+        .max_by_key(|h| h.1 + h.2)
+        .unwrap();
+    let cut = &bytes[..offset + size - 1];
+    let e = inspect(cut).unwrap_err().to_string();
+    assert!(
+        e.contains("malformed ELF file") && e.contains("reaches past the file's end"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_zeroed_dynamic_segment_is_malformed() {
+    let mut bytes = test_executable_without_sections();
+    let (_, offset, size) = program_headers(&bytes)
+        .into_iter()
+        .find(|h| h.0 == 2) // PT_DYNAMIC
+        .unwrap();
+    bytes[offset..offset + size].fill(0);
+    let e = inspect(&bytes).unwrap_err().to_string();
+    assert!(e.contains("names no symbol table"), "{e}");
+}

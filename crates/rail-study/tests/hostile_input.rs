@@ -354,6 +354,33 @@ fn huge_runs_are_refused_up_front() {
 }
 
 #[test]
+fn a_damaged_binary_is_refused_before_it_is_loaded() {
+    // the system loader faults inside dlopen on these (SIGBUS, SIGSEGV), taking the process
+    // down before any error could be returned: they are read and refused first
+    let c = Case::new();
+    let so = std::fs::read(hostile_binary()).unwrap();
+    let md = ("modelDescription.xml", HOSTILE_MD.as_bytes());
+    let cut = &so[..4096];
+    let mut zeroed = so.clone();
+    zeroed[4096..].fill(0);
+    for (what, binary) in [("cut short", cut), ("zeroed after its first page", &zeroed)] {
+        zip_into(
+            &c.path("Hostile.fmu"),
+            &[md, ("binaries/linux64/Hostile.so", binary)],
+        );
+        for sub in [&["run", "system.json"][..], &["inspect", "Hostile.fmu"][..]] {
+            let e = c.fails(sub, &[]);
+            assert!(
+                e.contains("binaries/linux64/Hostile.so")
+                    && (e.contains("is not a loadable shared library")
+                        || e.contains("malformed ELF file")),
+                "{what}, {sub:?}: {e}"
+            );
+        }
+    }
+}
+
+#[test]
 fn archive_limits_and_unsafe_entries_are_refused_before_extraction() {
     let c = Case::new();
     let so = std::fs::read(hostile_binary()).unwrap();

@@ -49,6 +49,18 @@ impl PreparedFmu {
             .join("binaries")
             .join(platform)
             .join(format!("{}{suffix}", cs.model_identifier));
+        // read before loading: the loader faults (SIGBUS, SIGSEGV) on some malformed
+        // libraries, e.g. a truncated one, taking the whole process down with it; a file that
+        // cannot be read is left to the loader, whose error names it
+        if let Ok(data) = std::fs::read(&binary) {
+            fmu_binary::inspect(&data).map_err(|e| {
+                load_err(format!(
+                    "its binary binaries/{platform}/{}{suffix} is not a loadable shared \
+                     library: {e}",
+                    cs.model_identifier
+                ))
+            })?;
+        }
         let library =
             Fmi2Library::load(&binary, cs.can_get_and_set_fmu_state).map_err(&load_err)?;
         // FMI 2.0 (2.1.5): fmuResourceLocation is a URI of the unpacked resources folder
