@@ -76,4 +76,5 @@ def write_results_csv(
     texts: List[Tuple[int, List[str]]],
     metadata_json: Optional[str] = None,
     summary_json: Optional[str] = None,
+    sampling_known: bool = True,
 ) -> None: ...

@@ -196,14 +196,18 @@ class Results:
         (``results.csv`` -> ``results.meta.json``: each column's type, unit and FMU variable,
         the sampling, the summary and the system as run), which :func:`read_results` and
         ``master assess`` read."""
-        if Path(path).suffix.lower() == ".parquet":
+        if Path(path).suffix.lower() in (".parquet", ".pq"):
             # CSV text under a Parquet name is a file nothing reads back
             raise _railfmu.OutputError(f"to_csv writes CSV: '{path}' names a Parquet file; give a .csv name")
         texts = [(self.names.index(n), list(t)) for n, t in self.texts.items()]
         meta = json.dumps(self.metadata) if self.metadata is not None else None
         data = np.ascontiguousarray(self.values, dtype=np.float64).tobytes()
         summary = json.dumps(self.summary)
-        _railfmu.write_results_csv(os.fspath(path), self.header, data, texts, meta, summary)
+        # a run's own table has its full band; one read from a file has what its metadata
+        # say; any other (e.g. built from every 20th row of another) records no sampling, so
+        # that an assessment of the file notes it as one of the table does
+        known = self.full_rate or (self.metadata is not None and self.metadata.get("sampling") is not None)
+        _railfmu.write_results_csv(os.fspath(path), self.header, data, texts, meta, summary, known)
 
 
 class RunSetResults(Mapping[str, Results]):

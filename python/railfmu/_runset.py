@@ -46,6 +46,15 @@ def _folder_lock(folder: Path):
 DoneCallback = Callable[[int, int, str, Optional[str]], Any]
 
 
+
+def _usable_cores() -> int:
+    """The cores this process may run on (its affinity mask: a batch job's allocation, a
+    ``taskset``), as ``master sweep`` counts them; all the machine's where there is no mask."""
+    try:
+        return len(os.sched_getaffinity(0)) or 1
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
 class RunSet:
     """A run set expanded into self-contained jobs: each job is its name, its parameters and
     its resolved system description (FMU paths absolute), exactly as ``master sweep`` runs it.
@@ -113,7 +122,7 @@ class RunSet:
           every run with its name and parameters as columns: ``pandas.read_parquet``); None:
           Parquet from 200 000 values (rows x columns) per run on, as ``master sweep``.
 
-        * ``client=None``: on ``threads`` local threads (default: all cores), the GIL released.
+        * ``client=None``: on ``threads`` local threads (default: the cores this process may use), the GIL released.
         * ``client=dask.distributed.Client(...)``: one Dask task per run (see
           :mod:`railfmu.dask`); the results come back to this process, which writes the folder.
           ``threads`` is refused with it (the cluster's workers run the tasks).
@@ -206,7 +215,9 @@ class RunSet:
                     local_runs = False
                     try:
                         if client is None and system is not None:
-                            threads = threads or os.cpu_count() or 1
+                            # no more threads than runs (a count beyond any machine's, 2**70,
+                            # is then no error after the folder was prepared)
+                            threads = min(threads or _usable_cores(), len(jobs))
                             local_runs = True
                             new = system.run_jobs(jobs, os.fspath(out), threads, on_done, format)
                         else:

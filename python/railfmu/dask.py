@@ -26,7 +26,10 @@ sub-folder's modification time). It stays bounded: whenever a worker writes a ne
 removes the copies not used for 7 days and, beyond the 16 most recently used, those not used for
 an hour (a copy is only read while a worker prepares the system, so an hour is ample). A copy is
 first renamed aside (``.removed-*``), then removed, so no worker finds it half-removed; one
-removed and needed again is written again. Nothing else in the folder is touched.
+removed and needed again is written again. Nothing else in the folder is touched. The folder is
+private (made 0700); one that belongs to another user, or that others may write to, is refused
+(the workers would run any FMU put there). A worker checks the SHA-256 of a copy before its first
+use and writes a damaged one again.
 
 A worker prepares a system (unpacks and loads its FMUs) once and keeps it for the later tasks of
 the same run set. A simulation that fails is the run's result (its error is kept in its
@@ -44,6 +47,7 @@ import json
 import os
 import re
 import shutil
+import stat
 import tempfile
 import threading
 import time
@@ -67,7 +71,57 @@ _KEEP_PREPARED = 4
 
 
 def _fmu_cache_dir() -> Path:
-    return Path(tempfile.gettempdir()) / f"railfmu-fmus-{os.getuid() if hasattr(os, 'getuid') else 'user'}"
+    """This user's FMU cache folder, made private (0700) when new. One that another user
+    could write to (made by them first under a shared temporary folder, or opened to others)
+    is refused: the workers would run whatever FMU was put there."""
+    root = Path(tempfile.gettempdir()) / f"railfmu-fmus-{os.getuid() if hasattr(os, 'getuid') else 'user'}"
+    try:
+        root.mkdir(mode=0o700)
+    except FileExistsError:
+        pass
+    if hasattr(os, "getuid"):
+        st = os.lstat(root)
+        if not stat.S_ISDIR(st.st_mode):
+            raise RuntimeError(f"FMU cache '{root}' is not a folder (a link or a file): remove it")
+        if st.st_uid != os.getuid():
+            raise RuntimeError(f"FMU cache '{root}' belongs to another user (uid {st.st_uid}): remove it")
+        if st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+            raise RuntimeError(f"FMU cache '{root}' is writable by other users: remove it, or chmod 700 it")
+    return root
+
+
+# Copies this worker found intact: path -> (inode, size, modification time in ns) when their
+# SHA-256 was checked (a copy is hashed once per worker, not on every run).
+_verified: Dict[str, Tuple[int, int, int]] = {}
+
+
+def _stamp(path: Path) -> Tuple[int, int, int]:
+    st = path.stat()
+    return (st.st_ino, st.st_size, st.st_mtime_ns)
+
+
+def _intact(path: Path, digest: str, size: int) -> bool:
+    """Whether the cached copy at ``path`` holds the FMU of ``digest`` (its bytes hashed once,
+    then recognised by its file stamp)."""
+    try:
+        stamp = _stamp(path)
+    except OSError:
+        return False
+    if stamp[1] != size:
+        return False
+    if _verified.get(str(path)) == stamp:
+        return True
+    h = hashlib.sha256()
+    try:
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                h.update(block)
+    except OSError:
+        return False
+    if h.hexdigest() != digest:
+        return False
+    _verified[str(path)] = stamp
+    return True
 
 
 # The FMU cache's bounds (see the module's documentation).
@@ -83,7 +137,8 @@ def _local_copy(digest: str, name: str, data: bytes) -> str:
     """Path of this worker's copy of an FMU (written once, atomically)."""
     folder = _fmu_cache_dir() / digest[:32]
     path = folder / name
-    if path.is_file() and path.stat().st_size == len(data):
+    # a copy damaged since it was written (a full disk, a hand) is written again
+    if _intact(path, digest, len(data)):
         try:
             os.utime(folder)  # used now: kept by the cache's trimming
             return str(path)
@@ -91,7 +146,7 @@ def _local_copy(digest: str, name: str, data: bytes) -> str:
             pass
     if hashlib.sha256(data).hexdigest() != digest:
         raise RuntimeError(f"FMU '{name}' arrived damaged (SHA-256 differs)")
-    folder.mkdir(parents=True, exist_ok=True)
+    folder.mkdir(mode=0o700, parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=folder, prefix=".tmp-")
     try:
         with os.fdopen(fd, "wb") as f:

@@ -886,9 +886,11 @@ fn read_results<'py>(py: Python<'py>, path: PathBuf) -> PyResult<ReadTable<'py>>
 /// (`<name>.meta.json`). The table (header, data bytes, texts, as [`read_results`] gives
 /// them) has its columns described by the metadata JSON (None: Reals, and Strings where there
 /// are texts), which also gives the run's name, parameters and system description, if any;
-/// `summary_json` is the run's summary (missing statistics are 0).
+/// `summary_json` is the run's summary (missing statistics are 0). `sampling_known`: false for
+/// a table of unknown origin (its metadata then record no sampling, so that an assessment of
+/// the file notes it, as one of the table did).
 #[pyfunction]
-#[pyo3(signature = (path, header, data, texts, metadata_json=None, summary_json=None))]
+#[pyo3(signature = (path, header, data, texts, metadata_json=None, summary_json=None, sampling_known=true))]
 fn write_results_csv(
     path: PathBuf,
     header: Vec<String>,
@@ -896,6 +898,7 @@ fn write_results_csv(
     texts: Vec<(usize, Vec<String>)>,
     metadata_json: Option<&str>,
     summary_json: Option<&str>,
+    sampling_known: bool,
 ) -> PyResult<()> {
     let meta = metadata_json
         .map(serde_json::from_str::<ResultsMetadata>)
@@ -911,7 +914,10 @@ fn write_results_csv(
     if let Some(s) = summary_json {
         out.summary = results::summary(s).map_err(OutputError::new_err)?;
     }
-    let mut ctx = RunContext::default();
+    let mut ctx = RunContext {
+        sampling_unknown: !sampling_known,
+        ..RunContext::default()
+    };
     if let Some(m) = meta {
         out.decimation = m.sampling.and_then(|s| s.decimation);
         ctx.run = m.run;

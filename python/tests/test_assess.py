@@ -61,6 +61,14 @@ def test_a_runs_results_are_assessed_as_the_command_line_assesses_their_file(hun
     f = railfmu.assess_stability(path, SIGNALS, 320.0, skip_s=5.0)
     assert f.max_rms == pytest.approx(a.max_rms, rel=1e-12)
     assert len(f.notes) == 1
+    # every 20th row, no anti-aliasing filter: a table of unknown sampling, noted as such in
+    # memory and in the file it is written to (not recorded as a full band it does not have)
+    every20 = railfmu.Results(hunting.header, hunting.values[::20])
+    assert len(railfmu.assess_stability(every20, SIGNALS, 320.0, skip_s=5.0).notes) == 1
+    every20.to_csv(tmp_path / "every20.csv")
+    assert json.loads((tmp_path / "every20.meta.json").read_text())["sampling"] is None
+    f = railfmu.assess_stability(tmp_path / "every20.csv", SIGNALS, 320.0, skip_s=5.0)
+    assert len(f.notes) == 1 and "its metadata has no sampling" in f.notes[0], f.notes
     df = a.to_pandas()
     assert list(df.columns) == ["signal", "window_centre_m", "rms"]
     assert df.attrs["limit"] == a.limit and len(df) == sum(len(s.rms) for s in a.signals.values())

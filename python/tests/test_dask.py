@@ -8,6 +8,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -426,8 +427,8 @@ def test_the_fmu_cache_of_the_workers_stays_bounded(monkeypatch, tmp_path):
     # the workers' temporary folder (TMPDIR), as tempfile reads it
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
     root = rdask._fmu_cache_dir()
-    assert root.parent == tmp_path
-    root.mkdir()
+    assert root.parent == tmp_path and root.is_dir()
+    assert root.stat().st_mode & 0o777 == 0o700, "private to its user"
     now = time.time()
     hour, day = 3600, 24 * 3600
 
@@ -476,6 +477,33 @@ def test_the_fmu_cache_of_the_workers_stays_bounded(monkeypatch, tmp_path):
     assert entries() == {third.name, second.name, path.parent.name} | {f.name for f in in_use}
     assert mine.is_dir() and (root / "note.txt").read_text() == "kept"
     assert not [p for p in root.iterdir() if p.name.startswith(".")]
+
+
+def test_the_fmu_cache_replaces_a_damaged_copy_and_refuses_a_folder_others_can_write(monkeypatch, tmp_path):
+    from railfmu import dask as rdask
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    content = b"an FMU's bytes"
+    digest = hashlib.sha256(content).hexdigest()
+    path = Path(rdask._local_copy(digest, "Model.fmu", content))
+    assert path.read_bytes() == content
+    # damaged in place at the same size (a hand, a disk): found by its hash, written again
+    path.write_bytes(b"x" * len(content))
+    assert Path(rdask._local_copy(digest, "Model.fmu", content)).read_bytes() == content
+    # a cache folder that other users may write to (or made by another user first) is refused
+    root = rdask._fmu_cache_dir()
+    root.chmod(0o777)
+    with pytest.raises(RuntimeError, match="writable by other users"):
+        rdask._local_copy(digest, "Model.fmu", content)
+    root.chmod(0o700)
+    # a link in its place, to a folder someone else prepared
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    shutil.rmtree(root)
+    root.symlink_to(elsewhere)
+    with pytest.raises(RuntimeError, match="is not a folder"):
+        rdask._local_copy(digest, "Model.fmu", content)
+    assert not any(elsewhere.iterdir())
 
 
 def test_the_command_line_reports_an_unreachable_scheduler_and_bad_options_as_errors(dist, tmp_path):

@@ -412,6 +412,9 @@ def test_a_bad_option_is_refused_before_the_earlier_sets_results_are_touched(dis
         after = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
         assert after == before, options
     assert railfmu.read_results(out).ok and len(first) == 2
+    # more threads than a machine has, or than runs: as many as there are runs
+    again = rs.run(tmp_path / "many", threads=2**70)
+    assert again.ok and len(again) == 2
     # an empty path is not taken for the working folder
     with pytest.raises(ValueError, match="empty path"):
         rs.run("")

@@ -368,6 +368,9 @@ def test_results_files_that_cannot_be_written_or_read_fail_whole(dist, master_cm
     # CSV text under a Parquet name would not read back
     with pytest.raises(railfmu.OutputError, match="names a Parquet file"):
         res.to_csv(tmp_path / "r.parquet")
+    with pytest.raises(railfmu.OutputError, match="names a Parquet file"):
+        res.to_csv(tmp_path / "r.PQ")
+    assert not (tmp_path / "r.PQ").exists()
     assert not (tmp_path / "r.parquet").exists()
     # a FIFO is refused without reading it (a read would block: nobody writes to it)
     fifo = tmp_path / "fifo.csv"

@@ -597,6 +597,7 @@ mod tests {
                 ("a.count".to_string(), ConstantKind::Integer),
                 ("a.seed".to_string(), ConstantKind::Integer),
             ]),
+            sampling_unknown: false,
         };
         let pq = dir.path().join("r.parquet");
         write_results(&pq, &out, ResultsFormat::Parquet, &ctx).unwrap();

@@ -103,6 +103,9 @@ pub struct RunContext {
     /// The kind of every constant column of the run set (parameters and labels of all its
     /// runs), so that every file of the set has the same columns; empty: this run's own.
     pub kinds: BTreeMap<String, ConstantKind>,
+    /// How the rows were sampled is not known (a table of unknown origin written again): the
+    /// metadata then record no sampling, rather than a full band the rows may not have.
+    pub sampling_unknown: bool,
 }
 
 impl RunContext {
@@ -181,7 +184,8 @@ where
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ResultsMetadata {
     pub version: u32,
-    /// The sampling of the rows; `None` with fewer than two rows.
+    /// The sampling of the rows; `None` with fewer than two rows, or when not known (see
+    /// [`RunContext::sampling_unknown`]).
     pub sampling: Option<Sampling>,
     /// The recorded columns in file order after the time (an Enumeration's item column is
     /// not listed).
@@ -202,7 +206,11 @@ impl ResultsMetadata {
     pub fn of(out: &SimOutput, ctx: &RunContext) -> Self {
         ResultsMetadata {
             version: METADATA_VERSION,
-            sampling: out.sampling(),
+            sampling: if ctx.sampling_unknown {
+                None
+            } else {
+                out.sampling()
+            },
             columns: (1..out.header.len())
                 .map(|c| ColumnMetadata {
                     label: out.header[c].clone(),

@@ -660,6 +660,7 @@ where
         labels: results.labels.get(&job.name).cloned().unwrap_or_default(),
         system: serde_json::to_value(&job.system).ok(),
         kinds: kinds.clone(),
+        sampling_unknown: false,
     };
     let result = (|| -> Result<Summary, String> {
         write_json_atomic(&dir.join("system.json"), &job.system).map_err(|e| e.to_string())?;
