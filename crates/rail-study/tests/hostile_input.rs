@@ -569,14 +569,15 @@ fn an_ssps_fmus_unpack_within_the_fmu_limit() {
         "{e}"
     );
     assert!(!c.path("bomb.csv").exists());
-    // within the limit, the zeros are no FMU: named as the archive's member, not as the
-    // temporary file they were unpacked to (gone when the message is read)
+    // within the limit, the zeros are no FMU: refused before they are written out, named as
+    // the archive's member, not as a temporary file (gone when the message is read)
     let e = c.fails(&["run", "bomb.ssp", "-o", "bomb.csv"], &[]);
     assert!(
-        e.contains("bomb.ssp:resources/") && e.contains("is not a valid zip archive"),
+        e.contains("bomb.ssp:resources/")
+            && e.contains("not an FMU: it does not begin as a zip archive"),
         "{e}"
     );
-    assert!(!e.contains("/tmp/") && !e.contains("ssp-"), "{e}");
+    assert!(!e.contains("/tmp/") && !e.contains("master-fmu-"), "{e}");
 }
 
 #[test]
@@ -603,6 +604,21 @@ fn extraction_folders_of_a_killed_master_are_removed_by_the_next_one() {
         c.extraction_folders()
     );
     assert!(c.path("out.csv").exists());
+    // an SSP's folder of FMU members too
+    c.master_ok(&["export-ssp", "system.json", "system.ssp"]);
+    let out = c.master(&["run", "system.ssp"], &[("HOSTILE_FMU_MODE", "kill")]);
+    assert_eq!(out.status.code(), None, "expected death by signal");
+    assert_eq!(
+        c.extraction_folders().len(),
+        2,
+        "the archive's and the FMU's"
+    );
+    c.master_ok(&["run", "system.ssp", "-o", "ssp.csv"]);
+    assert!(
+        c.extraction_folders().is_empty(),
+        "{:?}",
+        c.extraction_folders()
+    );
 }
 
 #[test]
@@ -977,6 +993,35 @@ fn outputs_never_replace_an_input_or_a_device() {
             && e.contains("`master run Hostile.fmu`"),
         "{e}"
     );
+    // an SSP where an FMU or a JSON description is meant is named for what it is
+    c.master_ok(&["export-ssp", "system.json", "exported.ssp"]);
+    let e = c.fails(&["inspect", "exported.ssp"], &[]);
+    assert!(e.contains("'exported.ssp' is an SSP, not an FMU"), "{e}");
+    c.write(
+        "ssp-set.json",
+        r#"{"base": "exported.ssp", "runs": [{"name": "a", "parameters": {}}]}"#,
+    );
+    let e = c.fails(&["sweep", "ssp-set.json", "-o", "ssp-set"], &[]);
+    assert!(
+        e.contains("'exported.ssp' is an SSP: a run set's base is a JSON system description"),
+        "{e}"
+    );
+    // one FMU file by two spellings is one member of the archive
+    std::fs::create_dir_all(c.path("sub")).unwrap();
+    c.write(
+        "two.json",
+        r#"{"instances": [{"name": "h", "fmu": "Hostile.fmu"},
+                          {"name": "g", "fmu": "sub/../Hostile.fmu"}],
+            "stop_time": 0.01, "step": 0.001}"#,
+    );
+    c.master_ok(&["export-ssp", "two.json", "two.ssp"]);
+    let z = zip::ZipArchive::new(std::fs::File::open(c.path("two.ssp")).unwrap()).unwrap();
+    let fmus: Vec<&str> = z.file_names().filter(|n| n.ends_with(".fmu")).collect();
+    assert_eq!(fmus, ["resources/Hostile.fmu"]);
+    for f in ["exported.ssp", "ssp-set.json", "two.json", "two.ssp"] {
+        std::fs::remove_file(c.path(f)).unwrap();
+    }
+    std::fs::remove_dir(c.path("sub")).unwrap();
     let e = c.fails(&["run", "system.json", "-o", "r.out"], &[]);
     assert!(e.contains("'r.out' names no results format"), "{e}");
     assert_eq!(std::fs::read(c.path("system.json")).unwrap(), system);

@@ -24,6 +24,15 @@ pub struct Args {
 }
 
 pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
+    // an SSP is a zip too: without this it read as an FMU with no modelDescription.xml
+    if crate::ssp::is_ssp_path(&args.fmu) {
+        return Err(CommandError::Failed(format!(
+            "'{}' is an SSP, not an FMU: inspect its FMUs (its resources/*.fmu), or run it \
+             with `master run {}`",
+            args.fmu.display(),
+            args.fmu.display()
+        )));
+    }
     let a = FmuArchive::open(&args.fmu)?;
     if !args.no_load {
         // the same path as a run: unpack, load, look up the functions, instantiate once

@@ -253,6 +253,7 @@ pub(crate) fn read_limited<R: Read>(
 }
 
 /// An extraction folder and the lock that marks it as in use.
+#[derive(Debug)]
 pub(crate) struct ExtractionDir {
     // Field order: the folder is removed while the lock is still held.
     dir: tempfile::TempDir,
@@ -262,6 +263,24 @@ pub(crate) struct ExtractionDir {
 impl ExtractionDir {
     pub fn path(&self) -> &Path {
         self.dir.path()
+    }
+
+    /// A new extraction folder in `root`, locked while it lives, after removing the stale
+    /// ones there (left by a master that was killed): an FMU's files, or the FMU members of an
+    /// SSP archive.
+    pub(crate) fn create(root: &Path) -> Result<Self, String> {
+        remove_stale_extractions(root);
+        let dir = tempfile::Builder::new()
+            .prefix(EXTRACTION_PREFIX)
+            .rand_bytes(6)
+            .tempdir_in(root)
+            .map_err(|e| format!("cannot create a folder in '{}': {e}", root.display()))?;
+        let lock = std::fs::File::create(dir.path().join(".lock"))
+            .map_err(|e| format!("cannot create the lock file: {e}"))?;
+        if !try_lock(&lock) {
+            return Err("cannot lock the new extraction folder".into());
+        }
+        Ok(ExtractionDir { dir, _lock: lock })
     }
 }
 
@@ -342,25 +361,10 @@ pub(crate) fn unpack(
         path: path.to_path_buf(),
         reason,
     };
-    remove_stale_extractions(root);
     let file = crate::input::open_regular_file(path).map_err(|e| err(e.to_string()))?;
     let mut zip = zip::ZipArchive::new(file).map_err(|e| err(e.to_string()))?;
     check_entries(path, &mut zip, limits)?;
-    let dir = tempfile::Builder::new()
-        .prefix(EXTRACTION_PREFIX)
-        .rand_bytes(6)
-        .tempdir_in(root)
-        .map_err(|e| {
-            err(format!(
-                "cannot create a folder in '{}': {e}",
-                root.display()
-            ))
-        })?;
-    let lock = std::fs::File::create(dir.path().join(".lock"))
-        .map_err(|e| err(format!("cannot create the lock file: {e}")))?;
-    if !try_lock(&lock) {
-        return Err(err("cannot lock the new extraction folder".into()));
-    }
+    let folder = ExtractionDir::create(root).map_err(err)?;
     let mut left = limits.max_unpacked_bytes;
     for i in 0..zip.len() {
         // every failure names the entry (as the archive spells it until it is read)
@@ -377,7 +381,7 @@ pub(crate) fn unpack(
         // a hostile name's control characters are shown escaped, not sent to the terminal
         let shown = || rel.display().to_string().escape_debug().to_string();
         let at = |e: std::io::Error| err(format!("entry '{}': {e}", shown()));
-        let target = dir.path().join(&rel);
+        let target = folder.path().join(&rel);
         if entry.is_dir() {
             std::fs::create_dir_all(&target).map_err(at)?;
             continue;
@@ -410,7 +414,7 @@ pub(crate) fn unpack(
             std::fs::set_permissions(&target, std::fs::Permissions::from_mode(mode)).map_err(at)?;
         }
     }
-    Ok(ExtractionDir { dir, _lock: lock })
+    Ok(folder)
 }
 
 /// The folder extraction folders are made in: the system's temporary directory.

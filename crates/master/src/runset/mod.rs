@@ -223,6 +223,18 @@ impl RunSet {
     ) -> Result<(LoadedSystem, Vec<Job>), SystemError> {
         let rs: RunSet = serde_json::from_str(text).map_err(|e| SystemError::json(file, &e))?;
         let base = match (&rs.base, &rs.system) {
+            // an archive would be read as JSON text ("did not contain valid UTF-8")
+            (Some(p), None) if crate::ssp::is_ssp_path(p) => {
+                return Err(invalid(
+                    file,
+                    "base".into(),
+                    format!(
+                        "'{}' is an SSP: a run set's base is a JSON system description (`master \
+                         run` runs an SSP as it is; `master export-ssp` goes the other way)",
+                        p.display()
+                    ),
+                ))
+            }
             (Some(p), None) => LoadedSystem::load(&base_dir.join(p))?,
             (None, Some(s)) => LoadedSystem::from_description(s.clone(), base_dir, file),
             _ => {

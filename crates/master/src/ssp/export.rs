@@ -130,7 +130,10 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
     let mut fmu_members: Vec<(String, PathBuf)> = Vec::new();
     for i in 0..d.instances.len() {
         let p = sys.fmu_path(i);
-        let key = std::path::absolute(&p).unwrap_or(p.clone());
+        // the file itself: `dist/X.fmu` and `systems/../dist/X.fmu` are one member
+        let key = std::fs::canonicalize(&p)
+            .or_else(|_| std::path::absolute(&p))
+            .unwrap_or(p.clone());
         if let Some(r) = by_path.get(&key) {
             resource_of.push(r.clone());
             continue;

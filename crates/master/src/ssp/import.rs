@@ -30,12 +30,15 @@ pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, S
     let (text, ssd_label) = pkg.read_ssd()?;
     let ssd = ssd::parse(&ssd_label, &text)?;
     let unpacked = match pkg {
-        Package::Zip { .. } => Some(tempfile::Builder::new().prefix("ssp-").tempdir().map_err(
-            |e| SspError::Read {
-                path: path.to_path_buf(),
-                reason: format!("cannot create a temporary folder: {e}"),
-            },
-        )?),
+        // locked while the system lives, removed as stale by a later master when this one
+        // is killed
+        Package::Zip { .. } => Some(
+            crate::fmu::extract::ExtractionDir::create(&crate::fmu::extract::extraction_root())
+                .map_err(|reason| SspError::Read {
+                    path: path.to_path_buf(),
+                    reason,
+                })?,
+        ),
         Package::Dir { .. } => None,
     };
     let base_dir = match (&pkg, &unpacked) {

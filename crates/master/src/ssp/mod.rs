@@ -91,7 +91,7 @@ pub struct ImportedSsp {
     pub system: LoadedSystem,
     /// The SSD's `version` attribute.
     pub version: String,
-    _unpacked: Option<tempfile::TempDir>,
+    _unpacked: Option<crate::fmu::extract::ExtractionDir>,
 }
 
 /// Whether `path` names an SSP (`.ssp` or `.ssd`) rather than a JSON system description.

@@ -2,7 +2,7 @@
 //! .ssv and .ssm files inside) or a bare .ssd in a folder (its references relative to that
 //! folder). References are relative URIs; in a zip none may leave the archive.
 
-use std::io::Read;
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use super::SspError;
@@ -18,6 +18,10 @@ pub(super) enum Package {
         /// of an FMU (`MASTER_FMU_MAX_UNPACKED_BYTES`), for the archive as a whole (each
         /// component's copy counts).
         budget: u64,
+        /// The FMU members unpacked so far, by reference: one file per member, shared by the
+        /// components that use it as the instances of one FMU file of a JSON system are (which
+        /// gives an FMU that can be instantiated only once per process a copy per instance).
+        unpacked: std::collections::HashMap<String, PathBuf>,
     },
     Dir {
         ssd: PathBuf,
@@ -45,6 +49,16 @@ impl Package {
                     .map_err(|e| read_err(format!("not a zip archive: {e}")))?;
                 let limits =
                     crate::fmu::ArchiveLimits::from_env().map_err(|e| read_err(e.to_string()))?;
+                // the search for a name stored twice reads at most this many entries: one
+                // beyond could hide a second SystemStructure.ssd
+                let n = zip.len() as u64;
+                if n > limits.max_entries {
+                    return Err(read_err(format!(
+                        "it has {n} entries, more than the limit of {} (raise it with {})",
+                        limits.max_entries,
+                        crate::fmu::extract::MAX_ENTRIES_VAR
+                    )));
+                }
                 let twice =
                     crate::fmu::extract::duplicate_entry_name(path, &zip, limits.max_entries)
                         .map_err(|e| read_err(e.to_string()))?;
@@ -58,6 +72,7 @@ impl Package {
                     path: path.to_path_buf(),
                     zip: Box::new(zip),
                     budget: limits.max_unpacked_bytes,
+                    unpacked: std::collections::HashMap::new(),
                 })
             }
             Some("ssd") => {
@@ -117,9 +132,9 @@ impl Package {
         match self {
             Package::Zip { path, zip, .. } => {
                 let label = format!("{}:{rel}", path.display());
-                let entry = zip.by_name(rel).map_err(|_| SspError::Read {
+                let entry = zip.by_name(rel).map_err(|e| SspError::Read {
                     path: PathBuf::from(&label),
-                    reason: "no such file in the archive".into(),
+                    reason: member_error(e),
                 })?;
                 let mut buf = Vec::new();
                 entry
@@ -152,7 +167,15 @@ impl Package {
     /// disk first and be refused after).
     pub fn fmu_file(&mut self, rel: &str, dest: &Path, index: usize) -> Result<PathBuf, SspError> {
         match self {
-            Package::Zip { path, zip, budget } => {
+            Package::Zip {
+                path,
+                zip,
+                budget,
+                unpacked,
+            } => {
+                if let Some(out) = unpacked.get(rel) {
+                    return Ok(out.clone());
+                }
                 let label = PathBuf::from(format!("{}:{rel}", path.display()));
                 let too_large = |what: String| SspError::Read {
                     path: label.clone(),
@@ -161,9 +184,9 @@ impl Package {
                          (MASTER_FMU_MAX_UNPACKED_BYTES)"
                     ),
                 };
-                let mut entry = zip.by_name(rel).map_err(|_| SspError::Read {
+                let mut entry = zip.by_name(rel).map_err(|e| SspError::Read {
                     path: label.clone(),
-                    reason: "no such file in the archive".into(),
+                    reason: member_error(e),
                 })?;
                 if entry.size() > *budget {
                     return Err(too_large(format!("declares {} bytes", entry.size())));
@@ -176,9 +199,29 @@ impl Package {
                     path: label.clone(),
                     reason: format!("cannot unpack: {e}"),
                 };
+                // an FMU is a zip archive: its first bytes are a local file header (a member
+                // of gigabytes of zeros is refused here, not after it was written out)
+                let mut head = [0u8; 4];
+                let begun = match entry.read_exact(&mut head) {
+                    Ok(()) => head == *b"PK\x03\x04",
+                    Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => false,
+                    Err(e) => return Err(io(e)),
+                };
+                if !begun {
+                    return Err(SspError::Read {
+                        path: label.clone(),
+                        reason: "not an FMU: it does not begin as a zip archive".into(),
+                    });
+                }
                 std::fs::create_dir_all(&dir).map_err(io)?;
                 let mut f = std::fs::File::create(&out).map_err(io)?;
-                let copied = std::io::copy(&mut (&mut entry).take(*budget + 1), &mut f);
+                let copied = f
+                    .write_all(&head)
+                    .and_then(|()| {
+                        let rest = budget.saturating_sub(head.len() as u64) + 1;
+                        std::io::copy(&mut (&mut entry).take(rest), &mut f)
+                    })
+                    .map(|n| n + 4);
                 let n = match copied {
                     Ok(n) if n <= *budget => n,
                     Ok(n) => {
@@ -193,6 +236,7 @@ impl Package {
                     }
                 };
                 *budget -= n;
+                unpacked.insert(rel.to_string(), out.clone());
                 Ok(out)
             }
             // relative to the folder, which is the system's base folder
@@ -283,4 +327,13 @@ fn percent_decode(s: &str) -> Option<String> {
         }
     }
     String::from_utf8(out).ok()
+}
+
+/// Why a member could not be opened: missing, or stored in a way the reader does not support
+/// (LZMA, bzip2, encryption), which the zip reader names.
+fn member_error(e: zip::result::ZipError) -> String {
+    match e {
+        zip::result::ZipError::FileNotFound => "no such file in the archive".into(),
+        other => format!("cannot read it from the archive: {other}"),
+    }
 }

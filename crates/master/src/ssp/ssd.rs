@@ -416,12 +416,41 @@ fn parse_component(ctx: Ctx, n: Node) -> Result<Component, SspError> {
 
 fn parse_connectors(ctx: Ctx, n: Node) -> Result<Vec<Connector>, SspError> {
     let mut out = Vec::new();
+    let mut seen: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
     for c in elements(n) {
         if !is(c, NS_SSD, "Connector") {
             return Err(ctx.unexpected(c));
         }
         let name = ctx.req(c, "name")?.to_string();
         let kind = ctx.req(c, "kind")?.to_string();
+        // SSD 1.0 5.3.4: the kinds the schema allows
+        const KINDS: [&str; 5] = [
+            "input",
+            "output",
+            "inout",
+            "parameter",
+            "calculatedParameter",
+        ];
+        if !KINDS.contains(&kind.as_str()) {
+            return Err(ctx.err(
+                c,
+                format!(
+                    "connector '{}' has kind '{}': one of {}",
+                    crate::show::text(&name),
+                    crate::show::text(&kind),
+                    KINDS.join(", ")
+                ),
+            ));
+        }
+        if let Some(first) = seen.insert(name.clone(), line(c)) {
+            return Err(ctx.err(
+                c,
+                format!(
+                    "connector '{}' is declared twice (first at line {first})",
+                    crate::show::text(&name),
+                ),
+            ));
+        }
         let mut ty = None;
         for t in elements(c) {
             if t.tag_name().namespace() == Some(NS_SSC) {
@@ -590,7 +619,10 @@ fn parse_bindings(ctx: Ctx, n: Node) -> Result<Vec<Binding>, SspError> {
                 _ => return Err(ctx.unexpected(c)),
             }
         }
-        let values = match (b.attribute("source"), inline) {
+        // SSP 1.0 5.3.5: with inline values the source "MUST be empty": an empty attribute is
+        // as none (some tools write source="")
+        let source = b.attribute("source").filter(|s| !s.is_empty());
+        let values = match (source, inline) {
             (Some(src), None) => BindingValues::File(src.to_string()),
             (None, Some(set)) => BindingValues::Inline(set),
             (Some(_), Some(_)) => {

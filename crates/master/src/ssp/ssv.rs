@@ -316,7 +316,15 @@ impl Transformation {
         let no_entry = |s: String| format!("the mapping has no entry for {s}");
         match (self, v) {
             (Transformation::Linear { factor, offset }, Value::Real(x)) => {
-                Ok(Value::Real(factor * x + offset))
+                let y = factor * x + offset;
+                if y.is_finite() {
+                    Ok(Value::Real(y))
+                } else {
+                    Err(format!(
+                        "{factor:?} x {x:?} + {offset:?} is {y}, not a finite number (the linear \
+                         transformation overflows)"
+                    ))
+                }
             }
             (Transformation::Boolean(m), Value::Boolean(b)) => m
                 .iter()

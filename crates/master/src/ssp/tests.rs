@@ -248,8 +248,9 @@ fn libcosim_style_component_bindings_and_annotations() {
     // written input -> output: read as output -> input
     assert_eq!(d.connections[0].from, "a.position");
     assert_eq!(d.connections[0].to, "b.force");
-    // both instances share one FMU source, unpacked once per component
-    assert_ne!(imp.system.fmu_path(0), imp.system.fmu_path(1));
+    // both instances share one FMU source, unpacked once from the archive (and loaded as the
+    // instances of one FMU file of a JSON system are)
+    assert_eq!(imp.system.fmu_path(0), imp.system.fmu_path(1));
 }
 
 const V2_SSD: &str = r#" name="v2" version="2.0">
@@ -324,6 +325,19 @@ fn ssp2_prefix_mapping_and_precedence() {
     assert_eq!(params.get("k"), Some(&json!(205.0)));
     assert_eq!(params.get("m"), Some(&json!(7.0)));
     assert_eq!(params.len(), 2);
+    // a mapping whose result overflows is named as such, not as a value that is "null"
+    let huge = BARE_SSV.replace(
+        r#"<ssv:Float64 value="2"/>"#,
+        r#"<ssv:Float64 value="1e307"/>"#,
+    );
+    let other = tempfile::tempdir().unwrap();
+    let e = import(&v2_archive(other.path(), &huge, MAP_SSM), &stepped())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("not a finite number") && !e.contains("null"),
+        "{e}"
+    );
     // without a step the SSP is refused, naming what is missing
     let e = import(&p, &ImportOptions::default())
         .unwrap_err()
@@ -715,4 +729,104 @@ fn a_fifo_or_folder_is_refused_as_not_a_regular_file() {
     // a missing one is still named as missing
     let e = import_message_within_seconds(&d.path().join("none.ssd"));
     assert!(e.contains("No such file"), "{e}");
+}
+
+/// A large parameter set names the line of a duplicate far down (each element's line comes
+/// from an index of the line starts, not a scan from the file's start per element, which was
+/// quadratic in the file's size); a tag crowded with attributes is refused before the XML
+/// parser, which compares each attribute with the element's others.
+#[test]
+fn large_parameter_sets_keep_their_line_numbers_and_crowded_tags_are_refused() {
+    let n = 30_000;
+    let mut ssv = String::from(
+        "<ssv:ParameterSet xmlns:ssv=\"http://ssp-standard.org/SSP1/SystemStructureParameterValues\" version=\"2.0\" name=\"big\">\n  <ssv:Parameters>\n",
+    );
+    for k in 0..n {
+        ssv.push_str(&format!(
+            "    <ssv:Parameter name=\"p{k}\"><ssv:Float64 value=\"{k}.5\"/></ssv:Parameter>\n"
+        ));
+    }
+    // line 3 holds p0; the copy of p7 below lands on line 3 + n
+    ssv.push_str("    <ssv:Parameter name=\"p7\"><ssv:Float64 value=\"1\"/></ssv:Parameter>\n");
+    ssv.push_str("  </ssv:Parameters>\n</ssv:ParameterSet>");
+    let e = super::ssv::parse_ssv("big.ssv", &ssv)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(&format!("line {}", 3 + n))
+            && e.contains("parameter 'p7' is given twice in set 'big' (first at line 10)"),
+        "{e}"
+    );
+    let attributes: String = (0..10_001).map(|k| format!(" a{k}=\"1\"")).collect();
+    let crowded = format!("<?xml version=\"1.0\"?>\n\n<x{attributes}/>");
+    let e = super::ssv::parse_ssv("crowded.ssv", &crowded)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("line 3") && e.contains("more than 10000 attributes"),
+        "{e}"
+    );
+}
+
+/// SSP 1.0 5.3.5: a binding with inline values has an empty source, which some tools write as
+/// `source=""`; a component's FMU member that is no zip archive is refused before it is written
+/// out (a member of gigabytes of zeros would fill the disk first).
+#[test]
+fn an_empty_binding_source_is_none_and_a_member_that_is_no_fmu_is_refused_at_once() {
+    let ssd = format!(
+        "{HEAD}{}",
+        OSP_SSD.replace(
+            "<ssd:ParameterBinding>\n            <ssd:ParameterValues>",
+            "<ssd:ParameterBinding source=\"\">\n            <ssd:ParameterValues>"
+        )
+    );
+    assert!(ssd.contains("source=\"\""));
+    let imp = import_ok(&[
+        ("SystemStructure.ssd", &ssd),
+        ("resources/ms.fmu", ""),
+        ("a_params.ssv", A_SSV),
+    ]);
+    let d = &imp.system.desc;
+    assert_eq!(d.instances[0].parameters.get("d"), Some(&json!(0.5)));
+    let e = import_err(&[
+        ("SystemStructure.ssd", &ssd),
+        ("resources/ms.fmu", "\0\0\0\0 zeros, not a zip"),
+        ("a_params.ssv", A_SSV),
+    ]);
+    assert!(
+        e.contains("resources/ms.fmu") && e.contains("not an FMU: it does not begin as a zip"),
+        "{e}"
+    );
+}
+
+/// A connector's kind is one the schema allows, and its name is declared once per component.
+#[test]
+fn a_connector_of_an_unknown_kind_or_declared_twice_is_refused() {
+    let files = |ssd: String| {
+        vec![
+            ("SystemStructure.ssd", ssd),
+            ("resources/ms.fmu", String::new()),
+            ("a_params.ssv", A_SSV.to_string()),
+        ]
+    };
+    let output = r#"<ssd:Connector name="position" kind="output"><ssc:Real/></ssd:Connector>"#;
+    assert!(OSP_SSD.contains(output));
+    let bogus = format!(
+        "{HEAD}{}",
+        OSP_SSD.replacen(r#"kind="output""#, r#"kind="bogus""#, 1)
+    );
+    let e = import_err(&refs(&files(bogus)));
+    assert!(
+        e.contains("connector 'position' has kind 'bogus': one of input, output"),
+        "{e}"
+    );
+    let twice = format!(
+        "{HEAD}{}",
+        OSP_SSD.replacen(output, &format!("{output}\n{output}"), 1)
+    );
+    let e = import_err(&refs(&files(twice)));
+    assert!(
+        e.contains("connector 'position' is declared twice (first at line"),
+        "{e}"
+    );
 }

@@ -12,19 +12,109 @@ pub(super) const NS_SSC: &str = "http://ssp-standard.org/SSP1/SystemStructureCom
 pub(super) const NS_SSV: &str = "http://ssp-standard.org/SSP1/SystemStructureParameterValues";
 pub(super) const NS_SSM: &str = "http://ssp-standard.org/SSP1/SystemStructureParameterMapping";
 
+/// Attributes one element may have at most: roxmltree checks each new attribute against the
+/// element's others, so a tag of 200 000 attributes (1 MB) took minutes to parse.
+const MAX_ATTRIBUTES_PER_ELEMENT: usize = 10_000;
+
+/// A parsed document, with the start of each of its lines for [`line`] while it lives.
+pub(super) struct Parsed<'a> {
+    doc: Document<'a>,
+    key: usize,
+}
+
+impl<'a> std::ops::Deref for Parsed<'a> {
+    type Target = Document<'a>;
+    fn deref(&self) -> &Document<'a> {
+        &self.doc
+    }
+}
+
+impl Drop for Parsed<'_> {
+    fn drop(&mut self) {
+        LINE_STARTS.with(|m| {
+            let mut m = m.borrow_mut();
+            if let Some((count, _)) = m.get_mut(&self.key) {
+                *count -= 1;
+                if *count == 0 {
+                    m.remove(&self.key);
+                }
+            }
+        });
+    }
+}
+
+thread_local! {
+    /// The byte offset of each line's start of the documents parsed on this thread and still
+    /// alive, by the address of their text (with how many live documents share it):
+    /// roxmltree's own position lookup scans the text from its start, which made the line of
+    /// every element quadratic in the file's size (a 40 MB description did not parse in 10
+    /// minutes).
+    static LINE_STARTS: std::cell::RefCell<std::collections::HashMap<usize, (usize, Vec<usize>)>> =
+        std::cell::RefCell::new(std::collections::HashMap::new());
+}
+
 /// Parses `text` (the content of `file`); DTDs are refused (roxmltree's default), so no entity
 /// expansion can blow up.
-pub(super) fn parse<'a>(file: &str, text: &'a str) -> Result<Document<'a>, SspError> {
-    Document::parse(text).map_err(|e| SspError::Invalid {
+pub(super) fn parse<'a>(file: &str, text: &'a str) -> Result<Parsed<'a>, SspError> {
+    let invalid = |line: usize, message: String| SspError::Invalid {
         file: file.to_string(),
-        line: Some(e.pos().row as usize),
-        message: format!("XML syntax error: {e}"),
-    })
+        line: Some(line),
+        message,
+    };
+    if let Some(line) = crowded_tag(text) {
+        return Err(invalid(
+            line,
+            format!("an element has more than {MAX_ATTRIBUTES_PER_ELEMENT} attributes"),
+        ));
+    }
+    let doc = Document::parse(text)
+        .map_err(|e| invalid(e.pos().row as usize, format!("XML syntax error: {e}")))?;
+    let key = text.as_ptr() as usize;
+    LINE_STARTS.with(|m| {
+        let mut m = m.borrow_mut();
+        let entry = m.entry(key).or_insert_with(|| {
+            let starts = std::iter::once(0)
+                .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+                .collect();
+            (0, starts)
+        });
+        entry.0 += 1;
+    });
+    Ok(Parsed { doc, key })
+}
+
+/// The line of the first tag with more than [`MAX_ATTRIBUTES_PER_ELEMENT`] attributes (counted
+/// as the `=` between `<` and `>`: a generous bound, so an `=` in a value does not matter).
+fn crowded_tag(text: &str) -> Option<usize> {
+    let (mut start, mut count) = (None, 0usize);
+    for (i, b) in text.bytes().enumerate() {
+        match b {
+            b'<' => (start, count) = (Some(i), 0),
+            b'>' => start = None,
+            b'=' if start.is_some() => {
+                count += 1;
+                if count > MAX_ATTRIBUTES_PER_ELEMENT {
+                    let at = start.unwrap_or(i);
+                    return Some(1 + text[..at].bytes().filter(|&c| c == b'\n').count());
+                }
+            }
+            _ => {}
+        }
+    }
+    None
 }
 
 /// 1-based line of an element.
 pub(super) fn line(n: Node) -> usize {
-    n.document().text_pos_at(n.range().start).row as usize
+    let doc = n.document();
+    let pos = n.range().start;
+    let found = LINE_STARTS.with(|m| {
+        m.borrow()
+            .get(&(doc.input_text().as_ptr() as usize))
+            .map(|(_, starts)| starts.partition_point(|&s| s <= pos))
+    });
+    // a document not parsed by `parse` (none today): roxmltree's own lookup
+    found.unwrap_or_else(|| doc.text_pos_at(pos).row as usize)
 }
 
 /// Whether `n` is the element `name` of namespace `ns`.
