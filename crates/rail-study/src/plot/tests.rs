@@ -286,7 +286,11 @@ fn panels_scale_their_own_y_axes_on_request_and_guides_are_listed() {
             .collect()
     };
     let shared = tick_texts(&two);
-    assert_eq!(shared.iter().filter(|t| *t == "30").count(), 2, "{shared:?}");
+    assert_eq!(
+        shared.iter().filter(|t| *t == "30").count(),
+        2,
+        "{shared:?}"
+    );
     let own = tick_texts(&two.clone().with_own_y_per_panel());
     assert_eq!(own.iter().filter(|t| *t == "30").count(), 1, "{own:?}");
     assert!(own.iter().any(|t| t == "0.2"), "{own:?}");
@@ -296,7 +300,10 @@ fn panels_scale_their_own_y_axes_on_request_and_guides_are_listed() {
         .with_guide(2.0, "N = 2: comfortable below")
         .with_y_from_zero();
     let all = tick_texts(&c);
-    assert!(all.iter().any(|t| t == "N = 2: comfortable below"), "{all:?}");
+    assert!(
+        all.iter().any(|t| t == "N = 2: comfortable below"),
+        "{all:?}"
+    );
     assert!(all.iter().any(|t| t == "0"), "{all:?}");
     assert!(all.iter().any(|t| t == "2"), "{all:?}");
 }
