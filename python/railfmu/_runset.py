@@ -15,6 +15,7 @@ import numpy as np
 
 from . import _railfmu
 from ._json import description_json
+from ._log import emit as emit_log, forwarded
 from ._progress import bar, check_progress
 from ._results import RunSetResults
 
@@ -175,8 +176,9 @@ class RunSet:
             # ranges) before anything is written or removed: a misspelt variable is refused
             # here, not failed run by run. On a cluster too, when this process ships the FMUs
             # (it reads them anyway); with shared FMUs their paths may be the workers' only.
-            system = _railfmu.PreparedSystem.from_json(self._base_json, "", self._label)
-            system.check_jobs(self._jobs_json)
+            with forwarded():
+                system = _railfmu.PreparedSystem.from_json(self._base_json, "", self._label)
+                system.check_jobs(self._jobs_json)
         try:
             out.mkdir(parents=True, exist_ok=True)
         except OSError as e:
@@ -206,6 +208,7 @@ class RunSet:
                 def on_done(name: str, error: Optional[str]) -> None:
                     nonlocal done
                     done += 1
+                    emit_log()  # the messages of the runs so far, as they finish
                     if cb is not None:
                         cb(done, total, name, error)
 
@@ -219,7 +222,8 @@ class RunSet:
                             # is then no error after the folder was prepared)
                             threads = min(threads or _usable_cores(), len(jobs))
                             local_runs = True
-                            new = system.run_jobs(jobs, os.fspath(out), threads, on_done, format)
+                            with forwarded():
+                                new = system.run_jobs(jobs, os.fspath(out), threads, on_done, format)
                         else:
                             from .dask import run_jobs_on_cluster
 

@@ -10,6 +10,7 @@ from typing import Any, Callable, Dict, List, Mapping, Optional, Union
 
 from . import _railfmu
 from ._json import description_json
+from ._log import forwarded
 from ._results import Results
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -90,19 +91,16 @@ class System:
         ``master run --step --stop --algorithm``). An SSP's defaults: its libcosim or
         OMSimulator step annotation, its DefaultExperiment's stop time, and the coupling
         ``master export-ssp`` kept in it (else Jacobi)."""
-        return cls(
-            _railfmu.PreparedSystem.load(
-                os.fspath(path),
-                _seconds("step", step),
-                _seconds("stop_time", stop_time),
-                algorithm,
-            )
-        )
+        step_s, stop_s = _seconds("step", step), _seconds("stop_time", stop_time)
+        with forwarded():
+            return cls(_railfmu.PreparedSystem.load(os.fspath(path), step_s, stop_s, algorithm))
 
     @classmethod
     def from_dict(cls, description: Mapping[str, Any], base_dir: PathLike = ".", label: str = "<dict>") -> "System":
         """A system from a description given as a dict (FMU paths relative to ``base_dir``)."""
-        return cls(_railfmu.PreparedSystem.from_json(description_json(description, label), os.fspath(base_dir), label))
+        text = description_json(description, label)
+        with forwarded():
+            return cls(_railfmu.PreparedSystem.from_json(text, os.fspath(base_dir), label))
 
     @property
     def file(self) -> str:
@@ -190,7 +188,7 @@ class System:
         from ._progress import bar
 
         try:
-            with bar(progress, "steps") as cb:
+            with bar(progress, "steps") as cb, forwarded():
                 header, data, texts, summary, meta = self._prepared.run(merged, stop, cb)
         except _railfmu.SimulationError as e:
             history = None

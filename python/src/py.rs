@@ -931,6 +931,36 @@ fn write_results_csv(
         .map_err(|e| OutputError::new_err(error_message(&e)))
 }
 
+/// The FMUs' and the master's messages since the last call, as (Python logging level, text),
+/// and how many were dropped beyond the number kept.
+#[pyfunction]
+fn take_log() -> (Vec<(u32, String)>, usize) {
+    let (messages, dropped) = master::fmu::logger::take_messages();
+    let level = |l: log::Level| match l {
+        log::Level::Error => 40,
+        log::Level::Warn => 30,
+        log::Level::Info => 20,
+        log::Level::Debug | log::Level::Trace => 10,
+    };
+    (
+        messages.into_iter().map(|(l, t)| (level(l), t)).collect(),
+        dropped,
+    )
+}
+
+/// Keeps messages of Python logging level `level` and above (DEBUG 10, INFO 20, WARNING 30,
+/// ERROR 40; above ERROR, none).
+#[pyfunction]
+fn set_log_level(level: i64) {
+    log::set_max_level(match level {
+        i64::MIN..=10 => log::LevelFilter::Debug,
+        11..=20 => log::LevelFilter::Info,
+        21..=30 => log::LevelFilter::Warn,
+        31..=40 => log::LevelFilter::Error,
+        _ => log::LevelFilter::Off,
+    });
+}
+
 /// EN 14363 assessment of a results file (CSV or Parquet), as `master assess`: options and
 /// answer as JSON ([`crate::assess`]).
 #[pyfunction]
@@ -975,6 +1005,9 @@ fn assess_answer_json(answer: &assess::AssessAnswer) -> PyResult<String> {
 fn _railfmu(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // FMU logger messages and the master's warnings go to stderr, as in the command line.
     master::fmu::install_logger(log::LevelFilter::Warn);
+    // the messages go to Python's logging (logger "railfmu"), not to the process's stderr,
+    // which a notebook's user does not see
+    master::fmu::logger::capture_messages(true);
     let py = m.py();
     m.add("Error", py.get_type::<Error>())?;
     m.add(
@@ -985,6 +1018,8 @@ fn _railfmu(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SimulationError", py.get_type::<SimulationError>())?;
     m.add("OutputError", py.get_type::<OutputError>())?;
     m.add("AssessmentError", py.get_type::<AssessmentError>())?;
+    m.add_function(wrap_pyfunction!(take_log, m)?)?;
+    m.add_function(wrap_pyfunction!(set_log_level, m)?)?;
     m.add_function(wrap_pyfunction!(assess_file, m)?)?;
     m.add_function(wrap_pyfunction!(assess_columns, m)?)?;
     m.add_class::<PySystem>()?;

@@ -4,6 +4,7 @@ progress, the GIL released during runs, errors as exceptions with the master's m
 from __future__ import annotations
 
 import json
+import logging
 import os
 import signal
 import subprocess
@@ -514,3 +515,22 @@ def test_errors_cross_process_boundaries_as_themselves(passive_file):
         pickle.dumps(s)
     again = railfmu.System.from_dict(pickle.loads(pickle.dumps(s.description)))
     assert np.array_equal(bits(again.run(stop_time=0.01).values), bits(s.run(stop_time=0.01).values))
+
+
+def test_the_fmus_messages_go_to_pythons_logging(passive_file, capfd, caplog):
+    # a damper that may take one internal step per communication step discards the first
+    sys = railfmu.System.load(passive_file)
+    with caplog.at_level(logging.WARNING, logger="railfmu"):
+        with pytest.raises(railfmu.SimulationError):
+            sys.run({"damper_left.solver.max_internal_steps": 1}, stop_time=0.1)
+    found = [r for r in caplog.records if r.name == "railfmu" and "FMU instance 'damper_left'" in r.getMessage()]
+    assert found and found[0].levelno == logging.WARNING, caplog.records
+    assert "max_internal_steps" in found[0].getMessage()
+    # not printed to the process's stderr besides (a notebook's user does not see it there)
+    assert "FMU instance" not in capfd.readouterr().err
+    # above the logger's level, nothing is kept
+    caplog.clear()
+    with caplog.at_level(logging.ERROR, logger="railfmu"):
+        with pytest.raises(railfmu.SimulationError):
+            sys.run({"damper_left.solver.max_internal_steps": 1}, stop_time=0.1)
+    assert not [r for r in caplog.records if r.name == "railfmu"], caplog.records

@@ -27,24 +27,62 @@ impl log::Log for FmuLogger {
         if !self.enabled(record.metadata()) {
             return;
         }
-        // eprintln! panics when stderr is closed; a lost log line must not stop a run
-        let mut err = std::io::stderr().lock();
-        if record.module_path() == Some(FMU_RECORD) {
-            let _ = writeln!(
-                err,
-                "[{}] FMU instance '{}': {}",
-                record.level(),
-                record.target(),
-                record.args()
-            );
+        let text = if record.module_path() == Some(FMU_RECORD) {
+            format!("FMU instance '{}': {}", record.target(), record.args())
         } else if record.target().starts_with("master") {
-            let _ = writeln!(err, "[{}] {}", record.level(), record.args());
+            record.args().to_string()
+        } else {
+            return;
+        };
+        if CAPTURING.load(std::sync::atomic::Ordering::Relaxed) {
+            keep_message(record.level(), text);
+            return;
         }
+        // eprintln! panics when stderr is closed; a lost log line must not stop a run
+        let _ = writeln!(std::io::stderr().lock(), "[{}] {text}", record.level());
     }
     fn flush(&self) {}
 }
 
 static LOGGER: FmuLogger = FmuLogger;
+
+/// Whether messages are kept for [`take_messages`] instead of printed (a host with its own
+/// logging, e.g. Python's, where stderr is not what its user reads).
+static CAPTURING: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Messages kept at most between two takes; later ones are counted, not kept.
+const KEPT_MESSAGES: usize = 10_000;
+
+/// The messages kept while capturing, oldest first, and how many were dropped beyond
+/// [`KEPT_MESSAGES`].
+static MESSAGES: std::sync::Mutex<(Vec<(log::Level, String)>, usize)> =
+    std::sync::Mutex::new((Vec::new(), 0));
+
+fn keep_message(level: log::Level, text: String) {
+    // a poisoned lock (a panic while holding it) still holds a usable list
+    let mut m = MESSAGES
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    if m.0.len() < KEPT_MESSAGES {
+        m.0.push((level, text));
+    } else {
+        m.1 += 1;
+    }
+}
+
+/// Keeps the messages for [`take_messages`] (true) or prints them to stderr (false, the
+/// default).
+pub fn capture_messages(on: bool) {
+    CAPTURING.store(on, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// The messages kept since the last take (level, text), and how many were dropped.
+pub fn take_messages() -> (Vec<(log::Level, String)>, usize) {
+    let mut m = MESSAGES
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    (std::mem::take(&mut m.0), std::mem::take(&mut m.1))
+}
 
 /// How many failure messages are kept per thread (the latest).
 const KEPT_FAILURES: usize = 4;
