@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from collections import abc
 import numbers as numbers_abc
 import os
 from dataclasses import dataclass
@@ -97,7 +98,8 @@ def assess_stability(
     wheelset, N or kN; limit from the static wheel load ``wheel_load_kn``, which it needs: the
     coach's is 54.2 kN, the 2-dof bogie's 70 kN). ``skip_s``: start-up excluded. A signal recorded with
     a narrower band than the one assessed (decimated too far) is refused unless
-    ``accept_narrow_band``.
+    ``accept_narrow_band``. A dominant frequency below 2.1 Hz is assessed in a band whose lower
+    edge is clamped to 0.1 Hz, with a note.
 
     The band check needs the record of how the signals were sampled: a file of ours carries it
     (assess the file itself), a run's own :class:`Results` are full rate; a table read back
@@ -107,7 +109,19 @@ def assess_stability(
     shorter than one window, bad option, narrow band) and :class:`OutputError` when the file
     cannot be read.
     """
-    names = [signals] if isinstance(signals, str) else list(signals)
+    if isinstance(signals, str):
+        names = [signals]
+    elif isinstance(signals, abc.Sequence) and all(isinstance(s, str) for s in signals):
+        names = list(signals)
+    else:
+        raise TypeError(f"signals must be a column name or a list of column names, got {signals!r}")
+    if not isinstance(accept_narrow_band, (bool, np.bool_)):
+        raise TypeError(f"accept_narrow_band must be True or False, got {accept_narrow_band!r}")
+    if not isinstance(source, (Results, str, bytes, os.PathLike)):
+        raise TypeError(
+            f"source must be railfmu.Results or the path of a results file, got {type(source).__name__}"
+            + (" (a DataFrame: assess the Results it came from, or write it to a CSV file)" if hasattr(source, "columns") else "")
+        )
     numbers = {"speed_kmh": speed_kmh, "bogie_mass_t": bogie_mass_t, "skip_s": skip_s}
     if f0_hz is not None:
         numbers["f0_hz"] = f0_hz

@@ -179,7 +179,7 @@ pub fn assess(table: &ResultsTable, options: &AssessOptions) -> Result<AssessAns
             python_names(&e.to_string())
         )],
     };
-    notes.extend(report.unit_notes());
+    notes.extend(report.notes());
     Ok(AssessAnswer {
         quantity: options.quantity.clone(),
         unit: report.unit(),

@@ -95,6 +95,19 @@ def test_what_cannot_be_assessed_raises_with_the_reason(hunting, tmp_path):
     # a text is no speed, even one that reads as a number
     with pytest.raises(TypeError, match="speed_kmh must be a number, got '320'"):
         railfmu.assess_stability(hunting, SIGNALS, "320")
+    # a text is no switch, a number no list of names, a DataFrame no source
+    with pytest.raises(TypeError, match="accept_narrow_band must be True or False, got 'no'"):
+        railfmu.assess_stability(hunting, SIGNALS, 320.0, accept_narrow_band="no")
+    with pytest.raises(TypeError, match="signals must be a column name or a list of column names"):
+        railfmu.assess_stability(hunting, 5, 320.0)
+    with pytest.raises(TypeError, match="got DataFrame \\(a DataFrame: assess the Results"):
+        railfmu.assess_stability(hunting.to_pandas(), SIGNALS, 320.0)
+    # a dominant frequency below 2.1 Hz: assessed in a clamped band, with a note
+    t = np.arange(0.0, 12.0, 0.001)
+    slow = railfmu.Results(["time [s]", "g [m/s2]"], np.column_stack([t, np.sin(2 * np.pi * 1.0 * t)]), full_rate=True)
+    a = railfmu.assess_stability(slow, "g", 100.0, skip_s=1.0)
+    assert a.signals["g"].band_hz[0] == pytest.approx(0.1)
+    assert any("clamped to 0.1 Hz" in n for n in a.notes), a.notes
     with pytest.raises(railfmu.OutputError, match="missing.csv"):
         railfmu.assess_stability(tmp_path / "missing.csv", SIGNALS, 320.0)
     assert issubclass(railfmu.AssessmentError, railfmu.Error)

@@ -449,7 +449,29 @@ impl AssessReport {
         }
     }
 
-    /// Text printed by the command.
+    /// The notes on the assessment: [`Self::unit_notes`], then [`Self::band_notes`].
+    pub fn notes(&self) -> Vec<String> {
+        let mut notes = self.unit_notes();
+        notes.extend(self.band_notes());
+        notes
+    }
+
+    /// One note per signal whose dominant frequency lies below 2.1 Hz: the band's lower edge,
+    /// f0 - 2 Hz, is clamped to 0.1 Hz, so the band is narrower than the criterion's +-2 Hz.
+    pub fn band_notes(&self) -> Vec<String> {
+        self.signals
+            .iter()
+            .filter(|(_, a)| a.band_hz.0 > a.dominant_frequency_hz - 2.0 + 1e-9)
+            .map(|(name, a)| {
+                format!(
+                    "signal '{name}': dominant frequency {:.2} Hz, below 2.1 Hz: the band's lower \
+                     edge is clamped to {} Hz (band {:.2}-{:.2} Hz, not +-2 Hz around it)",
+                    a.dominant_frequency_hz, a.band_hz.0, a.band_hz.0, a.band_hz.1
+                )
+            })
+            .collect()
+    }
+
     /// One note per assessed column without a unit: its values were taken as m/s2 (or N).
     pub fn unit_notes(&self) -> Vec<String> {
         let assumed = match self.criterion {
@@ -490,7 +512,7 @@ impl AssessReport {
                 if a.stable { "within the limit" } else { "LIMIT EXCEEDED" }
             ));
         }
-        for note in self.unit_notes() {
+        for note in self.notes() {
             s.push_str(&format!("note: {note}\n"));
         }
         s.push_str(&format!(
@@ -849,6 +871,32 @@ mod tests {
             },
             &StabilitySettings::default(),
         )
+    }
+
+    #[test]
+    fn a_band_clamped_below_2_1_hz_is_noted() {
+        let at = |f: f64| {
+            let table =
+                ResultsTable::parse(&sine_table(6.0, f, 500.0, 20.0, "m/s2"), Path::new("x.csv"))
+                    .unwrap();
+            assess_table(
+                &table,
+                &["a, quoted".to_string()],
+                300.0,
+                Criterion::LateralAcceleration { bogie_mass_t: 6.1 },
+                &StabilitySettings::default(),
+            )
+            .unwrap()
+        };
+        assert!(at(4.0).band_notes().is_empty());
+        let low = at(1.0);
+        let notes = low.band_notes();
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(
+            notes[0].contains("below 2.1 Hz") && notes[0].contains("clamped to 0.1 Hz"),
+            "{notes:?}"
+        );
+        assert!(low.summary().contains("note: signal 'a, quoted'"));
     }
 
     #[test]
