@@ -71,7 +71,7 @@ def results_format_by_size(base_json: str, label: str, jobs_json: List[str]) -> 
 def read_results(path: str) -> Tuple[List[str], bytes, List[Tuple[int, List[str]]], Optional[str]]: ...
 def take_log() -> Tuple[List[Tuple[int, str]], int]: ...
 def set_log_level(level: int) -> None: ...
-def write_results_csv(
+def write_results_file(
     path: str,
     header: List[str],
     data: bytes,
@@ -79,4 +79,5 @@ def write_results_csv(
     metadata_json: Optional[str] = None,
     summary_json: Optional[str] = None,
     sampling_known: bool = True,
+    parquet: bool = False,
 ) -> None: ...

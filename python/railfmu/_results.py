@@ -198,7 +198,18 @@ class Results:
         ``master assess`` read."""
         if Path(path).suffix.lower() in (".parquet", ".pq"):
             # CSV text under a Parquet name is a file nothing reads back
-            raise _railfmu.OutputError(f"to_csv writes CSV: '{path}' names a Parquet file; give a .csv name")
+            raise _railfmu.OutputError(f"to_csv writes CSV: '{path}' names a Parquet file; give a .csv name, or use to_parquet")
+        self._write(path, parquet=False)
+
+    def to_parquet(self, path: PathLike) -> None:
+        """Writes the table as ``master run -o results.parquet`` does (atomically): one Parquet
+        file, its metadata (as :meth:`to_csv` writes beside a CSV) inside it under the key
+        ``railfmu.results``, which :func:`read_results` and ``master assess`` read."""
+        if Path(path).suffix.lower() not in (".parquet", ".pq"):
+            raise _railfmu.OutputError(f"to_parquet writes Parquet: name '{path}' .parquet (or .pq)")
+        self._write(path, parquet=True)
+
+    def _write(self, path: PathLike, parquet: bool) -> None:
         texts = [(self.names.index(n), list(t)) for n, t in self.texts.items()]
         meta = json.dumps(self.metadata) if self.metadata is not None else None
         data = np.ascontiguousarray(self.values, dtype=np.float64).tobytes()
@@ -207,7 +218,7 @@ class Results:
         # say; any other (e.g. built from every 20th row of another) records no sampling, so
         # that an assessment of the file notes it as one of the table does
         known = self.full_rate or (self.metadata is not None and self.metadata.get("sampling") is not None)
-        _railfmu.write_results_csv(os.fspath(path), self.header, data, texts, meta, summary, known)
+        _railfmu.write_results_file(os.fspath(path), self.header, data, texts, meta, summary, known, parquet)
 
 
 class RunSetResults(Mapping[str, Results]):

@@ -882,16 +882,17 @@ fn read_results<'py>(py: Python<'py>, path: PathBuf) -> PyResult<ReadTable<'py>>
     Ok((t.header, f64_pybytes(py, &t.data)?, t.texts, meta))
 }
 
-/// Writes results as `master run` does, atomically: the CSV and its metadata file beside it
-/// (`<name>.meta.json`). The table (header, data bytes, texts, as [`read_results`] gives
+/// Writes results as `master run` does, atomically: a CSV and its metadata file beside it
+/// (`<name>.meta.json`), or with `parquet` a Parquet file holding its metadata. The table (header, data bytes, texts, as [`read_results`] gives
 /// them) has its columns described by the metadata JSON (None: Reals, and Strings where there
 /// are texts), which also gives the run's name, parameters and system description, if any;
 /// `summary_json` is the run's summary (missing statistics are 0). `sampling_known`: false for
 /// a table of unknown origin (its metadata then record no sampling, so that an assessment of
 /// the file notes it, as one of the table did).
 #[pyfunction]
-#[pyo3(signature = (path, header, data, texts, metadata_json=None, summary_json=None, sampling_known=true))]
-fn write_results_csv(
+#[pyo3(signature = (path, header, data, texts, metadata_json=None, summary_json=None, sampling_known=true, parquet=false))]
+#[allow(clippy::too_many_arguments)] // the parts of a table, as Python holds them
+fn write_results_file(
     path: PathBuf,
     header: Vec<String>,
     data: &[u8],
@@ -899,6 +900,7 @@ fn write_results_csv(
     metadata_json: Option<&str>,
     summary_json: Option<&str>,
     sampling_known: bool,
+    parquet: bool,
 ) -> PyResult<()> {
     let meta = metadata_json
         .map(serde_json::from_str::<ResultsMetadata>)
@@ -925,10 +927,16 @@ fn write_results_csv(
         ctx.labels = m.labels;
         ctx.system = m.system;
     }
-    let paths = [path.clone(), csv_metadata_path(&path)];
+    let (format, paths) = if parquet {
+        (ResultsFormat::Parquet, vec![path.clone()])
+    } else {
+        (
+            ResultsFormat::Csv,
+            vec![path.clone(), csv_metadata_path(&path)],
+        )
+    };
     check_outputs_apart(&[], &paths).map_err(|e| OutputError::new_err(error_message(&e)))?;
-    write_results(&path, &out, ResultsFormat::Csv, &ctx)
-        .map_err(|e| OutputError::new_err(error_message(&e)))
+    write_results(&path, &out, format, &ctx).map_err(|e| OutputError::new_err(error_message(&e)))
 }
 
 /// The FMUs' and the master's messages since the last call, as (Python logging level, text),
@@ -1032,6 +1040,6 @@ fn _railfmu(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyRunWriter>()?;
     m.add_function(wrap_pyfunction!(prepare_run_folder, m)?)?;
     m.add_function(wrap_pyfunction!(read_results, m)?)?;
-    m.add_function(wrap_pyfunction!(write_results_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(write_results_file, m)?)?;
     Ok(())
 }

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pyarrow.parquet as pq
+import pytest
 
 import railfmu
 
@@ -66,6 +67,21 @@ def test_master_run_writes_parquet_by_extension(passive_file, master_cmd, tmp_pa
     assert table.columns[0] == "time [s]" and len(table) == 1001
     assert "run" not in table.columns
     assert Path(out).with_suffix(".meta.json").exists() is False
+    # the same run from Python, written by to_parquet: the same table and metadata
+    res = railfmu.System.load(passive_file).run()
+    mine = tmp_path / "mine.pq"
+    res.to_parquet(mine)
+    assert pd.read_parquet(mine).equals(table)
+    meta = lambda p: json.loads(pq.read_schema(p).metadata[b"railfmu.results"])  # noqa: E731
+    a, b = meta(out), meta(mine)
+    for m in (a, b):
+        m["summary"].pop("wall_time_s")
+        m["summary"].pop("realtime_ratio")
+    assert a == b
+    back = railfmu.read_results(mine)
+    assert np.array_equal(bits(back.values), bits(res.values))
+    with pytest.raises(railfmu.OutputError, match="name .*mine.csv' .parquet"):
+        res.to_parquet(tmp_path / "mine.csv")
 
 
 def test_a_hosts_parquet_file_is_assessed_whatever_its_compression(tmp_path):
