@@ -248,7 +248,22 @@ pub struct ModelDescription {
     pub outputs: Vec<OutputDependency>,
     /// Enumeration SimpleTypes of TypeDefinitions: type name -> items in declaration order.
     pub enumerations: std::collections::BTreeMap<String, Vec<EnumItem>>,
+    /// UnitDefinitions with a BaseUnit: unit name -> its definition in SI base units.
+    #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub units: std::collections::BTreeMap<String, BaseUnit>,
 }
+
+/// A unit in SI base units (FMI 2.0, 2.2.2 `BaseUnit`): value in SI = factor * value + offset,
+/// with the exponents of kg, m, s, A, K, mol, cd and rad.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct BaseUnit {
+    pub exponents: [i64; 8],
+    pub factor: f64,
+    pub offset: f64,
+}
+
+/// The base units' attribute names, in the order of [`BaseUnit::exponents`].
+pub const BASE_UNIT_NAMES: [&str; 8] = ["kg", "m", "s", "A", "K", "mol", "cd", "rad"];
 
 impl ModelDescription {
     /// Index and variable by exact name.

@@ -192,7 +192,9 @@ impl ModelDescription {
             variables: Vec::new(),
             outputs: Vec::new(),
             enumerations: Default::default(),
+            units: Default::default(),
         };
+        let mut current_unit: Option<String> = None;
         // SimpleType name -> unit, and a Real's or Integer's (min, max)
         let mut type_units: HashMap<String, Option<String>> = HashMap::new();
         let mut type_ranges: HashMap<String, (Option<f64>, Option<f64>)> = HashMap::new();
@@ -288,6 +290,29 @@ impl ModelDescription {
                                     stop_time: e.f64("stopTime")?,
                                     step_size: e.f64("stepSize")?,
                                 });
+                            }
+                            ("UnitDefinitions", "Unit") => {
+                                current_unit = Some(e.req("name")?.to_string());
+                            }
+                            ("Unit", "BaseUnit") => {
+                                let mut exponents = [0i64; 8];
+                                for (x, key) in exponents.iter_mut().zip(super::BASE_UNIT_NAMES) {
+                                    if let Some(v) = e.get(key) {
+                                        *x = v.trim().parse::<i64>().map_err(|_| {
+                                            e.invalid(key, v, "expected an integer exponent")
+                                        })?;
+                                    }
+                                }
+                                if let Some(name) = &current_unit {
+                                    md.units.insert(
+                                        name.clone(),
+                                        super::BaseUnit {
+                                            exponents,
+                                            factor: e.f64("factor")?.unwrap_or(1.0),
+                                            offset: e.f64("offset")?.unwrap_or(0.0),
+                                        },
+                                    );
+                                }
                             }
                             ("TypeDefinitions", "SimpleType") => {
                                 let n = e.req("name")?.to_string();

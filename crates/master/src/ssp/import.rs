@@ -285,7 +285,7 @@ impl Importer {
                         ));
                     }
                     if let (ConnectorType::Real { unit: Some(u) }, Some(fu)) = (t, &v.unit) {
-                        if !same_unit(ssd, u, fu) {
+                        if !is_fmu_unit(ssd, None, md, u, fu) {
                             return Err(SspError::Unsupported {
                                 file: self.ssd_label.clone(),
                                 line: Some(k.line),
@@ -586,8 +586,7 @@ impl Importer {
         let value = match (fv.var_type, v) {
             (VarType::Real, Value::Real(x)) => {
                 if let (Some(u), Some(fu)) = (&p.unit, &fv.unit) {
-                    let defined = |n: &str| set.units.iter().chain(&ssd.units).any(|d| d.name == n);
-                    if u != fu && !(defined(u) && defined(fu) && same_unit_in(ssd, set, u, fu)) {
+                    if !is_fmu_unit(ssd, Some(set), md, u, fu) {
                         return Err(SspError::Unsupported {
                             file: origin.to_string(),
                             line: None,
@@ -641,7 +640,30 @@ fn same_unit(ssd: &Ssd, a: &str, b: &str) -> bool {
         }
 }
 
-fn same_unit_in(ssd: &Ssd, set: &ParameterSet, a: &str, b: &str) -> bool {
-    let find = |n: &str| set.units.iter().chain(&ssd.units).find(|u| u.name == n);
-    matches!((find(a), find(b)), (Some(x), Some(y)) if x.exponents == y.exponents && x.factor == y.factor && x.offset == y.offset)
+/// Whether the SSP's unit `a` (defined in the SSD, or in `set`) is the FMU's unit `fu`: the same
+/// name, or the same SI exponents, factor and offset, `fu` defined by the FMU's own
+/// UnitDefinitions where the SSP does not define it (`kilogram` in the SSP is the FMU's `kg`).
+fn is_fmu_unit(
+    ssd: &Ssd,
+    set: Option<&ParameterSet>,
+    md: &ModelDescription,
+    a: &str,
+    fu: &str,
+) -> bool {
+    if a == fu {
+        return true;
+    }
+    let in_ssp = |n: &str| {
+        set.into_iter()
+            .flat_map(|s| s.units.iter())
+            .chain(&ssd.units)
+            .find(|u| u.name == n)
+            .map(|u| (u.exponents, u.factor, u.offset))
+    };
+    let of_fmu = md
+        .units
+        .get(fu)
+        .map(|u| (u.exponents, u.factor, u.offset))
+        .or_else(|| in_ssp(fu));
+    matches!((in_ssp(a), of_fmu), (Some(x), Some(y)) if x == y)
 }

@@ -149,7 +149,7 @@ pub(super) struct UnitDef {
     pub offset: f64,
 }
 
-pub(super) const BASE_UNITS: [&str; 8] = ["kg", "m", "s", "A", "K", "mol", "cd", "rad"];
+pub(super) use crate::model_description::BASE_UNIT_NAMES as BASE_UNITS;
 
 #[derive(Debug, Clone)]
 pub(super) struct Ssd {

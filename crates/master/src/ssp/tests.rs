@@ -830,3 +830,37 @@ fn a_connector_of_an_unknown_kind_or_declared_twice_is_refused() {
         "{e}"
     );
 }
+
+/// A connector's unit named otherwise than its FMU variable's is that unit when both define
+/// the same SI unit, the FMU's through its own UnitDefinitions (`metre` in the SSP, `m` in the
+/// FMU); a different factor is a conversion the master does not make.
+#[test]
+fn a_unit_of_another_name_is_the_fmus_when_their_definitions_agree() {
+    let with_metre = |factor: &str| {
+        let units = format!(
+            r#"<ssd:Units><ssc:Unit name="metre"><ssc:BaseUnit m="1"{factor}/></ssc:Unit></ssd:Units>
+  <ssd:DefaultExperiment"#
+        );
+        let ssd = OSP_SSD
+            .replacen(
+                r#"<ssd:Connector name="position" kind="output"><ssc:Real/></ssd:Connector>"#,
+                r#"<ssd:Connector name="position" kind="output"><ssc:Real unit="metre"/></ssd:Connector>"#,
+                1,
+            )
+            .replacen("<ssd:DefaultExperiment", &units, 1);
+        assert!(ssd.contains(r#"unit="metre""#) && ssd.contains("<ssd:Units>"));
+        vec![
+            ("SystemStructure.ssd", format!("{HEAD}{ssd}")),
+            ("resources/ms.fmu", String::new()),
+            ("a_params.ssv", A_SSV.to_string()),
+        ]
+    };
+    import_ok(&refs(&with_metre("")));
+    let e = import_err(&refs(&with_metre(r#" factor="0.001""#)));
+    assert!(
+        e.contains("unit conversion: connector 'a.position' is in [metre]"),
+        "{e}"
+    );
+    let md = crate::model_description::ModelDescription::parse(MASS_SPRING).unwrap();
+    assert_eq!(md.units["m"].exponents, [0, 1, 0, 0, 0, 0, 0, 0]);
+}
