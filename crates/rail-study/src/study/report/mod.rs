@@ -92,30 +92,67 @@ fn speed_curve(chart: Chart, id: &str, label: &str, points: Vec<(f64, f64)>) -> 
 const HISTORY_DETAIL_CAPTION: &str = "the same over the last 2 s at the full recorded rate, \
      where its cycles and switchings show (each panel scaled to its own run)";
 
-/// A history's y axis: its description, and a grey line that says what its scale means.
+/// A history's y axis: its description, a grey line that says what its scale means, and the
+/// window of a moving mean the whole history is drawn as (the detail figure keeps every
+/// sample).
 #[derive(Clone, Copy)]
 struct YAxis<'a> {
     label: &'a str,
     guide: Option<(f64, &'a str)>,
+    mean_over_s: Option<f64>,
 }
 
 impl<'a> YAxis<'a> {
     const fn plain(label: &'a str) -> Self {
-        YAxis { label, guide: None }
+        YAxis {
+            label,
+            guide: None,
+            mean_over_s: None,
+        }
     }
 }
 
-/// The valve command's axis: which end is closed (the controllers' 0-10 V, (3.1)).
+/// The valve command's axis: which end is closed (the controllers' 0-10 V, (3.1)). An on/off
+/// sky-hook switches within milliseconds, which 100 Hz samples of 40 s draw as a solid comb:
+/// the whole history shows its 0.5 s moving mean, the share of time the valve is commanded
+/// open.
 const COMMAND_AXIS: YAxis<'static> = YAxis {
     label: "command [V]",
     guide: Some((10.0, "10 V: valve fully open (0 V: closed, most damping)")),
+    mean_over_s: Some(0.5),
+};
+
+/// The command of a controller whose command moves slowly (MPPT: 1 s updates), every sample.
+const SLOW_COMMAND_AXIS: YAxis<'static> = YAxis {
+    mean_over_s: None,
+    ..COMMAND_AXIS
 };
 
 /// The valve opening's axis.
 const OPENING_AXIS: YAxis<'static> = YAxis {
     label: OPENING_LABEL,
     guide: Some((1.0, "1: valve fully open (0: closed, most damping)")),
+    mean_over_s: None,
 };
+
+/// The centred moving mean of `s` over `window_s` (fewer points near the ends).
+fn moving_mean(s: &[(f64, f64)], window_s: f64) -> Points {
+    let half = 0.5 * window_s;
+    let (mut lo, mut hi, mut sum) = (0usize, 0usize, 0.0);
+    s.iter()
+        .map(|&(t, _)| {
+            while hi < s.len() && s[hi].0 <= t + half {
+                sum += s[hi].1;
+                hi += 1;
+            }
+            while s[lo].0 < t - half {
+                sum -= s[lo].1;
+                lo += 1;
+            }
+            (t, sum / (hi - lo) as f64)
+        })
+        .collect()
+}
 
 const OPENING_LABEL: &str = "opening [-]";
 
@@ -145,11 +182,21 @@ fn history_chart(
             .filter_map(|(label, run)| get(run).map(|s| (*label, format!("{label}: {y_label}"), s)))
             .collect()
     };
-    let found = of(&|run| series(r, run, column, scale));
+    let mut found = of(&|run| series(r, run, column, scale));
     if found.is_empty() {
         return Ok(None);
     }
-    let mut views = vec![(stem, title.to_string(), found, false)];
+    let mut whole_title = title.to_string();
+    if let Some(w) = y_axis.mean_over_s {
+        for (_, header, s) in &mut found {
+            *s = moving_mean(s, w);
+            header.push_str(&format!(", {w} s moving mean"));
+        }
+        whole_title.push_str(&format!(
+            "; drawn as its {w} s moving mean (the detail shows every switch)"
+        ));
+    }
+    let mut views = vec![(stem, whole_title, found, false)];
     let mut detail_written = None;
     if let Some((stem, title)) = detail {
         let tail = of(&|run| tail_series(r, run, column, scale));
@@ -622,7 +669,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
         out,
         stem::MPPT_COMMAND_CLOSED_START,
         &format!("MPPT valve command of the {first_damper} from a closed valve at {v_low:.0} km/h, irregular track"),
-        COMMAND_AXIS,
+        SLOW_COMMAND_AXIS,
         &low_runs,
         &command,
         1.0,
@@ -650,7 +697,7 @@ pub fn write_outputs(r: &StudyResults, out: &Path, timing: &Timing) -> Result<St
             "MPPT valve command of the {first_damper} from {:.0} V, slow valve, {v_hil:.0} km/h, {}",
             r.settings.hil_initial_command_v, hil_what
         ),
-        COMMAND_AXIS,
+        SLOW_COMMAND_AXIS,
         &mppt_hil,
         &command,
         1.0,

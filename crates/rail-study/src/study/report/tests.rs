@@ -435,3 +435,19 @@ fn time_histories_have_a_detail_figure_of_their_last_two_seconds() {
     assert!(!d.path().join("history_displacement_detail.svg").exists());
     assert!(!text.contains("history_displacement_detail"), "{text}");
 }
+
+#[test]
+fn the_moving_mean_of_a_switching_signal_is_its_duty_cycle() {
+    // 0/10 V switching every 10 ms (100 Hz samples): on a third of the time
+    let s: Vec<(f64, f64)> = (0..1000)
+        .map(|k| (k as f64 * 0.01, if k % 3 == 0 { 10.0 } else { 0.0 }))
+        .collect();
+    let m = super::moving_mean(&s, 0.5);
+    assert_eq!(m.len(), s.len());
+    for &(t, v) in &m[50..950] {
+        assert!((v - 10.0 / 3.0).abs() < 0.2, "{t}: {v}");
+    }
+    // the ends average what the window holds
+    assert!((m[0].1 - 10.0 * 9.0 / 26.0).abs() < 1e-12, "{}", m[0].1);
+    assert!(super::moving_mean(&[(0.0, 2.0)], 0.5) == [(0.0, 2.0)]);
+}
