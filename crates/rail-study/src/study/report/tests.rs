@@ -1,9 +1,9 @@
 use super::*;
 use crate::study::critical::Critical;
 use crate::study::metrics::RunMetrics;
-use crate::study::run::{ConfigResult, NamedRun, SpeedPoint, HISTORY_DETAIL_S};
+use crate::study::run::{scenario, ConfigResult, NamedRun, SpeedPoint, HISTORY_DETAIL_S};
 use crate::study::settings::StudySettings;
-use crate::study::vehicle::VehicleModel;
+use crate::study::vehicle::{Signals, VehicleModel};
 use std::collections::BTreeMap;
 
 fn metrics(rms: f64, amp: f64, cmd: Option<f64>) -> RunMetrics {
