@@ -240,7 +240,7 @@ impl FmuModel for Bogie2Dof {
             output "frame.lateral_acceleration_front" [unit = "m/s2", depends_on = FT_ACC] => shell.out.frame_acc_front_mps2;
             /// Bogie frame lateral acceleration above the rear wheelset y'' + p sigma''
             output "frame.lateral_acceleration_rear" [unit = "m/s2", depends_on = FT_ACC] => shell.out.frame_acc_rear_mps2;
-            /// Lateral displacement of the front (leading, at +p) wheelset, y -+ p sigma
+            /// Lateral displacement of the front (leading, at +p) wheelset, y - p sigma
             output "wheelset_front.lateral_displacement" [unit = "m", display_unit = "mm"] => shell.out.wheelset_front_lateral_m;
             /// Lateral displacement of the front (leading, at +p) wheelset relative to the track
             output "wheelset_front.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => shell.out.wheelset_front_rel_track_m;
@@ -250,7 +250,7 @@ impl FmuModel for Bogie2Dof {
             /// Sum Y of the lateral wheel/rail forces on the front (leading, at +p) wheelset
             /// (force of the rails on the wheelset, positive right)
             output "wheelset_front.guiding_force" [unit = "N", display_unit = "kN", depends_on = FT_TRACK] => shell.out.guiding_force_front_n;
-            /// Lateral displacement of the rear (at -p) wheelset, y -+ p sigma
+            /// Lateral displacement of the rear (at -p) wheelset, y + p sigma
             output "wheelset_rear.lateral_displacement" [unit = "m", display_unit = "mm"] => shell.out.wheelset_rear_lateral_m;
             /// Lateral displacement of the rear (at -p) wheelset relative to the track
             output "wheelset_rear.lateral_displacement_relative" [unit = "m", display_unit = "mm", depends_on = FT_TRACK] => shell.out.wheelset_rear_rel_track_m;

@@ -126,7 +126,9 @@ impl FmuModel for FullActiveActuator {
             parameter "friction.regularisation_velocity" [unit = "m/s", display_unit = "mm/s", min = 0.0] => params.friction_reg_velocity_mps;
 
             /// Spool position demand u of (3.46), m; positive feeds chamber A and pushes the rod
-            /// out (decreases the tension); beyond alpha + beta the orifice saturates
+            /// out (decreases the tension); beyond alpha + beta the orifice saturates. Its start
+            /// value, 1 mm, is the default experiment's step: left unconnected, the actuator
+            /// pushes at its force bound
             input "spool.command" [unit = "m", display_unit = "mm"] => inputs.spool_command_m;
             /// Rod position x imposed by the vehicle, positive = extension (chamber A grows)
             input "damper.elongation" [unit = "m", display_unit = "mm"] => inputs.elongation_m;

@@ -208,7 +208,9 @@ macro_rules! declare_motion_inputs {
         model_description::declare! { $v;
             /// Damper elongation, positive = extension (not used by the simplified model)
             input "damper.elongation" [unit = "m", display_unit = "mm"] => s.inputs.elongation_m;
-            /// Damper elongation velocity, positive = extension
+            /// Damper elongation velocity, positive = extension; its start value, 0.05 m/s, is
+            /// the default experiment's constant extension: left unconnected, the damper keeps
+            /// a steady force
             input "damper.elongation_velocity" [unit = "m/s", display_unit = "mm/s"] => s.inputs.elongation_velocity_mps;
         }
     };

@@ -38,7 +38,8 @@ pub struct Args {
     /// Linear model: the coach (`vehicle`) or the 2-dof bogie (`bogie2dof`).
     #[arg(long, value_enum, default_value = "vehicle")]
     pub model: VehicleModel,
-    /// First speed [km/h].
+    /// First speed of the plotted locus [km/h]; the critical speed is searched from 18 to 716
+    /// km/h whatever the plotted range.
     #[arg(
         long,
         value_name = "KMH",
@@ -46,7 +47,8 @@ pub struct Args {
         allow_negative_numbers = true
     )]
     pub from: f64,
-    /// Last speed [km/h] (at most 716).
+    /// Last speed of the plotted locus [km/h] (at most 716); the critical speed is searched
+    /// up to 716 km/h whatever the plotted range.
     #[arg(
         long,
         value_name = "KMH",

@@ -27,7 +27,9 @@ pub struct Args {
     /// bogie with two (`bogie2dof`, the seed's HIL configuration).
     #[arg(long, value_enum, default_value = "vehicle")]
     pub vehicle: VehicleModel,
-    /// Folder with the FMUs (RailVehicle.fmu, Bogie2Dof.fmu, SemiActiveDamper.fmu, ...).
+    /// Folder with the FMUs (RailVehicle.fmu, Bogie2Dof.fmu, SemiActiveDamper.fmu, ...);
+    /// default: `dist` in the current folder, else the `dist` of the workspace the binary was
+    /// built in.
     #[arg(long)]
     pub fmus: Option<PathBuf>,
     /// Output folder. An earlier study's report, figures and tables in it are removed when
