@@ -661,7 +661,7 @@ pub(super) fn hil_figures(
     )? {
         figures.push((
             s,
-            "slow valve: actual opening lagging the command (Fig. 5.25)",
+            "the valves' actual openings on the ideal track, slow and ideal valve (Fig. 5.25; the command beside the opening: skyhook_valve_zoom.svg)",
         ));
     }
 
