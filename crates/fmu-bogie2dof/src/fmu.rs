@@ -291,9 +291,27 @@ impl FmuModel for Bogie2Dof {
         })
     }
 
-    fn exit_initialization(&mut self, _diag: &mut Diagnostics) -> Result<(), ModelError> {
+    fn exit_initialization(&mut self, diag: &mut Diagnostics) -> Result<(), ModelError> {
         let params = self.build_params();
         params.validate().map_err(|e| field_error::<Self>(&e))?;
+        // the creep coefficients and the linear gravitational stiffness are parameters of
+        // their own, given for the default load: a new load alone leaves them as they were
+        let defaults = Params::default();
+        let load_changed =
+            (params.wheel_load_n - defaults.wheel_load_n).abs() > 1e-6 * defaults.wheel_load_n;
+        let load_dependent_kept = params.f11_n == defaults.f11_n
+            && params.f22_n == defaults.f22_n
+            && params.gravity_stiffness_n_per_m == defaults.gravity_stiffness_n_per_m;
+        if load_changed && load_dependent_kept {
+            diag.warn(format!(
+                "'wheelset.wheel_load' = {} kN, but 'creep.f11', 'creep.f22' and \
+                 'linear.gravitational_stiffness' keep their values for {} kN: they are not \
+                 derived from the load (Hertz-Kalker: f11, f22 grow with P^(2/3); the \
+                 gravitational stiffness with P); set them for this load",
+                params.wheel_load_n / 1e3,
+                defaults.wheel_load_n / 1e3
+            ));
+        }
         let b = match &params.contact {
             // A file named by the host: a regular file of sane size only, checked before it is
             // opened (a FIFO must not block the host, /dev/zero must not fill its memory).

@@ -131,6 +131,27 @@ fn parameters_too_stiff_to_integrate_are_refused() {
     assert!(logged(&l, Status::Error, "internal steps of"), "{l:?}");
 }
 
+/// A new wheel load alone leaves the load-dependent creep coefficients and gravitational
+/// stiffness at their 70 kN values: the exit says so (fmi2Warning), and is silent when they are
+/// set too.
+#[test]
+fn a_new_wheel_load_alone_warns_that_its_dependent_parameters_stay() {
+    let (mut c, log) = initialising::<M>();
+    assert_eq!(set::<M>(&mut c, "wheelset.wheel_load", 50e3), Status::Ok);
+    assert_eq!(c.exit_initialization_mode(), Status::Warning);
+    let l = log.take();
+    assert!(
+        logged(&l, Status::Warning, "'wheelset.wheel_load' = 50 kN")
+            && logged(&l, Status::Warning, "keep their values for 70 kN"),
+        "{l:?}"
+    );
+    let (mut c, log) = initialising::<M>();
+    assert_eq!(set::<M>(&mut c, "wheelset.wheel_load", 50e3), Status::Ok);
+    assert_eq!(set::<M>(&mut c, "creep.f11", 9.2e6), Status::Ok);
+    assert_eq!(c.exit_initialization_mode(), Status::Ok);
+    assert!(log.take().is_empty());
+}
+
 /// Negative values are rejected when set (declared min); zero, speed and friction at
 /// fmi2ExitInitializationMode by the physics' validation; the FMI variable is named.
 #[test]
