@@ -19,7 +19,11 @@ def assess_columns(names: List[str], data: bytes, full_rate: bool, options_json:
 class PreparedSystem:
     @staticmethod
     def load(
-        path: str, step: Optional[float] = None, stop_time: Optional[float] = None, algorithm: Optional[str] = None
+        path: str,
+        step: Optional[float] = None,
+        stop_time: Optional[float] = None,
+        algorithm: Optional[str] = None,
+        record: Optional[List[str]] = None,
     ) -> "PreparedSystem": ...
     @staticmethod
     def from_json(text: str, base_dir: str, label: str) -> "PreparedSystem": ...

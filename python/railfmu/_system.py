@@ -6,7 +6,7 @@ import json
 import numbers
 import os
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Mapping, Optional, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Union
 
 from . import _railfmu
 from ._json import description_json
@@ -80,6 +80,7 @@ class System:
         step: Optional[float] = None,
         stop_time: Optional[float] = None,
         algorithm: Optional[str] = None,
+        record: Optional[Sequence[str]] = None,
     ) -> "System":
         """Loads a system description file: JSON (FMU paths relative to its folder), or an SSP
         (a ``.ssp`` archive, or a bare ``.ssd`` next to its FMUs) as ``master run`` reads it.
@@ -90,10 +91,18 @@ class System:
         algorithm, ``"jacobi"`` or ``"gauss-seidel"``: each replaces the description's (as
         ``master run --step --stop --algorithm``). An SSP's defaults: its libcosim or
         OMSimulator step annotation, its DefaultExperiment's stop time, and the coupling
-        ``master export-ssp`` kept in it (else Jacobi)."""
+        ``master export-ssp`` kept in it (else Jacobi). ``record``: the ``instance.variable``
+        names to record, replacing the description's list (``master run --record``; an SSP
+        records every output unless given)."""
         step_s, stop_s = _seconds("step", step), _seconds("stop_time", stop_time)
+        if record is not None:
+            if isinstance(record, str) or not all(isinstance(r, str) for r in record):
+                raise TypeError(f"record must be a list of instance.variable names, got {record!r}")
+            record = list(record)
+            if not record:
+                raise ValueError("record: an empty list records nothing; give names, or None for the description's list")
         with forwarded():
-            return cls(_railfmu.PreparedSystem.load(os.fspath(path), step_s, stop_s, algorithm))
+            return cls(_railfmu.PreparedSystem.load(os.fspath(path), step_s, stop_s, algorithm, record))
 
     @classmethod
     def from_dict(cls, description: Mapping[str, Any], base_dir: PathLike = ".", label: str = "<dict>") -> "System":

@@ -325,18 +325,26 @@ impl PySystem {
     /// Loads a system description and prepares it: JSON (FMU paths relative to its folder),
     /// or an SSP (`.ssp` archive, or a bare `.ssd` next to its FMUs) as `master run` reads it.
     /// The communication step, stop time and coupling algorithm ("jacobi" or "gauss-seidel")
-    /// can be given, replacing the description's (`master run --step --stop --algorithm`).
+    /// can be given, replacing the description's (`master run --step --stop --algorithm`), and
+    /// the variables to record (`master run --record`; an SSP records every output unless
+    /// given).
     #[staticmethod]
-    #[pyo3(signature = (path, step=None, stop_time=None, algorithm=None))]
+    #[pyo3(signature = (path, step=None, stop_time=None, algorithm=None, record=None))]
     fn load(
         py: Python<'_>,
         path: PathBuf,
         step: Option<f64>,
         stop_time: Option<f64>,
         algorithm: Option<&str>,
+        record: Option<Vec<String>>,
     ) -> PyResult<Self> {
         refuse_fmu(&path, false)?;
         let algorithm = algorithm.map(parse_algorithm).transpose()?;
+        let record_only = master::system::SystemOverrides {
+            from: master::system::OverridesFrom::PythonLoad,
+            record: record.unwrap_or_default(),
+            ..Default::default()
+        };
         if master::ssp::is_ssp_path(&path) {
             let opts = master::ssp::ImportOptions {
                 step,
@@ -344,17 +352,20 @@ impl PySystem {
                 algorithm,
             };
             let imported = master::ssp::import(&path, &opts).map_err(|e| ssp_err(&e))?;
-            let mut system = Self::prepare(py, imported.system.clone())?;
+            let mut loaded = imported.system.clone();
+            loaded
+                .apply_overrides(&record_only)
+                .map_err(|e| system_err(&e))?;
+            let mut system = Self::prepare(py, loaded)?;
             system._ssp = Some(imported);
             return Ok(system);
         }
         let mut system = LoadedSystem::load(&path).map_err(|e| system_err(&e))?;
         let overrides = master::system::SystemOverrides {
-            from: master::system::OverridesFrom::PythonLoad,
             step,
             stop_time,
             algorithm,
-            ..Default::default()
+            ..record_only
         };
         system
             .apply_overrides(&overrides)

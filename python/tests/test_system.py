@@ -244,6 +244,19 @@ def test_an_ssp_loads_and_runs_as_the_command_line_runs_it(passive_file, master_
     assert cli.header == res.header
     assert np.array_equal(bits(cli.values), bits(res.values))
     assert np.max(np.abs(res["bogie.wheelset_front.lateral_displacement_relative"])) > 1e-6
+    # the variables to record, as `master run --record` names them: the same columns and values
+    names = ["bogie.wheelset_front.lateral_displacement_relative", "damper_left.damper.force"]
+    few = railfmu.System.load(ssp, record=names).run()
+    r = run_master(master_cmd, "run", ssp, "--record", *names, "-o", tmp_path / "few.csv")
+    assert r.returncode == 0, r.stderr
+    cli_few = railfmu.read_results(tmp_path / "few.csv")
+    assert few.header == cli_few.header and len(few.header) == 3
+    assert np.array_equal(bits(few.values), bits(cli_few.values))
+    assert np.array_equal(bits(few[names[1]]), bits(res[names[1]]))
+    with pytest.raises(railfmu.SystemDescriptionError, match="unknown variable 'bogie.nope'"):
+        railfmu.System.load(ssp, record=["bogie.nope"])
+    with pytest.raises(TypeError, match="record must be a list"):
+        railfmu.System.load(ssp, record="bogie.x")
     # a broken SSP raises with the master's message naming the file
     broken = tmp_path / "broken.ssp"
     broken.write_bytes(b"not a zip")
