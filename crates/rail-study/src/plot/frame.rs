@@ -410,7 +410,8 @@ where
     Ok(entries)
 }
 
-/// A dashed red horizontal line at `value` across `x_span`; returns its legend entry.
+/// A dashed red horizontal line at `value` across `x_span` (a limit); returns its legend
+/// entry.
 pub(crate) fn draw_limit<X, Y>(
     chart: &mut Frame<'_, '_, X, Y>,
     title: &str,
@@ -422,20 +423,11 @@ where
     X: Ranged<ValueType = f64>,
     Y: Ranged<ValueType = f64>,
 {
-    let style = RED.stroke_width(1);
-    chart
-        .draw_series(DashedLineSeries::new(
-            vec![(x_span.0, value), (x_span.1, value)],
-            8,
-            5,
-            style,
-        ))
-        .map_err(|e| draw_err(title, &e))?;
-    Ok(LegendEntry::new(label, Swatch::Dashed(RED.to_rgba())))
+    draw_horizontal(chart, title, (x_span, value), (RED, (8, 5)), label)
 }
 
-/// Draws a grey dotted horizontal line at `value` (a guide, e.g. a class boundary), and
-/// returns its legend entry.
+/// A grey dotted horizontal line at `value` (a guide, e.g. a class boundary); returns its
+/// legend entry.
 pub(crate) fn draw_guide<X, Y>(
     chart: &mut Frame<'_, '_, X, Y>,
     title: &str,
@@ -447,19 +439,36 @@ where
     X: Ranged<ValueType = f64>,
     Y: Ranged<ValueType = f64>,
 {
-    let style = REFERENCE_GREY.stroke_width(1);
+    draw_horizontal(
+        chart,
+        title,
+        (x_span, value),
+        (REFERENCE_GREY, (2, 4)),
+        label,
+    )
+}
+
+/// A horizontal line of `colour`, dashes of (length, gap) px, across `x_span` at `value`.
+fn draw_horizontal<X, Y>(
+    chart: &mut Frame<'_, '_, X, Y>,
+    title: &str,
+    (x_span, value): ((f64, f64), f64),
+    (colour, (dash, gap)): (RGBColor, (u32, u32)),
+    label: &str,
+) -> Result<LegendEntry, PlotError>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
     chart
         .draw_series(DashedLineSeries::new(
             vec![(x_span.0, value), (x_span.1, value)],
-            2,
-            4,
-            style,
+            dash,
+            gap,
+            colour.stroke_width(1),
         ))
         .map_err(|e| draw_err(title, &e))?;
-    Ok(LegendEntry::new(
-        label,
-        Swatch::Dashed(REFERENCE_GREY.to_rgba()),
-    ))
+    Ok(LegendEntry::new(label, Swatch::Dashed(colour.to_rgba())))
 }
 
 /// A tick value as a person writes it: 250 and 0.3, not 250.0 and 0.30000000000000004 (the
