@@ -111,10 +111,11 @@ def assess_stability(
     """
     if isinstance(signals, str):
         names = [signals]
-    elif isinstance(signals, abc.Sequence) and all(isinstance(s, str) for s in signals):
-        names = list(signals)
     else:
-        raise TypeError(f"signals must be a column name or a list of column names, got {signals!r}")
+        # any iterable of names: a list, a tuple, a NumPy array or pandas Index of str
+        names = list(signals) if isinstance(signals, abc.Iterable) and not isinstance(signals, bytes) else None
+        if names is None or not all(isinstance(s, str) for s in names):
+            raise TypeError(f"signals must be a column name or a list of column names, got {signals!r}")
     if not isinstance(accept_narrow_band, (bool, np.bool_)):
         raise TypeError(f"accept_narrow_band must be True or False, got {accept_narrow_band!r}")
     if not isinstance(source, (Results, str, bytes, os.PathLike)):

@@ -17,10 +17,10 @@ logger = logging.getLogger("railfmu")
 def emit() -> None:
     """Logs the messages kept since the last call."""
     messages, dropped = _railfmu.take_log()
+    if dropped:
+        logger.warning("%d earlier messages were dropped (the newest 10000 are kept between two calls)", dropped)
     for level, text in messages:
         logger.log(level, text)
-    if dropped:
-        logger.warning("%d more messages were dropped (at most 10000 are kept between two calls)", dropped)
 
 
 @contextlib.contextmanager

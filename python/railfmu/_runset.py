@@ -147,7 +147,7 @@ class RunSet:
             except TypeError:
                 count = -1
             if count < 1:
-                raise ValueError(f"threads must be a whole number >= 1 (or None: all cores), got {threads!r}")
+                raise ValueError(f"threads must be a whole number >= 1 (or None: the cores this process may use), got {threads!r}")
             threads = count
         if not isinstance(resume, (bool, np.bool_)):
             raise TypeError(f"resume must be True or False, got {resume!r}")

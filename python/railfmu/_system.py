@@ -96,9 +96,11 @@ class System:
         records every output unless given)."""
         step_s, stop_s = _seconds("step", step), _seconds("stop_time", stop_time)
         if record is not None:
-            if isinstance(record, str) or not all(isinstance(r, str) for r in record):
+            if isinstance(record, (str, bytes)):
                 raise TypeError(f"record must be a list of instance.variable names, got {record!r}")
             record = list(record)
+            if not all(isinstance(r, str) for r in record):
+                raise TypeError(f"record must be a list of instance.variable names, got {record!r}")
             if not record:
                 raise ValueError("record: an empty list records nothing; give names, or None for the description's list")
         with forwarded():

@@ -27,8 +27,8 @@ removes the copies not used for 7 days and, beyond the 16 most recently used, th
 an hour (a copy is only read while a worker prepares the system, so an hour is ample). A copy is
 first renamed aside (``.removed-*``), then removed, so no worker finds it half-removed; one
 removed and needed again is written again. Nothing else in the folder is touched. The folder is
-private (made 0700); one that belongs to another user, or that others may write to, is refused
-(the workers would run any FMU put there). A worker checks the SHA-256 of a copy before its first
+private (made 0700, and made so again when found open to others); one that belongs to another
+user, or that stays writable by others, is refused (the workers would run any FMU put there). A worker checks the SHA-256 of a copy before its first
 use and writes a damaged one again.
 
 A worker prepares a system (unpacks and loads its FMUs) once and keeps it for the later tasks of
@@ -42,6 +42,7 @@ working cluster completes it.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -56,6 +57,7 @@ from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from . import _railfmu
+from ._log import forwarded
 
 
 
@@ -86,7 +88,15 @@ def _fmu_cache_dir() -> Path:
         if st.st_uid != os.getuid():
             raise RuntimeError(f"FMU cache '{root}' belongs to another user (uid {st.st_uid}): remove it")
         if st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
-            raise RuntimeError(f"FMU cache '{root}' is writable by other users: remove it, or chmod 700 it")
+            # ours, opened to others (made by an earlier version under a umask of 002): closed
+            # again; refused where the file system keeps no such modes
+            with contextlib.suppress(OSError):
+                os.chmod(root, 0o700)
+            if os.lstat(root).st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+                raise RuntimeError(
+                    f"FMU cache '{root}' is writable by other users and cannot be made private "
+                    "(a file system without Unix modes?): set TMPDIR of the workers to a private folder"
+                )
     return root
 
 
@@ -270,7 +280,9 @@ def run_task(
         job["system"] = _localise(job["system"], paths)
         job_json = json.dumps(job)
     should_stop = _stop_check(stop_event) if stop_event is not None else None
-    header, data, summary_json, columns_json, error = _prepared(base_json, label).run_job(job_json, should_stop)
+    # the run's messages go to the worker's logging (its log, which the cluster keeps)
+    with forwarded():
+        header, data, summary_json, columns_json, error = _prepared(base_json, label).run_job(job_json, should_stop)
     return {"header": header, "data": data, "summary_json": summary_json, "columns_json": columns_json, "error": error}
 
 

@@ -1022,10 +1022,10 @@ fn assess_answer_json(answer: &assess::AssessAnswer) -> PyResult<String> {
 
 #[pymodule]
 fn _railfmu(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    // FMU logger messages and the master's warnings go to stderr, as in the command line.
+    // FMU logger messages and the master's warnings, kept for Python's logging (logger
+    // "railfmu", railfmu._log), not printed on the process's stderr, which a notebook's user
+    // does not see
     master::fmu::install_logger(log::LevelFilter::Warn);
-    // the messages go to Python's logging (logger "railfmu"), not to the process's stderr,
-    // which a notebook's user does not see
     master::fmu::logger::capture_messages(true);
     let py = m.py();
     m.add("Error", py.get_type::<Error>())?;

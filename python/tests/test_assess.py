@@ -100,6 +100,9 @@ def test_what_cannot_be_assessed_raises_with_the_reason(hunting, tmp_path):
         railfmu.assess_stability(hunting, SIGNALS, 320.0, accept_narrow_band="no")
     with pytest.raises(TypeError, match="signals must be a column name or a list of column names"):
         railfmu.assess_stability(hunting, 5, 320.0)
+    # names as NumPy or pandas hold them
+    by_array = railfmu.assess_stability(hunting, np.array(SIGNALS), 320.0, skip_s=5.0)
+    assert by_array.max_rms == railfmu.assess_stability(hunting, SIGNALS, 320.0, skip_s=5.0).max_rms
     with pytest.raises(TypeError, match="got DataFrame \\(a DataFrame: assess the Results"):
         railfmu.assess_stability(hunting.to_pandas(), SIGNALS, 320.0)
     # a dominant frequency below 2.1 Hz: assessed in a clamped band, with a note

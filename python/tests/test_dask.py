@@ -490,12 +490,12 @@ def test_the_fmu_cache_replaces_a_damaged_copy_and_refuses_a_folder_others_can_w
     # damaged in place at the same size (a hand, a disk): found by its hash, written again
     path.write_bytes(b"x" * len(content))
     assert Path(rdask._local_copy(digest, "Model.fmu", content)).read_bytes() == content
-    # a cache folder that other users may write to (or made by another user first) is refused
+    # our cache folder opened to others (an earlier version under a umask of 002) is made
+    # private again
     root = rdask._fmu_cache_dir()
     root.chmod(0o777)
-    with pytest.raises(RuntimeError, match="writable by other users"):
-        rdask._local_copy(digest, "Model.fmu", content)
-    root.chmod(0o700)
+    assert Path(rdask._local_copy(digest, "Model.fmu", content)).read_bytes() == content
+    assert root.stat().st_mode & 0o777 == 0o700
     # a link in its place, to a folder someone else prepared
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()

@@ -257,6 +257,8 @@ def test_an_ssp_loads_and_runs_as_the_command_line_runs_it(passive_file, master_
         railfmu.System.load(ssp, record=["bogie.nope"])
     with pytest.raises(TypeError, match="record must be a list"):
         railfmu.System.load(ssp, record="bogie.x")
+    # any iterable of names, a generator too
+    assert railfmu.System.load(ssp, record=(n for n in names)).columns == few.header
     # a broken SSP raises with the master's message naming the file
     broken = tmp_path / "broken.ssp"
     broken.write_bytes(b"not a zip")

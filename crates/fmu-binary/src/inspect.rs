@@ -262,10 +262,12 @@ fn elf_image<'data, H: FileHeader<Endian = object::Endianness>>(
         if p.p_type(endian) != elf::PT_LOAD {
             continue;
         }
-        let (offset, size) = (p.p_offset(endian).into(), p.p_filesz(endian).into());
-        if offset
-            .checked_add(size)
-            .is_none_or(|end| end > data.len() as u64)
+        let (offset, size): (u64, u64) = (p.p_offset(endian).into(), p.p_filesz(endian).into());
+        // a segment with nothing in the file (zero-filled memory only) maps no file byte
+        if size > 0
+            && offset
+                .checked_add(size)
+                .is_none_or(|end| end > data.len() as u64)
         {
             return Err(BinaryError::Malformed {
                 format: "ELF",

@@ -176,6 +176,11 @@ fn what_is_no_shared_library_is_an_error() {
 /// The test executable (a position-independent ELF file, with a dynamic segment as a shared
 /// library has) without its section table, as a stripped library may come: what is left for a
 /// check is what the loader reads, the program headers.
+#[cfg(all(
+    target_os = "linux",
+    target_pointer_width = "64",
+    target_endian = "little"
+))]
 fn test_executable_without_sections() -> Vec<u8> {
     let mut bytes = std::fs::read(std::env::current_exe().unwrap()).unwrap();
     assert_eq!(&bytes[..5], b"\x7fELF\x02", "a 64-bit ELF file");
@@ -187,6 +192,11 @@ fn test_executable_without_sections() -> Vec<u8> {
 }
 
 /// (type, offset, size in the file) of each program header of a little-endian ELF64 file.
+#[cfg(all(
+    target_os = "linux",
+    target_pointer_width = "64",
+    target_endian = "little"
+))]
 fn program_headers(bytes: &[u8]) -> Vec<(u32, usize, usize)> {
     let u = |at: usize, n: usize| {
         bytes[at..at + n]
@@ -203,6 +213,12 @@ fn program_headers(bytes: &[u8]) -> Vec<(u32, usize, usize)> {
         .collect()
 }
 
+// the offsets read are those of a little-endian ELF64 file, as the test executable is here
+#[cfg(all(
+    target_os = "linux",
+    target_pointer_width = "64",
+    target_endian = "little"
+))]
 #[test]
 fn a_truncated_library_is_malformed_before_a_loader_maps_past_its_end() {
     let bytes = test_executable_without_sections();
@@ -219,6 +235,12 @@ fn a_truncated_library_is_malformed_before_a_loader_maps_past_its_end() {
     );
 }
 
+// the offsets read are those of a little-endian ELF64 file, as the test executable is here
+#[cfg(all(
+    target_os = "linux",
+    target_pointer_width = "64",
+    target_endian = "little"
+))]
 #[test]
 fn a_zeroed_dynamic_segment_is_malformed() {
     let mut bytes = test_executable_without_sections();

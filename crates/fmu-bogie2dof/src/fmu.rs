@@ -299,16 +299,24 @@ impl FmuModel for Bogie2Dof {
         let defaults = Params::default();
         let load_changed =
             (params.wheel_load_n - defaults.wheel_load_n).abs() > 1e-6 * defaults.wheel_load_n;
-        let load_dependent_kept = params.f11_n == defaults.f11_n
-            && params.f22_n == defaults.f22_n
-            && params.gravity_stiffness_n_per_m == defaults.gravity_stiffness_n_per_m;
-        if load_changed && load_dependent_kept {
+        let kept: Vec<&str> = [
+            ("'creep.f11'", params.f11_n == defaults.f11_n),
+            ("'creep.f22'", params.f22_n == defaults.f22_n),
+            (
+                "'linear.gravitational_stiffness'",
+                params.gravity_stiffness_n_per_m == defaults.gravity_stiffness_n_per_m,
+            ),
+        ]
+        .into_iter()
+        .filter_map(|(name, at_default)| at_default.then_some(name))
+        .collect();
+        if load_changed && !kept.is_empty() {
             diag.warn(format!(
-                "'wheelset.wheel_load' = {} kN, but 'creep.f11', 'creep.f22' and \
-                 'linear.gravitational_stiffness' keep their values for {} kN: they are not \
-                 derived from the load (Hertz-Kalker: f11, f22 grow with P^(2/3); the \
+                "'wheelset.wheel_load' = {} kN, but {} keep the values given for {} kN: they \
+                 are not derived from the load (Hertz-Kalker: f11, f22 grow with P^(2/3); the \
                  gravitational stiffness with P); set them for this load",
                 params.wheel_load_n / 1e3,
+                kept.join(", "),
                 defaults.wheel_load_n / 1e3
             ));
         }

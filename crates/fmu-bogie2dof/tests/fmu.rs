@@ -141,13 +141,38 @@ fn a_new_wheel_load_alone_warns_that_its_dependent_parameters_stay() {
     assert_eq!(c.exit_initialization_mode(), Status::Warning);
     let l = log.take();
     assert!(
-        logged(&l, Status::Warning, "'wheelset.wheel_load' = 50 kN")
-            && logged(&l, Status::Warning, "keep their values for 70 kN"),
+        logged(
+            &l,
+            Status::Warning,
+            "'wheelset.wheel_load' = 50 kN, but 'creep.f11', 'creep.f22', \
+             'linear.gravitational_stiffness' keep the values given for 70 kN"
+        ),
         "{l:?}"
     );
+    // one of them set: the others are named
     let (mut c, log) = initialising::<M>();
     assert_eq!(set::<M>(&mut c, "wheelset.wheel_load", 50e3), Status::Ok);
     assert_eq!(set::<M>(&mut c, "creep.f11", 9.2e6), Status::Ok);
+    assert_eq!(c.exit_initialization_mode(), Status::Warning);
+    let l = log.take();
+    assert!(
+        logged(
+            &l,
+            Status::Warning,
+            "but 'creep.f22', 'linear.gravitational_stiffness' keep"
+        ),
+        "{l:?}"
+    );
+    // all three set: silent
+    let (mut c, log) = initialising::<M>();
+    for (name, x) in [
+        ("wheelset.wheel_load", 50e3),
+        ("creep.f11", 9.2e6),
+        ("creep.f22", 8.3e6),
+        ("linear.gravitational_stiffness", 1.4e6),
+    ] {
+        assert_eq!(set::<M>(&mut c, name, x), Status::Ok, "{name}");
+    }
     assert_eq!(c.exit_initialization_mode(), Status::Ok);
     assert!(log.take().is_empty());
 }

@@ -50,24 +50,26 @@ static LOGGER: FmuLogger = FmuLogger;
 /// logging, e.g. Python's, where stderr is not what its user reads).
 static CAPTURING: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
-/// Messages kept at most between two takes; later ones are counted, not kept.
+/// Messages kept at most between two takes: the newest (the ones that explain a failure);
+/// older ones are counted, not kept.
 const KEPT_MESSAGES: usize = 10_000;
 
-/// The messages kept while capturing, oldest first, and how many were dropped beyond
-/// [`KEPT_MESSAGES`].
-static MESSAGES: std::sync::Mutex<(Vec<(log::Level, String)>, usize)> =
-    std::sync::Mutex::new((Vec::new(), 0));
+/// The messages kept while capturing, oldest first, and how many older ones were dropped
+/// beyond [`KEPT_MESSAGES`].
+type Kept = (std::collections::VecDeque<(log::Level, String)>, usize);
+static MESSAGES: std::sync::Mutex<Kept> =
+    std::sync::Mutex::new((std::collections::VecDeque::new(), 0));
 
 fn keep_message(level: log::Level, text: String) {
     // a poisoned lock (a panic while holding it) still holds a usable list
     let mut m = MESSAGES
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner);
-    if m.0.len() < KEPT_MESSAGES {
-        m.0.push((level, text));
-    } else {
+    if m.0.len() >= KEPT_MESSAGES {
+        m.0.pop_front();
         m.1 += 1;
     }
+    m.0.push_back((level, text));
 }
 
 /// Keeps the messages for [`take_messages`] (true) or prints them to stderr (false, the
@@ -76,12 +78,13 @@ pub fn capture_messages(on: bool) {
     CAPTURING.store(on, std::sync::atomic::Ordering::Relaxed);
 }
 
-/// The messages kept since the last take (level, text), and how many were dropped.
+/// The messages kept since the last take (level, text), oldest first, and how many older ones
+/// were dropped.
 pub fn take_messages() -> (Vec<(log::Level, String)>, usize) {
     let mut m = MESSAGES
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner);
-    (std::mem::take(&mut m.0), std::mem::take(&mut m.1))
+    (std::mem::take(&mut m.0).into(), std::mem::take(&mut m.1))
 }
 
 /// How many failure messages are kept per thread (the latest).

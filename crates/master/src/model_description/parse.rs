@@ -295,21 +295,38 @@ impl ModelDescription {
                                 current_unit = Some(e.req("name")?.to_string());
                             }
                             ("Unit", "BaseUnit") => {
+                                // read for comparing units only (SSP import): a definition
+                                // that does not read is left out, not an error of the FMU
+                                let exponent = |key: &str| match e.get(key) {
+                                    None => Some(0),
+                                    Some(v) => v.trim().parse::<i64>().ok(),
+                                };
+                                let number = |key: &str, default: f64| match e.get(key) {
+                                    None => Some(default),
+                                    Some(v) => {
+                                        v.trim().parse::<f64>().ok().filter(|x| x.is_finite())
+                                    }
+                                };
                                 let mut exponents = [0i64; 8];
+                                let mut readable = true;
                                 for (x, key) in exponents.iter_mut().zip(super::BASE_UNIT_NAMES) {
-                                    if let Some(v) = e.get(key) {
-                                        *x = v.trim().parse::<i64>().map_err(|_| {
-                                            e.invalid(key, v, "expected an integer exponent")
-                                        })?;
+                                    match exponent(key) {
+                                        Some(v) => *x = v,
+                                        None => readable = false,
                                     }
                                 }
-                                if let Some(name) = &current_unit {
+                                if let (Some(name), true, Some(factor), Some(offset)) = (
+                                    &current_unit,
+                                    readable,
+                                    number("factor", 1.0),
+                                    number("offset", 0.0),
+                                ) {
                                     md.units.insert(
                                         name.clone(),
                                         super::BaseUnit {
                                             exponents,
-                                            factor: e.f64("factor")?.unwrap_or(1.0),
-                                            offset: e.f64("offset")?.unwrap_or(0.0),
+                                            factor,
+                                            offset,
                                         },
                                     );
                                 }

@@ -16,7 +16,7 @@ pub(super) enum Package {
         zip: Box<zip::ZipArchive<std::fs::File>>,
         /// Bytes the FMUs unpacked from the archive may take together: the unpacked-size limit
         /// of an FMU (`MASTER_FMU_MAX_UNPACKED_BYTES`), for the archive as a whole (each
-        /// component's copy counts).
+        /// member unpacked counts once).
         budget: u64,
         /// The FMU members unpacked so far, by reference: one file per member, shared by the
         /// components that use it as the instances of one FMU file of a JSON system are (which
@@ -159,9 +159,10 @@ impl Package {
         }
     }
 
-    /// The FMU at reference `rel` as a file: unpacked into `dest` (a fresh folder per
-    /// component, so that each instance has its own copy, as FMUs that can be instantiated only
-    /// once per process need) from a zip, the file itself next to a bare .ssd. The FMUs of an
+    /// The FMU at reference `rel` as a file: unpacked into `dest` from a zip once per member (in
+    /// a folder named by the first component that uses it; the components that share the member
+    /// share the file, and the loading gives an FMU that can be instantiated only once per
+    /// process a copy per instance), the file itself next to a bare .ssd. The FMUs of an
     /// archive unpack within one budget, checked against each entry's declared size before a
     /// byte is written and against what it really gives (a small archive must not fill the
     /// disk first and be refused after).
@@ -192,7 +193,8 @@ impl Package {
                     return Err(too_large(format!("declares {} bytes", entry.size())));
                 }
                 let file_name = rel.rsplit('/').next().unwrap_or("component.fmu");
-                // one folder per component: two sources may share a file name
+                // a folder per member, named by its first component: two members may share a
+                // file name
                 let dir = dest.join(index.to_string());
                 let out = dir.join(file_name);
                 let io = |e: std::io::Error| SspError::Read {

@@ -423,13 +423,17 @@ fn parse_connectors(ctx: Ctx, n: Node) -> Result<Vec<Connector>, SspError> {
         }
         let name = ctx.req(c, "name")?.to_string();
         let kind = ctx.req(c, "kind")?.to_string();
-        // SSD 1.0 5.3.4: the kinds the schema allows
-        const KINDS: [&str; 5] = [
+        // the kinds the schemas allow: SSD 1.0 5.3.4, and those SSP 2.0 adds
+        const KINDS: [&str; 9] = [
             "input",
             "output",
             "inout",
             "parameter",
             "calculatedParameter",
+            "structuralParameter",
+            "constant",
+            "local",
+            "unspecified",
         ];
         if !KINDS.contains(&kind.as_str()) {
             return Err(ctx.err(

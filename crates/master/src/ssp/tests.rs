@@ -757,7 +757,8 @@ fn large_parameter_sets_keep_their_line_numbers_and_crowded_tags_are_refused() {
             && e.contains("parameter 'p7' is given twice in set 'big' (first at line 10)"),
         "{e}"
     );
-    let attributes: String = (0..10_001).map(|k| format!(" a{k}=\"1\"")).collect();
+    // a value may hold '>' and '=': the count goes on past them
+    let attributes: String = (0..10_001).map(|k| format!(" a{k}=\">=\"")).collect();
     let crowded = format!("<?xml version=\"1.0\"?>\n\n<x{attributes}/>");
     let e = super::ssv::parse_ssv("crowded.ssv", &crowded)
         .unwrap_err()
@@ -811,6 +812,12 @@ fn a_connector_of_an_unknown_kind_or_declared_twice_is_refused() {
     };
     let output = r#"<ssd:Connector name="position" kind="output"><ssc:Real/></ssd:Connector>"#;
     assert!(OSP_SSD.contains(output));
+    // a kind SSP 2.0 adds is one the schema allows
+    let unspecified = format!(
+        "{HEAD}{}",
+        OSP_SSD.replacen(r#"kind="output""#, r#"kind="unspecified""#, 1)
+    );
+    import_ok(&refs(&files(unspecified)));
     let bogus = format!(
         "{HEAD}{}",
         OSP_SSD.replacen(r#"kind="output""#, r#"kind="bogus""#, 1)

@@ -49,7 +49,7 @@ thread_local! {
     /// roxmltree's own position lookup scans the text from its start, which made the line of
     /// every element quadratic in the file's size (a 40 MB description did not parse in 10
     /// minutes).
-    static LINE_STARTS: std::cell::RefCell<std::collections::HashMap<usize, (usize, Vec<usize>)>> =
+    static LINE_STARTS: std::cell::RefCell<std::collections::HashMap<usize, (usize, Vec<u32>)>> =
         std::cell::RefCell::new(std::collections::HashMap::new());
 }
 
@@ -61,6 +61,9 @@ pub(super) fn parse<'a>(file: &str, text: &'a str) -> Result<Parsed<'a>, SspErro
         line: Some(line),
         message,
     };
+    if u32::try_from(text.len()).is_err() {
+        return Err(invalid(1, "larger than 4 GiB".into()));
+    }
     if let Some(line) = crowded_tag(text) {
         return Err(invalid(
             line,
@@ -73,8 +76,9 @@ pub(super) fn parse<'a>(file: &str, text: &'a str) -> Result<Parsed<'a>, SspErro
     LINE_STARTS.with(|m| {
         let mut m = m.borrow_mut();
         let entry = m.entry(key).or_insert_with(|| {
+            // u32 offsets: a member is at most 64 MiB (a file of newlines: 4 bytes a line)
             let starts = std::iter::once(0)
-                .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+                .chain(text.match_indices('\n').map(|(i, _)| (i + 1) as u32))
                 .collect();
             (0, starts)
         });
@@ -83,23 +87,50 @@ pub(super) fn parse<'a>(file: &str, text: &'a str) -> Result<Parsed<'a>, SspErro
     Ok(Parsed { doc, key })
 }
 
-/// The line of the first tag with more than [`MAX_ATTRIBUTES_PER_ELEMENT`] attributes (counted
-/// as the `=` between `<` and `>`: a generous bound, so an `=` in a value does not matter).
+/// The line of the first tag with more than [`MAX_ATTRIBUTES_PER_ELEMENT`] attributes, counted
+/// as the `=` of a tag outside its quoted values (a value may hold `>` and `=`); comments,
+/// declarations and processing instructions (`<!`, `<?`) are not tags.
 fn crowded_tag(text: &str) -> Option<usize> {
-    let (mut start, mut count) = (None, 0usize);
-    for (i, b) in text.bytes().enumerate() {
-        match b {
-            b'<' => (start, count) = (Some(i), 0),
-            b'>' => start = None,
-            b'=' if start.is_some() => {
-                count += 1;
-                if count > MAX_ATTRIBUTES_PER_ELEMENT {
-                    let at = start.unwrap_or(i);
-                    return Some(1 + text[..at].bytes().filter(|&c| c == b'\n').count());
+    let bytes = text.as_bytes();
+    let (mut tag_start, mut quote, mut count) = (None::<usize>, None::<u8>, 0usize);
+    let mut i = 0;
+    while i < bytes.len() {
+        let b = bytes[i];
+        match (tag_start, quote) {
+            (None, _) => {
+                if b == b'<' {
+                    match bytes.get(i + 1) {
+                        Some(b'!') if bytes[i..].starts_with(b"<!--") => {
+                            // a comment ends at "-->" whatever it holds
+                            let end = text[i + 4..].find("-->").map_or(bytes.len(), |e| i + 4 + e);
+                            i = end;
+                        }
+                        Some(b'!' | b'?') => {
+                            let end = text[i..].find('>').map_or(bytes.len(), |e| i + e);
+                            i = end;
+                        }
+                        _ => (tag_start, count) = (Some(i), 0),
+                    }
                 }
             }
-            _ => {}
+            (Some(_), Some(q)) => {
+                if b == q {
+                    quote = None;
+                }
+            }
+            (Some(at), None) => match b {
+                b'"' | b'\'' => quote = Some(b),
+                b'>' => tag_start = None,
+                b'=' => {
+                    count += 1;
+                    if count > MAX_ATTRIBUTES_PER_ELEMENT {
+                        return Some(1 + bytes[..at].iter().filter(|&&c| c == b'\n').count());
+                    }
+                }
+                _ => {}
+            },
         }
+        i += 1;
     }
     None
 }
@@ -111,7 +142,7 @@ pub(super) fn line(n: Node) -> usize {
     let found = LINE_STARTS.with(|m| {
         m.borrow()
             .get(&(doc.input_text().as_ptr() as usize))
-            .map(|(_, starts)| starts.partition_point(|&s| s <= pos))
+            .map(|(_, starts)| starts.partition_point(|&s| s as usize <= pos))
     });
     // a document not parsed by `parse` (none today): roxmltree's own lookup
     found.unwrap_or_else(|| doc.text_pos_at(pos).row as usize)
@@ -257,3 +288,27 @@ pub(super) fn scalar<'a>(ctx: Ctx, n: Node<'a, '_>) -> Result<&'a str, SspError>
 }
 
 pub(super) use fmu_binary::escape_attribute as escape;
+
+#[cfg(test)]
+mod crowded_tag_tests {
+    use super::crowded_tag;
+
+    #[test]
+    fn attributes_are_counted_outside_values_comments_and_declarations() {
+        let many =
+            |value: &str| -> String { (0..10_001).map(|k| format!(" a{k}=\"{value}\"")).collect() };
+        // quoted '>' and '=' neither end the tag nor count
+        assert_eq!(
+            crowded_tag(&format!("<r>\n<x{}/></r>", many(">="))),
+            Some(2)
+        );
+        assert_eq!(crowded_tag(&format!("<x{}/>", many("'"))), Some(1));
+        // fewer: not crowded
+        let few: String = (0..100).map(|k| format!(" a{k}=\"1\"")).collect();
+        assert_eq!(crowded_tag(&format!("<x{few}/>")), None);
+        // '=' in a comment, a declaration or an instruction is no attribute
+        let eqs = "=".repeat(20_000);
+        let text = format!("<?xml version=\"1.0\"?><!-- {eqs} \" --><!DOCTYPE x><r a=\"1\"/>");
+        assert_eq!(crowded_tag(&text), None);
+    }
+}

@@ -456,16 +456,20 @@ impl AssessReport {
         notes
     }
 
-    /// One note per signal whose dominant frequency lies below 2.1 Hz: the band's lower edge,
-    /// f0 - 2 Hz, is clamped to 0.1 Hz, so the band is narrower than the criterion's +-2 Hz.
+    /// One note per signal whose band's lower edge, f0 minus the half band, was clamped to
+    /// 0.1 Hz (a dominant frequency below 2.1 Hz with the criterion's +-2 Hz): the band is
+    /// narrower below f0 than above it.
     pub fn band_notes(&self) -> Vec<String> {
         self.signals
             .iter()
-            .filter(|(_, a)| a.band_hz.0 > a.dominant_frequency_hz - 2.0 + 1e-9)
+            .filter(|(_, a)| {
+                let (f0, (lo, hi)) = (a.dominant_frequency_hz, a.band_hz);
+                f0 - lo < hi - f0 - 1e-9
+            })
             .map(|(name, a)| {
                 format!(
-                    "signal '{name}': dominant frequency {:.2} Hz, below 2.1 Hz: the band's lower \
-                     edge is clamped to {} Hz (band {:.2}-{:.2} Hz, not +-2 Hz around it)",
+                    "signal '{name}': dominant frequency {:.2} Hz: the band's lower edge is \
+                     clamped to {} Hz (band {:.2}-{:.2} Hz, narrower below it than above)",
                     a.dominant_frequency_hz, a.band_hz.0, a.band_hz.0, a.band_hz.1
                 )
             })
@@ -893,7 +897,8 @@ mod tests {
         let notes = low.band_notes();
         assert_eq!(notes.len(), 1, "{notes:?}");
         assert!(
-            notes[0].contains("below 2.1 Hz") && notes[0].contains("clamped to 0.1 Hz"),
+            notes[0].contains("dominant frequency 1.00 Hz")
+                && notes[0].contains("clamped to 0.1 Hz"),
             "{notes:?}"
         );
         assert!(low.summary().contains("note: signal 'a, quoted'"));

@@ -332,10 +332,12 @@ impl Chart {
                     legend_px,
                     legend: self.needs_legend(p),
                 };
-                let (py0, py1) = if self.own_y_per_panel {
-                    self.ranges_of(self.panel_series(p).into_iter())?.1
-                } else {
-                    (y0, y1)
+                // a panel without a finite point keeps the shared range
+                let (py0, py1) = match self.own_y_per_panel {
+                    true => self
+                        .ranges_of(self.panel_series(p).into_iter())
+                        .map_or((y0, y1), |r| r.1),
+                    false => (y0, y1),
                 };
                 draw_frame(area, t, &spec, (x0..x1, py0..py1), |c| body(p, c))?;
             }

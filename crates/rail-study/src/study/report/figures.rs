@@ -105,21 +105,29 @@ const OPENING_AXIS: YAxis<'static> = YAxis {
     mean_over_s: None,
 };
 
-/// The centred moving mean of `s` over `window_s` (fewer points near the ends).
+/// The centred moving mean of `s` (times in order) over `window_s`, fewer points near the
+/// ends; a value that is not finite is left out of the windows holding it (NaN where a window
+/// holds none).
 pub(super) fn moving_mean(s: &[(f64, f64)], window_s: f64) -> Points {
     let half = 0.5 * window_s;
-    let (mut lo, mut hi, mut sum) = (0usize, 0usize, 0.0);
+    let (mut lo, mut hi, mut sum, mut n) = (0usize, 0usize, 0.0, 0usize);
     s.iter()
         .map(|&(t, _)| {
             while hi < s.len() && s[hi].0 <= t + half {
-                sum += s[hi].1;
+                if s[hi].1.is_finite() {
+                    sum += s[hi].1;
+                    n += 1;
+                }
                 hi += 1;
             }
-            while s[lo].0 < t - half {
-                sum -= s[lo].1;
+            while lo < hi && s[lo].0 < t - half {
+                if s[lo].1.is_finite() {
+                    sum -= s[lo].1;
+                    n -= 1;
+                }
                 lo += 1;
             }
-            (t, sum / (hi - lo) as f64)
+            (t, if n > 0 { sum / n as f64 } else { f64::NAN })
         })
         .collect()
 }

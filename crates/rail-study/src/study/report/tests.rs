@@ -450,4 +450,10 @@ fn the_moving_mean_of_a_switching_signal_is_its_duty_cycle() {
     // the ends average what the window holds
     assert!((m[0].1 - 10.0 * 9.0 / 26.0).abs() < 1e-12, "{}", m[0].1);
     assert!(super::moving_mean(&[(0.0, 2.0)], 0.5) == [(0.0, 2.0)]);
+    // a NaN is left out of its windows only
+    let mut gap = s.clone();
+    gap[500].1 = f64::NAN;
+    let m = super::moving_mean(&gap, 0.5);
+    assert!(m.iter().all(|p| p.1.is_finite()));
+    assert!((m[900].1 - 10.0 / 3.0).abs() < 0.2, "{}", m[900].1);
 }
