@@ -136,10 +136,16 @@ fn parameters_too_stiff_to_integrate_are_refused() {
 /// set too.
 #[test]
 fn a_new_wheel_load_alone_warns_that_its_dependent_parameters_stay() {
-    let (mut c, log) = initialising::<M>();
-    assert_eq!(set::<M>(&mut c, "wheelset.wheel_load", 50e3), Status::Ok);
-    assert_eq!(c.exit_initialization_mode(), Status::Warning);
-    let l = log.take();
+    // the exit's status and messages with these start values
+    let exit_with = |values: &[(&str, f64)]| {
+        let (mut c, log) = initialising::<M>();
+        for &(name, x) in values {
+            assert_eq!(set::<M>(&mut c, name, x), Status::Ok, "{name}");
+        }
+        (c.exit_initialization_mode(), log.take())
+    };
+    let (status, l) = exit_with(&[("wheelset.wheel_load", 50e3)]);
+    assert_eq!(status, Status::Warning);
     assert!(
         logged(
             &l,
@@ -150,11 +156,8 @@ fn a_new_wheel_load_alone_warns_that_its_dependent_parameters_stay() {
         "{l:?}"
     );
     // one of them set: the others are named
-    let (mut c, log) = initialising::<M>();
-    assert_eq!(set::<M>(&mut c, "wheelset.wheel_load", 50e3), Status::Ok);
-    assert_eq!(set::<M>(&mut c, "creep.f11", 9.2e6), Status::Ok);
-    assert_eq!(c.exit_initialization_mode(), Status::Warning);
-    let l = log.take();
+    let (status, l) = exit_with(&[("wheelset.wheel_load", 50e3), ("creep.f11", 9.2e6)]);
+    assert_eq!(status, Status::Warning);
     assert!(
         logged(
             &l,
@@ -164,17 +167,14 @@ fn a_new_wheel_load_alone_warns_that_its_dependent_parameters_stay() {
         "{l:?}"
     );
     // all three set: silent
-    let (mut c, log) = initialising::<M>();
-    for (name, x) in [
+    let (status, l) = exit_with(&[
         ("wheelset.wheel_load", 50e3),
         ("creep.f11", 9.2e6),
         ("creep.f22", 8.3e6),
         ("linear.gravitational_stiffness", 1.4e6),
-    ] {
-        assert_eq!(set::<M>(&mut c, name, x), Status::Ok, "{name}");
-    }
-    assert_eq!(c.exit_initialization_mode(), Status::Ok);
-    assert!(log.take().is_empty());
+    ]);
+    assert_eq!(status, Status::Ok);
+    assert!(l.is_empty());
 }
 
 /// Negative values are rejected when set (declared min); zero, speed and friction at

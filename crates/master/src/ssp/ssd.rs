@@ -4,7 +4,7 @@
 use roxmltree::Node;
 
 use super::ssv::{self, Mapping, ParameterSet};
-use super::xml::{self, elements, is, line, Ctx, NS_SSC, NS_SSD};
+use super::xml::{self, elements, is, Ctx, NS_SSC, NS_SSD};
 use super::SspError;
 use crate::show;
 
@@ -164,8 +164,11 @@ pub(super) struct Ssd {
 
 /// Parses the text of an .ssd file (`file` names it in messages).
 pub(super) fn parse(file: &str, text: &str) -> Result<Ssd, SspError> {
-    let doc = xml::parse(file, text)?;
-    let ctx = Ctx { file };
+    let (doc, lines) = xml::parse(file, text)?;
+    let ctx = Ctx {
+        file,
+        lines: &lines,
+    };
     let root = doc.root_element();
     if !is(root, NS_SSD, "SystemStructureDescription") {
         return Err(ctx.err(
@@ -389,7 +392,7 @@ fn parse_component(ctx: Ctx, n: Node) -> Result<Component, SspError> {
         connectors: Vec::new(),
         bindings: Vec::new(),
         step_size_hint_s: None,
-        line: line(n),
+        line: ctx.line(n),
     };
     for c in elements(n) {
         if c.tag_name().namespace() != Some(NS_SSD) {
@@ -446,7 +449,7 @@ fn parse_connectors(ctx: Ctx, n: Node) -> Result<Vec<Connector>, SspError> {
                 ),
             ));
         }
-        if let Some(first) = seen.insert(name.clone(), line(c)) {
+        if let Some(first) = seen.insert(name.clone(), ctx.line(c)) {
             return Err(ctx.err(
                 c,
                 format!(
@@ -472,7 +475,7 @@ fn parse_connectors(ctx: Ctx, n: Node) -> Result<Vec<Connector>, SspError> {
             name,
             kind,
             ty,
-            line: line(c),
+            line: ctx.line(c),
         });
     }
     Ok(out)
@@ -544,7 +547,7 @@ fn parse_connection(ctx: Ctx, e: Node) -> Result<Connection, SspError> {
             e.attribute("suppressUnitConversion").map(str::trim),
             Some("true" | "1")
         ),
-        line: line(e),
+        line: ctx.line(e),
     })
 }
 
@@ -646,7 +649,7 @@ fn parse_bindings(ctx: Ctx, n: Node) -> Result<Vec<Binding>, SspError> {
             values,
             mapping,
             prefix: b.attribute("prefix").unwrap_or("").to_string(),
-            line: line(b),
+            line: ctx.line(b),
         });
     }
     Ok(out)

@@ -3,7 +3,7 @@
 
 use roxmltree::Node;
 
-use super::xml::{self, elements, is, line, qualified, scalar, Ctx, NS_SSC, NS_SSM, NS_SSV};
+use super::xml::{self, elements, is, qualified, scalar, Ctx, NS_SSC, NS_SSM, NS_SSV};
 use super::SspError;
 use crate::show;
 
@@ -78,8 +78,12 @@ fn check_version(ctx: Ctx, n: Node) -> Result<(), SspError> {
 
 /// Parses a whole .ssv file.
 pub(super) fn parse_ssv(file: &str, text: &str) -> Result<ParameterSet, SspError> {
-    let doc = xml::parse(file, text)?;
-    parse_set(Ctx { file }, doc.root_element())
+    let (doc, lines) = xml::parse(file, text)?;
+    let ctx = Ctx {
+        file,
+        lines: &lines,
+    };
+    parse_set(ctx, doc.root_element())
 }
 
 /// Parses an `ssv:ParameterSet` element.
@@ -201,14 +205,18 @@ fn parse_parameter(ctx: Ctx, p: Node) -> Result<Parameter, SspError> {
         name,
         value,
         unit,
-        line: line(p),
+        line: ctx.line(p),
     })
 }
 
 /// Parses a whole .ssm file.
 pub(super) fn parse_ssm(file: &str, text: &str) -> Result<Mapping, SspError> {
-    let doc = xml::parse(file, text)?;
-    parse_mapping(Ctx { file }, doc.root_element())
+    let (doc, lines) = xml::parse(file, text)?;
+    let ctx = Ctx {
+        file,
+        lines: &lines,
+    };
+    parse_mapping(ctx, doc.root_element())
 }
 
 /// Parses an `ssm:ParameterMapping` element.
@@ -242,7 +250,7 @@ pub(super) fn parse_mapping(ctx: Ctx, n: Node) -> Result<Mapping, SspError> {
                 }
                 let target = ctx.req(e, "target")?.to_string();
                 // SSM 1.0 7: multiple parameters MUST NOT be mapped to the same name
-                if let Some(first) = targets.insert(target.clone(), line(e)) {
+                if let Some(first) = targets.insert(target.clone(), ctx.line(e)) {
                     return Err(ctx.err(
                         e,
                         format!(
@@ -256,7 +264,7 @@ pub(super) fn parse_mapping(ctx: Ctx, n: Node) -> Result<Mapping, SspError> {
                     source: ctx.req(e, "source")?.to_string(),
                     target,
                     transformation,
-                    line: line(e),
+                    line: ctx.line(e),
                 });
             }
             "Annotations" | "MetaData" | "Signature"

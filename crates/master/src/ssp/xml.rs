@@ -16,46 +16,31 @@ pub(super) const NS_SSM: &str = "http://ssp-standard.org/SSP1/SystemStructurePar
 /// element's others, so a tag of 200 000 attributes (1 MB) took minutes to parse.
 const MAX_ATTRIBUTES_PER_ELEMENT: usize = 10_000;
 
-/// A parsed document, with the start of each of its lines for [`line`] while it lives.
-pub(super) struct Parsed<'a> {
-    doc: Document<'a>,
-    key: usize,
-}
+/// The byte offset of each line's start in a document's text, for the line of an element
+/// (roxmltree's own position lookup scans the text from its start: the line of every element
+/// was quadratic in the file's size, and a 40 MB description did not parse in 10 minutes).
+/// u32: a member is at most 64 MiB.
+pub(super) struct LineStarts(Vec<u32>);
 
-impl<'a> std::ops::Deref for Parsed<'a> {
-    type Target = Document<'a>;
-    fn deref(&self) -> &Document<'a> {
-        &self.doc
+impl LineStarts {
+    fn of(text: &str) -> Self {
+        LineStarts(
+            std::iter::once(0)
+                .chain(text.match_indices('\n').map(|(i, _)| (i + 1) as u32))
+                .collect(),
+        )
+    }
+
+    /// 1-based line of an element.
+    pub fn line(&self, n: Node) -> usize {
+        let pos = n.range().start;
+        self.0.partition_point(|&s| s as usize <= pos)
     }
 }
 
-impl Drop for Parsed<'_> {
-    fn drop(&mut self) {
-        LINE_STARTS.with(|m| {
-            let mut m = m.borrow_mut();
-            if let Some((count, _)) = m.get_mut(&self.key) {
-                *count -= 1;
-                if *count == 0 {
-                    m.remove(&self.key);
-                }
-            }
-        });
-    }
-}
-
-thread_local! {
-    /// The byte offset of each line's start of the documents parsed on this thread and still
-    /// alive, by the address of their text (with how many live documents share it):
-    /// roxmltree's own position lookup scans the text from its start, which made the line of
-    /// every element quadratic in the file's size (a 40 MB description did not parse in 10
-    /// minutes).
-    static LINE_STARTS: std::cell::RefCell<std::collections::HashMap<usize, (usize, Vec<u32>)>> =
-        std::cell::RefCell::new(std::collections::HashMap::new());
-}
-
-/// Parses `text` (the content of `file`); DTDs are refused (roxmltree's default), so no entity
-/// expansion can blow up.
-pub(super) fn parse<'a>(file: &str, text: &'a str) -> Result<Parsed<'a>, SspError> {
+/// Parses `text` (the content of `file`), with its line starts; DTDs are refused (roxmltree's
+/// default), so no entity expansion can blow up.
+pub(super) fn parse<'a>(file: &str, text: &'a str) -> Result<(Document<'a>, LineStarts), SspError> {
     let invalid = |line: usize, message: String| SspError::Invalid {
         file: file.to_string(),
         line: Some(line),
@@ -72,19 +57,7 @@ pub(super) fn parse<'a>(file: &str, text: &'a str) -> Result<Parsed<'a>, SspErro
     }
     let doc = Document::parse(text)
         .map_err(|e| invalid(e.pos().row as usize, format!("XML syntax error: {e}")))?;
-    let key = text.as_ptr() as usize;
-    LINE_STARTS.with(|m| {
-        let mut m = m.borrow_mut();
-        let entry = m.entry(key).or_insert_with(|| {
-            // u32 offsets: a member is at most 64 MiB (a file of newlines: 4 bytes a line)
-            let starts = std::iter::once(0)
-                .chain(text.match_indices('\n').map(|(i, _)| (i + 1) as u32))
-                .collect();
-            (0, starts)
-        });
-        entry.0 += 1;
-    });
-    Ok(Parsed { doc, key })
+    Ok((doc, LineStarts::of(text)))
 }
 
 /// The line of the first tag with more than [`MAX_ATTRIBUTES_PER_ELEMENT`] attributes, counted
@@ -135,19 +108,6 @@ fn crowded_tag(text: &str) -> Option<usize> {
     None
 }
 
-/// 1-based line of an element.
-pub(super) fn line(n: Node) -> usize {
-    let doc = n.document();
-    let pos = n.range().start;
-    let found = LINE_STARTS.with(|m| {
-        m.borrow()
-            .get(&(doc.input_text().as_ptr() as usize))
-            .map(|(_, starts)| starts.partition_point(|&s| s as usize <= pos))
-    });
-    // a document not parsed by `parse` (none today): roxmltree's own lookup
-    found.unwrap_or_else(|| doc.text_pos_at(pos).row as usize)
-}
-
 /// Whether `n` is the element `name` of namespace `ns`.
 pub(super) fn is(n: Node, ns: &str, name: &str) -> bool {
     n.is_element() && n.tag_name().name() == name && n.tag_name().namespace() == Some(ns)
@@ -170,17 +130,23 @@ pub(super) fn qualified(n: Node) -> String {
     format!("{prefix}{}", n.tag_name().name())
 }
 
-/// Errors located in one file.
+/// Errors located in one file: its name and line starts.
 #[derive(Clone, Copy)]
 pub(super) struct Ctx<'f> {
     pub file: &'f str,
+    pub lines: &'f LineStarts,
 }
 
 impl Ctx<'_> {
+    /// 1-based line of an element of this file.
+    pub fn line(&self, n: Node) -> usize {
+        self.lines.line(n)
+    }
+
     pub fn err(&self, n: Node, message: impl Into<String>) -> SspError {
         SspError::Invalid {
             file: self.file.to_string(),
-            line: Some(line(n)),
+            line: Some(self.line(n)),
             message: message.into(),
         }
     }
@@ -189,7 +155,7 @@ impl Ctx<'_> {
     pub fn unsupported(&self, n: Node, what: impl Into<String>) -> SspError {
         SspError::Unsupported {
             file: self.file.to_string(),
-            line: Some(line(n)),
+            line: Some(self.line(n)),
             what: what.into(),
         }
     }

@@ -816,23 +816,26 @@ mod tests {
         );
     }
 
+    /// The lateral-acceleration criterion (6.1 t bogie, 300 km/h) on the quoted column of a
+    /// sine table of `amp` m/s2 at `f` Hz, `secs` long at 500 Hz.
+    fn assess_sine(amp: f64, f: f64, secs: f64) -> AssessReport {
+        let text = sine_table(amp, f, 500.0, secs, "m/s2");
+        let table = ResultsTable::parse(&text, Path::new("x.csv")).unwrap();
+        assess_table(
+            &table,
+            &["a, quoted".to_string()],
+            300.0,
+            Criterion::LateralAcceleration { bogie_mass_t: 6.1 },
+            &StabilitySettings::default(),
+        )
+        .unwrap()
+    }
+
     #[test]
     fn sine_of_known_rms_is_assessed_against_the_limit() {
         // amplitude 6 m/s2 -> rms 4.24 < 5.39; amplitude 8 -> 5.66 > 5.39
         for (amp, stable) in [(6.0, true), (8.0, false)] {
-            let table = ResultsTable::parse(
-                &sine_table(amp, 4.0, 500.0, 10.0, "m/s2"),
-                Path::new("x.csv"),
-            )
-            .unwrap();
-            let r = assess_table(
-                &table,
-                &["a, quoted".to_string()],
-                300.0,
-                Criterion::LateralAcceleration { bogie_mass_t: 6.1 },
-                &StabilitySettings::default(),
-            )
-            .unwrap();
+            let r = assess_sine(amp, 4.0, 10.0);
             let a = &r.signals[0].1;
             assert!((a.dominant_frequency_hz - 4.0).abs() < 0.1, "{a:?}");
             assert!((r.limit() - 5.39).abs() < 1e-12);
@@ -879,19 +882,7 @@ mod tests {
 
     #[test]
     fn a_band_clamped_below_2_1_hz_is_noted() {
-        let at = |f: f64| {
-            let table =
-                ResultsTable::parse(&sine_table(6.0, f, 500.0, 20.0, "m/s2"), Path::new("x.csv"))
-                    .unwrap();
-            assess_table(
-                &table,
-                &["a, quoted".to_string()],
-                300.0,
-                Criterion::LateralAcceleration { bogie_mass_t: 6.1 },
-                &StabilitySettings::default(),
-            )
-            .unwrap()
-        };
+        let at = |f: f64| assess_sine(6.0, f, 20.0);
         assert!(at(4.0).band_notes().is_empty());
         let low = at(1.0);
         let notes = low.band_notes();

@@ -9,8 +9,8 @@ use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 
 use crate::plot::{
-    draw_err, draw_limit, draw_lines, legend_width, longest, render_svg, Chart, LegendEntry,
-    PlotError, Swatch,
+    draw_err, draw_lines, draw_rule, legend_width, longest, render_svg, Chart, LegendEntry,
+    PlotError, Rule, Swatch,
 };
 
 /// Axis scale.
@@ -172,7 +172,7 @@ where
         let mut entries = draw_lines(ctx, t, &series, chart.markers, |p| usable(p, xs, ys))?;
         match &chart.limit {
             Some((v, label)) if ys == Scale::Linear || *v > 0.0 => {
-                entries.push(draw_limit(ctx, t, x_span, *v, label)?);
+                entries.push(draw_rule(ctx, t, (x_span, *v), Rule::Limit, label)?);
             }
             _ => {}
         }

@@ -410,56 +410,31 @@ where
     Ok(entries)
 }
 
-/// A dashed red horizontal line at `value` across `x_span` (a limit); returns its legend
-/// entry.
-pub(crate) fn draw_limit<X, Y>(
-    chart: &mut Frame<'_, '_, X, Y>,
-    title: &str,
-    x_span: (f64, f64),
-    value: f64,
-    label: &str,
-) -> Result<LegendEntry, PlotError>
-where
-    X: Ranged<ValueType = f64>,
-    Y: Ranged<ValueType = f64>,
-{
-    draw_horizontal(chart, title, (x_span, value), (RED, (8, 5)), label)
+/// What a horizontal line across a chart marks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Rule {
+    /// A limit (EN 14363's a_lim): dashed red.
+    Limit,
+    /// A guide (a class boundary, a scale's end): dotted grey.
+    Guide,
 }
 
-/// A grey dotted horizontal line at `value` (a guide, e.g. a class boundary); returns its
-/// legend entry.
-pub(crate) fn draw_guide<X, Y>(
-    chart: &mut Frame<'_, '_, X, Y>,
-    title: &str,
-    x_span: (f64, f64),
-    value: f64,
-    label: &str,
-) -> Result<LegendEntry, PlotError>
-where
-    X: Ranged<ValueType = f64>,
-    Y: Ranged<ValueType = f64>,
-{
-    draw_horizontal(
-        chart,
-        title,
-        (x_span, value),
-        (REFERENCE_GREY, (2, 4)),
-        label,
-    )
-}
-
-/// A horizontal line of `colour`, dashes of (length, gap) px, across `x_span` at `value`.
-fn draw_horizontal<X, Y>(
+/// A horizontal line of `rule`'s style at `value` across `x_span`; returns its legend entry.
+pub(crate) fn draw_rule<X, Y>(
     chart: &mut Frame<'_, '_, X, Y>,
     title: &str,
     (x_span, value): ((f64, f64), f64),
-    (colour, (dash, gap)): (RGBColor, (u32, u32)),
+    rule: Rule,
     label: &str,
 ) -> Result<LegendEntry, PlotError>
 where
     X: Ranged<ValueType = f64>,
     Y: Ranged<ValueType = f64>,
 {
+    let (colour, dash, gap) = match rule {
+        Rule::Limit => (RED, 8, 5),
+        Rule::Guide => (REFERENCE_GREY, 2, 4),
+    };
     chart
         .draw_series(DashedLineSeries::new(
             vec![(x_span.0, value), (x_span.1, value)],

@@ -22,8 +22,8 @@ use frame::{
     Frame, FrameSpec, MAX_PANEL_CHARS, PANEL_FONT_PX,
 };
 pub(crate) use frame::{
-    colour, draw_err, draw_guide, draw_legend, draw_limit, draw_lines, legend_width, longest,
-    render_svg, tick_label, LegendEntry, Swatch,
+    colour, draw_err, draw_legend, draw_lines, draw_rule, legend_width, longest, render_svg,
+    tick_label, LegendEntry, Rule, Swatch,
 };
 
 #[derive(Debug, thiserror::Error)]
@@ -302,10 +302,10 @@ impl Chart {
                 entries.retain(|e| e.label != captioned);
             }
             if let Some((v, label)) = &self.limit {
-                entries.push(draw_limit(chart, t, (x0, x1), *v, label)?);
+                entries.push(draw_rule(chart, t, ((x0, x1), *v), Rule::Limit, label)?);
             }
             for (v, label) in &self.guides {
-                entries.push(draw_guide(chart, t, (x0, x1), *v, label)?);
+                entries.push(draw_rule(chart, t, ((x0, x1), *v), Rule::Guide, label)?);
             }
             Ok(entries)
         };

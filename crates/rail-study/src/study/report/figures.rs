@@ -182,10 +182,7 @@ fn history_chart(
         // a run ended early by its FMU, or at another step, has none of its own here
         let grid = |s: &Points| s.iter().map(|p| p.0).collect::<Vec<f64>>();
         let same_grid = tail.windows(2).all(|w| grid(&w[0].2) == grid(&w[1].2));
-        let rate_hz = tail.first().and_then(|(_, _, s)| {
-            let span = s.last()?.0 - s.first()?.0;
-            (span > 0.0).then(|| (s.len() - 1) as f64 / span)
-        });
+        let rate_hz = tail.first().and_then(|(_, _, s)| rate_of(s));
         if let (Some(rate_hz), true) = (rate_hz, same_grid) {
             let title = format!(
                 "{title} ({rate_hz:.0} Hz samples, unfiltered; each panel scaled to its run)"
@@ -473,29 +470,13 @@ pub(super) fn history_figures(
         vehicle.first("actuator", "damper.force"),
         vehicle.first("idf", "reference.force"),
     );
-    let full_rate = (
-        tail_series(r, &fa, &fa_force, 1e-3),
-        tail_series(r, &fa, &fa_reference, 1e-3),
-    );
-    let stored = || {
-        (
-            series(r, &fa, &fa_force, 1e-3),
-            series(r, &fa, &fa_reference, 1e-3),
-        )
-    };
-    let (tail, picked) = match full_rate {
-        (Some(f), Some(fr)) => (true, (Some(f), Some(fr))),
-        _ => (false, stored()),
-    };
-    if let (Some(f), Some(fr)) = picked {
+    let both = |get: &dyn Fn(&str) -> Option<Points>| get(&fa_force).zip(get(&fa_reference));
+    let picked =
+        both(&|c| tail_series(r, &fa, c, 1e-3)).or_else(|| both(&|c| series(r, &fa, c, 1e-3)));
+    if let Some((f, fr)) = picked {
         let t_end = f.last().map_or(0.0, |p| p.0);
         let zoom = |s: &[(f64, f64)]| from_time(s, t_end - HISTORY_DETAIL_S);
-        let rate_hz = if tail {
-            let span = f.last().map_or(0.0, |p| p.0) - f.first().map_or(0.0, |p| p.0);
-            (f.len().saturating_sub(1)) as f64 / span.max(f64::MIN_POSITIVE)
-        } else {
-            r.settings.stored_rate_hz
-        };
+        let rate_hz = rate_of(&f).unwrap_or(r.settings.stored_rate_hz);
         write_series_csv(
             &out.join("full_active_force.csv"),
             &[
@@ -850,6 +831,12 @@ pub(super) fn cv_figures(
         ));
     }
     Ok(())
+}
+
+/// The sampling rate of equally spaced points [Hz] (`None` for fewer than two, or no span).
+fn rate_of(s: &[(f64, f64)]) -> Option<f64> {
+    let span = s.last()?.0 - s.first()?.0;
+    (span > 0.0).then(|| (s.len() - 1) as f64 / span)
 }
 
 /// The points of a time series from `t0` on (zoomed figures).
