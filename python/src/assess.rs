@@ -85,6 +85,7 @@ pub fn table_from_columns(
         columns,
         sampling: None,
         described: full_rate,
+        recorded_speed: None,
         text_columns: Vec::new(),
     };
     if full_rate {

@@ -85,11 +85,19 @@ pub enum AssessError {
 /// Result of one rms assessment.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Assessment {
+    /// f0, the centre of the band: the spectrum's peak, or the frequency given
+    /// ([`StabilitySettings::dominant_frequency_hz`]).
     pub dominant_frequency_hz: f64,
+    /// Whether f0 was given rather than found in the spectrum.
+    pub f0_given: bool,
+    /// The spectrum's own peak in [`StabilitySettings::search_hz`] (`None`: f0 was given and
+    /// the record has no peak there), to compare with a given f0.
+    pub spectrum_peak_hz: Option<f64>,
     pub band_hz: (f64, f64),
     pub limit: f64,
     pub max_rms: f64,
-    /// (window centre along the track \[m\], rms)
+    /// (window centre along the track from the record's first sample \[m\] (the skipped
+    /// start-up included), rms)
     pub rms: Vec<(f64, f64)>,
     /// `max_rms <= limit`
     pub stable: bool,
@@ -126,12 +134,16 @@ pub fn assess_rms(
     param("skip_s", s.skip_s, s.skip_s >= 0.0, "must be >= 0")?;
     let skip = ((s.skip_s * fs).round() as usize).min(signal.len());
     let x = &signal[skip..];
-    let f0 = match s.dominant_frequency_hz {
+    let peak = || dominant_frequency(x, fs, s.search_hz.0, s.search_hz.1);
+    let (f0, spectrum_peak_hz) = match s.dominant_frequency_hz {
         Some(f) => {
             param("dominant_frequency_hz", f, f > 0.0, "must be > 0")?;
-            f
+            (f, peak().ok())
         }
-        None => dominant_frequency(x, fs, s.search_hz.0, s.search_hz.1)?,
+        None => {
+            let f = peak()?;
+            (f, Some(f))
+        }
     };
     let lo = (f0 - s.half_band_hz).max(0.1);
     let hi = f0 + s.half_band_hz;
@@ -142,10 +154,15 @@ pub fn assess_rms(
     let y = bp.filtfilt(x, pad);
     // a filtered signal that overflowed is refused there (not finite); its windows' rms stay
     // finite for any finite sample
-    let rms = sliding_rms_distance(&y, fs, speed_mps, s.window_m, s.step_m)?;
+    let mut rms = sliding_rms_distance(&y, fs, speed_mps, s.window_m, s.step_m)?;
+    // positions from the record's first sample, not from the end of the skipped start-up
+    let skipped_m = skip as f64 / fs * speed_mps;
+    rms.iter_mut().for_each(|(x, _)| *x += skipped_m);
     let max_rms = rms.iter().map(|r| r.1).fold(0.0, f64::max);
     Ok(Assessment {
         dominant_frequency_hz: f0,
+        f0_given: s.dominant_frequency_hz.is_some(),
+        spectrum_peak_hz,
         band_hz: (lo, hi),
         limit,
         max_rms,

@@ -714,8 +714,9 @@ fn a_hang_up_under_nohup_does_not_stop_a_run() {
 }
 
 /// A run that fails midway (a bogie without secondary suspension derails at 150 m/s) writes
-/// its history up to the failure in place of the results, with the failure in its metadata,
-/// and says where: an earlier run's results do not stay under its name.
+/// its history up to the failure beside the results' name (`r.history.csv`), with the failure
+/// in its metadata, and says where: neither an earlier run's results nor the truncated history
+/// stay under the results' name.
 #[test]
 fn a_failed_run_writes_its_history_up_to_the_failure() {
     let dir = tempfile::tempdir().unwrap();
@@ -750,16 +751,21 @@ fn a_failed_run_writes_its_history_up_to_the_failure() {
     let stderr = String::from_utf8_lossy(&failed.stderr);
     assert_eq!(failed.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("derailment"), "{stderr}");
+    // the history beside the results' name; the earlier run's results are gone (they would
+    // read as this run's), and so is their metadata
+    let history = dir.path().join("r.history.csv");
     assert!(
-        stderr.contains(&format!("is in {}", out.display())),
+        stderr.contains(&format!("is in {}", history.display())),
         "{stderr}"
     );
-    let csv = std::fs::read_to_string(&out).unwrap();
+    assert!(!out.exists() && !dir.path().join("r.meta.json").exists());
+    let csv = std::fs::read_to_string(&history).unwrap();
     let last = *csv_times(&csv).last().unwrap();
     assert!(last > 0.1 && last < 2.0, "last row at {last} s");
-    let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.meta.json")).unwrap())
-            .unwrap();
+    let meta: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("r.history.meta.json")).unwrap(),
+    )
+    .unwrap();
     let failure = &meta["summary"]["failed"];
     assert_eq!(failure["time_s"].as_f64(), Some(last), "{meta}");
     assert!(
@@ -852,6 +858,16 @@ fn a_sweep_into_a_file_names_it() {
     assert_eq!(out.status.code(), Some(1), "{e}");
     assert!(e.contains("'afile' is a file, not a folder"), "{e}");
     assert_eq!(std::fs::read(dir.path().join("afile")).unwrap(), b"x");
+    // no runs at a time is refused too, before the folder is made
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .args(["--quiet", "sweep", "set.json", "-o", "out", "--jobs", "0"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(e.contains("invalid option --jobs = 0"), "{e}");
+    assert!(!dir.path().join("out").exists());
 }
 
 /// An Enumeration parameter given by item name in one run and by number in another is refused
@@ -970,4 +986,47 @@ fn a_studys_failed_run_keeps_its_full_rate_history() {
     // every communication point of 1 ms, not the stored rate's
     assert_eq!(time.len(), (failed / 1e-3).round() as usize + 1);
     assert!(!run.join("results.csv").exists());
+}
+
+/// Results files take the user's umask (a private one keeps them private; they were always
+/// 0644), and a number beyond 1e15 is written in exponent notation that reads back as the same
+/// float (1e300 was 301 digits, which pandas reads as a Python integer).
+#[test]
+fn results_files_follow_the_umask_and_huge_numbers_stay_floats() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let fmu = dist().join("MassSpring.fmu");
+    for (umask, mode) in [("077", 0o600), ("022", 0o644)] {
+        let out = Command::new("sh")
+            .arg("-c")
+            .arg(format!(
+                "umask {umask} && exec \"$0\" --quiet run \"$1\" --stop 0.003 \
+                 --set initial_position=1e300 -o r{umask}.csv",
+            ))
+            .arg(env!("CARGO_BIN_EXE_master"))
+            .arg(&fmu)
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for file in [format!("r{umask}.csv"), format!("r{umask}.meta.json")] {
+            let m = std::fs::metadata(dir.path().join(&file)).unwrap();
+            assert_eq!(m.permissions().mode() & 0o777, mode, "{file}");
+        }
+    }
+    let csv = std::fs::read_to_string(dir.path().join("r022.csv")).unwrap();
+    let row: Vec<&str> = csv.lines().nth(1).unwrap().split(',').collect();
+    let position = row
+        .iter()
+        .find(|f| f.contains('e'))
+        .unwrap_or_else(|| panic!("no exponent in {row:?}"));
+    assert!(position.len() < 30, "{position}");
+    let x: f64 = position.parse().unwrap();
+    assert!((x / 1e300 - 1.0).abs() < 1e-3, "{x}");
+    // ordinary numbers stay as they were
+    assert_eq!(row[0], "0");
 }

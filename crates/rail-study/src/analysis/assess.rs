@@ -17,6 +17,7 @@
 //! (Nyquist frequency, or the anti-aliasing filter of a decimated file) does not reach the
 //! upper edge of the band the assessment filters.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use super::{AnalysisError, Artefacts, Table};
@@ -26,7 +27,7 @@ use crate::en14363::{
 use crate::plot::Chart;
 use master::decimation::Sampling;
 use master::parquet_file::{read_parquet, ColumnData};
-use master::results::{read_metadata, ResultsFormat};
+use master::results::{read_metadata, ResultsFormat, ResultsMetadata};
 
 /// Which EN 14363 quantity the signals are.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,6 +50,9 @@ pub struct ResultsTable {
     pub sampling: Option<Sampling>,
     /// Whether the file has our metadata.
     pub described: bool,
+    /// The running speed the file's metadata records (a vehicle FMU's `running.speed` or
+    /// `vehicle.speed` parameter, one value): its name and value \[m/s\].
+    pub recorded_speed: Option<(String, f64)>,
     /// Columns left out because they hold text (a recorded String, an Enumeration's item
     /// name, a host's label): their names and why, so that asking for one says so.
     pub text_columns: Vec<TextColumn>,
@@ -99,6 +103,40 @@ fn split_unit(name: &str) -> (&str, Option<&str>) {
         (Some(i), true) => (&name[..i], Some(&name[i + 2..name.len() - 1])),
         _ => (name, None),
     }
+}
+
+/// The running speed `meta` records: the value of every vehicle FMU's running-speed parameter
+/// (`running.speed` of RailVehicle, `vehicle.speed` of Bogie2Dof, both in m/s) that the
+/// system or the run set gives, if they are one value; `None` when none is given (the FMU's
+/// default) or they differ.
+fn recorded_speed(meta: &ResultsMetadata) -> Option<(String, f64)> {
+    const SPEEDS: [&str; 2] = ["running.speed", "vehicle.speed"];
+    let mut found: BTreeMap<String, f64> = BTreeMap::new();
+    let instances = meta
+        .system
+        .as_ref()
+        .and_then(|s| s["instances"].as_array())
+        .into_iter()
+        .flatten();
+    for inst in instances {
+        let name = inst["name"].as_str().unwrap_or_default();
+        for key in SPEEDS {
+            if let Some(v) = inst["parameters"][key].as_f64() {
+                found.insert(format!("{name}.{key}"), v);
+            }
+        }
+    }
+    // a run set's parameters are the run's own, over the system's
+    for (key, value) in &meta.parameters {
+        let own = key
+            .split_once('.')
+            .is_some_and(|(_, k)| SPEEDS.contains(&k));
+        if let (true, Some(v)) = (own, value.as_f64()) {
+            found.insert(key.clone(), v);
+        }
+    }
+    let (name, &v) = found.iter().next()?;
+    found.values().all(|&x| x == v).then(|| (name.clone(), v))
 }
 
 impl ResultsTable {
@@ -224,6 +262,7 @@ impl ResultsTable {
             columns: kept,
             sampling: None,
             described: false,
+            recorded_speed: None,
             text_columns,
         })
     }
@@ -240,6 +279,7 @@ impl ResultsTable {
         let mut table = Self::parse(&text, path)?;
         let meta = read_metadata(path).map_err(|e| input(&e))?;
         table.described = meta.is_some();
+        table.recorded_speed = meta.as_ref().and_then(recorded_speed);
         table.sampling = meta.and_then(|m| m.sampling);
         table.check_recorded_rate()
     }
@@ -303,6 +343,7 @@ impl ResultsTable {
             names,
             columns: values,
             described: meta.is_some(),
+            recorded_speed: meta.as_ref().and_then(recorded_speed),
             sampling: meta.and_then(|m| m.sampling),
             text_columns,
         }
@@ -391,21 +432,29 @@ impl ResultsTable {
                 self.path.display()
             )));
         }
-        // the first step unlike the usual one (the median): a single gap in a long record
-        // shifts the mean step off every step, so the mean would point at the first sample
-        let mut steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-        let mid = steps.len() / 2;
-        let usual = *steps.select_nth_unstable_by(mid, f64::total_cmp).1;
-        let off = |step: f64| (step - usual).abs() > 1e-6 * usual.abs() + 1e-12;
-        if let Some(w) = t.windows(2).find(|w| off(w[1] - w[0])) {
+        // uniform: every time within 1 % of a step of the grid t0 + k dt; a host's export
+        // prints its times rounded (1024 Hz to six decimals, a float32 column), which moves
+        // them by far less, while a gap or a variable step moves them by a step or more
+        let grid_off = |k: usize| (t[k] - (t[0] + k as f64 * dt)).abs() > 0.01 * dt;
+        if let Some(k) = (1..t.len()).find(|&k| grid_off(k)) {
+            // name the first step unlike the usual one (the median): a single gap in a long
+            // record shifts the mean step off every step, so the mean would point at the first
+            // sample
+            let mut steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+            let mid = steps.len() / 2;
+            let usual = *steps.select_nth_unstable_by(mid, f64::total_cmp).1;
+            let at = t
+                .windows(2)
+                .position(|w| ((w[1] - w[0]) - usual).abs() > 0.01 * usual)
+                .unwrap_or(k - 1);
             // to the nanosecond: the differences of times carry rounding noise
             let ns = |x: f64| (x * scale * 1e9).round() / 1e9;
             return Err(AnalysisError::Input(format!(
                 "{}: the time column is not uniformly sampled (step {} s after t = {} s, \
                  where the others are {} s): resample the signals first",
                 self.path.display(),
-                ns(w[1] - w[0]),
-                ns(w[0]),
+                ns(t[at + 1] - t[at]),
+                ns(t[at]),
                 ns(usual)
             )));
         }
@@ -458,22 +507,44 @@ impl AssessReport {
 
     /// One note per signal whose band's lower edge, f0 minus the half band, was clamped to
     /// 0.1 Hz (a dominant frequency below 2.1 Hz with the criterion's +-2 Hz): the band is
-    /// narrower below f0 than above it.
+    /// narrower below f0 than above it; and one per signal whose f0 was given but whose
+    /// spectrum peaks outside the band (the rms then leaves out the signal's main oscillation).
     pub fn band_notes(&self) -> Vec<String> {
-        self.signals
-            .iter()
-            .filter(|(_, a)| {
-                let (f0, (lo, hi)) = (a.dominant_frequency_hz, a.band_hz);
-                f0 - lo < hi - f0 - 1e-9
-            })
-            .map(|(name, a)| {
-                format!(
-                    "signal '{name}': dominant frequency {:.2} Hz: the band's lower edge is \
-                     clamped to {} Hz (band {:.2}-{:.2} Hz, narrower below it than above)",
-                    a.dominant_frequency_hz, a.band_hz.0, a.band_hz.0, a.band_hz.1
-                )
-            })
-            .collect()
+        let mut notes = Vec::new();
+        for (name, a) in &self.signals {
+            let (f0, (lo, hi)) = (a.dominant_frequency_hz, a.band_hz);
+            if f0 - lo < hi - f0 - 1e-9 {
+                notes.push(format!(
+                    "signal '{name}': {} {:.2} Hz: the band's lower edge is clamped to {} Hz \
+                     (band {:.2}-{:.2} Hz, narrower below it than above)",
+                    if a.f0_given {
+                        "f0 (given)"
+                    } else {
+                        "dominant frequency"
+                    },
+                    f0,
+                    lo,
+                    lo,
+                    hi
+                ));
+            }
+            if !a.f0_given {
+                continue;
+            }
+            match a.spectrum_peak_hz {
+                Some(peak) if !(lo..=hi).contains(&peak) => notes.push(format!(
+                    "signal '{name}': f0 = {f0:.2} Hz was given, but its spectrum peaks at \
+                     {peak:.2} Hz, outside the assessed band {lo:.2}-{hi:.2} Hz: the rms leaves \
+                     out the signal's main oscillation"
+                )),
+                Some(_) => {}
+                None => notes.push(format!(
+                    "signal '{name}': f0 = {f0:.2} Hz was given; the record has no spectral \
+                     peak to compare it with"
+                )),
+            }
+        }
+        notes
     }
 
     /// One note per assessed column without a unit: its values were taken as m/s2 (or N).
@@ -507,34 +578,61 @@ impl AssessReport {
         );
         for (name, a) in &self.signals {
             s.push_str(&format!(
-                "  {name}: dominant {:.2} Hz, band {:.2}-{:.2} Hz, max rms {} {u} over {} windows: {}\n",
+                "  {name}: {} {:.2} Hz, band {:.2}-{:.2} Hz, max rms {} {u} over {} windows: {}\n",
+                if a.f0_given { "f0 (given)" } else { "dominant" },
                 a.dominant_frequency_hz,
                 a.band_hz.0,
                 a.band_hz.1,
                 fixed(a.max_rms, 3),
                 a.rms.len(),
-                if a.stable { "within the limit" } else { "LIMIT EXCEEDED" }
+                if a.stable {
+                    "within the limit"
+                } else {
+                    "LIMIT EXCEEDED"
+                }
             ));
         }
         for note in self.notes() {
             s.push_str(&format!("note: {note}\n"));
         }
         s.push_str(&format!(
-            "verdict: {} (max rms {} {u}, {} % of the limit)\n",
+            "verdict: {} (max rms {} {u}, {} % of the limit{})\n",
             if self.stable() { "stable" } else { "unstable" },
             fixed(self.max_rms(), 3),
-            fixed(100.0 * self.max_rms() / self.limit(), 0)
+            fixed(100.0 * self.max_rms() / self.limit(), 0),
+            if self.unitless.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "; with the unit of {} assumed, see the note",
+                    self.unitless
+                        .iter()
+                        .map(|c| format!("'{c}'"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            }
         ));
         s
     }
 
-    /// assess.csv (rms along the track per signal) and assess.svg.
-    pub fn add_artefacts(&self, files: &mut Artefacts) -> Result<(), AnalysisError> {
+    /// assess.csv (rms along the track per signal), assess.svg and assess_summary.csv (one
+    /// row per signal with what it was assessed with; `band_check` says whether the recorded
+    /// band was checked: `covered`, `unrecorded` or `narrower, accepted`).
+    pub fn add_artefacts(
+        &self,
+        files: &mut Artefacts,
+        band_check: &str,
+    ) -> Result<(), AnalysisError> {
         let u = self.unit();
-        let mut t = Table::new(&["signal index", "window centre [m]", &format!("rms [{u}]")]);
+        let mut t = Table::new(&[
+            "signal index",
+            "window centre from the record's start [m]",
+            &format!("rms [{u}]"),
+        ]);
         let mut chart = Chart::new(
             &format!("EN 14363 rms at {:.1} km/h", self.speed_kmh),
-            "position along the track [m]",
+            "window centre from the record's start [m]",
             &format!("rms [{u}]"),
         );
         for (k, (name, a)) in self.signals.iter().enumerate() {
@@ -553,17 +651,29 @@ impl AssessReport {
         }
         files.add_table("assess.csv", &t)?;
         files.add_lines("assess.svg", &chart)?;
+        let quantity = match self.criterion {
+            Criterion::LateralAcceleration { .. } => "acceleration",
+            Criterion::GuidingForces { .. } => "guiding-force",
+        };
         let mut legend = format!(
-            "signal index,signal,dominant frequency [Hz],max rms [{u}],limit [{u}],stable\n"
+            "signal index,signal,dominant frequency [Hz],max rms [{u}],limit [{u}],stable,\
+             f0 given,band low [Hz],band high [Hz],speed [km/h],quantity,unit assumed,band check\n"
         );
         for (k, (name, a)) in self.signals.iter().enumerate() {
+            let column = |c: &str| c == name || split_unit(c).0 == name;
             legend.push_str(&format!(
-                "{k},{},{},{},{},{}\n",
+                "{k},{},{},{},{},{},{},{},{},{},{quantity},{},{}\n",
                 master::output::csv_field(name),
                 a.dominant_frequency_hz,
                 a.max_rms,
                 a.limit,
-                a.stable
+                a.stable,
+                a.f0_given,
+                a.band_hz.0,
+                a.band_hz.1,
+                self.speed_kmh,
+                self.unitless.iter().any(|c| column(c)),
+                master::output::csv_field(band_check)
             ));
         }
         files.add_text("assess_summary.csv", legend);
@@ -579,9 +689,12 @@ fn check_unit(
     let (_, unit) = split_unit(&table.names[col]);
     let scale = match (criterion, unit) {
         (_, None) => Some(1.0),
-        (Criterion::LateralAcceleration { .. }, Some(u)) => {
-            matches!(u, "m/s2" | "m/s^2" | "m s-2").then_some(1.0)
-        }
+        (Criterion::LateralAcceleration { .. }, Some(u)) => match u {
+            "m/s2" | "m/s^2" | "m/s\u{b2}" | "m s-2" | "m s^-2" | "m\u{b7}s-2" => Some(1.0),
+            // standard gravity (the unit hosts and accelerometers give)
+            "g" => Some(9.806_65),
+            _ => None,
+        },
         (Criterion::GuidingForces { .. }, Some("N")) => Some(1.0),
         (Criterion::GuidingForces { .. }, Some("kN")) => Some(1e3),
         (Criterion::GuidingForces { .. }, Some(_)) => None,
@@ -592,11 +705,38 @@ fn check_unit(
             table.path.display(),
             table.names[col],
             match criterion {
-                Criterion::LateralAcceleration { .. } => "lateral-acceleration (m/s2)",
+                Criterion::LateralAcceleration { .. } => "lateral-acceleration (m/s2 or g)",
                 Criterion::GuidingForces { .. } => "guiding-force (N or kN)",
             }
         ))
     })
+}
+
+/// A guiding force without a unit is taken in N; values that never reach 1 kN as N are
+/// those of a force in kN (a wheelset's guiding forces are kN), which taken in N would pass
+/// any limit: refused, asking for the unit.
+fn check_unitless_force(
+    table: &ResultsTable,
+    col: usize,
+    criterion: Criterion,
+    x: &[f64],
+) -> Result<(), AnalysisError> {
+    let force = matches!(criterion, Criterion::GuidingForces { .. });
+    if !force || split_unit(&table.names[col]).1.is_some() {
+        return Ok(());
+    }
+    let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if peak >= 1e3 {
+        return Ok(());
+    }
+    let name = &table.names[col];
+    Err(AnalysisError::Input(format!(
+        "{}: column '{name}' names no unit and its largest value is {}: as a force in N that \
+         is below 1 kN, so it is likely in kN; name its unit in the header ('{name} [kN]' or \
+         '{name} [N]')",
+        table.path.display(),
+        master::show::num(peak)
+    )))
 }
 
 /// Whether the recorded band of `table` covers what `report` assessed: `Err` names each
@@ -699,6 +839,19 @@ pub fn assess_table(
             reason: "must be a speed > 0 km/h".into(),
         });
     }
+    if let Some((name, v)) = &table.recorded_speed {
+        // a speed given in m/s, or another run's: the 100 m windows would span other times
+        if (speed_kmh / 3.6 - v).abs() > 5e-3 * v {
+            return Err(AnalysisError::Input(format!(
+                "{}: the speed given, {} km/h, is not the running speed its metadata records: \
+                 '{name}' = {} m/s ({} km/h)",
+                table.path.display(),
+                master::show::num(speed_kmh),
+                master::show::num(*v),
+                master::show::num((v * 3.6 * 1e3).round() / 1e3)
+            )));
+        }
+    }
     let fs = table.sampling_rate_hz()?;
     let duration = table.columns[0].len() as f64 / fs;
     let assessed_m = settings.assessed_m(duration, speed_kmh);
@@ -722,6 +875,7 @@ pub fn assess_table(
             unitless.push(table.names[col].clone());
         }
         let x: Vec<f64> = table.columns[col].iter().map(|v| v * scale).collect();
+        check_unitless_force(table, col, criterion, &x)?;
         let a = match criterion {
             Criterion::LateralAcceleration { bogie_mass_t } => {
                 assess_lateral_acceleration(&x, fs, speed_kmh / 3.6, bogie_mass_t, settings)
@@ -754,321 +908,4 @@ fn fixed(x: f64, decimals: usize) -> String {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use std::f64::consts::PI;
-
-    fn sine_table(amp: f64, f: f64, fs: f64, secs: f64, unit: &str) -> String {
-        let n = (secs * fs) as usize;
-        let mut s = format!("time [s],\"a, quoted [{unit}]\",other [m]\n");
-        for k in 0..n {
-            let t = k as f64 / fs;
-            s.push_str(&format!("{t},{},{}\n", amp * (2.0 * PI * f * t).sin(), 0.0));
-        }
-        s
-    }
-
-    /// A name given without its unit that fits several columns asks for the unit; a full name
-    /// that two columns share names the file's fault instead.
-    #[test]
-    fn a_column_is_found_by_its_name_and_ambiguity_is_named() {
-        let text = "time [s],a [m/s2],a [g],b [m],b [m]\n0,1,2,3,4\n0.1,1,2,3,4\n";
-        let t = ResultsTable::parse(text, Path::new("x.csv")).unwrap();
-        assert_eq!(t.find("a [g]").unwrap(), 2);
-        let e = t.find("a").unwrap_err().to_string();
-        assert!(e.contains("give the full name with its unit"), "{e}");
-        let e = t.find("b [m]").unwrap_err().to_string();
-        assert!(
-            e.contains("2 columns are named 'b [m]': the file must name each column once"),
-            "{e}"
-        );
-    }
-
-    #[test]
-    fn the_time_column_is_read_in_seconds_or_milliseconds_and_any_other_unit_refused() {
-        let in_s = sine_table(6.0, 4.0, 500.0, 10.0, "m/s2");
-        let rate = |text: &str| {
-            ResultsTable::parse(text, Path::new("x.csv"))
-                .unwrap()
-                .sampling_rate_hz()
-        };
-        assert_eq!(rate(&in_s).unwrap(), 500.0);
-        // the same samples with the time in ms
-        let in_ms: String = in_s
-            .lines()
-            .enumerate()
-            .map(|(i, l)| {
-                if i == 0 {
-                    l.replace("time [s]", "time [ms]")
-                } else {
-                    let (t, rest) = l.split_once(',').unwrap();
-                    format!("{},{rest}", t.parse::<f64>().unwrap() * 1e3)
-                }
-            })
-            .collect::<Vec<_>>()
-            .join("\n");
-        assert!((rate(&in_ms).unwrap() - 500.0).abs() < 1e-9);
-        let in_min = in_s.replacen("time [s]", "time [min]", 1);
-        let e = rate(&in_min).unwrap_err().to_string();
-        assert!(
-            e.contains("the time column 'time [min]' is in min: give it in s (or ms)"),
-            "{e}"
-        );
-    }
-
-    /// The lateral-acceleration criterion (6.1 t bogie, 300 km/h) on the quoted column of a
-    /// sine table of `amp` m/s2 at `f` Hz, `secs` long at 500 Hz.
-    fn assess_sine(amp: f64, f: f64, secs: f64) -> AssessReport {
-        let text = sine_table(amp, f, 500.0, secs, "m/s2");
-        let table = ResultsTable::parse(&text, Path::new("x.csv")).unwrap();
-        assess_table(
-            &table,
-            &["a, quoted".to_string()],
-            300.0,
-            Criterion::LateralAcceleration { bogie_mass_t: 6.1 },
-            &StabilitySettings::default(),
-        )
-        .unwrap()
-    }
-
-    #[test]
-    fn sine_of_known_rms_is_assessed_against_the_limit() {
-        // amplitude 6 m/s2 -> rms 4.24 < 5.39; amplitude 8 -> 5.66 > 5.39
-        for (amp, stable) in [(6.0, true), (8.0, false)] {
-            let r = assess_sine(amp, 4.0, 10.0);
-            let a = &r.signals[0].1;
-            assert!((a.dominant_frequency_hz - 4.0).abs() < 0.1, "{a:?}");
-            assert!((r.limit() - 5.39).abs() < 1e-12);
-            assert!(
-                (a.max_rms - amp / 2f64.sqrt()).abs() < 0.02 * amp,
-                "{} vs {}",
-                a.max_rms,
-                amp / 2f64.sqrt()
-            );
-            assert_eq!(r.stable(), stable);
-            let mut files = Artefacts::default();
-            r.add_artefacts(&mut files).unwrap();
-            assert_eq!(
-                files.names(),
-                vec!["assess.csv", "assess.svg", "assess_summary.csv"]
-            );
-            assert!(r.summary().contains(if stable {
-                "verdict: stable"
-            } else {
-                "verdict: unstable"
-            }));
-        }
-    }
-
-    /// The guiding-force criterion (70 kN wheel load) on the quoted column of a 20 kN sine
-    /// table at 300 km/h, its header's unit replaced by `header_unit` (None: no unit).
-    fn assess_forces(header_unit: Option<&str>) -> Result<AssessReport, AnalysisError> {
-        let text = sine_table(20.0, 5.0, 500.0, 10.0, "kN");
-        let text = match header_unit {
-            Some(u) => text.replace("[kN]", &format!("[{u}]")),
-            None => text.replace(" [kN]", ""),
-        };
-        let table = ResultsTable::parse(&text, Path::new("f.csv")).unwrap();
-        assess_table(
-            &table,
-            &["a, quoted".to_string()],
-            300.0,
-            Criterion::GuidingForces {
-                static_wheel_load_n: 70e3,
-            },
-            &StabilitySettings::default(),
-        )
-    }
-
-    #[test]
-    fn a_band_clamped_below_2_1_hz_is_noted() {
-        let at = |f: f64| assess_sine(6.0, f, 20.0);
-        assert!(at(4.0).band_notes().is_empty());
-        let low = at(1.0);
-        let notes = low.band_notes();
-        assert_eq!(notes.len(), 1, "{notes:?}");
-        assert!(
-            notes[0].contains("dominant frequency 1.00 Hz")
-                && notes[0].contains("clamped to 0.1 Hz"),
-            "{notes:?}"
-        );
-        assert!(low.summary().contains("note: signal 'a, quoted'"));
-    }
-
-    #[test]
-    fn a_column_without_a_unit_is_assessed_with_a_note_saying_what_was_assumed() {
-        let r = assess_forces(None).unwrap();
-        assert_eq!(r.unitless, ["a, quoted"]);
-        let summary = r.summary();
-        assert!(
-            summary.contains("note: column 'a, quoted' names no unit: its values were taken in N"),
-            "{summary}"
-        );
-        // a labelled column gets no note
-        let r = assess_forces(Some("kN")).unwrap();
-        assert!(r.unit_notes().is_empty() && !r.summary().contains("note:"));
-    }
-
-    #[test]
-    fn forces_in_kn_are_converted_and_wrong_units_refused() {
-        let text = sine_table(20.0, 5.0, 500.0, 10.0, "kN");
-        let table = ResultsTable::parse(&text, Path::new("f.csv")).unwrap();
-        let r = assess_table(
-            &table,
-            &["a, quoted".to_string()],
-            300.0,
-            Criterion::GuidingForces {
-                static_wheel_load_n: 70e3,
-            },
-            &StabilitySettings::default(),
-        )
-        .unwrap();
-        // reported in kN: 20 kN amplitude -> 14.1 kN rms against (10 + 2*70/3)/2 = 28.3 kN
-        assert!(
-            (r.signals[0].1.max_rms - 14.14).abs() < 0.3,
-            "{:?}",
-            r.signals[0].1.max_rms
-        );
-        assert!(r.stable());
-        let e = assess_table(
-            &table,
-            &["a, quoted".to_string()],
-            300.0,
-            Criterion::LateralAcceleration { bogie_mass_t: 6.1 },
-            &StabilitySettings::default(),
-        )
-        .unwrap_err();
-        assert!(e.to_string().contains("wrong unit"), "{e}");
-    }
-
-    #[test]
-    fn bad_tables_name_the_file_and_line() {
-        let p = Path::new("bad.csv");
-        let e = ResultsTable::parse("time,a\n0,1\n0.1,x\n", p).unwrap_err();
-        assert!(
-            e.to_string().contains("bad.csv:3") && e.to_string().contains("'x'"),
-            "{e}"
-        );
-        let e = ResultsTable::parse("time,a\nx,1\n", p).unwrap_err();
-        assert!(
-            e.to_string().contains("bad.csv:2: 'x' in column 'time'"),
-            "{e}"
-        );
-        // a text column (a recorded String, an Enumeration's item) is left out; asking for it
-        // says why
-        let csv = "time,model,model (item),a,label\n0,1,nonlinear,2,AA\n0.1,1,nonlinear,3,\n";
-        let t = ResultsTable::parse(csv, p).unwrap();
-        assert_eq!(t.names, vec!["time", "model", "a"]);
-        assert_eq!(t.columns[2], vec![2.0, 3.0]);
-        let e = t.find("model (item)").unwrap_err().to_string();
-        assert!(
-            e.contains("bad.csv:2: 'nonlinear' in column 'model (item)' is not a number"),
-            "{e}"
-        );
-        assert!(e.ends_with("signal 'model (item)' is not numeric"), "{e}");
-        let e = t.find("label").unwrap_err().to_string();
-        assert!(e.contains("bad.csv:2: 'AA'"), "{e}");
-        // a String is quoted by our writer: text whatever it holds (a number, NaN, a line
-        // break); a column with a value that is not finite is left out, named when asked for
-        let csv =
-            "time,s,t,u,a,b\n0,\"12\",\"NaN\",\"two\nlines\",2,inf\n0.1,\"13\",\"x\",\"y\",3,1\n";
-        let t = ResultsTable::parse(csv, p).unwrap();
-        assert_eq!(t.names, vec!["time", "a"]);
-        assert_eq!(t.columns[1], vec![2.0, 3.0]);
-        let e = t.find("b").unwrap_err().to_string();
-        assert!(
-            e.contains("bad.csv:2: inf in column 'b' is not finite"),
-            "{e}"
-        );
-        let e = t.find("s").unwrap_err().to_string();
-        assert!(e.contains("'12' in column 's' is not a number"), "{e}");
-        // a quoted field left open is named at the line its record starts on
-        let e = ResultsTable::parse("time,a\n0,1\n0.1,\"2\n", p).unwrap_err();
-        assert!(
-            e.to_string()
-                .contains("bad.csv:3: unterminated quoted field"),
-            "{e}"
-        );
-        let e = ResultsTable::parse("time,a\n0,1,2\n", p).unwrap_err();
-        assert!(e.to_string().contains("bad.csv:2"), "{e}");
-        let e = ResultsTable::parse("time,a\n0,NaN\n", p).unwrap_err();
-        assert!(e.to_string().contains("not finite"), "{e}");
-        let e = ResultsTable::parse("# only a comment\n", p).unwrap_err();
-        assert!(e.to_string().contains("no header"), "{e}");
-        // whitespace and semicolons, comments
-        let t = ResultsTable::parse("# c\ntime a b\n0 1 2\n1 3 4\n", p).unwrap();
-        assert_eq!(t.columns[2], vec![2.0, 4.0]);
-        let t = ResultsTable::parse("time;a\n0;1\n", p).unwrap();
-        assert_eq!(t.names, vec!["time", "a"]);
-        // metadata of another recording: 10 Hz recorded beside a 1 kHz time column
-        let mut t = ResultsTable::parse("time,a\n0,1\n0.001,2\n0.002,3\n", p).unwrap();
-        t.sampling = Some(Sampling {
-            rate_hz: 10.0,
-            passband_hz: 5.0,
-            decimation: None,
-        });
-        let e = t.clone().check_recorded_rate().unwrap_err().to_string();
-        assert!(
-            e.contains("records a sampling rate of 10 Hz") && e.contains("1000 Hz"),
-            "{e}"
-        );
-        t.sampling = Some(Sampling {
-            rate_hz: 1000.0,
-            passband_hz: 500.0,
-            decimation: None,
-        });
-        assert!(t.check_recorded_rate().is_ok());
-        // a whitespace-separated header carries units as the others do
-        let t = ResultsTable::parse("time [ms]   a [m/s2]\n0 1\n1 3\n", p).unwrap();
-        assert_eq!(t.names, vec!["time [ms]", "a [m/s2]"]);
-        assert_eq!(t.columns[1], vec![1.0, 3.0]);
-        // unknown signal lists the available ones
-        let e = t.find("b").unwrap_err();
-        assert!(e.to_string().contains("the signals are: a"), "{e}");
-        // non-uniform time
-        let t = ResultsTable::parse("time,a\n0,1\n0.1,1\n0.3,1\n0.4,1\n", p).unwrap();
-        let e = t.sampling_rate_hz().unwrap_err();
-        assert!(e.to_string().contains("not uniformly sampled"), "{e}");
-        // one missing sample in a long record is named where it is, against the usual step
-        let mut text = String::from("time,a\n");
-        for k in (0..1000).filter(|&k| k != 700) {
-            text.push_str(&format!("{},1\n", k as f64 * 1e-3));
-        }
-        let e = ResultsTable::parse(&text, p)
-            .unwrap()
-            .sampling_rate_hz()
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("(step 0.002 s after t = 0.699 s, where the others are 0.001 s)"),
-            "{e}"
-        );
-        // a NaN or an infinity inside the time column of columns given as such (Python's
-        // assess_stability; a file's are refused when read): a NaN passes every step comparison
-        for bad in [f64::NAN, f64::INFINITY] {
-            let mut t = ResultsTable::parse("time,a\n0,1\n0.1,1\n0.2,1\n0.3,1\n", p).unwrap();
-            t.columns[0][2] = bad;
-            let e = t.sampling_rate_hz().unwrap_err().to_string();
-            assert!(e.contains("the time column (first column) holds"), "{e}");
-            assert!(e.contains("at sample 3"), "{e}");
-        }
-    }
-
-    #[test]
-    fn too_short_records_are_refused() {
-        let table = ResultsTable::parse(
-            &sine_table(1.0, 4.0, 200.0, 1.0, "m/s2"),
-            Path::new("s.csv"),
-        )
-        .unwrap();
-        let e = assess_table(
-            &table,
-            &["other".to_string()],
-            200.0,
-            Criterion::LateralAcceleration { bogie_mass_t: 6.1 },
-            &StabilitySettings::default(),
-        )
-        .unwrap_err();
-        assert!(e.to_string().contains("less than one 100 m window"), "{e}");
-    }
-}
+mod tests;

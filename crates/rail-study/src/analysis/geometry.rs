@@ -226,6 +226,25 @@ pub fn setup_of(inputs: &GeometryInputs) -> Result<ContactSetup, AnalysisError> 
     setup.wheel_right = inputs.wheel_right.load()?;
     setup.rail_right = inputs.rail_right.load()?;
     setup.nominal_radius_right_m = inputs.radius_right_m;
+    // rail A stands at 1:20 in its own coordinates: an inclination added to it compounds (1:40
+    // on it is about 1:13, and tan gamma_e at 3 mm falls from 0.18 to 0.013 without a word)
+    if inputs.inclination != 0.0 {
+        let rail_a = Profile::parse_str(RAIL_A, "rail A")?;
+        let same =
+            |r: &Profile| r.lateral_m == rail_a.lateral_m && r.vertical_m == rail_a.vertical_m;
+        if same(&setup.rail_left) || same(&setup.rail_right) {
+            return Err(AnalysisError::Option {
+                option: "--inclination",
+                value: master::show::num(inputs.inclination).to_string(),
+                reason: "rail A (EN 15302's benchmark rail, built in and in \
+                         data/wheel-rail/SUIC519A.dat) is already inclined at 1:20 in its \
+                         coordinates, and an inclination added to it compounds: leave \
+                         --inclination out for rail A, or give a rail profile in upright \
+                         coordinates"
+                    .to_string(),
+            });
+        }
+    }
     setup.rail_inclination = inputs.inclination;
     setup.radius_convention = inputs.radius_convention;
     setup.validate()?;
@@ -266,8 +285,14 @@ pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
              rolling circles are 1500 mm apart, its flanges about 1425 mm)",
         ));
     }
-    if !(inputs.step_m.is_finite() && inputs.step_m > 0.0) {
-        return Err(bad("--step", inputs.step_m * 1e3, "must be > 0 mm"));
+    // the table's y column has 0.1 um resolution: finer steps would write rows of equal y,
+    // which the vehicle models refuse
+    if !(inputs.step_m.is_finite() && inputs.step_m >= 1e-6) {
+        return Err(bad(
+            "--step",
+            inputs.step_m * 1e3,
+            "must be at least 0.001 mm (the table gives y to 0.1 um)",
+        ));
     }
     if !(inputs.y_max_m.is_finite() && inputs.y_max_m >= 3.0 * inputs.step_m) {
         return Err(bad(
@@ -625,6 +650,11 @@ impl GeometryResults {
                 format!("1:{:.0}", 1.0 / i.inclination)
             }
         );
+        // where the wheels stand is set by the profiles' datum, which the user must know
+        s.push_str(
+            "wheel profile origins 1500 mm apart: back-to-back 1360 mm for origins 70 mm from \
+             the back faces (EN 15302's, S1002's taping line)\n",
+        );
         s.push_str(&format!(
             "reachable y: {:.2} to {:.2} mm (flange limit), e0 = {:.2} mm",
             self.table.y_reachable_min_m * 1e3,
@@ -703,6 +733,33 @@ mod tests {
         assert!(parse_inclination("1:0").is_err());
         assert!(parse_inclination("steep").is_err());
         assert!(parse_inclination("1:2").is_err());
+    }
+
+    /// Rail A already stands at 1:20: an inclination added to it is refused (1:40 on it gave
+    /// tan gamma_e 0.013 at 3 mm, exit status 0), from its file as well as built in.
+    #[test]
+    fn an_inclination_on_rail_a_is_refused() {
+        let from_file = tempfile::NamedTempFile::new().unwrap();
+        std::fs::write(from_file.path(), RAIL_A).unwrap();
+        for rail in [
+            GeometryInputs::default().rail_left,
+            ProfileSource::File(from_file.path().to_path_buf()),
+        ] {
+            let i = GeometryInputs {
+                inclination: 0.025,
+                rail_left: rail.clone(),
+                rail_right: rail,
+                ..GeometryInputs::default()
+            };
+            let e = contact_geometry(&i, &AtomicBool::new(false))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.starts_with("invalid option --inclination = 0.025")
+                    && e.contains("already inclined at 1:20"),
+                "{e}"
+            );
+        }
     }
 
     #[test]

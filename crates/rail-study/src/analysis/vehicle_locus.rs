@@ -49,6 +49,10 @@ pub struct VehicleLocus {
     /// sqrt(lambda / (r0 s)) [rad/m]: times the speed, the angular frequency of a free
     /// wheelset's kinematic (Klingel) oscillation, above which no hunting mode of the coach lies.
     pub kinematic_rad_per_m: f64,
+    /// The linear model's equivalent conicity, and whether it was changed from the calibrated
+    /// default.
+    pub conicity: f64,
+    pub conicity_changed: bool,
 }
 
 fn vehicle_err(e: EigenError) -> AnalysisError {
@@ -89,6 +93,9 @@ pub fn vehicle_root_locus(
         results,
         critical,
         kinematic_rad_per_m,
+        conicity: params.wheel_rail.conicity,
+        conicity_changed: params.wheel_rail.conicity
+            != VehicleParams::default().wheel_rail.conicity,
     })
 }
 
@@ -255,9 +262,14 @@ impl VehicleLocus {
             "front bogie energy share [-]",
             "rear bogie energy share [-]",
             "mode (0 car body, 1 front bogie, 2 rear bogie, 3 both bogies)",
+            // the least-damped mode is not always a hunting one (the passive coach: a 90 Hz
+            // mode of the bogies below 215 km/h); hunting modes lie below the free wheelset's
+            // kinematic frequency
+            "hunting (1: below the kinematic frequency, 0: another mode)",
         ]);
         let ld = self.least_damped();
         for (v, m) in &ld {
+            let hunting = m.im <= self.kinematic_rad_per_m * v / 3.6;
             modes.rows.push(vec![
                 *v,
                 m.re,
@@ -268,6 +280,7 @@ impl VehicleLocus {
                 m.shares.front_bogie,
                 m.shares.rear_bogie,
                 kind_code(m),
+                f64::from(u8::from(hunting)),
             ]);
         }
         a.add_table("root_locus_least_damped.csv", &modes)?;
@@ -281,8 +294,20 @@ impl VehicleLocus {
             .map_or("rigid mounting".to_string(), |k| {
                 format!("mounting stiffness {:.1} MN/m", k * 1e-6)
             });
+        let conicity = if self.conicity_changed {
+            format!(
+                "fmu-vehicle defaults, conicity {:.3} instead of the calibrated {:.3}",
+                self.conicity,
+                VehicleParams::default().wheel_rail.conicity
+            )
+        } else {
+            format!(
+                "calibrated fmu-vehicle defaults, conicity {:.3}",
+                self.conicity
+            )
+        };
         let mut s = format!(
-            "linear coach (calibrated fmu-vehicle defaults), damper: {}, {mounting}\n",
+            "linear coach ({conicity}), damper: {}, {mounting}\n",
             self.damper.describe()
         );
         s.push_str(&speeds_line(&self.speeds_kmh));
@@ -414,6 +439,28 @@ mod tests {
                 *v > r.critical.as_ref().unwrap().speed_kmh,
                 "{v} km/h"
             );
+        }
+        // the least-damped table says which rows are not a hunting mode
+        let mut files = Artefacts::default();
+        r.add_artefacts(&mut files).unwrap();
+        let (_, csv) = files
+            .files
+            .iter()
+            .find(|(n, _)| n == "root_locus_least_damped.csv")
+            .unwrap();
+        let csv = String::from_utf8(csv.clone()).unwrap();
+        let hunting: Vec<(f64, &str)> = csv
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let cells: Vec<&str> = l.split(',').collect();
+                (cells[0].parse().unwrap(), *cells.last().unwrap())
+            })
+            .collect();
+        assert_eq!(hunting.len(), speeds.len());
+        for (v, h) in hunting {
+            let f = ld[speeds.iter().position(|s| *s == v).unwrap()].freq_hz;
+            assert_eq!(h, if f > 50.0 { "0" } else { "1" }, "{v} km/h, {f} Hz");
         }
     }
 }

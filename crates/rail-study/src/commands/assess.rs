@@ -200,19 +200,30 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         args.accept_narrow_band,
     )
     .map_err(failed)?;
-    match remark {
-        None => {}
-        Some(BandRemark::Unrecorded(note)) => eprintln!("note: {note}"),
-        Some(BandRemark::Narrow(e)) => {
-            eprintln!("WARNING: {e}\nWARNING: assessed anyway (--accept-narrow-band): the rms below may be wrong");
+    // the band check goes into the summary (and assess.json) as well as to the terminal
+    let mut summary = report.summary();
+    let band_check = match remark {
+        None => "covered",
+        Some(BandRemark::Unrecorded(note)) => {
+            summary.push_str(&format!("note: {note}\n"));
+            "unrecorded"
         }
-    }
+        Some(BandRemark::Narrow(e)) => {
+            let warning = format!(
+                "WARNING: {e}\nWARNING: assessed anyway (--accept-narrow-band): the rms above \
+                 may be wrong\n"
+            );
+            eprint!("{warning}");
+            summary.push_str(&warning);
+            "narrower, accepted"
+        }
+    };
     write_analysis(
         &COMMAND,
         &args.out,
         std::slice::from_ref(&args.table),
         ctx.cancel,
-        &report.summary(),
-        |f| report.add_artefacts(f),
+        &summary,
+        |f| report.add_artefacts(f, band_check),
     )
 }

@@ -76,7 +76,8 @@ pub(crate) fn check_out_folder(out: &Path) -> Result<(), CommandError> {
 /// `out` (only now, after everything is computed, and none over one of the files it read,
 /// `inputs`) and prints `summary` with the file list.
 ///
-/// The folder also gets `<command>.json`: the command, its summary and the files it wrote.
+/// The folder also gets `<command>.json`: the command, its command line and working folder,
+/// its summary and the files it wrote.
 /// A file of the command's kind ([`AnalysisCommand::owns`]) listed there by its previous run
 /// into the same folder and not written this time (another mode, another amplitude, a figure
 /// drawn only sometimes) is removed, so that the folder never mixes two runs' results;
@@ -115,6 +116,14 @@ pub(crate) fn write_analysis(
     let manifest = |listed: &[String]| -> Result<Artefacts, CommandError> {
         let json = serde_json::json!({
             "command": command.name,
+            // how these files were made, so that they can be told from another run's and
+            // made again (the inputs as given, relative to the working directory)
+            "command_line": std::env::args_os()
+                .map(|a| a.to_string_lossy().into_owned())
+                .collect::<Vec<_>>(),
+            "working_directory": std::env::current_dir()
+                .map(|d| d.to_string_lossy().into_owned())
+                .unwrap_or_default(),
             "summary": summary,
             "files": listed,
         });

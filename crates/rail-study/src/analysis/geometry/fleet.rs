@@ -2,9 +2,11 @@
 //! of the wheelset, on the rails and with the set-up of the single run, into one conicity table
 //! (a row per profile) and a figure of the conicity at 3 mm per profile.
 //!
-//! All or nothing: a profile that cannot be read, or whose conicity the EN 15302 method does not
-//! define at an amplitude of the table, stops the run before anything is written, and the error
-//! lists every such profile with its reason (not only the first).
+//! A profile that cannot be read, or whose conicity the EN 15302 method does not define at an
+//! amplitude of the table, gets a row with its reason and no numbers (a fleet of measured
+//! wheels holds a few bad measurements; they must not withhold the others' table); the
+//! command then exits with status 1 naming them. Only when no profile gives a table is nothing
+//! written.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -110,6 +112,8 @@ pub struct FleetResults {
     /// Set-up (the wheels of `inputs` are not used).
     pub inputs: GeometryInputs,
     pub rows: Vec<FleetRow>,
+    /// The profiles without a complete table: (profile as given, why).
+    pub failed: Vec<(String, String)>,
     /// Amplitudes of the table \[m\]: 1, 2, ... mm up to the largest amplitude.
     pub amplitudes_m: Vec<f64>,
 }
@@ -195,27 +199,51 @@ pub fn fleet(
         return Err(AnalysisError::Cancelled);
     }
     let mut rows = Vec::with_capacity(results.len());
-    let mut failures = Vec::new();
+    let mut failed = Vec::new();
     for (wheel, r) in wheels.iter().zip(results) {
         match r {
             Ok(row) => rows.push(row),
-            Err(e) => failures.push(format!("  {}: {e}", wheel.describe())),
+            Err(AnalysisError::Cancelled) => return Err(AnalysisError::Cancelled),
+            Err(e) => failed.push((wheel.describe(), e.to_string())),
         }
     }
-    if !failures.is_empty() {
+    if rows.is_empty() {
+        let list: Vec<String> = failed.iter().map(|(p, e)| format!("  {p}: {e}")).collect();
         return Err(AnalysisError::Geometry(format!(
-            "{} of {} wheel profiles have no complete conicity table (nothing written; remove \
-             them, or lower --amplitude-max):\n{}",
-            failures.len(),
+            "none of the {} wheel profiles has a complete conicity table (nothing written; \
+             lower --amplitude-max, or see each reason):\n{}",
             wheels.len(),
-            failures.join("\n")
+            list.join("\n")
         )));
     }
     Ok(FleetResults {
         inputs: inputs.clone(),
         rows,
+        failed,
         amplitudes_m,
     })
+}
+
+impl FleetResults {
+    /// The error a run with [`FleetResults::failed`] profiles ends with, once its files are
+    /// written: each such profile with its reason.
+    pub fn incomplete(&self) -> Option<String> {
+        if self.failed.is_empty() {
+            return None;
+        }
+        let list: Vec<String> = self
+            .failed
+            .iter()
+            .map(|(p, e)| format!("  {p}: {e}"))
+            .collect();
+        Some(format!(
+            "{} of {} wheel profiles have no complete conicity table (their rows in \
+             fleet_conicity.csv give the reason; lower --amplitude-max, or see each reason):\n{}",
+            self.failed.len(),
+            self.failed.len() + self.rows.len(),
+            list.join("\n")
+        ))
+    }
 }
 
 impl FleetResults {
@@ -237,6 +265,7 @@ impl FleetResults {
             "tan gamma_e EN 15302 Annex C regression at 3 mm ({conv})"
         ));
         head.push("wavelength at 3 mm [m] (inf: not restored)".to_string());
+        head.push("error (empty: a complete table)".to_string());
         let mut out: String = head
             .iter()
             .map(|h| csv_field(h))
@@ -255,6 +284,16 @@ impl FleetResults {
             let at3 = r.at(FIGURE_AMPLITUDE_M);
             cells.push(at3.map(|p| p.regression.to_string()).unwrap_or_default());
             cells.push(at3.map(|p| p.wavelength_m.to_string()).unwrap_or_default());
+            cells.push(String::new());
+            out.push_str(&cells.join(","));
+            out.push('\n');
+        }
+        // a profile without a complete table: its name, empty numbers, why
+        let empty = 2 + self.amplitudes_m.len() + 2;
+        for (profile, error) in &self.failed {
+            let mut cells = vec![csv_field(profile)];
+            cells.extend(std::iter::repeat_n(String::new(), empty));
+            cells.push(csv_field(error));
             out.push_str(&cells.join(","));
             out.push('\n');
         }
@@ -314,7 +353,7 @@ impl FleetResults {
         let mut s = format!(
             "{} wheel profiles, each on both wheels; rails {} / {}, nominal radius {:.1} / {:.1} \
              mm, gauge {:.2} mm; conicity in the {} convention\n",
-            self.rows.len(),
+            self.rows.len() + self.failed.len(),
             self.inputs.rail_left.describe(),
             self.inputs.rail_right.describe(),
             self.inputs.radius_left_m * 1e3,
@@ -347,6 +386,11 @@ impl FleetResults {
                     r.flange_limit_m * 1e3
                 ));
             }
+        }
+        for (profile, _) in &self.failed {
+            s.push_str(&format!(
+                "  {profile}: no complete conicity table (the reason is in its row)\n"
+            ));
         }
         s
     }
