@@ -109,6 +109,8 @@ fn sweep_err(e: &SweepError) -> PyErr {
         | SweepError::NotAFolder { .. }
         | SweepError::NotARunFolder { .. }
         | SweepError::NotARunTable { .. }
+        | SweepError::AddedToRunFolder { .. }
+        | SweepError::InputInRunFolder { .. }
         | SweepError::NoOutputFolder
         | SweepError::NotATablesFolder { .. }
         | SweepError::FolderInUse { .. } => OutputError::new_err(error_message(e)),

@@ -44,6 +44,11 @@ pub fn read_text_file(path: &Path, max_bytes: u64) -> std::io::Result<String> {
             format!("larger than the {max_bytes} bytes allowed"),
         ));
     }
+    // the byte-order mark some Windows editors and spreadsheet exports put first is no text
+    // (a JSON reader would stop at it, a CSV's first column would carry it in its name)
+    if let Some(rest) = text.strip_prefix('\u{feff}') {
+        text = rest.to_string();
+    }
     Ok(text)
 }
 
@@ -128,4 +133,25 @@ pub fn file_digest(path: &Path) -> Option<String> {
             .insert(path.to_path_buf(), (key, digest.clone()));
     }
     Some(digest)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A file saved with a byte-order mark reads as its text: a system description from a
+    /// Windows editor was refused ("line 1, column 1: expected value").
+    #[test]
+    fn a_byte_order_mark_is_not_part_of_the_text() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bom.json");
+        std::fs::write(&path, "\u{feff}{\"a\": 1}").unwrap();
+        let text = read_text_file(&path, 1 << 20).unwrap();
+        assert_eq!(text, "{\"a\": 1}");
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(v["a"], 1);
+        // a mark inside the text is the text's
+        std::fs::write(&path, "x\u{feff}").unwrap();
+        assert_eq!(read_text_file(&path, 1 << 20).unwrap(), "x\u{feff}");
+    }
 }

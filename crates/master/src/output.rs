@@ -181,9 +181,16 @@ fn listed_temporary_file(dir: &Path) -> std::io::Result<(tempfile::NamedTempFile
             "the process is ending (interrupted twice)",
         ));
     };
-    let tmp = tempfile::Builder::new()
-        .prefix(UNFINISHED_PREFIX)
-        .tempfile_in(dir)?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(UNFINISHED_PREFIX);
+    // results are ordinary files: read-write for all as far as the user's umask allows (a
+    // private umask keeps them private), where a temporary file would be 0600
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let tmp = builder.tempfile_in(dir)?;
     // held while the file is written: another master tells it from one a dead master left
     crate::fmu::extract::try_lock(tmp.as_file());
     list.push(tmp.path().to_path_buf());
@@ -228,14 +235,6 @@ where
         let mut w = std::io::BufWriter::new(tmp.as_file());
         fill(&mut w)?;
         w.flush().map_err(io_err(path))?;
-    }
-    // Temporary files are created 0600; results are ordinary files others may read.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        tmp.as_file()
-            .set_permissions(std::fs::Permissions::from_mode(0o644))
-            .map_err(io_err(path))?;
     }
     tmp.as_file().sync_all().map_err(io_err(path))?;
     Ok(Unfinished {
@@ -464,6 +463,18 @@ pub fn write_results_csv(path: &Path, out: &SimOutput) -> Result<(), OutputError
     results_csv_unfinished(path, out)?.commit()
 }
 
+/// Appends `v` as the shortest text that reads back as the same number: plain for magnitudes
+/// within 1e-5 .. 1e15, in exponent notation beyond (1e300 would print as 301 digits, which
+/// pandas reads as a Python integer, not a float).
+fn push_number(line: &mut String, v: f64) {
+    let a = v.abs();
+    let _ = if a == 0.0 || (1e-5..1e15).contains(&a) || !a.is_finite() {
+        std::fmt::Write::write_fmt(line, format_args!("{v}"))
+    } else {
+        std::fmt::Write::write_fmt(line, format_args!("{v:e}"))
+    };
+}
+
 /// [`write_results_csv`], not yet committed ([`write_unfinished`]).
 pub fn results_csv_unfinished(path: &Path, out: &SimOutput) -> Result<Unfinished, OutputError> {
     let types: Vec<ColumnInfo> = (0..out.header.len()).map(|c| out.column_info(c)).collect();
@@ -478,9 +489,7 @@ pub fn results_csv_unfinished(path: &Path, out: &SimOutput) -> Result<Unfinished
                     line.push(',');
                 }
                 match info.scalar_type() {
-                    ScalarType::Real | ScalarType::Integer => {
-                        let _ = std::fmt::Write::write_fmt(&mut line, format_args!("{v}"));
-                    }
+                    ScalarType::Real | ScalarType::Integer => push_number(&mut line, v),
                     ScalarType::Boolean => line.push(if v != 0.0 { '1' } else { '0' }),
                     ScalarType::Enumeration => {
                         let _ = std::fmt::Write::write_fmt(&mut line, format_args!("{v},"));

@@ -103,6 +103,19 @@ impl Args {
     }
 }
 
+/// Where a failed run's history goes: `<stem>.history.<ext>` beside its results' name
+/// (`r.csv` -> `r.history.csv`; a name without an extension gets `.history`).
+fn history_path(results: &std::path::Path) -> PathBuf {
+    let stem = results
+        .file_stem()
+        .map_or_else(|| "results".into(), |s| s.to_string_lossy().into_owned());
+    let name = match results.extension() {
+        Some(ext) => format!("{stem}.history.{}", ext.to_string_lossy()),
+        None => format!("{stem}.history"),
+    };
+    results.with_file_name(name)
+}
+
 /// The results file of a run without --output: `results.csv` or `results.parquet` in the
 /// current folder.
 fn default_output(format: ResultsFormat) -> PathBuf {
@@ -209,9 +222,10 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     };
     let out = sys.run_keeping_history(&opts);
     bar.finish_and_clear();
-    // a run that fails (not one stopped by Ctrl-C) writes its history up to the failure in
-    // place of the results, marked in its metadata, so that it can be looked into and no
-    // earlier run's results stay under its name
+    // a run that fails (not one stopped by Ctrl-C) writes its history up to the failure
+    // beside the results' name (`<name>.history.<ext>`, marked in its metadata), so that it can
+    // be looked into, and an earlier run's results under the name are removed: neither they
+    // nor a truncated history read as this run's results
     let (out, failure) = match out {
         Ok(out) => (out, None),
         Err(FailedRun {
@@ -226,10 +240,18 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         let format = chosen.unwrap_or_else(|| {
             ResultsFormat::by_size(out.rows().count() as u64, out.header.len() as u64)
         });
-        let output = args
+        let results_name = args
             .output
             .clone()
             .unwrap_or_else(|| default_output(format));
+        let output = match failure {
+            Some(_) => history_path(&results_name),
+            None => results_name.clone(),
+        };
+        if failure.is_some() {
+            check_outputs_apart(&inputs, &written(&output, format))?;
+            crate::output::check_folders_exist(&written(&output, format))?;
+        }
         if args.output.is_none() || (chosen.is_none() && format == ResultsFormat::Csv) {
             // the files the run's size decided, checked as the others were before the run
             check_outputs_apart(&inputs, &written(&output, format))?;
@@ -262,6 +284,14 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         results.commit()?;
         if let Some(summary) = summary {
             summary.commit()?;
+        }
+        if failure.is_some() {
+            // the results an earlier run wrote under this name (the master's only, and not an
+            // input): they would read as this run's
+            let ours = crate::results::written_by_master(&results_name, format);
+            if ours && check_outputs_apart(&inputs, &written(&results_name, format)).is_ok() {
+                remove_results(&results_name, format)?;
+            }
         }
         if args.output.is_none() {
             // the default file of the other format, from an earlier run, would read as a result

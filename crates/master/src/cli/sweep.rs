@@ -7,9 +7,9 @@ use super::{CommandError, Context};
 use crate::output::write_json_atomic;
 use crate::results::ResultsFormat;
 use crate::runset::{
-    check_given_one_way, check_start_values, completed, execute_with as run_all,
-    format_by_description, lock_output_folder, prepare_run_folder, run_job, Job, ResultsOptions,
-    RunReport, RunSet, NOT_STARTED,
+    check_given_one_way, check_inputs_outside_runs, check_start_values, completed,
+    execute_with as run_all, format_by_description, lock_output_folder, prepare_run_folder,
+    run_job, thread_pool, Job, ResultsOptions, RunReport, RunSet, NOT_STARTED,
 };
 use crate::system::PreparedSystem;
 
@@ -90,6 +90,29 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     } else {
         None
     };
+    if args.jobs == Some(0) {
+        return Err(CommandError::Failed(
+            "invalid option --jobs = 0: at least one run at a time (leave it out for one per \
+             core)"
+                .into(),
+        ));
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = args.jobs.unwrap_or(cores);
+    if threads > cores && todo.len() > cores {
+        log::warn!(
+            target: "master",
+            "--jobs {threads} runs more runs at a time than the {cores} cores: they share the \
+             cores (no faster) and each holds its results in memory"
+        );
+    }
+    // the workers started before anything is removed: a count the system cannot start leaves
+    // the earlier runs in place
+    if !todo.is_empty() {
+        drop(thread_pool(threads, todo.len())?);
+    }
+    // no input inside what the set replaces or removes (a run's system.json swept again)
+    check_inputs_outside_runs(&inputs, &jobs, &args.output)?;
     // one set at a time in a folder: a second one would mix its runs into this one's
     let _lock = lock_output_folder(&args.output)?;
     // the runs of this set only: nothing of the user's is replaced by a run folder, and
@@ -97,9 +120,6 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     prepare_run_folder(&jobs, &args.output)?;
     let mut fresh = Vec::new();
     if let Some(system) = system {
-        let threads = args
-            .jobs
-            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
         let cancel = ctx.cancel;
         let results = ResultsOptions {
             format,

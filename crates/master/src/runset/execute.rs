@@ -264,6 +264,8 @@ where
     };
     std::fs::create_dir_all(outdir).map_err(dir_err)?;
     check_run_folders(jobs, outdir)?;
+    // the threads first: a pool that cannot be started leaves the folder as it was
+    let pool = thread_pool(threads, jobs.len())?;
     let report_path = outdir.join("sweep.json");
     match std::fs::remove_file(&report_path) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
@@ -275,13 +277,12 @@ where
         _ => {}
     }
     remove_partial_folders(outdir);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.clamp(1, jobs.len().max(1)))
-        .build()
-        .map_err(|e| SweepError::Pool {
-            jobs: threads,
-            reason: e.to_string(),
-        })?;
+    // an earlier set's runs of these names go now, not when each run ends: a process killed
+    // in between (a second Ctrl-C, SIGKILL, the OOM killer) would leave them beside this
+    // set's, each looking complete, under this set's run names
+    for job in jobs {
+        clear_earlier_run(job, outdir);
+    }
     let bar = if show_progress {
         indicatif::ProgressBar::new(jobs.len() as u64)
     } else {
@@ -320,13 +321,22 @@ where
     Ok(reports)
 }
 
-/// Error of a run that an interrupted run set did not start.
-pub const NOT_STARTED: &str = "not run: the run set was interrupted before this run started";
+/// The pool of `threads` workers (at least one, at most one per job) that runs a set of
+/// `n_jobs`; built before anything in the output folder changes, so that a count the system
+/// cannot start (its thread or memory limits) is refused with the folder as it was.
+pub fn thread_pool(threads: usize, n_jobs: usize) -> Result<rayon::ThreadPool, SweepError> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.clamp(1, n_jobs.max(1)))
+        .build()
+        .map_err(|e| SweepError::Pool {
+            jobs: threads,
+            reason: e.to_string(),
+        })
+}
 
-/// The report of a run that did not finish because its set stopped (`error` says how): no
-/// folder is written for it, and an earlier set's run folder and Parquet table of its name
-/// are removed, so that nothing of an earlier run looks like this one's result.
-pub fn not_finished(job: &Job, outdir: &Path, error: &str) -> RunReport {
+/// Removes an earlier set's run folder (only a run's files: [`check_run_folders`] refused any
+/// other) and Parquet table of `job`'s name.
+fn clear_earlier_run(job: &Job, outdir: &Path) {
     let dest = outdir.join(&job.name);
     if replaceable_run_folder(&dest) {
         let _ = std::fs::remove_dir_all(&dest);
@@ -335,6 +345,16 @@ pub fn not_finished(job: &Job, outdir: &Path, error: &str) -> RunReport {
     if crate::parquet_file::is_run_table(&table) {
         let _ = std::fs::remove_file(&table);
     }
+}
+
+/// Error of a run that an interrupted run set did not start.
+pub const NOT_STARTED: &str = "not run: the run set was interrupted before this run started";
+
+/// The report of a run that did not finish because its set stopped (`error` says how): no
+/// folder is written for it, and an earlier set's run folder and Parquet table of its name
+/// are removed, so that nothing of an earlier run looks like this one's result.
+pub fn not_finished(job: &Job, outdir: &Path, error: &str) -> RunReport {
+    clear_earlier_run(job, outdir);
     RunReport {
         name: job.name.clone(),
         parameters: job.parameters.clone(),
@@ -406,11 +426,25 @@ fn holds_its_runs_report(dir: &Path) -> bool {
 }
 
 /// Whether a run of the set may replace `dir`, the folder of its name: one that
-/// [`holds_only_run_files`], or a finished run's folder of that name (with what was added to
-/// it since). Anything else there is the user's and is refused.
+/// [`holds_only_run_files`]. A folder with anything else in it (a note added to an earlier
+/// run's folder) is the user's, and is refused rather than removed with the run.
 fn replaceable_run_folder(dir: &Path) -> bool {
-    dir.symlink_metadata().is_ok_and(|m| m.is_dir())
-        && (holds_only_run_files(dir) || holds_its_runs_report(dir))
+    holds_only_run_files(dir)
+}
+
+/// The first entry of `dir` that no run writes, if `dir` is a finished run's folder (its
+/// report naming it) to which something was added since (a note of the user's).
+fn added_to_run_folder(dir: &Path) -> Option<String> {
+    if !holds_its_runs_report(dir) || holds_only_run_files(dir) {
+        return None;
+    }
+    let entries = std::fs::read_dir(dir).ok()?;
+    entries.flatten().find_map(|e| {
+        let name = e.file_name().to_string_lossy().to_string();
+        let ours =
+            RUN_FOLDER_FILES.contains(&name.as_str()) && e.file_type().is_ok_and(|t| t.is_file());
+        (!ours).then_some(name)
+    })
 }
 
 /// Whether `dir` is a finished run folder of an earlier sweep, which a new set removes when
@@ -430,6 +464,13 @@ pub fn check_run_folders(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> 
     }
     for job in jobs {
         let dest = outdir.join(&job.name);
+        if let Some(file) = added_to_run_folder(&dest) {
+            return Err(SweepError::AddedToRunFolder {
+                path: dest,
+                run: job.name.clone(),
+                file,
+            });
+        }
         if dest.symlink_metadata().is_ok() && !replaceable_run_folder(&dest) {
             return Err(SweepError::NotARunFolder {
                 path: dest,
@@ -443,6 +484,47 @@ pub fn check_run_folders(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> 
             return Err(SweepError::NotARunTable {
                 path: table,
                 run: job.name.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Refuses an input (the run-set file, its base system, an FMU) that lies in what a set of
+/// `jobs` into `outdir` replaces or removes: a folder of one of its runs, an earlier run's
+/// folder, the tables' folder (sweeping around the `system.json` of an earlier run into the
+/// same folder would remove the file being read, or rewrite it).
+pub fn check_inputs_outside_runs(
+    inputs: &[PathBuf],
+    jobs: &[Job],
+    outdir: &Path,
+) -> Result<(), SweepError> {
+    let Ok(out) = outdir.canonicalize() else {
+        // not there yet: nothing lies in it
+        return Ok(());
+    };
+    let names: std::collections::HashSet<&str> = jobs.iter().map(|j| j.name.as_str()).collect();
+    for input in inputs {
+        let Ok(path) = input.canonicalize() else {
+            continue;
+        };
+        let Ok(rest) = path.strip_prefix(&out) else {
+            continue;
+        };
+        let mut parts = rest.components();
+        let (Some(first), Some(_)) = (parts.next(), parts.next()) else {
+            continue;
+        };
+        let first = first.as_os_str().to_string_lossy();
+        let folder = out.join(&*first);
+        let replaced = names.contains(&*first)
+            || first == PARQUET_FOLDER
+            || is_earlier_run_folder(&folder)
+            || added_to_run_folder(&folder).is_some();
+        if replaced {
+            return Err(SweepError::InputInRunFolder {
+                input: input.clone(),
+                folder: outdir.join(&*first),
             });
         }
     }
@@ -506,8 +588,26 @@ pub fn prepare_run_folder(jobs: &[Job], outdir: &Path) -> Result<(), SweepError>
                 continue;
             }
             let path = e.path();
-            if name != PARQUET_FOLDER && is_earlier_run_folder(&path) {
+            if name == PARQUET_FOLDER {
+                continue;
+            }
+            if is_earlier_run_folder(&path) {
                 std::fs::remove_dir_all(&path).map_err(remove_err(path.clone()))?;
+            } else if let Some(file) = added_to_run_folder(&path) {
+                // an earlier run's folder with something of the user's in it: the run's own
+                // files go (they would read as a run of this set), the user's stay
+                for own in RUN_FOLDER_FILES {
+                    let f = path.join(own);
+                    if f.symlink_metadata().is_ok_and(|m| m.is_file()) {
+                        std::fs::remove_file(&f).map_err(remove_err(f.clone()))?;
+                    }
+                }
+                log::warn!(
+                    target: "master",
+                    "'{}' held an earlier run that is not in this set, and '{file}', which no \
+                     run writes: the run's files are removed, the rest is left",
+                    path.display()
+                );
             }
         }
     }

@@ -100,6 +100,21 @@ pub enum SweepError {
     #[error("cannot start {jobs} worker threads: {reason}")]
     Pool { jobs: usize, reason: String },
     #[error(
+        "'{path}', the folder of an earlier run '{run}', holds '{file}', which no run writes: \
+         move it out of the folder (run '{run}' replaces the folder) or choose another output \
+         folder"
+    )]
+    AddedToRunFolder {
+        path: PathBuf,
+        run: String,
+        file: String,
+    },
+    #[error(
+        "'{input}' lies in '{folder}', which this sweep replaces or removes: copy it out of \
+         the output folder first"
+    )]
+    InputInRunFolder { input: PathBuf, folder: PathBuf },
+    #[error(
         "'{path}' exists and is not a run folder of an earlier sweep, which run '{run}' would \
          replace; choose another output folder or rename the run"
     )]

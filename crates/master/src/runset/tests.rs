@@ -571,3 +571,93 @@ fn a_failed_run_keeps_its_history_in_its_folder() {
         assert!(results_path(dir.path(), "run-001", format).exists());
     }
 }
+
+/// A set clears an earlier set's runs of its names before its first run starts, so that a
+/// process killed mid-set (no chance to tidy up) leaves no earlier run under this set's names;
+/// a note of the user's in an earlier run's folder is never removed: a run that would replace
+/// that folder is refused before anything changes, an earlier run not in the set leaves the
+/// note where it was (its own files go); and no input may lie in what the set replaces.
+#[test]
+fn earlier_runs_go_before_the_first_run_and_a_users_files_stay() {
+    let j = jobs(r#"{"product": {"ms.k": [50, 100, 200]}}"#).unwrap();
+    let run = |job: &Job| -> Result<SimOutput, String> {
+        let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.01);
+        plan.instances[0].parameters[1].1 = job.parameters["ms.k"].as_f64().unwrap();
+        let mut a = Mock::new("ms", MassSpring::new(1.0, 1.0, 1.0, 0.0));
+        let mut b = Mock::new("sdm", SpringDamperMass::new(1.0, 1.0, 1.0));
+        simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default()).map_err(|e| e.to_string())
+    };
+    for format in [ResultsFormat::Csv, ResultsFormat::Parquet] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path();
+        let opts = ResultsOptions {
+            format,
+            ..ResultsOptions::default()
+        };
+        assert!(execute_with(&j, out, 1, false, &opts, None, run)
+            .unwrap()
+            .iter()
+            .all(|r| r.ok));
+        // the first run of the next set finds none of the earlier ones
+        let seen_earlier = std::sync::Mutex::new(Vec::new());
+        execute_with(&j, out, 1, false, &opts, None, |job: &Job| {
+            if job.name == j[0].name {
+                for other in &j {
+                    let table = results_path(out, &other.name, ResultsFormat::Parquet);
+                    if out.join(&other.name).exists() || table.exists() {
+                        seen_earlier.lock().unwrap().push(other.name.clone());
+                    }
+                }
+            }
+            run(job)
+        })
+        .unwrap();
+        assert_eq!(
+            *seen_earlier.lock().unwrap(),
+            Vec::<String>::new(),
+            "{format:?}"
+        );
+        if format == ResultsFormat::Parquet {
+            continue;
+        }
+        // a note in the folder of a run the set would replace: refused, nothing removed
+        let note = out.join(&j[1].name).join("notes.md");
+        std::fs::write(&note, "mine").unwrap();
+        let before = std::fs::read_dir(out).unwrap().count();
+        let e = prepare_run_folder(&j, out)
+            .and_then(|()| execute_with(&j, out, 1, false, &opts, None, run).map(|_| ()))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("holds 'notes.md', which no run writes: move it out"),
+            "{e}"
+        );
+        assert_eq!(std::fs::read_to_string(&note).unwrap(), "mine");
+        assert!(out.join(&j[1].name).join("results.csv").is_file());
+        assert_eq!(std::fs::read_dir(out).unwrap().count(), before);
+        // the same folder's run left out of the next set: its files go, the note stays
+        let fewer = vec![j[0].clone()];
+        prepare_run_folder(&fewer, out).unwrap();
+        let left: Vec<String> = std::fs::read_dir(out.join(&j[1].name))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .collect();
+        assert_eq!(left, ["notes.md"]);
+        assert!(
+            !out.join(&j[2].name).exists(),
+            "an earlier run only: removed"
+        );
+        // an input inside a run folder the set replaces, or an earlier run's: refused
+        let inside = out.join(&j[0].name).join("system.json");
+        let e = check_inputs_outside_runs(std::slice::from_ref(&inside), &j, out).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("which this sweep replaces or removes"),
+            "{e}"
+        );
+        assert!(check_inputs_outside_runs(&[inside], &[], out).is_err());
+        let user_file = out.join("base.json");
+        std::fs::write(&user_file, "{}").unwrap();
+        assert!(check_inputs_outside_runs(&[user_file], &j, out).is_ok());
+    }
+}
