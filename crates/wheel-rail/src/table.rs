@@ -7,7 +7,10 @@
 //! * `y_m`: wheelset lateral displacement RELATIVE TO THE TRACK, positive to the right,
 //!   strictly increasing;
 //! * `delta_r_right_m` grows for y > 0 (r_R = r0 + delta_r_right), `delta_r_left_m` falls;
-//! * `tan_gamma_*` are POSITIVE magnitudes (the cone angle on the tread, large on the flange).
+//! * `tan_gamma_*` are the contact angles' tangents, signed: positive where the contact plane
+//!   leans towards the track centre (the tread's cone, large on the flange), negative where
+//!   it leans the other way (a hollow-worn tread, the field side of a new profile: the E1
+//!   table has 240 such rows of 401), used with their sign below.
 //!
 //! The format is written by [`write_csv`] alone, with [`CsvNumbers`] choosing how numbers are
 //! printed; [`GeometryTable::to_csv`] and [`crate::ContactTable::to_bogie_csv`] (the profile

@@ -199,20 +199,19 @@ pub fn conicity_at(d: &DeltaR, a: f64) -> Result<ConicityPoint, AnalysisError> {
     })
 }
 
-/// Amplitudes of the conicity curve: from 1 mm (or the largest amplitude, if smaller) to the
-/// largest amplitude in steps of `step` \[m\].
+/// Amplitudes of the conicity curve: from 1 mm (or the largest amplitude, if smaller) in
+/// steps of `step` \[m\] on the grid 1 mm + k step (so that 3 mm, the standard's figure, is
+/// one of them whenever the step divides 2 mm), the largest amplitude last even off the grid;
+/// each to the nanometre (no 2.2500000000000004 mm in the table).
 pub fn curve_amplitudes(amplitude_max_m: f64, step_m: f64) -> Vec<f64> {
     let start = amplitude_max_m.min(1e-3);
-    let n = ((amplitude_max_m - start) / step_m).round().max(0.0) as usize;
-    (0..=n)
-        .map(|i| {
-            if n == 0 {
-                start
-            } else {
-                start + (amplitude_max_m - start) * i as f64 / n as f64
-            }
-        })
-        .collect()
+    let nm = |a: f64| (a * 1e9).round() / 1e9;
+    let n = ((amplitude_max_m - start) / step_m + 1e-9).floor().max(0.0) as usize;
+    let mut out: Vec<f64> = (0..=n).map(|k| nm(start + k as f64 * step_m)).collect();
+    if out.last().is_some_and(|&a| a < amplitude_max_m - 1e-12) {
+        out.push(nm(amplitude_max_m));
+    }
+    out
 }
 
 /// The contact set-up of a run (profiles read, options applied and checked).
@@ -551,7 +550,8 @@ impl GeometryResults {
         ]);
         for p in &self.conicity {
             c.rows.push(vec![
-                p.amplitude_m * 1e3,
+                // to the micrometre: the metres' round-off does not reach the file
+                (p.amplitude_m * 1e6).round() / 1e3,
                 p.tan_gamma_e,
                 p.wavelength_m,
                 p.regression,
@@ -668,6 +668,20 @@ impl GeometryResults {
             ));
         }
         s.push('\n');
+        // --y-max is no physical limit, but the models read the table's end as one
+        if i.y_max_m
+            > self
+                .table
+                .y_reachable_max_m
+                .max(-self.table.y_reachable_min_m)
+                + 1e-9
+        {
+            s.push_str(&format!(
+                "wheel_rail_table.csv: rows beyond the flange limit to +-{:.2} mm (--y-max) repeat \
+                 the limit's values; the vehicle FMUs take the table's end as derailment\n",
+                i.y_max_m * 1e3
+            ));
+        }
         let conv = self.table.radius_convention.name();
         if i.radius_left_m != i.radius_right_m {
             s.push_str(&format!(
@@ -716,6 +730,15 @@ impl GeometryResults {
             }
             s.push('\n');
         }
+        // the vehicle FMUs take a table only if it reaches flange contact on both sides (its
+        // end is their derailment limit): said now, not when a simulation refuses it
+        if let Ok(Err(e)) = self.bogie_table.geometry_table().map(|t| t.check_flange()) {
+            s.push_str(&format!(
+                "note: wheel_rail_table.csv does not reach flange contact ({e}): the vehicle \
+                 FMUs refuse it as their contact.table (a wider --y-max, or a wheel with a \
+                 flange)\n"
+            ));
+        }
         s
     }
 }
@@ -723,6 +746,44 @@ impl GeometryResults {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The curve's amplitudes lie on the grid 1 mm + k step, 3 mm among them, the largest last
+    /// (with 7.6 mm a spacing of 0.2538 mm had left out 3 mm), without float noise.
+    #[test]
+    fn curve_amplitudes_keep_the_standards_3_mm() {
+        let mm = |v: Vec<f64>| {
+            v.iter()
+                .map(|a| (a * 1e6).round() / 1e3)
+                .collect::<Vec<_>>()
+        };
+        let a = curve_amplitudes(7.6e-3, 0.25e-3);
+        assert!(a.contains(&3e-3), "{a:?}");
+        assert_eq!(*a.last().unwrap(), 7.6e-3);
+        assert_eq!(mm(a.clone())[5], 2.25);
+        assert_eq!(a.len(), 28);
+        assert_eq!(mm(curve_amplitudes(7e-3, 0.25e-3)).len(), 25);
+        assert_eq!(curve_amplitudes(0.5e-3, 0.25e-3), vec![0.5e-3]);
+    }
+
+    /// A table that stops short of flange contact (here a --y-max of 3 mm) is written, with a
+    /// note that the vehicle FMUs refuse it; the default one reaches the flange.
+    #[test]
+    fn a_table_without_flange_contact_is_noted() {
+        let short = GeometryInputs {
+            y_max_m: 3e-3,
+            amplitude_max_m: 2e-3,
+            ..GeometryInputs::default()
+        };
+        let r = contact_geometry(&short, &AtomicBool::new(false)).unwrap();
+        let s = r.summary();
+        assert!(
+            s.contains("note: wheel_rail_table.csv does not reach flange contact")
+                && s.contains("the vehicle FMUs refuse it"),
+            "{s}"
+        );
+        let r = contact_geometry(&GeometryInputs::default(), &AtomicBool::new(false)).unwrap();
+        assert!(!r.summary().contains("does not reach flange contact"));
+    }
 
     #[test]
     fn inclination_parsing() {

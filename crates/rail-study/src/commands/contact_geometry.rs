@@ -95,7 +95,9 @@ pub struct Args {
     /// Nominal rolling radius of the right wheel [mm].
     #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     pub radius_right: Option<f64>,
-    /// The table covers y from -y_max to +y_max [mm], a whole number of --step.
+    /// The table covers y from -y_max to +y_max [mm], a whole number of --step. Rows beyond the
+    /// flange limit repeat the limit's values, and the vehicle FMUs take the table's end as
+    /// derailment: this sets where they stop.
     #[arg(
         long,
         value_name = "MM",
