@@ -231,12 +231,19 @@ fn rerun_replaces_the_run_folder_and_a_failed_sweep_reports_failure() {
     );
     let csv = std::fs::read_to_string(c.path("out/a/results.csv")).unwrap();
     assert_eq!(csv.lines().count(), 12, "{csv}");
-    std::fs::write(c.path("out/a/stale.txt"), "from an older sweep").unwrap();
-    // the same run now fails: its folder holds the new description and summary only
+    // a file added to the run's folder is the user's: the run that would replace the folder
+    // is refused, and nothing changes
+    std::fs::write(c.path("out/a/notes.txt"), "mine").unwrap();
     c.write(
         "set.json",
         r#"{"base": "system.json", "runs": [{"name": "a", "parameters": {"h.gain": 13}}]}"#,
     );
+    let e = c.fails(&["sweep", "set.json", "-o", "out"], &[]);
+    assert!(e.contains("holds 'notes.txt', which no run writes"), "{e}");
+    assert_eq!(std::fs::read_to_string(c.path("out/a/results.csv")).unwrap(), csv);
+    assert!(c.path("out/sweep.json").is_file());
+    std::fs::remove_file(c.path("out/a/notes.txt")).unwrap();
+    // the same run now fails: its folder holds the new description and summary only
     let e = c.fails(&["sweep", "set.json", "-o", "out"], &[]);
     assert!(e.contains("1 run(s) failed: a"), "{e}");
     let mut files: Vec<String> = std::fs::read_dir(c.path("out/a"))
