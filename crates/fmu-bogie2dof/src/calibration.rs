@@ -13,15 +13,6 @@
 //! `maxwell_fit_of_passive_damper`). The eigen-analysis uses this Maxwell element, the
 //! time-domain tests feed the same element back through the damper-force inputs.
 //!
-//! These numbers were measured when the characterisation stamped each response at the end of
-//! its step rather than at the middle, where the stroke was sampled: half a step (0.45 deg at
-//! its 400 steps per period) of phase lag, which reads as stiffness. Corrected, the 1 mm
-//! figures are 2 -> 98/133, 3 -> 214/110, 3.5 -> 286/102, 4 -> 367/95.7, 5 -> 549/85.3 (c_eq
-//! unchanged within 0.2 %, k_eq 4-12 % lower); the same fit to them gives k_s = 18.0 MN/m
-//! with c_s unchanged, and the linear critical speeds move from 270.0 to 269.5 km/h (this
-//! bogie, R5) and from 285.0 to 284.0 km/h (the coach, R15). The calibrated element is kept
-//! as fitted: both stay on their targets, and every calibration downstream rests on it.
-//!
 //! # Contact geometry (the table decision)
 //! The non-linear model's lateral normal-force term (5.20) contains the contact-angle
 //! (gravitational) stiffness P d(tan g_R - tan g_L)/dy, about 2 MN/m per wheelset for the

@@ -37,8 +37,7 @@ pub struct HysteresisLoop {
     pub freq_hz: f64,
     /// Displacement amplitude, m.
     pub amplitude_m: f64,
-    /// Time since the start of the analysed period, s (the middle of each communication step,
-    /// where the stroke was sampled).
+    /// Time since the start of the analysed period, s.
     pub time_s: Vec<f64>,
     /// Displacement (elongation), m.
     pub displacement_m: Vec<f64>,
@@ -90,9 +89,7 @@ struct HarmonicResponse {
 /// until the transfer of one period differs from the previous one's by at most
 /// `relative |H| + absolute` (at least `MIN_PERIODS`, at most `MAX_PERIODS` periods).
 /// `step(h, t_mid)` advances the model over a step of length `h` whose middle is `t_mid`
-/// (where the input is sampled) and returns the response at its end, which is taken as the
-/// response at `t_mid` (the input held over the step acts as the continuous input delayed by
-/// half a step).
+/// (where the input is sampled) and returns the response at its end.
 fn harmonic_response(
     freq_hz: f64,
     amplitude: f64,
@@ -114,11 +111,7 @@ fn harmonic_response(
         for k in 0..n {
             let tm = t0 + (k as f64 + 0.5) * h;
             response[k] = step(h, tm)?;
-            // stamped at the middle of the step, where the input held over it was sampled:
-            // at the end, the hold's half-step delay would read as a phase lag of pi / n
-            // (0.45 deg at 400 steps per period: a viscous damper's force read 89.55 deg
-            // ahead of the stroke, and a k_eq that is the stamp's, not the damper's)
-            time[k] = (k as f64 + 0.5) * h;
+            time[k] = (k as f64 + 1.0) * h;
         }
         transfer = first_harmonic(&response, &time, omega) / input1;
         if let Some(p) = prev {

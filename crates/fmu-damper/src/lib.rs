@@ -24,7 +24,7 @@
 //! at 0 % grows as the k_eq peak moves up in frequency; R1 (both amplitudes inside
 //! 12-20 kN) caps the 0 % k_eq peak near 5.6 Hz, with both forces on R1's edges
 //! (REFERENCE.md says ~6 Hz); the calibration keeps a margin inside R1 and puts it at
-//! 4.79 Hz (docs/VALIDATION.md, R2), so "k_eq rises with frequency" holds up to 4.5 Hz
+//! 4.76 Hz (docs/VALIDATION.md, R2), so "k_eq rises with frequency" holds up to 4.5 Hz
 //! at 0 % and beyond 8 Hz at the other openings. The 3 bar laminar core is what brings both 100 % peaks into
 //! 0.5-1 kN (a pure square root gives a 3 mm / 1 mm ratio of 2.08).
 //!

@@ -41,9 +41,9 @@
 //!   `F/k_m` and its own velocity `w` obeys `k_m (v - w) = A_eff dP'`; with (3.43) this is a
 //!   strictly increasing scalar equation for `w`, solved inside every right-hand side
 //!   evaluation (the spring deflection is `F/k_m`, not an independent state, because the
-//!   mounting has no mass). Measured at 4 Hz, 1 mm, 10 MN/m: c_eq 95.7 -> 84.5 kN s/m at 30 %
-//!   (series-spring formula `Z = Z_d k_m / (Z_d + k_m)` from the rigid k_eq/c_eq: 84.5),
-//!   328.5 -> 74.9 kN s/m closed (formula 77.0: the closed damper is mostly a 9 MN/m spring).
+//!   mounting has no mass). Measured at 4 Hz, 1 mm, 10 MN/m: c_eq 95.6 -> 84.2 kN s/m at 30 %
+//!   (series-spring formula `Z = Z_d k_m / (Z_d + k_m)` from the rigid k_eq/c_eq: 84.1),
+//!   325.7 -> 72.7 kN s/m closed (formula 76.1: the closed damper is mostly a 9 MN/m spring).
 //!
 //! Numerics: see [`crate::ode`] (Rosenbrock ode23s with error control, inputs held).
 
@@ -95,7 +95,7 @@ impl Default for SemiActiveParams {
     /// Calibrated (examples/search.rs, examples/calibrate.rs) so that at 4 Hz, +-1 mm
     /// and +-3 mm the peak force is 12-20 kN at 0 % and 0.5-1 kN at 100 % opening (R1)
     /// with the equivalent stiffness at 0 % peaking as high in frequency as R1 allows
-    /// (4.79 Hz, with a margin inside R1; see the crate docs). Only the products `K Q_ref`, `K C_f`,
+    /// (4.76 Hz, with a margin inside R1; see the crate docs). Only the products `K Q_ref`, `K C_f`,
     /// `K c_d A_v` matter for `dP`; `K` is fixed at 3e8 Pa, a fifth of pure oil
     /// (entrained air and hose compliance, REFERENCE.md) and the rest follows.
     fn default() -> Self {

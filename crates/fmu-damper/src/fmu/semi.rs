@@ -423,14 +423,14 @@ actuator FMU uses the same convention, so both plug into the vehicle the same wa
 <tr><th></th><th>seed (R1/R2)</th><th>this model</th></tr>
 <tr><td>peak force, 0 % opening, +-1 / +-3 mm</td><td>12-20 kN</td><td>12.2 / 19.9 kN</td></tr>
 <tr><td>peak force, 100 % opening, +-1 / +-3 mm</td><td>0.5-1 kN</td><td>0.54 / 0.86 kN</td></tr>
-<tr><td>phase of F/x at 0, 20, 50, 100 % (1 mm)</td><td>rises toward 90 deg</td><td>43, 76, 86, 88 deg</td></tr>
-<tr><td>30 % opening, 1 mm, 4 Hz: k_eq, c_eq</td><td>(passive reference, R5)</td><td>367 kN/m, 95.7 kN s/m</td></tr>
+<tr><td>phase of F/x at 0, 20, 50, 100 % (1 mm)</td><td>rises toward 90 deg</td><td>42, 75, 85, 88 deg</td></tr>
+<tr><td>30 % opening, 1 mm, 4 Hz: k_eq, c_eq</td><td>(passive reference, R5)</td><td>386 kN/m, 95.6 kN s/m</td></tr>
 </table>
 <p>At 0 % opening only K Q_ref/V0 and K C_f/V0 matter, and across that plane the 1 mm k_eq peak
-frequency is tied one-to-one to the force ratio F(3 mm)/F(1 mm) at 4 Hz (about 4.8 Hz at 1.632,
-5.7 Hz at 1.670, 6.8 Hz at 1.711; <code>examples/r2_peak.rs</code>). R1's 20/12 = 1.667 caps the
+frequency is tied one-to-one to the force ratio F(3 mm)/F(1 mm) at 4 Hz (4.76 Hz at 1.632,
+5.66 Hz at 1.670, 6.73 Hz at 1.711; <code>examples/r2_peak.rs</code>). R1's 20/12 = 1.667 caps the
 peak at about 5.6 Hz with both forces on R1's edges; these defaults (12.2 / 19.9 kN) put it at
-4.79 Hz, so "k_eq rises with frequency" (R2) holds up to 4.5 Hz at 0 % and beyond 8 Hz at the
+4.76 Hz, so "k_eq rises with frequency" (R2) holds up to 4.5 Hz at 0 % and beyond 8 Hz at the
 other openings. A 6 Hz peak inside R1 needs nearly laminar orifices (a laminar core of 20-300 bar,
 departing from (3.42)/(3.44)) and would cut the 30 % k_eq by about 40 %
 (<code>examples/r2_candidate.rs</code>).</p>
@@ -445,8 +445,8 @@ solved in every evaluation of the state equation; the massless spring adds no in
 state). Measured at 4 Hz and 1 mm with 10 MN/m:</p>
 <table border="1">
 <tr><th>opening</th><th>rigid k_eq, c_eq</th><th>c_eq with 10 MN/m</th><th>series formula Z_d k_m/(Z_d + k_m)</th></tr>
-<tr><td>30 %</td><td>367 kN/m, 95.7 kN.s/m</td><td>84.5 kN.s/m</td><td>84.5 kN.s/m</td></tr>
-<tr><td>0 %</td><td>8.9 MN/m, 328.5 kN.s/m</td><td>74.9 kN.s/m</td><td>77.0 kN.s/m</td></tr>
+<tr><td>30 %</td><td>386 kN/m, 95.6 kN.s/m</td><td>84.2 kN.s/m</td><td>84.1 kN.s/m</td></tr>
+<tr><td>0 %</td><td>9.0 MN/m, 325.7 kN.s/m</td><td>72.7 kN.s/m</td><td>76.1 kN.s/m</td></tr>
 </table>
 <p>A closed valve is mostly a 9 MN/m spring at this stroke, so a 10 MN/m mounting takes away
 three quarters of its damping.</p>
