@@ -27,7 +27,8 @@ class SignalAssessment:
     max_rms: float
     stable: bool
     window_centre_m: np.ndarray
-    """Centre of each 100 m window along the track [m] (10 m apart)."""
+    """Centre of each 100 m window along the track [m] (10 m apart), counted from the record's
+    first sample (the skipped start-up included: ``skip_s`` at the speed moves them along)."""
     rms: np.ndarray
     """rms of the band-passed signal in each window (unit of the assessment)."""
 

@@ -200,6 +200,10 @@ class RunSet:
                 for i, j in enumerate(self._jobs_json):
                     reports[i] = _railfmu.completed_report(os.fspath(out), j, format)
             todo = [i for i, r in enumerate(reports) if r is None]
+            # the earlier runs of the names about to be computed go before the first starts:
+            # a set killed midway leaves none of them beside this set's (a file of the user's
+            # in such a folder is refused first)
+            _railfmu.clear_earlier_runs(os.fspath(out), [self._jobs_json[i] for i in todo])
             total, done = len(self), len(self) - len(todo)
             with bar(progress, "runs") as cb:
                 if cb is not None and done:

@@ -40,7 +40,8 @@ pub struct SignalAnswer {
     pub band_hz: (f64, f64),
     pub max_rms: f64,
     pub stable: bool,
-    /// Centre of each 100 m window along the track \[m\].
+    /// Centre of each 100 m window along the track from the record's first sample \[m\] (the
+    /// skipped start-up included).
     pub window_centre_m: Vec<f64>,
     pub rms: Vec<f64>,
 }

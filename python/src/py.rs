@@ -634,6 +634,16 @@ fn prepare_run_folder(outdir: PathBuf, jobs_json: Vec<String>) -> PyResult<()> {
     master::runset::prepare_run_folder(&jobs, &outdir).map_err(|e| sweep_err(&e))
 }
 
+/// Before a run set writes `jobs_json` (the runs it computes, kept ones left out) into
+/// `outdir`: refuses one whose earlier folder holds a file of the user's, then removes the
+/// earlier folders and tables of these runs, so that a set killed midway (locally or on a
+/// cluster) leaves no earlier run under their names, as `master sweep` does.
+#[pyfunction]
+fn clear_earlier_runs(outdir: PathBuf, jobs_json: Vec<String>) -> PyResult<()> {
+    let jobs = parse_jobs(&jobs_json)?;
+    master::runset::clear_earlier_runs(&jobs, &outdir).map_err(|e| sweep_err(&e))
+}
+
 fn report_json(r: &RunReport) -> PyResult<String> {
     serde_json::to_string(r).map_err(|e| Error::new_err(format!("internal: report: {e}")))
 }
@@ -1052,6 +1062,7 @@ fn _railfmu(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(results_format_by_size, m)?)?;
     m.add_class::<PyRunWriter>()?;
     m.add_function(wrap_pyfunction!(prepare_run_folder, m)?)?;
+    m.add_function(wrap_pyfunction!(clear_earlier_runs, m)?)?;
     m.add_function(wrap_pyfunction!(read_results, m)?)?;
     m.add_function(wrap_pyfunction!(write_results_file, m)?)?;
     Ok(())

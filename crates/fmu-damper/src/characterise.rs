@@ -22,8 +22,18 @@ use crate::full_active::{
 use crate::semi_active::{SemiActiveDamper, SemiActiveInputs, SemiActiveParams};
 use num_complex::Complex64;
 
-/// Samples per period of the sinusoidal tests (communication steps).
+/// Samples per period of the sinusoidal tests (communication steps), at least.
 pub const STEPS_PER_PERIOD: usize = 400;
+/// The longest communication step of the damper's sinusoidal tests \[s\]: 400 steps per period
+/// at 4 Hz. The stroke is held over each step at its mid-step value and the force taken at the
+/// step's end, which is right while the oil column responds slower than a step (400 and 4000
+/// steps per period agree at 4 Hz); a slow stroke at 400 steps per period would take steps of
+/// seconds, over which the force settles to the held stroke's and reads half a step late
+/// (89.55 deg instead of 90 at 0.001 Hz, and a k_eq that is that lag's).
+const MAX_DAMPER_STEP_S: f64 = 1.0 / (4.0 * 400.0);
+/// At most this many steps per period (below 0.004 Hz the step grows again; there the lag of
+/// half a step is below 0.001 deg).
+const MAX_DAMPER_STEPS_PER_PERIOD: usize = 400_000;
 const MIN_PERIODS: usize = 3;
 const MAX_PERIODS: usize = 60;
 const CONVERGENCE: f64 = 1e-6;
@@ -141,23 +151,38 @@ pub fn hysteresis_loop(
     check_opening_input("opening", opening)?;
     positive_input("freq_hz", freq_hz)?;
     positive_input("amplitude_m", amplitude_m)?;
+    hysteresis_loop_in(params, opening, freq_hz, amplitude_m, damper_steps(freq_hz))
+}
+
+/// Steps per period of the damper's sinusoidal tests at `freq_hz`: [`STEPS_PER_PERIOD`], more
+/// where that would make a step longer than [`MAX_DAMPER_STEP_S`].
+fn damper_steps(freq_hz: f64) -> usize {
+    let bounded = (1.0 / (freq_hz * MAX_DAMPER_STEP_S)).ceil();
+    if bounded.is_finite() {
+        (bounded as usize).clamp(STEPS_PER_PERIOD, MAX_DAMPER_STEPS_PER_PERIOD)
+    } else {
+        STEPS_PER_PERIOD
+    }
+}
+
+/// [`hysteresis_loop`] with `steps` communication steps per period.
+fn hysteresis_loop_in(
+    params: &SemiActiveParams,
+    opening: f64,
+    freq_hz: f64,
+    amplitude_m: f64,
+    steps: usize,
+) -> Result<HysteresisLoop, StepError> {
     let mut damper = SemiActiveDamper::new(params.with_fixed_opening(opening))?;
     let omega = 2.0 * PI * freq_hz;
-    let r = harmonic_response(
-        freq_hz,
-        amplitude_m,
-        STEPS_PER_PERIOD,
-        CONVERGENCE,
-        0.0,
-        |h, tm| {
-            let inputs = SemiActiveInputs {
-                elongation_m: amplitude_m * (omega * tm).sin(),
-                elongation_velocity_mps: amplitude_m * omega * (omega * tm).cos(),
-                valve_command_v: 0.0,
-            };
-            Ok(damper.step(h, &inputs)?.force_n)
-        },
-    )?;
+    let r = harmonic_response(freq_hz, amplitude_m, steps, CONVERGENCE, 0.0, |h, tm| {
+        let inputs = SemiActiveInputs {
+            elongation_m: amplitude_m * (omega * tm).sin(),
+            elongation_velocity_mps: amplitude_m * omega * (omega * tm).cos(),
+            valve_command_v: 0.0,
+        };
+        Ok(damper.step(h, &inputs)?.force_n)
+    })?;
     let (time, fs, transfer) = (r.time_s, r.response, r.transfer);
     let xs = time
         .iter()
@@ -356,4 +381,57 @@ pub fn seed_actuator_frfs(
         out.push((amp, full, red, lin));
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// At 4 Hz the default 400 steps per period give what ten times as many give (k_eq within
+    /// 0.5 % where it is the damper's stiffness, the phase within 0.1 deg at every opening):
+    /// the force taken at the end of a step whose stroke is held at its middle is the
+    /// continuous response there. A slow stroke's steps are bounded so that the same holds.
+    #[test]
+    fn the_steps_per_period_are_converged() {
+        let p = SemiActiveParams::default();
+        for opening in [0.0, 0.3, 1.0] {
+            let coarse = hysteresis_loop_in(&p, opening, 4.0, 1e-3, damper_steps(4.0))
+                .unwrap()
+                .transfer;
+            let fine = hysteresis_loop_in(&p, opening, 4.0, 1e-3, 4000)
+                .unwrap()
+                .transfer;
+            let phase = (coarse.arg() - fine.arg()).to_degrees().abs();
+            assert!(phase < 0.1, "{opening}: phase differs by {phase} deg");
+            if opening < 1.0 {
+                let k = (coarse.re / fine.re - 1.0).abs();
+                assert!(k < 5e-3, "{opening}: k_eq {} vs {}", coarse.re, fine.re);
+            }
+        }
+        // a slow stroke: the bounded steps give what four times as many give, where 400 steps
+        // per period (50 ms steps at 0.05 Hz) read the phase up to half a step late (0.45 deg;
+        // 0.2 through the closed valve, which responds slower)
+        for opening in [0.0, 0.3, 1.0] {
+            let phase = |steps| {
+                hysteresis_loop_in(&p, opening, 0.05, 1e-3, steps)
+                    .unwrap()
+                    .transfer
+                    .arg()
+                    .to_degrees()
+            };
+            let (bounded, fine, coarse) = (phase(damper_steps(0.05)), phase(128_000), phase(400));
+            assert!(
+                (bounded - fine).abs() < 0.01,
+                "{opening}: {bounded} vs {fine}"
+            );
+            assert!(
+                (coarse - fine).abs() > 0.15,
+                "{opening}: {coarse} vs {fine}"
+            );
+        }
+        assert_eq!(damper_steps(4.0), STEPS_PER_PERIOD);
+        assert_eq!(damper_steps(20.0), STEPS_PER_PERIOD);
+        assert_eq!(damper_steps(0.5), 3200);
+        assert_eq!(damper_steps(1e-9), MAX_DAMPER_STEPS_PER_PERIOD);
+    }
 }

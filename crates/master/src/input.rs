@@ -46,8 +46,8 @@ pub fn read_text_file(path: &Path, max_bytes: u64) -> std::io::Result<String> {
     }
     // the byte-order mark some Windows editors and spreadsheet exports put first is no text
     // (a JSON reader would stop at it, a CSV's first column would carry it in its name)
-    if let Some(rest) = text.strip_prefix('\u{feff}') {
-        text = rest.to_string();
+    if text.starts_with('\u{feff}') {
+        text.drain(..'\u{feff}'.len_utf8());
     }
     Ok(text)
 }

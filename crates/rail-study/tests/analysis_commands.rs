@@ -1137,9 +1137,7 @@ fn root_locus_of_the_coach_gives_r15_and_the_mode() {
 
 /// The hydraulic damper itself in the coach's eigen-analysis (`--damper semi-active:...`, its
 /// first harmonic at one stroke and frequency; docs/VALIDATION.md R9): the 30 % passive damper
-/// at +-1 mm, 4 Hz gives 279.9 km/h, at R15's lower edge (280-290; the calibrated Maxwell
-/// stand-in, fitted to a characterisation that read k' 5 % high, gives 285.0), at a frequency
-/// that agrees with the linearisation's; a closed valve
+/// at +-1 mm, 4 Hz gives R15 at a frequency that agrees with the linearisation's; a closed valve
 /// keeps the coach stable to the end of the search (716 km/h) at strokes up to 2 mm and gives
 /// 422 km/h only at +-5 mm (linearised at the 5.39 Hz of that crossing, which the command finds
 /// itself without FREQ), far above the seed's MPPT (passive + 70, about 355 km/h), which the
@@ -1167,7 +1165,7 @@ fn root_locus_with_the_linearised_semi_active_damper() {
     };
     // (damper, critical speed range [km/h], linearisation frequency [Hz])
     for (damper, range, freq) in [
-        ("semi-active:0.3:1e-3:4", 278.0..=290.0, 4.0),
+        ("semi-active:0.3:1e-3:4", 280.0..=290.0, 4.0),
         ("semi-active:0:5e-3:5.39", 417.0..=427.0, 5.39),
         ("semi-active:0.1:5e-3:4.69", 348.0..=358.0, 4.69),
     ] {
@@ -1206,7 +1204,7 @@ fn root_locus_with_the_linearised_semi_active_damper() {
             "{damper}: linearised at {used} Hz\n{s}"
         );
     }
-    // stable at 4 Hz, crossing at the frequency the coach hunts at (564 km/h at 5.64 Hz);
+    // stable at 4 Hz, crossing at the frequency the coach hunts at (563 km/h at 5.65 Hz);
     // stable at every frequency at +-2 mm, linearised at the hunting mode's at 716 km/h
     let s = run("semi-active:0:2.8e-3");
     let v = number_after(&s, "linear critical speed:");

@@ -773,6 +773,41 @@ fn a_failed_run_writes_its_history_up_to_the_failure() {
         "{failure}"
     );
     assert!(stderr.contains(&format!("up to t = {last} s")), "{stderr}");
+    // a later complete run removes the history (it would read as this run's)
+    let ok = run(&["--stop", "0.1"]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    assert!(out.is_file() && !history.exists());
+    assert!(!dir.path().join("r.history.meta.json").exists());
+    // a results name without an extension: the history takes the format's, and a file of the
+    // user's under the results' name stays
+    let plain = dir.path().join("plain");
+    std::fs::write(&plain, "the user's").unwrap();
+    let failed = Command::new(env!("CARGO_BIN_EXE_master"))
+        .args(["--quiet", "run"])
+        .arg(&system)
+        .arg("-o")
+        .arg(&plain)
+        .args([
+            "--format",
+            "csv",
+            "--stop",
+            "2",
+            "--set",
+            "bogie.vehicle.speed=150",
+        ])
+        .args(["--set", "bogie.suspension.lateral_stiffness=0"])
+        .args(["--set", "bogie.suspension.longitudinal_stiffness=0"])
+        .output()
+        .unwrap();
+    assert_eq!(failed.status.code(), Some(1));
+    assert_eq!(std::fs::read_to_string(&plain).unwrap(), "the user's");
+    assert!(dir.path().join("plain.history.csv").is_file());
+    assert!(dir.path().join("plain.history.meta.json").is_file());
+    assert!(!dir.path().join("plain.meta.json").exists());
 }
 
 /// A sweep's run that fails midway (the derailing bogie above) keeps its history up to the

@@ -240,7 +240,10 @@ fn rerun_replaces_the_run_folder_and_a_failed_sweep_reports_failure() {
     );
     let e = c.fails(&["sweep", "set.json", "-o", "out"], &[]);
     assert!(e.contains("holds 'notes.txt', which no run writes"), "{e}");
-    assert_eq!(std::fs::read_to_string(c.path("out/a/results.csv")).unwrap(), csv);
+    assert_eq!(
+        std::fs::read_to_string(c.path("out/a/results.csv")).unwrap(),
+        csv
+    );
     assert!(c.path("out/sweep.json").is_file());
     std::fs::remove_file(c.path("out/a/notes.txt")).unwrap();
     // the same run now fails: its folder holds the new description and summary only

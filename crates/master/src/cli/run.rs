@@ -104,14 +104,19 @@ impl Args {
 }
 
 /// Where a failed run's history goes: `<stem>.history.<ext>` beside its results' name
-/// (`r.csv` -> `r.history.csv`; a name without an extension gets `.history`).
-fn history_path(results: &std::path::Path) -> PathBuf {
-    let stem = results
-        .file_stem()
+/// (`r.csv` -> `r.history.csv`; a name without an extension, `r`, gets the format's:
+/// `r.history.csv`, whose metadata `r.history.meta.json` is not the results').
+fn history_path(results: &std::path::Path, format: ResultsFormat) -> PathBuf {
+    let name = results
+        .file_name()
         .map_or_else(|| "results".into(), |s| s.to_string_lossy().into_owned());
-    let name = match results.extension() {
-        Some(ext) => format!("{stem}.history.{}", ext.to_string_lossy()),
-        None => format!("{stem}.history"),
+    let name = match (results.extension(), results.file_stem()) {
+        (Some(ext), Some(stem)) => format!(
+            "{}.history.{}",
+            stem.to_string_lossy(),
+            ext.to_string_lossy()
+        ),
+        _ => format!("{name}.history.{}", format.extension()),
     };
     results.with_file_name(name)
 }
@@ -245,9 +250,18 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             .clone()
             .unwrap_or_else(|| default_output(format));
         let output = match failure {
-            Some(_) => history_path(&results_name),
+            Some(_) => history_path(&results_name, format),
             None => results_name.clone(),
         };
+        // decided before anything is written: the history's metadata must not make a file of
+        // the user's under the results' name look like ours
+        let earlier_results_ours = failure.is_some()
+            && crate::results::written_by_master(&results_name, format)
+            && check_outputs_apart(&inputs, &written(&results_name, format)).is_ok();
+        let earlier_history = history_path(&results_name, format);
+        let earlier_history_ours = failure.is_none()
+            && crate::results::written_by_master(&earlier_history, format)
+            && check_outputs_apart(&inputs, &written(&earlier_history, format)).is_ok();
         if failure.is_some() {
             check_outputs_apart(&inputs, &written(&output, format))?;
             crate::output::check_folders_exist(&written(&output, format))?;
@@ -285,13 +299,14 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         if let Some(summary) = summary {
             summary.commit()?;
         }
-        if failure.is_some() {
+        if earlier_results_ours {
             // the results an earlier run wrote under this name (the master's only, and not an
             // input): they would read as this run's
-            let ours = crate::results::written_by_master(&results_name, format);
-            if ours && check_outputs_apart(&inputs, &written(&results_name, format)).is_ok() {
-                remove_results(&results_name, format)?;
-            }
+            remove_results(&results_name, format)?;
+        }
+        if earlier_history_ours {
+            // an earlier failed run's history beside these results would read as this run's
+            remove_results(&earlier_history, format)?;
         }
         if args.output.is_none() {
             // the default file of the other format, from an earlier run, would read as a result

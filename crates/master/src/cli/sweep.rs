@@ -7,9 +7,9 @@ use super::{CommandError, Context};
 use crate::output::write_json_atomic;
 use crate::results::ResultsFormat;
 use crate::runset::{
-    check_given_one_way, check_inputs_outside_runs, check_start_values, completed,
-    execute_with as run_all, format_by_description, lock_output_folder, prepare_run_folder,
-    run_job, thread_pool, Job, ResultsOptions, RunReport, RunSet, NOT_STARTED,
+    check_added_files, check_given_one_way, check_inputs_outside_runs, check_start_values,
+    completed, execute_with as run_all, format_by_description, lock_output_folder,
+    prepare_run_folder, run_job, thread_pool, Job, ResultsOptions, RunReport, RunSet, NOT_STARTED,
 };
 use crate::system::PreparedSystem;
 
@@ -111,8 +111,10 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     if !todo.is_empty() {
         drop(thread_pool(threads, todo.len())?);
     }
-    // no input inside what the set replaces or removes (a run's system.json swept again)
-    check_inputs_outside_runs(&inputs, &jobs, &args.output)?;
+    // no input inside what the set replaces or removes (a run's system.json swept again), and
+    // nothing of the user's in a folder it replaces
+    check_inputs_outside_runs(&inputs, &jobs, &todo, &args.output)?;
+    check_added_files(&todo, &args.output)?;
     // one set at a time in a folder: a second one would mix its runs into this one's
     let _lock = lock_output_folder(&args.output)?;
     // the runs of this set only: nothing of the user's is replaced by a run folder, and

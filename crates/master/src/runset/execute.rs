@@ -264,6 +264,7 @@ where
     };
     std::fs::create_dir_all(outdir).map_err(dir_err)?;
     check_run_folders(jobs, outdir)?;
+    check_added_files(jobs, outdir)?;
     // the threads first: a pool that cannot be started leaves the folder as it was
     let pool = thread_pool(threads, jobs.len())?;
     let report_path = outdir.join("sweep.json");
@@ -334,11 +335,11 @@ pub fn thread_pool(threads: usize, n_jobs: usize) -> Result<rayon::ThreadPool, S
         })
 }
 
-/// Removes an earlier set's run folder (only a run's files: [`check_run_folders`] refused any
-/// other) and Parquet table of `job`'s name.
+/// Removes an earlier set's run folder (one that holds only a run's files) and Parquet table of
+/// `job`'s name.
 fn clear_earlier_run(job: &Job, outdir: &Path) {
     let dest = outdir.join(&job.name);
-    if replaceable_run_folder(&dest) {
+    if holds_only_run_files(&dest) {
         let _ = std::fs::remove_dir_all(&dest);
     }
     let table = results_path(outdir, &job.name, ResultsFormat::Parquet);
@@ -425,16 +426,49 @@ fn holds_its_runs_report(dir: &Path) -> bool {
     small && names_this_run() == Some(true)
 }
 
-/// Whether a run of the set may replace `dir`, the folder of its name: one that
-/// [`holds_only_run_files`]. A folder with anything else in it (a note added to an earlier
-/// run's folder) is the user's, and is refused rather than removed with the run.
+/// Whether `dir`, the folder of a run's name, is a run folder of an earlier set: one that
+/// [`holds_only_run_files`], or a finished run's folder of that name with something added to it
+/// since (which a run of the set that writes the folder refuses, [`check_added_files`]; a kept
+/// run leaves it). Anything else there is the user's and is refused.
 fn replaceable_run_folder(dir: &Path) -> bool {
-    holds_only_run_files(dir)
+    dir.symlink_metadata().is_ok_and(|m| m.is_dir())
+        && (holds_only_run_files(dir) || holds_its_runs_report(dir))
+}
+
+/// Refuses a run of `jobs` (the runs a set is about to write) whose earlier folder holds a file
+/// that no run writes (a note of the user's): the run would replace the folder with it.
+pub fn check_added_files(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> {
+    for job in jobs {
+        let dest = outdir.join(&job.name);
+        if let Some(file) = added_to_run_folder(&dest) {
+            return Err(SweepError::AddedToRunFolder {
+                path: dest,
+                run: job.name.clone(),
+                file,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Removes an earlier set's run folder and table of each of `jobs`, the runs a set is about to
+/// write, before the first of them starts ([`check_added_files`] first: nothing of the user's is
+/// removed). A set killed midway then leaves no earlier run under its names.
+pub fn clear_earlier_runs(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> {
+    check_added_files(jobs, outdir)?;
+    for job in jobs {
+        clear_earlier_run(job, outdir);
+    }
+    Ok(())
 }
 
 /// The first entry of `dir` that no run writes, if `dir` is a finished run's folder (its
 /// report naming it) to which something was added since (a note of the user's).
 fn added_to_run_folder(dir: &Path) -> Option<String> {
+    // a link is no run folder of ours: nothing is removed through it
+    if !dir.symlink_metadata().is_ok_and(|m| m.is_dir()) {
+        return None;
+    }
     if !holds_its_runs_report(dir) || holds_only_run_files(dir) {
         return None;
     }
@@ -464,13 +498,6 @@ pub fn check_run_folders(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> 
     }
     for job in jobs {
         let dest = outdir.join(&job.name);
-        if let Some(file) = added_to_run_folder(&dest) {
-            return Err(SweepError::AddedToRunFolder {
-                path: dest,
-                run: job.name.clone(),
-                file,
-            });
-        }
         if dest.symlink_metadata().is_ok() && !replaceable_run_folder(&dest) {
             return Err(SweepError::NotARunFolder {
                 path: dest,
@@ -491,19 +518,23 @@ pub fn check_run_folders(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> 
 }
 
 /// Refuses an input (the run-set file, its base system, an FMU) that lies in what a set of
-/// `jobs` into `outdir` replaces or removes: a folder of one of its runs, an earlier run's
-/// folder, the tables' folder (sweeping around the `system.json` of an earlier run into the
-/// same folder would remove the file being read, or rewrite it).
+/// `jobs` (of which it writes `writes`) into `outdir` replaces or removes: the folder of a run
+/// it writes, an earlier run's folder not in the set (sweeping around the `system.json` of an
+/// earlier run into the same folder would remove the file being read, or rewrite it).
 pub fn check_inputs_outside_runs(
     inputs: &[PathBuf],
     jobs: &[Job],
+    writes: &[Job],
     outdir: &Path,
 ) -> Result<(), SweepError> {
     let Ok(out) = outdir.canonicalize() else {
         // not there yet: nothing lies in it
         return Ok(());
     };
-    let names: std::collections::HashSet<&str> = jobs.iter().map(|j| j.name.as_str()).collect();
+    // the runs written (the kept ones of a resumed set stay), and the earlier runs not in
+    // the set, which go
+    let set: std::collections::HashSet<&str> = jobs.iter().map(|j| j.name.as_str()).collect();
+    let written: std::collections::HashSet<&str> = writes.iter().map(|j| j.name.as_str()).collect();
     for input in inputs {
         let Ok(path) = input.canonicalize() else {
             continue;
@@ -517,10 +548,9 @@ pub fn check_inputs_outside_runs(
         };
         let first = first.as_os_str().to_string_lossy();
         let folder = out.join(&*first);
-        let replaced = names.contains(&*first)
-            || first == PARQUET_FOLDER
-            || is_earlier_run_folder(&folder)
-            || added_to_run_folder(&folder).is_some();
+        let replaced = written.contains(&*first)
+            || (!set.contains(&*first)
+                && (is_earlier_run_folder(&folder) || added_to_run_folder(&folder).is_some()));
         if replaced {
             return Err(SweepError::InputInRunFolder {
                 input: input.clone(),
@@ -629,7 +659,7 @@ pub fn prepare_run_folder(jobs: &[Job], outdir: &Path) -> Result<(), SweepError>
 }
 
 /// Removes the hidden run folders an interrupted sweep left in `outdir`.
-fn remove_partial_folders(outdir: &Path) {
+pub fn remove_partial_folders(outdir: &Path) {
     let Ok(entries) = std::fs::read_dir(outdir) else {
         return;
     };
@@ -724,10 +754,16 @@ where
         history: None,
         fmu_digests: job.system.fmu_digests(),
     };
-    let partial = match tempfile::Builder::new()
-        .prefix(&format!("{PARTIAL_PREFIX}{}-", job.name))
-        .tempdir_in(outdir)
+    let prefix = format!("{PARTIAL_PREFIX}{}-", job.name);
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix);
+    // the run's folder as the user's umask allows (a temporary folder would be 0700)
+    #[cfg(unix)]
     {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o777));
+    }
+    let partial = match builder.tempdir_in(outdir) {
         Ok(d) => d,
         Err(e) => {
             report.error = Some(format!(

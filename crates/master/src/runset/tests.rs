@@ -635,6 +635,13 @@ fn earlier_runs_go_before_the_first_run_and_a_users_files_stay() {
         assert_eq!(std::fs::read_to_string(&note).unwrap(), "mine");
         assert!(out.join(&j[1].name).join("results.csv").is_file());
         assert_eq!(std::fs::read_dir(out).unwrap().count(), before);
+        // ... but a resumed set that keeps that run (writes only the others) goes ahead
+        let others = vec![j[0].clone(), j[2].clone()];
+        prepare_run_folder(&j, out).unwrap();
+        assert!(check_inputs_outside_runs(std::slice::from_ref(&note), &j, &others, out).is_ok());
+        let reports = execute_with(&others, out, 1, false, &opts, None, run).unwrap();
+        assert!(reports.iter().all(|r| r.ok));
+        assert!(note.is_file() && out.join(&j[1].name).join("results.csv").is_file());
         // the same folder's run left out of the next set: its files go, the note stays
         let fewer = vec![j[0].clone()];
         prepare_run_folder(&fewer, out).unwrap();
@@ -649,15 +656,26 @@ fn earlier_runs_go_before_the_first_run_and_a_users_files_stay() {
         );
         // an input inside a run folder the set replaces, or an earlier run's: refused
         let inside = out.join(&j[0].name).join("system.json");
-        let e = check_inputs_outside_runs(std::slice::from_ref(&inside), &j, out).unwrap_err();
+        let e = check_inputs_outside_runs(std::slice::from_ref(&inside), &j, &j, out).unwrap_err();
         assert!(
             e.to_string()
                 .contains("which this sweep replaces or removes"),
             "{e}"
         );
-        assert!(check_inputs_outside_runs(&[inside], &[], out).is_err());
+        assert!(check_inputs_outside_runs(&[inside], &[], &[], out).is_err());
         let user_file = out.join("base.json");
         std::fs::write(&user_file, "{}").unwrap();
-        assert!(check_inputs_outside_runs(&[user_file], &j, out).is_ok());
+        assert!(check_inputs_outside_runs(&[user_file], &j, &j, out).is_ok());
+        // an earlier run's folder that is a link (to an archive) with a note in it: nothing is
+        // removed through the link
+        let archive = tempfile::tempdir().unwrap();
+        let archived = archive.path().join(&j[0].name);
+        std::fs::rename(out.join(&j[0].name), &archived).unwrap();
+        std::os::unix::fs::symlink(&archived, out.join(&j[0].name)).unwrap();
+        std::fs::write(archived.join("notes.md"), "mine").unwrap();
+        let in_archive = || std::fs::read_dir(&archived).unwrap().count();
+        let files = in_archive();
+        prepare_run_folder(&[], out).unwrap();
+        assert_eq!(in_archive(), files, "files removed through a link");
     }
 }

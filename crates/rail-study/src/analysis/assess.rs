@@ -432,10 +432,12 @@ impl ResultsTable {
                 self.path.display()
             )));
         }
-        // uniform: every time within 1 % of a step of the grid t0 + k dt; a host's export
-        // prints its times rounded (1024 Hz to six decimals, a float32 column), which moves
-        // them by far less, while a gap or a variable step moves them by a step or more
-        let grid_off = |k: usize| (t[k] - (t[0] + k as f64 * dt)).abs() > 0.01 * dt;
+        // uniform: every time within 1 % of a step of the grid t0 + k dt, or within the
+        // rounding of a float32 time (2 of its units in the last place, which grow with t); a
+        // host's export prints its times rounded (1024 Hz to six decimals, a float32 column),
+        // which moves them by less, while a gap or a variable step moves them by a step or more
+        let grid_off =
+            |k: usize| (t[k] - (t[0] + k as f64 * dt)).abs() > (0.01 * dt).max(2.4e-7 * t[k].abs());
         if let Some(k) = (1..t.len()).find(|&k| grid_off(k)) {
             // name the first step unlike the usual one (the median): a single gap in a long
             // record shifts the mean step off every step, so the mean would point at the first

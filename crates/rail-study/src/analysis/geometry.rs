@@ -208,7 +208,7 @@ pub fn curve_amplitudes(amplitude_max_m: f64, step_m: f64) -> Vec<f64> {
     let nm = |a: f64| (a * 1e9).round() / 1e9;
     let n = ((amplitude_max_m - start) / step_m + 1e-9).floor().max(0.0) as usize;
     let mut out: Vec<f64> = (0..=n).map(|k| nm(start + k as f64 * step_m)).collect();
-    if out.last().is_some_and(|&a| a < amplitude_max_m - 1e-12) {
+    if out.last().is_some_and(|&a| a < nm(amplitude_max_m)) {
         out.push(nm(amplitude_max_m));
     }
     out

@@ -401,12 +401,19 @@ fn remove_batches(runs: &std::path::Path, prefix: &str) -> Result<(), StudyError
             && e.file_type().is_ok_and(|t| t.is_dir())
             && path.join("sweep.json").is_file();
         if ours {
-            std::fs::remove_dir_all(&path).map_err(|err| {
+            // its runs and their tables as a run set's are removed (a file of the user's in a
+            // run folder stays), then its report, then the folders left empty
+            master::runset::prepare_run_folder(&[], &path)?;
+            master::runset::remove_partial_folders(&path);
+            let cannot = |err: std::io::Error| {
                 StudyError::Folder(format!(
                     "cannot remove the earlier study's '{}': {err}",
                     path.display()
                 ))
-            })?;
+            };
+            std::fs::remove_file(path.join("sweep.json")).map_err(cannot)?;
+            let _ = std::fs::remove_dir(path.join(master::runset::PARQUET_FOLDER));
+            let _ = std::fs::remove_dir(&path);
         }
     }
     Ok(())
@@ -415,6 +422,37 @@ fn remove_batches(runs: &std::path::Path, prefix: &str) -> Result<(), StudyError
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An earlier study's bisection batches go with their runs and reports, but a file of the
+    /// user's in one stays (with the folder holding it).
+    #[test]
+    fn earlier_batches_go_but_a_users_file_stays() {
+        let d = tempfile::tempdir().unwrap();
+        let runs = d.path();
+        for batch in ["bisect-1", "bisect-2"] {
+            let run = runs.join(batch).join("r");
+            std::fs::create_dir_all(&run).unwrap();
+            std::fs::write(runs.join(batch).join("sweep.json"), "[]").unwrap();
+            std::fs::write(run.join("system.json"), "{}").unwrap();
+            std::fs::write(
+                run.join("summary.json"),
+                r#"{"name": "r", "parameters": {}, "ok": true, "error": null,
+                    "summary": null, "results": null}"#,
+            )
+            .unwrap();
+        }
+        std::fs::write(runs.join("bisect-1").join("notes.txt"), "mine").unwrap();
+        std::fs::create_dir(runs.join("bisect-1").join(".partial-r-x")).unwrap();
+        std::fs::create_dir(runs.join("mine")).unwrap();
+        remove_batches(runs, "bisect-").unwrap();
+        assert!(!runs.join("bisect-2").exists());
+        let left: Vec<String> = std::fs::read_dir(runs.join("bisect-1"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .collect();
+        assert_eq!(left, ["notes.txt"]);
+        assert!(runs.join("mine").is_dir());
+    }
 
     #[test]
     fn speeds_as_a_range_or_a_list() {

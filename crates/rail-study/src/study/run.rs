@@ -323,7 +323,9 @@ impl Executor<'_> {
         Ok(jobs)
     }
 
-    /// Prepares the systems of `planned` and checks each run's start values against them.
+    /// Prepares the systems of `planned` and checks each run's start values against them, and
+    /// that no earlier run folder of the main batch holds a file of the user's (the batch
+    /// would replace it): refused before the earlier study's files are removed.
     fn check(&mut self, planned: &mut [Planned]) -> Result<(), StudyError> {
         let jobs = self.jobs_of(planned)?;
         for (p, job) in planned.iter().zip(&jobs) {
@@ -331,6 +333,9 @@ impl Executor<'_> {
                 master::runset::check_jobs(system, std::slice::from_ref(job))?;
             }
         }
+        let main = self.opts.out.join("runs").join("main");
+        master::runset::check_run_folders(&jobs, &main)?;
+        master::runset::check_added_files(&jobs, &main)?;
         Ok(())
     }
 

@@ -454,6 +454,16 @@ fn bad_tables_name_the_file_and_line() {
     assert!((hz - 1024.0).abs() < 1e-3, "{hz}");
     let hz = rounded(200.0, &|t| format!("{}", t as f32)).unwrap();
     assert!((hz - 200.0).abs() < 1e-3, "{hz}");
+    // a long float32 column, whose rounding grows with t (1 kHz over 200 s)
+    let mut text = String::from("time,a\n");
+    for k in 0..200_000 {
+        text.push_str(&format!("{},1\n", (k as f64 * 1e-3) as f32));
+    }
+    let hz = ResultsTable::parse(&text, p)
+        .unwrap()
+        .sampling_rate_hz()
+        .unwrap();
+    assert!((hz - 1000.0).abs() < 1e-2, "{hz}");
     assert!(rounded(1024.0, &|t| format!("{t:.8e}")).is_ok());
     // ... but times rounded coarser than the step (1024 Hz to the millisecond) are not
     let e = rounded(1024.0, &|t| format!("{t:.3}")).unwrap_err();
