@@ -116,7 +116,19 @@ pub struct GeometryInputs {
     /// Convention of Δr, the detailed table and the conicity (the bogie-format table is always
     /// [`RadiusConvention::RigidRoll`]).
     pub radius_convention: RadiusConvention,
+    /// Where the wheels stand: `None`, the profile origins [`ORIGIN_DISTANCE_M`] apart (EN
+    /// 15302's profiles); `Some((back_to_back_m, back_face_to_origin_m))`, the wheels' back
+    /// faces that far apart and each profile's origin that far from its back face.
+    pub back_to_back: Option<(f64, f64)>,
 }
+
+/// Distance between the wheel profiles' origins when no back-to-back distance is given \[m\]:
+/// EN 15302's profiles, whose origins lie 70 mm from the back faces, at 1360 mm back to back.
+pub const ORIGIN_DISTANCE_M: f64 = 1.5;
+
+/// The nominal back-to-back distance of standard-gauge wheelsets \[m\] and the distance from
+/// an S1002 wheel's back face to its taping line (the profiles' origin) \[m\].
+pub const NOMINAL_BACK_TO_BACK_M: (f64, f64) = (1.360, 0.070);
 
 impl Default for GeometryInputs {
     /// EN 15302 case E1 with the built-in profiles; y in -10..10 mm every 0.05 mm as the
@@ -144,6 +156,7 @@ impl Default for GeometryInputs {
             conicity_step_m: 0.25e-3,
             amplitude_max_m: 7e-3,
             radius_convention: RadiusConvention::En15302Offset,
+            back_to_back: None,
         }
     }
 }
@@ -246,8 +259,30 @@ pub fn setup_of(inputs: &GeometryInputs) -> Result<ContactSetup, AnalysisError> 
     }
     setup.rail_inclination = inputs.inclination;
     setup.radius_convention = inputs.radius_convention;
+    if let Some((back_to_back_m, back_face_to_origin_m)) = inputs.back_to_back {
+        setup.wheel_placement = wheel_rail::WheelPlacement::BackToBack {
+            back_to_back_m,
+            back_face_to_origin_m,
+        };
+    }
     setup.validate()?;
     Ok(setup)
+}
+
+/// Where the wheels of `inputs` stand, for a summary (one line, no newline).
+pub fn placement_text(inputs: &GeometryInputs) -> String {
+    match inputs.back_to_back {
+        None => "wheel profile origins 1500 mm apart: back-to-back 1360 mm for origins 70 mm \
+                 from the back faces (EN 15302's, S1002's taping line)"
+            .to_string(),
+        Some((b, o)) => format!(
+            "wheels {:.2} mm back to back, each profile origin {:.2} mm from its back face \
+             (origins {:.2} mm apart)",
+            b * 1e3,
+            o * 1e3,
+            (b + 2.0 * o) * 1e3
+        ),
+    }
 }
 
 /// Checks the numeric options shared by the single and the fleet run.
@@ -283,6 +318,24 @@ pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
             "must be a standard track gauge, tight to wide, in [1425, 1480] mm (the wheelset's \
              rolling circles are 1500 mm apart, its flanges about 1425 mm)",
         ));
+    }
+    // a standard-gauge wheelset: 1357-1363 mm in service (EN 15313), wider for a study; the
+    // origin near the taping line, 70 mm from the back face on S1002
+    if let Some((b, o)) = inputs.back_to_back {
+        if !(b.is_finite() && (1.340..=1.380).contains(&b)) {
+            return Err(bad(
+                "--back-to-back",
+                b * 1e3,
+                "must be a standard-gauge back-to-back distance in [1340, 1380] mm",
+            ));
+        }
+        if !(o.is_finite() && (0.040..=0.100).contains(&o)) {
+            return Err(bad(
+                "--back-face-offset",
+                o * 1e3,
+                "must be the back face's distance from the profile origin, in [40, 100] mm",
+            ));
+        }
     }
     // the table's y column has 0.1 um resolution: finer steps would write rows of equal y,
     // which the vehicle models refuse
@@ -651,10 +704,8 @@ impl GeometryResults {
             }
         );
         // where the wheels stand is set by the profiles' datum, which the user must know
-        s.push_str(
-            "wheel profile origins 1500 mm apart: back-to-back 1360 mm for origins 70 mm from \
-             the back faces (EN 15302's, S1002's taping line)\n",
-        );
+        s.push_str(&placement_text(i));
+        s.push('\n');
         s.push_str(&format!(
             "reachable y: {:.2} to {:.2} mm (flange limit), e0 = {:.2} mm",
             self.table.y_reachable_min_m * 1e3,
@@ -783,6 +834,48 @@ mod tests {
         );
         let r = contact_geometry(&GeometryInputs::default(), &AtomicBool::new(false)).unwrap();
         assert!(!r.summary().contains("does not reach flange contact"));
+    }
+
+    /// The wheels placed by their back faces: 1360 mm with origins 70 mm from the back faces
+    /// is EN 15302's placement (the same conicity); a tighter wheelset, 1357 mm, another one;
+    /// values outside a standard-gauge wheelset are refused, named.
+    #[test]
+    fn wheels_placed_back_to_back() {
+        let at3 = |back_to_back| {
+            let i = GeometryInputs {
+                back_to_back,
+                ..GeometryInputs::default()
+            };
+            let r = contact_geometry(&i, &AtomicBool::new(false)).unwrap();
+            let p = r
+                .summary_conicity
+                .iter()
+                .find(|p| (p.amplitude_m - 3e-3).abs() < 1e-12)
+                .unwrap()
+                .tan_gamma_e;
+            (p, r.summary())
+        };
+        let (origins, _) = at3(None);
+        let (nominal, summary) = at3(Some(NOMINAL_BACK_TO_BACK_M));
+        assert!((nominal - origins).abs() < 1e-9, "{nominal} vs {origins}");
+        assert!(
+            summary.contains("wheels 1360.00 mm back to back"),
+            "{summary}"
+        );
+        let (tight, _) = at3(Some((1.357, 0.070)));
+        assert!((tight - origins).abs() > 0.01, "{tight} vs {origins}");
+        for (b, o, option) in [
+            (1.2, 0.07, "--back-to-back = 1200"),
+            (1.36, 0.3, "--back-face-offset = 300"),
+            (f64::NAN, 0.07, "--back-to-back = NaN"),
+        ] {
+            let i = GeometryInputs {
+                back_to_back: Some((b, o)),
+                ..GeometryInputs::default()
+            };
+            let e = check_options(&i).unwrap_err().to_string();
+            assert!(e.contains(option), "{e}");
+        }
     }
 
     #[test]

@@ -54,7 +54,7 @@ impl From<RadiusConventionArg> for RadiusConvention {
 /// Options of `master contact-geometry` (the description shown by `--help` is the `after_help`).
 #[derive(Debug, clap::Args)]
 #[command(
-    after_help = "Wheel/rail contact geometry from profiles. Without options: EN 15302 case E1 (wheel A, rail A, 920 mm wheels, gauge 1435.16 mm) with the built-in benchmark profiles.\n\nProfile files: two numbers per line, lateral and vertical in mm (whitespace, comma or semicolon separated), '#' comments, optional header line; lateral positive towards the field side (flange at negative values), vertical up, wheel origin on the nominal rolling circle. The wheels' origins are placed 1500 mm apart: a back-to-back distance of 1360 mm for profiles whose origin lies 70 mm from the wheel's back face (EN 15302's profiles, S1002's taping line); a measured profile with another datum must be shifted to it (1 mm off changes tan gamma_e at 3 mm by about a third). A bad file stops the command with file:line and writes nothing.\n\nUnequal radii (--radius-right): delta r, contact_detail.csv and the conicity follow --radius-convention (EN 15302's offset by default, named in the CSV headers); wheel_rail_table.csv is always the rigid wheelset's (rigid-roll), the geometry the bogie model feels.\n\nThe conicity is EN 15302 Annex B (with the Annex C regression and the harmonic linearisation beside it), 0 on a flat tread; an amplitude without a value is an error naming it and why (exit code 1, nothing written).\n\nFiles: wheel_rail_table.csv (the bogie model's contact table format), contact_detail.csv (with the located two-point contacts), conicity.csv (1 mm to --amplitude-max), delta_r.svg, tan_gamma.svg, conicity.svg. With --wheels or --wheel-dir (a fleet of wheel profiles, each on both wheels): fleet_conicity.csv (a row per profile) and fleet_conicity_3mm.svg instead; a profile without a complete table (unreadable, or an amplitude without a conicity) gets a row with its reason and no numbers, and the command exits with status 1 naming it (nothing is written when no profile has a table). Also contact-geometry.json: the summary and the files written; a run into the same folder removes the files of its previous run there that it does not write again (the other mode's), and a --wheel-dir folder's earlier results (these names) are not read as profiles."
+    after_help = "Wheel/rail contact geometry from profiles. Without options: EN 15302 case E1 (wheel A, rail A, 920 mm wheels, gauge 1435.16 mm) with the built-in benchmark profiles.\n\nProfile files: two numbers per line, lateral and vertical in mm (whitespace, comma or semicolon separated), '#' comments, optional header line; lateral positive towards the field side (flange at negative values), vertical up, wheel origin on the nominal rolling circle. The wheels' origins are placed 1500 mm apart: a back-to-back distance of 1360 mm for profiles whose origin lies 70 mm from the wheel's back face (EN 15302's profiles, S1002's taping line); for a measured profile with another datum, or another wheelset, give --back-to-back (and --back-face-offset, the back face's distance from the profile's origin): 1 mm off changes tan gamma_e at 3 mm by about a third. A bad file stops the command with file:line and writes nothing.\n\nUnequal radii (--radius-right): delta r, contact_detail.csv and the conicity follow --radius-convention (EN 15302's offset by default, named in the CSV headers); wheel_rail_table.csv is always the rigid wheelset's (rigid-roll), the geometry the bogie model feels.\n\nThe conicity is EN 15302 Annex B (with the Annex C regression and the harmonic linearisation beside it), 0 on a flat tread; an amplitude without a value is an error naming it and why (exit code 1, nothing written).\n\nFiles: wheel_rail_table.csv (the bogie model's contact table format), contact_detail.csv (with the located two-point contacts), conicity.csv (1 mm to --amplitude-max), delta_r.svg, tan_gamma.svg, conicity.svg. With --wheels or --wheel-dir (a fleet of wheel profiles, each on both wheels): fleet_conicity.csv (a row per profile) and fleet_conicity_3mm.svg instead; a profile without a complete table (unreadable, or an amplitude without a conicity) gets a row with its reason and no numbers, and the command exits with status 1 naming it (nothing is written when no profile has a table). Also contact-geometry.json: the summary and the files written; a run into the same folder removes the files of its previous run there that it does not write again (the other mode's), and a --wheel-dir folder's earlier results (these names) are not read as profiles."
 )]
 // help texts for a terminal: `[unit]` and `<name>` are plain text, not links or HTML
 #[allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
@@ -121,6 +121,21 @@ pub struct Args {
         allow_negative_numbers = true
     )]
     pub amplitude_max: f64,
+    /// Back-to-back distance of the wheels [mm] (1360 nominal): the wheels stand by their back
+    /// faces instead of their profile origins (1500 mm apart, which is 1360 back to back only
+    /// for origins 70 mm from the back faces). With --back-face-offset.
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    pub back_to_back: Option<f64>,
+    /// Distance from each wheel's back face to its profile's origin [mm] (S1002's taping line:
+    /// 70), used with --back-to-back.
+    #[arg(
+        long,
+        value_name = "MM",
+        default_value_t = 70.0,
+        allow_negative_numbers = true,
+        requires = "back_to_back"
+    )]
+    pub back_face_offset: f64,
     /// How unequal wheel radii enter delta r and the conicity.
     #[arg(long, value_enum, default_value = "en15302-offset")]
     pub radius_convention: RadiusConventionArg,
@@ -167,6 +182,9 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         step_m: args.step * 1e-3,
         amplitude_max_m: args.amplitude_max * 1e-3,
         radius_convention: args.radius_convention.into(),
+        back_to_back: args
+            .back_to_back
+            .map(|b| (b * 1e-3, args.back_face_offset * 1e-3)),
         ..d
     };
     if !args.wheels.is_empty() || args.wheel_dir.is_some() {

@@ -361,6 +361,8 @@ impl FleetResults {
             self.inputs.gauge_m * 1e3,
             self.inputs.radius_convention.name()
         );
+        s.push_str(&super::placement_text(&self.inputs));
+        s.push('\n');
         if !skipped.is_empty() {
             s.push_str(&format!(
                 "skipped {} folder entries that are not profile files (.{}): {}\n",
