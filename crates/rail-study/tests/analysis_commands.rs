@@ -549,7 +549,8 @@ fn contact_geometry_without_a_value_fails_and_writes_nothing() {
         out.to_str().unwrap(),
     ]);
     assert!(
-        r.stderr.contains("mirrored_wheel.dat on rail") && r.stderr.contains("at y = 0 mm"),
+        r.stderr.contains("mirrored_wheel.dat on rail")
+            && r.stderr.contains("is the wheel profile mirrored?"),
         "{}",
         r.stderr
     );

@@ -43,6 +43,10 @@ const SLOPE_HALF_WINDOW_M: f64 = 0.25e-3;
 /// A wheel whose steepest rising segment exceeds this slope is considered flanged; its flange limit
 /// is the steepest point of the active flange face.
 const FLANGE_MIN_SLOPE: f64 = 1.0;
+/// A flange-steep rise this near the origin on the field side \[m\] is a mirrored profile's
+/// flange (a flange's face lies 25-45 mm from the taping line), not an outer chamfer or rim
+/// face (S1002's chamfer: +60.7 mm).
+const MIRRORED_FLANGE_MAX_M: f64 = 0.050;
 /// Lateral grid step of the contact-zone integration [m].
 const ZONE_STEP_M: f64 = 0.01e-3;
 /// Largest half width of a contact zone, in grid steps (30 mm).
@@ -91,6 +95,20 @@ pub enum ContactError {
         y_m: f64,
         /// Reason.
         reason: &'static str,
+    },
+    /// A wheel profile without a flange on its flange side but as steep a rise near its origin
+    /// on the field side: its flange is there, the profile mirrored.
+    #[error(
+        "{profile}: no flange at negative lateral values, but a rise as steep as a flange at \
+         +{} mm: is the wheel profile mirrored? (lateral positive towards the field side, the \
+         flange at negative values)",
+        (*.at_m * 1e4).round() / 10.0
+    )]
+    MirroredWheel {
+        /// Profile name.
+        profile: String,
+        /// Where the flange-steep rise lies \[m\].
+        at_m: f64,
     },
     /// The caller asked the computation to stop.
     #[error("stopped before the table was complete")]
@@ -320,7 +338,29 @@ pub(crate) fn prepare(setup: &ContactSetup) -> Result<Prepared, ContactError> {
         if side == WheelSide::Left {
             pts.reverse();
         }
-        let (fs, fm) = wheel.max_slope();
+        // the flange on the flange side only (negative lateral values): a measured profile's
+        // outer rim face or chamfer, on the field side, is steeper than its tread and was taken
+        // for the flange (the central row then lay "beyond the flange limit")
+        let (fs, fm) = wheel.max_slope_within(f64::NEG_INFINITY, 0.0);
+        if fm <= FLANGE_MIN_SLOPE {
+            // mirrored, the flange lies on the field side and falls as steeply as it rose
+            let falling = Profile::from_points(
+                &wheel.name,
+                &wheel
+                    .lateral_m
+                    .iter()
+                    .zip(&wheel.vertical_m)
+                    .map(|(&s, &z)| (s, -z))
+                    .collect::<Vec<_>>(),
+            )?;
+            let (ms, mm) = falling.max_slope_within(0.0, MIRRORED_FLANGE_MAX_M);
+            if mm > FLANGE_MIN_SLOPE {
+                return Err(ContactError::MirroredWheel {
+                    profile: wheel.name.clone(),
+                    at_m: ms,
+                });
+            }
+        }
         Ok(PreparedSide {
             side,
             wheel: wheel.clone(),

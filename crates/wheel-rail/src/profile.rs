@@ -335,12 +335,23 @@ impl Profile {
     /// Lateral position and value of the steepest rising segment (max dz/ds). On a flanged wheel
     /// profile this is the steepest point of the active flange face.
     pub fn max_slope(&self) -> (f64, f64) {
-        let mut best = (self.lateral_m[0], f64::NEG_INFINITY);
+        self.max_slope_within(f64::NEG_INFINITY, f64::INFINITY)
+    }
+
+    /// [`Self::max_slope`] over the segments whose middle lies in `lo..hi` \[m\] (the flange
+    /// side of a wheel: negative lateral values, so that its outer rim face or chamfer, on the
+    /// field side, is not taken for its flange); `(lo, -inf)` when no segment lies there.
+    pub fn max_slope_within(&self, lo: f64, hi: f64) -> (f64, f64) {
+        let mut best = (lo, f64::NEG_INFINITY);
         for i in 1..self.len() {
+            let mid = 0.5 * (self.lateral_m[i] + self.lateral_m[i - 1]);
+            if !(lo..hi).contains(&mid) {
+                continue;
+            }
             let ds = self.lateral_m[i] - self.lateral_m[i - 1];
             let m = (self.vertical_m[i] - self.vertical_m[i - 1]) / ds;
             if m > best.1 {
-                best = (0.5 * (self.lateral_m[i] + self.lateral_m[i - 1]), m);
+                best = (mid, m);
             }
         }
         best

@@ -878,6 +878,55 @@ mod tests {
         }
     }
 
+    /// A measured wheel profile with its outer rim face (steeper than its flange, on the field
+    /// side) gives wheel A's geometry: the flange is sought on the flange side only (it was
+    /// refused, "are the wheel and rail profiles swapped?"); a mirrored wheel is named as one.
+    #[test]
+    fn a_rim_face_is_no_flange_and_a_mirrored_wheel_is_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let with_rim = dir.path().join("rim.dat");
+        std::fs::write(&with_rim, format!("{WHEEL_A}\n70.1 12.0\n70.2 20.0\n")).unwrap();
+        let run = |wheel: &std::path::Path| {
+            let w = ProfileSource::File(wheel.to_path_buf());
+            let i = GeometryInputs {
+                wheel_left: w.clone(),
+                wheel_right: w,
+                ..GeometryInputs::default()
+            };
+            contact_geometry(&i, &AtomicBool::new(false))
+        };
+        let at3 = |r: &GeometryResults| {
+            r.summary_conicity
+                .iter()
+                .find(|p| (p.amplitude_m - 3e-3).abs() < 1e-12)
+                .unwrap()
+                .tan_gamma_e
+        };
+        let rim = run(&with_rim).unwrap();
+        let a = contact_geometry(&GeometryInputs::default(), &AtomicBool::new(false)).unwrap();
+        assert!(
+            (at3(&rim) - at3(&a)).abs() < 1e-9,
+            "{} vs {}",
+            at3(&rim),
+            at3(&a)
+        );
+        let mirrored = dir.path().join("mirrored.dat");
+        let mut points: Vec<String> = WHEEL_A
+            .lines()
+            .filter_map(|l| {
+                let mut it = l.split_whitespace().map(|v| v.parse::<f64>());
+                match (it.next(), it.next()) {
+                    (Some(Ok(x)), Some(Ok(z))) => Some(format!("{} {z}", -x)),
+                    _ => None,
+                }
+            })
+            .collect();
+        points.reverse();
+        std::fs::write(&mirrored, points.join("\n")).unwrap();
+        let e = run(&mirrored).unwrap_err().to_string();
+        assert!(e.contains("is the wheel profile mirrored?"), "{e}");
+    }
+
     #[test]
     fn inclination_parsing() {
         assert_eq!(parse_inclination("1:40").unwrap(), 0.025);
