@@ -949,6 +949,13 @@ fn root_locus_passive_gives_r5_r6() {
     let f = number_after(&r.stdout, "rad/s, frequency");
     assert!((3.0..=4.5).contains(&f), "hunting frequency {f} Hz");
     assert!((im / (2.0 * std::f64::consts::PI) - f).abs() < 0.01);
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("root-locus.json")).unwrap())
+            .unwrap();
+    let critical = &manifest["results"]["critical"];
+    assert_eq!(manifest["results"]["model"], "bogie2dof");
+    assert!((critical["speed_kmh"].as_f64().unwrap() - v).abs() < 0.06);
+    assert!((critical["frequency_hz"].as_f64().unwrap() - f).abs() < 0.006);
     // every speed has all its eigenvalues (5 with the Maxwell damper), 21 speeds
     let csv = std::fs::read_to_string(out.join("root_locus_eigenvalues.csv")).unwrap();
     let rows: Vec<Vec<f64>> = csv
@@ -1078,6 +1085,21 @@ fn root_locus_of_the_coach_gives_r15_and_the_mode() {
         "{}",
         r.stdout
     );
+    // the same numbers as fields of root-locus.json, for a script
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("root-locus.json")).unwrap())
+            .unwrap();
+    let results = &manifest["results"];
+    assert_eq!(results["model"], "vehicle");
+    let json_v = results["critical"]["speed_kmh"].as_f64().unwrap();
+    assert!((json_v - v).abs() < 0.06, "{json_v} vs {v}");
+    assert!(results["critical"]["mode"]
+        .as_str()
+        .unwrap()
+        .starts_with("bogie hunting"));
+    assert!(results["critical"]["frequency_hz"].as_f64().unwrap() > 3.0);
+    assert_eq!(results["conicity"].as_f64(), Some(0.25));
+    assert!(results["no_crossing"].is_null());
     let f = number_after(&r.stdout, "rad/s, frequency");
     assert!((3.0..=5.0).contains(&f), "{f} Hz");
     let soft = run(&["--mounting-stiffness", "5e6"]);
@@ -1291,6 +1313,13 @@ fn assess_reports_the_en14363_verdict_and_refuses_bad_input() {
     assert!(manifest["working_directory"]
         .as_str()
         .is_some_and(|d| !d.is_empty()));
+    let results = &manifest["results"];
+    assert_eq!(results["stable"], true);
+    assert_eq!(results["limit"].as_f64(), Some(5.39));
+    assert_eq!(results["band_check"], "unrecorded");
+    assert_eq!(results["signals"][0]["signal"], "front");
+    assert_eq!(results["signals"][0]["f0_given"], false);
+    assert!((results["max_rms"].as_f64().unwrap() - 4.243).abs() < 0.08);
     let max_rms = number_after(&r.stdout, "max rms");
     // the same record with the text columns a recorded Enumeration and String give
     let with_text = dir.path().join("with_text.csv");

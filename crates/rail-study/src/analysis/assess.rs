@@ -618,6 +618,42 @@ impl AssessReport {
         s
     }
 
+    /// The key numbers for `assess.json`: verdict, limit, largest rms and each signal's
+    /// assessment, with `band_check` as in [`Self::add_artefacts`].
+    pub fn results_json(&self, band_check: &str) -> serde_json::Value {
+        let signals: Vec<serde_json::Value> = self
+            .signals
+            .iter()
+            .map(|(name, a)| {
+                serde_json::json!({
+                    "signal": name,
+                    "dominant_frequency_hz": a.dominant_frequency_hz,
+                    "f0_given": a.f0_given,
+                    "band_hz": [a.band_hz.0, a.band_hz.1],
+                    "max_rms": a.max_rms,
+                    "stable": a.stable,
+                    "unit_assumed": self
+                        .unitless
+                        .iter()
+                        .any(|c| c == name || split_unit(c).0 == name),
+                })
+            })
+            .collect();
+        serde_json::json!({
+            "quantity": match self.criterion {
+                Criterion::LateralAcceleration { .. } => "acceleration",
+                Criterion::GuidingForces { .. } => "guiding-force",
+            },
+            "unit": self.unit(),
+            "speed_kmh": self.speed_kmh,
+            "limit": self.limit(),
+            "max_rms": self.max_rms(),
+            "stable": self.stable(),
+            "band_check": band_check,
+            "signals": signals,
+        })
+    }
+
     /// assess.csv (rms along the track per signal), assess.svg and assess_summary.csv (one
     /// row per signal with what it was assessed with; `band_check` says whether the recorded
     /// band was checked: `covered`, `unrecorded` or `narrower, accepted`).

@@ -504,6 +504,30 @@ impl LocusResults {
     }
 
     /// Critical speed and hunting frequency at onset next to the seed's.
+    /// The key numbers for `root-locus.json`: the linear critical speed (null, with the
+    /// reason, when nothing crosses), the hunting mode's frequency at onset, the set-up.
+    pub fn results_json(&self) -> serde_json::Value {
+        let (critical, reason) = match &self.critical {
+            Ok(c) => (
+                serde_json::json!({
+                    "speed_kmh": c.speed_kmh,
+                    "frequency_hz": c.hunting.freq_hz,
+                    "im_rad_per_s": c.hunting.im,
+                    "mode": "hunting",
+                }),
+                serde_json::Value::Null,
+            ),
+            Err(why) => (serde_json::Value::Null, serde_json::json!(why)),
+        };
+        serde_json::json!({
+            "model": "bogie2dof",
+            "damper": self.damper.describe(),
+            "conicity": self.conicity,
+            "critical": critical,
+            "no_crossing": reason,
+        })
+    }
+
     pub fn summary(&self) -> String {
         let mut s = format!(
             "linear bogie (calibrated fmu-bogie2dof defaults, conicity {:.3}), damper: {}\n",

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use super::{csv_or_svg_starting, failed, write_analysis, AnalysisCommand};
+use super::{csv_or_svg_starting, failed, write_analysis_with, AnalysisCommand};
 use crate::analysis::assess::{assess_checked, BandRemark, Criterion, ResultsTable};
 use crate::en14363::StabilitySettings;
 use master::cli::{CommandError, Context};
@@ -218,12 +218,13 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             "narrower, accepted"
         }
     };
-    write_analysis(
+    write_analysis_with(
         &COMMAND,
         &args.out,
         std::slice::from_ref(&args.table),
         ctx.cancel,
         &summary,
+        report.results_json(band_check),
         |f| report.add_artefacts(f, band_check),
     )
 }

@@ -91,6 +91,29 @@ pub(crate) fn write_analysis(
     summary: &str,
     add: impl FnOnce(&mut Artefacts) -> Result<(), AnalysisError>,
 ) -> Result<(), CommandError> {
+    write_analysis_with(
+        command,
+        out,
+        inputs,
+        cancel,
+        summary,
+        serde_json::Value::Null,
+        add,
+    )
+}
+
+/// [`write_analysis`] with the run's key numbers as `results` in `<command>.json` (a critical
+/// speed, a verdict: what a script reads rather than parse the summary's text; `null` leaves
+/// them out).
+pub(crate) fn write_analysis_with(
+    command: &AnalysisCommand,
+    out: &Path,
+    inputs: &[PathBuf],
+    cancel: &AtomicBool,
+    summary: &str,
+    results: serde_json::Value,
+    add: impl FnOnce(&mut Artefacts) -> Result<(), AnalysisError>,
+) -> Result<(), CommandError> {
     check_cancel(cancel).map_err(failed)?;
     let mut files = Artefacts::default();
     add(&mut files).map_err(failed)?;
@@ -114,7 +137,7 @@ pub(crate) fn write_analysis(
     // the files and the list of them written in full before any replaces an earlier one (a
     // full disk must not leave the folder holding two runs' files)
     let manifest = |listed: &[String]| -> Result<Artefacts, CommandError> {
-        let json = serde_json::json!({
+        let mut json = serde_json::json!({
             "command": command.name,
             // how these files were made, so that they can be told from another run's and
             // made again (the inputs as given, relative to the working directory)
@@ -127,6 +150,9 @@ pub(crate) fn write_analysis(
             "summary": summary,
             "files": listed,
         });
+        if !results.is_null() {
+            json["results"] = results.clone();
+        }
         let text = serde_json::to_string_pretty(&json)
             .map_err(|e| CommandError::Failed(format!("{manifest_name}: {e}")))?;
         let mut list = Artefacts::default();

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use fmu_bogie2dof::Params;
 use fmu_vehicle::VehicleParams;
 
-use super::{csv_or_svg_starting, failed, write_analysis, AnalysisCommand};
+use super::{csv_or_svg_starting, failed, write_analysis_with, AnalysisCommand};
 use crate::analysis::locus::{
     bogie_onset, linearise_at_crossing, parse_damper_arg, root_locus, speed_grid_kmh, DamperArg,
     DamperSpec, Onset,
@@ -125,9 +125,15 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             let r = vehicle_root_locus(&params, damper, args.mounting_stiffness, &speeds)
                 .map_err(failed)?;
             let summary = format!("{note}{}", r.summary());
-            write_analysis(&COMMAND, &args.out, &[], ctx.cancel, &summary, |f| {
-                r.add_artefacts(f)
-            })
+            write_analysis_with(
+                &COMMAND,
+                &args.out,
+                &[],
+                ctx.cancel,
+                &summary,
+                r.results_json(),
+                |f| r.add_artefacts(f),
+            )
         }
         VehicleModel::Bogie2Dof => {
             if args.mounting_stiffness.is_some() {
@@ -142,9 +148,15 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             let (damper, note) = resolve(args.damper, |spec| bogie_onset(&params, spec))?;
             let r = root_locus(&params, damper, &speeds).map_err(failed)?;
             let summary = format!("{note}{}", r.summary());
-            write_analysis(&COMMAND, &args.out, &[], ctx.cancel, &summary, |f| {
-                r.add_artefacts(f)
-            })
+            write_analysis_with(
+                &COMMAND,
+                &args.out,
+                &[],
+                ctx.cancel,
+                &summary,
+                r.results_json(),
+                |f| r.add_artefacts(f),
+            )
         }
     }
 }
