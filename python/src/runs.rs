@@ -7,15 +7,16 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use master::coupling::{ColumnInfo, FailedRun, SimOutput};
-use master::output::{write_json_atomic, OutputError};
+use master::output::OutputError;
 use master::results::{constant_kinds, with_integer_kinds, ConstantKind, ResultsFormat};
 pub use master::runset::{completed, format_by_description};
 use master::runset::{run_one_with, Job, ResultsOptions, RunReport};
 use master::system::{split_ref, LoadedSystem, SystemError};
 
-/// Writes `<outdir>/sweep.json`, the reports in job order (the master's format).
+/// Writes `<outdir>/sweep.json`, the reports in job order (the master's format, paths relative
+/// to the folder).
 pub fn write_sweep(outdir: &Path, reports: &[RunReport]) -> Result<(), OutputError> {
-    write_json_atomic(&outdir.join("sweep.json"), &reports)
+    master::runset::write_sweep_report(outdir, reports)
 }
 
 /// The unit of each `instance.variable` in `names` (a run set's parameters), as the model

@@ -4,12 +4,12 @@
 use std::path::PathBuf;
 
 use super::{CommandError, Context};
-use crate::output::write_json_atomic;
 use crate::results::ResultsFormat;
 use crate::runset::{
     check_added_files, check_given_one_way, check_inputs_outside_runs, check_start_values,
     completed, execute_with as run_all, format_by_description, lock_output_folder,
-    prepare_run_folder, run_job, thread_pool, Job, ResultsOptions, RunReport, RunSet, NOT_STARTED,
+    prepare_run_folder, run_job, thread_pool, write_sweep_report, Job, ResultsOptions, RunReport,
+    RunSet, NOT_STARTED,
 };
 use crate::system::PreparedSystem;
 
@@ -146,7 +146,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         .collect::<Option<_>>()
         .ok_or_else(|| CommandError::Failed("internal: a run has no report".into()))?;
     if args.resume {
-        write_json_atomic(&args.output.join("sweep.json"), &reports)?;
+        write_sweep_report(&args.output, &reports)?;
         let n_kept = reports.len() - todo.len();
         println!("{n_kept} complete run(s) kept, {} run", todo.len());
     }

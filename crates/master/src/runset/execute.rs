@@ -318,8 +318,39 @@ where
             .collect()
     });
     bar.finish_and_clear();
-    write_json_atomic(&report_path, &reports)?;
+    write_sweep_report(outdir, &reports)?;
     Ok(reports)
+}
+
+/// `report` as the run set's folder stores it: its results and history relative to `outdir`
+/// (`run-000/results.csv`, `results/run-000.parquet`), so that they read from the folder
+/// wherever the set was started from and wherever the folder is moved (they were relative to
+/// the working folder the set ran in).
+pub fn report_in_folder(report: &RunReport, outdir: &Path) -> RunReport {
+    let inside = |p: &Option<PathBuf>| {
+        p.as_ref().map(|p| {
+            p.strip_prefix(outdir)
+                .map_or_else(|_| p.clone(), Path::to_path_buf)
+        })
+    };
+    RunReport {
+        results: inside(&report.results),
+        history: inside(&report.history),
+        ..report.clone()
+    }
+}
+
+/// Writes `<outdir>/sweep.json`: the reports in job order, their paths relative to `outdir`
+/// ([`report_in_folder`]).
+pub fn write_sweep_report(
+    outdir: &Path,
+    reports: &[RunReport],
+) -> Result<(), crate::output::OutputError> {
+    let stored: Vec<RunReport> = reports
+        .iter()
+        .map(|r| report_in_folder(r, outdir))
+        .collect();
+    write_json_atomic(&outdir.join("sweep.json"), &stored)
 }
 
 /// The pool of `threads` workers (at least one, at most one per job) that runs a set of
@@ -849,9 +880,12 @@ where
         }
         Err(e) => report.error = Some(e),
     }
-    let finished = write_json_atomic(&dir.join("summary.json"), &report)
-        .map_err(|e| e.to_string())
-        .and_then(|()| swap_into_place(partial, &dest, outdir));
+    let finished = write_json_atomic(
+        &dir.join("summary.json"),
+        &report_in_folder(&report, outdir),
+    )
+    .map_err(|e| e.to_string())
+    .and_then(|()| swap_into_place(partial, &dest, outdir));
     if let Err(e) = finished {
         let _ = std::fs::remove_file(&table_file);
         report.ok = false;

@@ -558,12 +558,28 @@ fn a_failed_run_keeps_its_history_in_its_folder() {
         let failed = meta.summary.failed.as_ref().expect("summary.failed");
         assert_eq!(failed.time_s, last);
         assert_eq!(Some(failed.error.as_str()), reports[1].error.as_deref());
-        // the report in the run's folder names it too
+        // the report in the run's folder names it too, relative to the set's folder (as
+        // sweep.json does: they read wherever the set ran from)
         let report: RunReport = serde_json::from_str(
             &std::fs::read_to_string(dir.path().join("run-001/summary.json")).unwrap(),
         )
         .unwrap();
-        assert_eq!(report.history, reports[1].history);
+        let in_folder = reports[1]
+            .history
+            .as_ref()
+            .map(|h| h.strip_prefix(dir.path()).unwrap().to_path_buf());
+        assert_eq!(report.history, in_folder);
+        let sweep: Vec<RunReport> =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join("sweep.json")).unwrap())
+                .unwrap();
+        assert_eq!(sweep[1].history, in_folder);
+        assert!(dir
+            .path()
+            .join(sweep[1].history.as_ref().unwrap())
+            .is_file());
+        if let Some(r) = &sweep[0].results {
+            assert!(r.is_relative() && dir.path().join(r).is_file(), "{r:?}");
+        }
         // a set that completes the runs replaces the failed runs' folders whole
         let again = execute_with(&j, dir.path(), 2, false, &opts, None, runner(false)).unwrap();
         assert!(again.iter().all(|r| r.ok && r.history.is_none()));
