@@ -1067,3 +1067,44 @@ fn results_files_follow_the_umask_and_huge_numbers_stay_floats() {
     // ordinary numbers stay as they were
     assert_eq!(row[0], "0");
 }
+
+/// An FMU's message in a run set names the run it comes from (runs in parallel interleave
+/// their messages); a single run's does not.
+#[test]
+fn an_fmus_message_in_a_sweep_names_its_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../systems/passive.json");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(shipped).unwrap()).unwrap();
+    v["stop_time"] = serde_json::json!(0.01);
+    for inst in v["instances"].as_array_mut().unwrap() {
+        let name = Path::new(inst["fmu"].as_str().unwrap())
+            .file_name()
+            .unwrap()
+            .to_owned();
+        inst["fmu"] = serde_json::json!(dist().join(name).to_str().unwrap());
+    }
+    let system = dir.path().join("base.json");
+    std::fs::write(&system, v.to_string()).unwrap();
+    std::fs::write(
+        dir.path().join("set.json"),
+        format!(
+            r#"{{"base": "{}", "runs": [
+  {{"name": "standing", "parameters": {{"bogie.vehicle.speed": 0}}}},
+  {{"name": "running", "parameters": {{}}}}]}}"#,
+            system.display()
+        ),
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_master"))
+        .args(["--quiet", "sweep", "set.json", "-o", "out", "--jobs", "2"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("run 'standing', FMU instance 'bogie':"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("run 'running', FMU"), "{stderr}");
+}

@@ -28,7 +28,15 @@ impl log::Log for FmuLogger {
             return;
         }
         let text = if record.module_path() == Some(FMU_RECORD) {
-            format!("FMU instance '{}': {}", record.target(), record.args())
+            // in a run set, the run the instance belongs to (runs in parallel interleave)
+            match current_run() {
+                Some(run) => format!(
+                    "run '{run}', FMU instance '{}': {}",
+                    record.target(),
+                    record.args()
+                ),
+                None => format!("FMU instance '{}': {}", record.target(), record.args()),
+            }
         } else if record.target().starts_with("master") {
             record.args().to_string()
         } else {
@@ -91,6 +99,39 @@ pub fn take_messages() -> (Vec<(log::Level, String)>, usize) {
 const KEPT_FAILURES: usize = 4;
 /// Longest failure message kept [bytes].
 const KEPT_FAILURE_BYTES: usize = 2048;
+
+std::thread_local! {
+    /// The run of a run set this thread computes, named in its FMUs' messages.
+    static RUN: std::cell::RefCell<Option<String>> = const { std::cell::RefCell::new(None) };
+}
+
+/// Runs `f` with the FMU messages logged on this thread naming run `name` (the run set's
+/// runs compute on worker threads, one run at a time each).
+pub fn in_run<R>(name: &str, f: impl FnOnce() -> R) -> R {
+    let before = RUN
+        .try_with(|r| {
+            r.try_borrow_mut()
+                .ok()
+                .map(|mut r| r.replace(name.to_string()))
+        })
+        .ok()
+        .flatten()
+        .flatten();
+    let out = f();
+    let _ = RUN.try_with(|r| {
+        if let Ok(mut r) = r.try_borrow_mut() {
+            *r = before;
+        }
+    });
+    out
+}
+
+/// The run [`in_run`] names on this thread.
+fn current_run() -> Option<String> {
+    RUN.try_with(|r| r.try_borrow().ok().and_then(|r| r.clone()))
+        .ok()
+        .flatten()
+}
 
 std::thread_local! {
     /// Messages logged with fmi2Discard, fmi2Error or fmi2Fatal on this thread, as (instance,

@@ -832,7 +832,7 @@ where
     let result = (|| -> Result<Summary, String> {
         write_json_atomic(&dir.join("system.json"), &job.system).map_err(|e| e.to_string())?;
         let ran = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            runner(job).map_err(Into::into)
+            crate::fmu::logger::in_run(&job.name, || runner(job).map_err(Into::into))
         }))
         .unwrap_or_else(|p| {
             let what = p
