@@ -463,18 +463,6 @@ pub fn write_results_csv(path: &Path, out: &SimOutput) -> Result<(), OutputError
     results_csv_unfinished(path, out)?.commit()
 }
 
-/// Appends `v` as the shortest text that reads back as the same number: plain for magnitudes
-/// within 1e-5 .. 1e15, in exponent notation beyond (1e300 would print as 301 digits, which
-/// pandas reads as a Python integer, not a float).
-fn push_number(line: &mut String, v: f64) {
-    let a = v.abs();
-    let _ = if a == 0.0 || (1e-5..1e15).contains(&a) || !a.is_finite() {
-        std::fmt::Write::write_fmt(line, format_args!("{v}"))
-    } else {
-        std::fmt::Write::write_fmt(line, format_args!("{v:e}"))
-    };
-}
-
 /// [`write_results_csv`], not yet committed ([`write_unfinished`]).
 pub fn results_csv_unfinished(path: &Path, out: &SimOutput) -> Result<Unfinished, OutputError> {
     let types: Vec<ColumnInfo> = (0..out.header.len()).map(|c| out.column_info(c)).collect();
@@ -489,7 +477,15 @@ pub fn results_csv_unfinished(path: &Path, out: &SimOutput) -> Result<Unfinished
                     line.push(',');
                 }
                 match info.scalar_type() {
-                    ScalarType::Real | ScalarType::Integer => push_number(&mut line, v),
+                    // the shortest text that reads back as the same number, in exponent
+                    // form beyond 1e16 (1e300 would print as 301 digits, which pandas reads as
+                    // a Python integer) and below 1e-4
+                    ScalarType::Real | ScalarType::Integer => {
+                        let _ = std::fmt::Write::write_fmt(
+                            &mut line,
+                            format_args!("{}", crate::show::num(v)),
+                        );
+                    }
                     ScalarType::Boolean => line.push(if v != 0.0 { '1' } else { '0' }),
                     ScalarType::Enumeration => {
                         let _ = std::fmt::Write::write_fmt(&mut line, format_args!("{v},"));

@@ -1026,7 +1026,7 @@ fn a_studys_failed_run_keeps_its_full_rate_history() {
 }
 
 /// Results files take the user's umask (a private one keeps them private; they were always
-/// 0644), and a number beyond 1e15 is written in exponent notation that reads back as the same
+/// 0644), and a number beyond 1e16 is written in exponent notation that reads back as the same
 /// float (1e300 was 301 digits, which pandas reads as a Python integer).
 #[test]
 fn results_files_follow_the_umask_and_huge_numbers_stay_floats() {

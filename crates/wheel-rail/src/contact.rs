@@ -344,16 +344,7 @@ pub(crate) fn prepare(setup: &ContactSetup) -> Result<Prepared, ContactError> {
         let (fs, fm) = wheel.max_slope_within(f64::NEG_INFINITY, 0.0);
         if fm <= FLANGE_MIN_SLOPE {
             // mirrored, the flange lies on the field side and falls as steeply as it rose
-            let falling = Profile::from_points(
-                &wheel.name,
-                &wheel
-                    .lateral_m
-                    .iter()
-                    .zip(&wheel.vertical_m)
-                    .map(|(&s, &z)| (s, -z))
-                    .collect::<Vec<_>>(),
-            )?;
-            let (ms, mm) = falling.max_slope_within(0.0, MIRRORED_FLANGE_MAX_M);
+            let (ms, mm) = wheel.steepest_fall_within(0.0, MIRRORED_FLANGE_MAX_M);
             if mm > FLANGE_MIN_SLOPE {
                 return Err(ContactError::MirroredWheel {
                     profile: wheel.name.clone(),

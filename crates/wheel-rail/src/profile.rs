@@ -342,6 +342,17 @@ impl Profile {
     /// side of a wheel: negative lateral values, so that its outer rim face or chamfer, on the
     /// field side, is not taken for its flange); `(lo, -inf)` when no segment lies there.
     pub fn max_slope_within(&self, lo: f64, hi: f64) -> (f64, f64) {
+        self.steepest_within(lo, hi, 1.0)
+    }
+
+    /// Lateral position and value of the steepest falling segment (max -dz/ds) whose middle
+    /// lies in `lo..hi` \[m\] (a mirrored wheel's flange); `(lo, -inf)` when none lies there.
+    pub fn steepest_fall_within(&self, lo: f64, hi: f64) -> (f64, f64) {
+        self.steepest_within(lo, hi, -1.0)
+    }
+
+    /// The segment in `lo..hi` with the largest `sign * dz/ds`, and that value.
+    fn steepest_within(&self, lo: f64, hi: f64, sign: f64) -> (f64, f64) {
         let mut best = (lo, f64::NEG_INFINITY);
         for i in 1..self.len() {
             let mid = 0.5 * (self.lateral_m[i] + self.lateral_m[i - 1]);
@@ -349,7 +360,7 @@ impl Profile {
                 continue;
             }
             let ds = self.lateral_m[i] - self.lateral_m[i - 1];
-            let m = (self.vertical_m[i] - self.vertical_m[i - 1]) / ds;
+            let m = sign * (self.vertical_m[i] - self.vertical_m[i - 1]) / ds;
             if m > best.1 {
                 best = (mid, m);
             }

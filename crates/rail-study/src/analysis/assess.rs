@@ -618,6 +618,22 @@ impl AssessReport {
         s
     }
 
+    /// The criterion's quantity as `--quantity` names it.
+    fn quantity(&self) -> &'static str {
+        match self.criterion {
+            Criterion::LateralAcceleration { .. } => "acceleration",
+            Criterion::GuidingForces { .. } => "guiding-force",
+        }
+    }
+
+    /// Whether signal `name` (as given) was assessed with its unit assumed (its column names
+    /// none).
+    fn unit_assumed(&self, name: &str) -> bool {
+        self.unitless
+            .iter()
+            .any(|c| c == name || split_unit(c).0 == name)
+    }
+
     /// The key numbers for `assess.json`: verdict, limit, largest rms and each signal's
     /// assessment, with `band_check` as in [`Self::add_artefacts`].
     pub fn results_json(&self, band_check: &str) -> serde_json::Value {
@@ -632,18 +648,12 @@ impl AssessReport {
                     "band_hz": [a.band_hz.0, a.band_hz.1],
                     "max_rms": a.max_rms,
                     "stable": a.stable,
-                    "unit_assumed": self
-                        .unitless
-                        .iter()
-                        .any(|c| c == name || split_unit(c).0 == name),
+                    "unit_assumed": self.unit_assumed(name),
                 })
             })
             .collect();
         serde_json::json!({
-            "quantity": match self.criterion {
-                Criterion::LateralAcceleration { .. } => "acceleration",
-                Criterion::GuidingForces { .. } => "guiding-force",
-            },
+            "quantity": self.quantity(),
             "unit": self.unit(),
             "speed_kmh": self.speed_kmh,
             "limit": self.limit(),
@@ -689,16 +699,12 @@ impl AssessReport {
         }
         files.add_table("assess.csv", &t)?;
         files.add_lines("assess.svg", &chart)?;
-        let quantity = match self.criterion {
-            Criterion::LateralAcceleration { .. } => "acceleration",
-            Criterion::GuidingForces { .. } => "guiding-force",
-        };
+        let quantity = self.quantity();
         let mut legend = format!(
             "signal index,signal,dominant frequency [Hz],max rms [{u}],limit [{u}],stable,\
              f0 given,band low [Hz],band high [Hz],speed [km/h],quantity,unit assumed,band check\n"
         );
         for (k, (name, a)) in self.signals.iter().enumerate() {
-            let column = |c: &str| c == name || split_unit(c).0 == name;
             legend.push_str(&format!(
                 "{k},{},{},{},{},{},{},{},{},{},{quantity},{},{}\n",
                 master::output::csv_field(name),
@@ -710,7 +716,7 @@ impl AssessReport {
                 a.band_hz.0,
                 a.band_hz.1,
                 self.speed_kmh,
-                self.unitless.iter().any(|c| column(c)),
+                self.unit_assumed(name),
                 master::output::csv_field(band_check)
             ));
         }

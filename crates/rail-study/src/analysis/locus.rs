@@ -394,6 +394,18 @@ pub fn speed_grid_kmh(from: f64, to: f64, step: f64) -> Result<Vec<f64>, Analysi
     Ok((0..=n as usize).map(|i| from + i as f64 * step).collect())
 }
 
+/// The `critical` and `no_crossing` fields of a locus' key numbers: the crossing's `fields`, or
+/// null with the reason nothing crosses.
+pub(super) fn critical_json<C>(
+    critical: &Result<C, String>,
+    fields: impl FnOnce(&C) -> serde_json::Value,
+) -> (serde_json::Value, serde_json::Value) {
+    match critical {
+        Ok(c) => (fields(c), serde_json::Value::Null),
+        Err(why) => (serde_json::Value::Null, serde_json::json!(why)),
+    }
+}
+
 /// Result of a root-locus run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LocusResults {
@@ -507,18 +519,14 @@ impl LocusResults {
     /// The key numbers for `root-locus.json`: the linear critical speed (null, with the
     /// reason, when nothing crosses), the hunting mode's frequency at onset, the set-up.
     pub fn results_json(&self) -> serde_json::Value {
-        let (critical, reason) = match &self.critical {
-            Ok(c) => (
-                serde_json::json!({
-                    "speed_kmh": c.speed_kmh,
-                    "frequency_hz": c.hunting.freq_hz,
-                    "im_rad_per_s": c.hunting.im,
-                    "mode": "hunting",
-                }),
-                serde_json::Value::Null,
-            ),
-            Err(why) => (serde_json::Value::Null, serde_json::json!(why)),
-        };
+        let (critical, reason) = critical_json(&self.critical, |c| {
+            serde_json::json!({
+                "speed_kmh": c.speed_kmh,
+                "frequency_hz": c.hunting.freq_hz,
+                "im_rad_per_s": c.hunting.im,
+                "mode": "hunting",
+            })
+        });
         serde_json::json!({
             "model": "bogie2dof",
             "damper": self.damper.describe(),

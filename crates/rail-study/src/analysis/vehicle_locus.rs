@@ -290,21 +290,17 @@ impl VehicleLocus {
     /// The key numbers for `root-locus.json`: the linear critical speed (null, with the
     /// reason, when nothing crosses), the onset's frequency and mode, the set-up.
     pub fn results_json(&self) -> serde_json::Value {
-        let (critical, reason) = match &self.critical {
-            Ok(c) => (
-                serde_json::json!({
-                    "speed_kmh": c.speed_kmh,
-                    "frequency_hz": c.mode.freq_hz,
-                    "im_rad_per_s": c.mode.im,
-                    "mode": c.mode.kind.label(),
-                    "energy_carbody": c.mode.shares.carbody,
-                    "energy_front_bogie": c.mode.shares.front_bogie,
-                    "energy_rear_bogie": c.mode.shares.rear_bogie,
-                }),
-                serde_json::Value::Null,
-            ),
-            Err(why) => (serde_json::Value::Null, serde_json::json!(why)),
-        };
+        let (critical, reason) = super::locus::critical_json(&self.critical, |c| {
+            serde_json::json!({
+                "speed_kmh": c.speed_kmh,
+                "frequency_hz": c.mode.freq_hz,
+                "im_rad_per_s": c.mode.im,
+                "mode": c.mode.kind.label(),
+                "energy_carbody": c.mode.shares.carbody,
+                "energy_front_bogie": c.mode.shares.front_bogie,
+                "energy_rear_bogie": c.mode.shares.rear_bogie,
+            })
+        });
         serde_json::json!({
             "model": "vehicle",
             "damper": self.damper.describe(),

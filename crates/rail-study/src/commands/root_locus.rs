@@ -13,6 +13,7 @@ use crate::analysis::locus::{
     DamperSpec, Onset,
 };
 use crate::analysis::vehicle_locus::{vehicle_onset, vehicle_root_locus};
+use crate::analysis::{AnalysisError, Artefacts};
 use crate::study::VehicleModel;
 use master::cli::{CommandError, Context};
 
@@ -113,7 +114,9 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             )));
         }
     }
-    match args.model {
+    // (summary, key numbers, files) of the model's locus
+    type Files = Box<dyn FnOnce(&mut Artefacts) -> Result<(), AnalysisError>>;
+    let (summary, results, files): (String, serde_json::Value, Files) = match args.model {
         VehicleModel::Coach => {
             let mut params = VehicleParams::default();
             if let Some(c) = args.conicity {
@@ -125,14 +128,10 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             let r = vehicle_root_locus(&params, damper, args.mounting_stiffness, &speeds)
                 .map_err(failed)?;
             let summary = format!("{note}{}", r.summary());
-            write_analysis_with(
-                &COMMAND,
-                &args.out,
-                &[],
-                ctx.cancel,
-                &summary,
+            (
+                summary,
                 r.results_json(),
-                |f| r.add_artefacts(f),
+                Box::new(move |f| r.add_artefacts(f)),
             )
         }
         VehicleModel::Bogie2Dof => {
@@ -148,17 +147,22 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             let (damper, note) = resolve(args.damper, |spec| bogie_onset(&params, spec))?;
             let r = root_locus(&params, damper, &speeds).map_err(failed)?;
             let summary = format!("{note}{}", r.summary());
-            write_analysis_with(
-                &COMMAND,
-                &args.out,
-                &[],
-                ctx.cancel,
-                &summary,
+            (
+                summary,
                 r.results_json(),
-                |f| r.add_artefacts(f),
+                Box::new(move |f| r.add_artefacts(f)),
             )
         }
-    }
+    };
+    write_analysis_with(
+        &COMMAND,
+        &args.out,
+        &[],
+        ctx.cancel,
+        &summary,
+        results,
+        files,
+    )
 }
 
 /// The damper of `arg`, a `semi-active` one given without its frequency linearised at the

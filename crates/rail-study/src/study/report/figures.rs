@@ -218,6 +218,20 @@ fn history_chart(
 }
 
 /// Writes a CSV of text cells (quoted where needed).
+/// Draws `chart` as `<stem>.svg` in `out` and lists it in `figures` with its caption (the file
+/// name is the stem's, never spelt twice).
+fn publish(
+    chart: Chart,
+    out: &Path,
+    stem: &str,
+    caption: &'static str,
+    figures: &mut Vec<(String, &'static str)>,
+) -> Result<(), StudyError> {
+    chart.write_lines(&out.join(format!("{stem}.svg")))?;
+    figures.push((stem.into(), caption));
+    Ok(())
+}
+
 fn write_text_csv(path: &Path, header: &[String], rows: &[Vec<String>]) -> Result<(), StudyError> {
     master::output::write_atomic(path, |w| {
         let line = |w: &mut dyn std::io::Write, f: &[String]| {
@@ -341,38 +355,48 @@ pub(super) fn speed_figures(
         header.push("comfort N_y max [-]".into());
         header.push("damper stroke max [mm]".into());
     }
-    write_text_csv(&out.join("rms_vs_speed.csv"), &header, &rows)?;
+    write_text_csv(
+        &out.join(format!("{}.csv", stem::RMS_VS_SPEED)),
+        &header,
+        &rows,
+    )?;
     if !r.configs.is_empty() {
-        chart.write_lines(&out.join("rms_vs_speed.svg"))?;
-        figures.push((
-            stem::RMS_VS_SPEED.into(),
+        publish(
+            chart,
+            out,
+            stem::RMS_VS_SPEED,
             "rms vs speed, a panel per control family with the passive damper in grey, a_lim dashed (Figs. 4.13, 4.23, 4.24)",
-        ));
+            figures,
+        )?;
     }
     if coach && !r.configs.is_empty() {
         let head = |what: &str| -> Vec<String> {
             vec!["configuration".into(), "speed [km/h]".into(), what.into()]
         };
         write_text_csv(
-            &out.join("carbody_vs_speed.csv"),
+            &out.join(format!("{}.csv", stem::CARBODY_VS_SPEED)),
             &head("car-body rms max [m/s2]"),
             &carbody_rows,
         )?;
         write_text_csv(
-            &out.join("comfort_vs_speed.csv"),
+            &out.join(format!("{}.csv", stem::COMFORT_VS_SPEED)),
             &head("comfort N_y max [-]"),
             &comfort_rows,
         )?;
-        carbody_chart.write_lines(&out.join("carbody_vs_speed.svg"))?;
-        comfort_chart.write_lines(&out.join("comfort_vs_speed.svg"))?;
-        figures.push((
-            stem::CARBODY_VS_SPEED.into(),
+        publish(
+            carbody_chart,
+            out,
+            stem::CARBODY_VS_SPEED,
             "car-body floor lateral acceleration rms vs speed, max over seeds",
-        ));
-        figures.push((
-            stem::COMFORT_VS_SPEED.into(),
+            figures,
+        )?;
+        publish(
+            comfort_chart,
+            out,
+            stem::COMFORT_VS_SPEED,
             "EN 12299 lateral comfort N_y vs speed, max over seeds",
-        ));
+            figures,
+        )?;
     }
     Ok(())
 }
@@ -478,13 +502,13 @@ pub(super) fn history_figures(
         let zoom = |s: &[(f64, f64)]| from_time(s, t_end - HISTORY_DETAIL_S);
         let rate_hz = rate_of(&f).unwrap_or(r.settings.stored_rate_hz);
         write_series_csv(
-            &out.join("full_active_force.csv"),
+            &out.join(format!("{}.csv", stem::FULL_ACTIVE_FORCE)),
             &[
                 ("actuator force [kN]".into(), f.clone()),
                 ("reference c_v v [kN]".into(), fr.clone()),
             ],
         )?;
-        Chart::new(
+        let chart = Chart::new(
             &format!(
                 "full-active, {first}: actuator force and IDF reference c_v v at {v_hist:.0} \
                  km/h, irregular track (last {HISTORY_DETAIL_S:.0} s, {rate_hz:.0} Hz samples)",
@@ -498,12 +522,14 @@ pub(super) fn history_figures(
             "force [kN]",
         )
         .with_series("actuator force", zoom(&f))
-        .with_series("reference c_v v", zoom(&fr))
-        .write_lines(&out.join("full_active_force.svg"))?;
-        figures.push((
-            stem::FULL_ACTIVE_FORCE.into(),
+        .with_series("reference c_v v", zoom(&fr));
+        publish(
+            chart,
+            out,
+            stem::FULL_ACTIVE_FORCE,
             "full-active force vs IDF reference (Fig. 4.27)",
-        ));
+            figures,
+        )?;
     }
     Ok(())
 }
@@ -541,18 +567,18 @@ pub(super) fn hil_figures(
         }
     }
     if !pert_cols.is_empty() {
-        write_series_csv(&out.join("perturbation.csv"), &pert_cols)?;
-        chart
-            .one_panel_per_series()
-            .write_lines(&out.join("perturbation.svg"))?;
-        figures.push((
-            stem::PERTURBATION.into(),
+        write_series_csv(&out.join(format!("{}.csv", stem::PERTURBATION)), &pert_cols)?;
+        publish(
+            chart.one_panel_per_series(),
+            out,
+            stem::PERTURBATION,
             if coach {
                 "initial-perturbation runs, passive coach, 240/280/300 km/h (Figs. 4.4-4.6, R16)"
             } else {
                 "initial-perturbation runs, passive, 220/285/320 km/h (Figs. 5.11-5.13, R7)"
             },
-        ));
+            figures,
+        )?;
     }
 
     // ---- MPPT valve commands (Figs. 4.16, 5.22) and the HIL runs (5.19-5.24)
@@ -668,31 +694,32 @@ pub(super) fn hil_figures(
         let zoom = |s: &[(f64, f64)]| between(s, t0, t0 + 1.0);
         let peak_mm = zoom(&disp).iter().fold(0.0_f64, |m, p| m.max(p.1.abs()));
         write_series_csv(
-            &out.join("skyhook_valve_zoom.csv"),
+            &out.join(format!("{}.csv", stem::SKYHOOK_VALVE_ZOOM)),
             &[
                 ("slow valve: command / 10 V [-]".into(), cmd.clone()),
                 ("slow valve: actual opening [-]".into(), open.clone()),
                 ("leading wheelset displacement [mm]".into(), disp.clone()),
             ],
         )?;
-        Chart::new(
-            &format!(
-                "on/off sky-hook, slow valve, {v_hil:.0} km/h, {hil_what}: command and actual \
+        publish(
+            Chart::new(
+                &format!(
+                    "on/off sky-hook, slow valve, {v_hil:.0} km/h, {hil_what}: command and actual \
                  opening over {t0:.0}-{:.0} s, the second where the leading wheelset moves most \
                  (up to {peak_mm:.2} mm; {:.0} Hz samples)",
-                t0 + 1.0,
-                r.settings.stored_rate_hz
-            ),
-            "time [s]",
-            OPENING_LABEL,
-        )
-        .with_series("slow valve: command / 10 V", zoom(&cmd))
-        .with_series("slow valve: actual opening", zoom(&open))
-        .write_lines(&out.join("skyhook_valve_zoom.svg"))?;
-        figures.push((
-            stem::SKYHOOK_VALVE_ZOOM.into(),
+                    t0 + 1.0,
+                    r.settings.stored_rate_hz
+                ),
+                "time [s]",
+                OPENING_LABEL,
+            )
+            .with_series("slow valve: command / 10 V", zoom(&cmd))
+            .with_series("slow valve: actual opening", zoom(&open)),
+            out,
+            stem::SKYHOOK_VALVE_ZOOM,
             "on/off sky-hook: the slow valve cannot follow the switching command (Fig. 5.25, R12)",
-        ));
+            figures,
+        )?;
     }
     Ok(())
 }
@@ -776,7 +803,7 @@ pub(super) fn cv_figures(
     let (acceleration, peak, reference) = (ours(1), ours(2), ours(4));
     if acceleration.len() >= 2 {
         columns_csv(stem::CV_ACCELERATION, &[0, 1, 7])?;
-        Chart::new(
+        let chart = Chart::new(
             "full-active c_v sensitivity: EN 14363 rms acceleration (Table 4-3)",
             "c_v [kNs/m]",
             "rms acceleration [m/s^2]",
@@ -788,12 +815,14 @@ pub(super) fn cv_figures(
             "seed (Table 4-3, speed not given)",
             SEED_TABLE_4_3.iter().map(|s| (s.0, s.1)).collect(),
         )
-        .with_limit(r.limit_mps2, &format!("a_lim = {:.2} m/s^2", r.limit_mps2))
-        .write_lines(&out.join("cv_acceleration.svg"))?;
-        figures.push((
-            stem::CV_ACCELERATION.into(),
+        .with_limit(r.limit_mps2, &format!("a_lim = {:.2} m/s^2", r.limit_mps2));
+        publish(
+            chart,
+            out,
+            stem::CV_ACCELERATION,
             "full-active: rms acceleration vs c_v, ours and the seed's (Table 4-3, R14)",
-        ));
+            figures,
+        )?;
     }
     if peak.len() >= 2 {
         columns_csv(stem::CV_FORCE, &[0, 2, 4, 8])?;
@@ -810,7 +839,7 @@ pub(super) fn cv_figures(
         if reference.len() >= 2 {
             chart = chart.with_series(&format!("{ours_label}: peak reference c_v v"), reference);
         }
-        chart
+        let chart = chart
             .with_reference(
                 "seed (Table 4-3, speed not given): F_max",
                 SEED_TABLE_4_3.iter().map(|s| (s.0, s.2)).collect(),
@@ -823,12 +852,14 @@ pub(super) fn cv_figures(
                     bound.pressure_bar,
                     bound.area_cm2
                 ),
-            )
-            .write_lines(&out.join("cv_force.svg"))?;
-        figures.push((
-            stem::CV_FORCE.into(),
+            );
+        publish(
+            chart,
+            out,
+            stem::CV_FORCE,
             "full-active: peak force vs c_v against the actuator's force bound, ours and the seed's (Table 4-3, R14)",
-        ));
+            figures,
+        )?;
     }
     Ok(())
 }
