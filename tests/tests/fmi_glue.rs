@@ -156,11 +156,17 @@ fn logger_gets_environment_category_and_percent_s() {
 #[test]
 fn unknown_guid_is_refused_with_a_message() {
     let f = fmu();
+    let wrong = "{00000000-0000-0000-0000-000000000000}";
     let err = f
-        .instantiate_with_guid("g", "{00000000-0000-0000-0000-000000000000}")
+        .instantiate_with_guid("g", wrong)
         .err()
         .expect("must fail");
     assert!(err.contains("matches none of the models"), "{err}");
+    // the binary works its GUIDs out once: a right one after a wrong one is accepted, and a
+    // wrong one after a right one is still refused
+    let right = f.instantiate("r").expect("the model's own GUID");
+    assert!(f.instantiate_with_guid("g2", wrong).is_err());
+    drop(right);
 }
 
 #[test]

@@ -57,6 +57,33 @@ fn create_erased<M: FmuModel>(ctx: &InstanceContext) -> Result<Box<dyn ErasedMod
     Ok(Box::new(Typed::<M>::new(ctx)?))
 }
 
+/// The models of one binary, with their GUIDs worked out once: fmi2Instantiate compares the
+/// host's GUID with each model's, which is a hash of its rendered model description (about
+/// 2 M instructions per model), and a run set instantiates the same binary for every run.
+pub struct Registry {
+    pub models: &'static [ModelEntry],
+    guids: std::sync::OnceLock<Vec<Result<String, String>>>,
+}
+
+impl Registry {
+    pub const fn new(models: &'static [ModelEntry]) -> Self {
+        Registry {
+            models,
+            guids: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// Each model's GUID, or why its description cannot be generated (in `models`' order).
+    fn guids(&self) -> &[Result<String, String>] {
+        self.guids.get_or_init(|| {
+            self.models
+                .iter()
+                .map(|e| (e.describe)().map(|d| d.guid).map_err(|e| e.to_string()))
+                .collect()
+        })
+    }
+}
+
 impl ModelEntry {
     pub const fn of<M: FmuModel>() -> Self {
         ModelEntry {
@@ -229,7 +256,7 @@ unsafe fn early_log(functions: *const fmi2CallbackFunctions, name: *const c_char
 
 #[allow(clippy::too_many_arguments)]
 pub unsafe fn instantiate(
-    registry: &[ModelEntry],
+    registry: &Registry,
     instance_name: fmi2String,
     fmu_type: fmi2Type,
     guid: fmi2String,
@@ -257,18 +284,18 @@ pub unsafe fn instantiate(
             return fail("fmuGUID is missing");
         };
         let mut entry = None;
-        for e in registry {
-            match (e.describe)() {
-                Ok(d) if d.guid == guid => {
+        for (e, known) in registry.models.iter().zip(registry.guids()) {
+            match known {
+                Ok(g) if g == guid => {
                     entry = Some(e);
                     break;
                 }
                 Ok(_) => {}
-                Err(err) => return fail(&err.to_string()),
+                Err(err) => return fail(err),
             }
         }
         let Some(entry) = entry else {
-            let known: Vec<&str> = registry.iter().map(|e| e.name).collect();
+            let known: Vec<&str> = registry.models.iter().map(|e| e.name).collect();
             return fail(&format!(
                 "GUID {guid} matches none of the models in this binary ({}); \
                  the modelDescription.xml and the binary are from different builds",
@@ -952,8 +979,8 @@ pub type Opaque = c_void;
 macro_rules! export_fmus {
     ($($model:ty),+ $(,)?) => {
         #[doc(hidden)]
-        pub static __FMU_REGISTRY: &[$crate::capi::ModelEntry] =
-            &[$($crate::capi::ModelEntry::of::<$model>()),+];
+        pub static __FMU_REGISTRY: $crate::capi::Registry =
+            $crate::capi::Registry::new(&[$($crate::capi::ModelEntry::of::<$model>()),+]);
 
         #[doc(hidden)]
         pub mod __fmi2_exports {
@@ -967,7 +994,7 @@ macro_rules! export_fmus {
             pub unsafe extern "C" fn rfmi_manifest(len: *mut usize) -> *const u8 {
                 static MANIFEST: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
                 let bytes = MANIFEST.get_or_init(|| {
-                    std::panic::catch_unwind(|| c::manifest(super::__FMU_REGISTRY))
+                    std::panic::catch_unwind(|| c::manifest(super::__FMU_REGISTRY.models))
                         .unwrap_or_default()
                 });
                 if !len.is_null() {
@@ -982,7 +1009,7 @@ macro_rules! export_fmus {
             #[no_mangle]
             pub unsafe extern "C" fn fmi2SetDebugLogging(c_: fmi2Component, on: fmi2Boolean, n: usize, cats: *const fmi2String) -> fmi2Status { c::set_debug_logging(c_, on, n, cats) }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2Instantiate(name: fmi2String, ty: fmi2Type, guid: fmi2String, res: fmi2String, f: *const fmi2CallbackFunctions, visible: fmi2Boolean, logging: fmi2Boolean) -> fmi2Component { c::instantiate(super::__FMU_REGISTRY, name, ty, guid, res, f, visible, logging) }
+            pub unsafe extern "C" fn fmi2Instantiate(name: fmi2String, ty: fmi2Type, guid: fmi2String, res: fmi2String, f: *const fmi2CallbackFunctions, visible: fmi2Boolean, logging: fmi2Boolean) -> fmi2Component { c::instantiate(&super::__FMU_REGISTRY, name, ty, guid, res, f, visible, logging) }
             #[no_mangle]
             pub unsafe extern "C" fn fmi2FreeInstance(c_: fmi2Component) { c::free_instance(c_) }
             #[no_mangle]
