@@ -266,6 +266,7 @@ pub unsafe fn instantiate(
     logging_on: fmi2Boolean,
 ) -> fmi2Component {
     install_panic_hook();
+    call_count::enter();
     let result = catch_unwind(AssertUnwindSafe(|| {
         let fail = |msg: &str| {
             early_log(functions, instance_name, &format!("fmi2Instantiate: {msg}"));
@@ -325,7 +326,18 @@ pub unsafe fn instantiate(
         live_instances().push(c as usize);
         c
     }));
-    result.unwrap_or(std::ptr::null_mut())
+    call_count::leave();
+    result.unwrap_or_else(|payload| {
+        let _ = catch_unwind(AssertUnwindSafe(|| {
+            let msg = format!(
+                "fmi2Instantiate: internal error (panic caught at the C boundary: {}); no \
+                 instance was created",
+                panic_text(payload.as_ref())
+            );
+            early_log(functions, instance_name, &msg);
+        }));
+        std::ptr::null_mut()
+    })
 }
 
 /// The instances this binary gave out and has not freed. Only fmi2Instantiate and
@@ -341,23 +353,51 @@ fn live_instances() -> std::sync::MutexGuard<'static, Vec<usize>> {
         .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
-/// How many `fmi2*` calls on components are running ([`with`]), in any thread. In an FMU's
-/// binary every panic is inside one (its standard library is its own, and no thread of its own
-/// runs), so the hook below is silent exactly for the panics [`with`] reports; where the glue is
-/// linked into a Rust program calling the C API in-process (its tests), a panic of another
-/// thread during such a call is silent too. A counter, not a thread-local flag: a shared
-/// library reaches a thread-local through `__tls_get_addr` on every call.
-static CALLS_RUNNING: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+/// Whether a panic now is one that [`with`] catches and reports through the host's logger, so
+/// the panic hook stays silent for it.
+///
+/// In an FMU's binary (feature `fmu-library`, which each FMU crate's `fmi-export` turns on)
+/// every panic is one: its standard library is its own, no thread of its own runs, and every
+/// entry point catches and reports its panics, so nothing is counted (a locked increment and
+/// decrement on every call took about 3 % of a coupled run's wall time, and a thread-local
+/// lookup through `__tls_get_addr` more). Where the glue is linked into a Rust program
+/// calling the C API in-process (its tests), the calls running in any thread are counted, so
+/// that the program's other panics keep their hook.
+#[cfg(feature = "fmu-library")]
+mod call_count {
+    pub fn enter() {}
+    pub fn leave() {}
+    pub fn silent() -> bool {
+        true
+    }
+}
 
-/// Installs (once) a panic hook that stays silent for a panic inside an `fmi2*` call, which
-/// [`with`] reports through the host's logger, and leaves every other panic to the hook
-/// before it (see [`CALLS_RUNNING`]).
+#[cfg(not(feature = "fmu-library"))]
+mod call_count {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    static CALLS_RUNNING: AtomicUsize = AtomicUsize::new(0);
+
+    pub fn enter() {
+        CALLS_RUNNING.fetch_add(1, Ordering::Relaxed);
+    }
+    pub fn leave() {
+        CALLS_RUNNING.fetch_sub(1, Ordering::Relaxed);
+    }
+    pub fn silent() -> bool {
+        CALLS_RUNNING.load(Ordering::Relaxed) > 0
+    }
+}
+
+/// Installs (once) a panic hook that stays silent for a panic that an `fmi2*` call reports
+/// through the host's logger, and leaves every other panic to the hook before it (see
+/// [`call_count`]).
 fn install_panic_hook() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         let previous = std::panic::take_hook();
         std::panic::set_hook(Box::new(move |info| {
-            if CALLS_RUNNING.load(std::sync::atomic::Ordering::Relaxed) == 0 {
+            if !call_count::silent() {
                 previous(info);
             }
         }));
@@ -410,9 +450,9 @@ pub unsafe fn with(
     }
     let cc = &mut *(c as *mut CComponent);
     cc.component.trace(call);
-    CALLS_RUNNING.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    call_count::enter();
     let result = catch_unwind(AssertUnwindSafe(|| f(&mut *cc)));
-    CALLS_RUNNING.fetch_sub(1, std::sync::atomic::Ordering::Relaxed);
+    call_count::leave();
     match result {
         Ok(s) => to_c(s),
         Err(payload) => {
