@@ -161,6 +161,10 @@ impl Default for GeometryInputs {
     }
 }
 
+/// The conicity chart's legend for the reference method at amplitudes whose turning point
+/// lies beyond the flange limit.
+pub const BEYOND_FLANGE_LIMIT: &str = "Annex B, turning point on the climbing flange";
+
 /// Conicity at one amplitude by the three methods (they share the turning points).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ConicityPoint {
@@ -657,13 +661,23 @@ impl GeometryResults {
                 .collect(),
         );
         a.add_lines("tan_gamma.svg", &tg)?;
+        // an amplitude whose turning point lies on the climbing flange gives the geometry's
+        // number, not a running wheelset's: the three methods are drawn up to the flange
+        // limit, the reference method beyond it in grey (every value is in conicity.csv)
+        let within: Vec<&ConicityPoint> = self
+            .conicity
+            .iter()
+            .filter(|p| !p.beyond_flange_limit)
+            .collect();
+        let split = !within.is_empty() && within.len() < self.conicity.len();
         let pts = |f: fn(&ConicityPoint) -> f64| -> Vec<(f64, f64)> {
             self.conicity
                 .iter()
+                .filter(|p| !split || !p.beyond_flange_limit)
                 .map(|p| (p.amplitude_m * 1e3, f(p)))
                 .collect()
         };
-        let con = Chart::new(
+        let mut con = Chart::new(
             &format!("Equivalent conicity (EN 15302, {conv})"),
             "amplitude [mm]",
             "equivalent conicity tan gamma_e [-]",
@@ -671,6 +685,17 @@ impl GeometryResults {
         .with_series("reference method (Annex B)", pts(|p| p.tan_gamma_e))
         .with_series("linear regression (Annex C)", pts(|p| p.regression))
         .with_series("harmonic linearisation", pts(|p| p.harmonic));
+        if split {
+            // from the last amplitude within the limit, so that the grey line continues it
+            let beyond = within
+                .last()
+                .into_iter()
+                .copied()
+                .chain(self.conicity.iter().filter(|p| p.beyond_flange_limit))
+                .map(|p| (p.amplitude_m * 1e3, p.tan_gamma_e))
+                .collect();
+            con = con.with_reference(BEYOND_FLANGE_LIMIT, beyond);
+        }
         a.add_lines("conicity.svg", &con)?;
         Ok(())
     }
@@ -814,6 +839,33 @@ mod tests {
         assert_eq!(a.len(), 28);
         assert_eq!(mm(curve_amplitudes(7e-3, 0.25e-3)).len(), 25);
         assert_eq!(curve_amplitudes(0.5e-3, 0.25e-3), vec![0.5e-3]);
+    }
+
+    /// The conicity chart draws the three methods up to the flange limit and the reference
+    /// method beyond it in grey, named in the legend (the values stay in conicity.csv); a
+    /// curve within the limit has no such line.
+    #[test]
+    fn the_conicity_chart_marks_amplitudes_beyond_the_flange_limit() {
+        let chart = |amplitude_max_m| {
+            let i = GeometryInputs {
+                amplitude_max_m,
+                ..GeometryInputs::default()
+            };
+            let r = contact_geometry(&i, &AtomicBool::new(false)).unwrap();
+            let mut a = Artefacts::default();
+            r.add_artefacts(&mut a).unwrap();
+            let svg = a.files.iter().find(|(n, _)| n == "conicity.svg").unwrap();
+            let csv = a.files.iter().find(|(n, _)| n == "conicity.csv").unwrap();
+            let beyond = r.conicity.iter().filter(|p| p.beyond_flange_limit).count();
+            let rows = String::from_utf8_lossy(&csv.1).lines().count() - 1;
+            (String::from_utf8_lossy(&svg.1).into_owned(), beyond, rows)
+        };
+        let (svg, beyond, _) = chart(7e-3);
+        assert_eq!(beyond, 0);
+        assert!(!svg.contains(BEYOND_FLANGE_LIMIT));
+        let (svg, beyond, rows) = chart(9e-3);
+        assert!(beyond > 0 && beyond < rows, "{beyond} of {rows}");
+        assert!(svg.contains(BEYOND_FLANGE_LIMIT), "{svg}");
     }
 
     /// A table that stops short of flange contact (here a --y-max of 3 mm) is written, with a
