@@ -19,7 +19,10 @@ from conftest import bits, run_master, speed_set
 
 def test_a_parquet_run_set_folder_is_one_table_with_units_and_parameters(dist, master_cmd, tmp_path):
     set_file = tmp_path / "set.json"
-    set_file.write_text(json.dumps(speed_set(dist, [50.0, 60.0], seeds=[1, 2], stop_time=0.5)))
+    runs = speed_set(dist, [50.0, 60.0], seeds=[1, 2], stop_time=0.5)
+    # a Real whose values are whole (0.0 throughout)
+    runs["system"]["record"].append("bogie.initial.lateral_displacement")
+    set_file.write_text(json.dumps(runs))
     r = run_master(master_cmd, "sweep", set_file, "-o", tmp_path / "pq", "--jobs", "2", "--format", "parquet")
     assert r.returncode == 0, r.stderr
     folder = tmp_path / "pq" / "results"
@@ -50,6 +53,9 @@ def test_a_parquet_run_set_folder_is_one_table_with_units_and_parameters(dist, m
     one = table[table["run"] == "run-002"]
     for label in csv.columns:
         assert np.array_equal(bits(one[label].to_numpy()), bits(csv[label].to_numpy())), label
+        # pandas reads each column of either file as the same type: a Real as float64, whole
+        # values too (a CSV's "0" read as int64)
+        assert csv[label].dtype == one[label].dtype == np.float64, label
     csv_meta = json.loads((tmp_path / "csv" / "run-002" / "results.meta.json").read_text())
     assert csv_meta["columns"] == meta["columns"]
     # the Python package reads either run set to the same bits

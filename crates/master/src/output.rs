@@ -457,7 +457,7 @@ pub fn results_header(out: &SimOutput) -> Vec<String> {
 }
 
 /// Writes results as CSV atomically, each value as its type reads: Reals in Rust's shortest
-/// round-trip form, Integers and Enumerations as integers (an Enumeration followed by its item
+/// round-trip form (a whole one with `.0`), Integers and Enumerations as integers (an Enumeration followed by its item
 /// name), Booleans as 0/1, Strings quoted (RFC 4180).
 pub fn write_results_csv(path: &Path, out: &SimOutput) -> Result<(), OutputError> {
     results_csv_unfinished(path, out)?.commit()
@@ -479,8 +479,14 @@ pub fn results_csv_unfinished(path: &Path, out: &SimOutput) -> Result<Unfinished
                 match info.scalar_type() {
                     // the shortest text that reads back as the same number, in exponent
                     // form beyond 1e16 (1e300 would print as 301 digits, which pandas reads as
-                    // a Python integer) and below 1e-4
-                    ScalarType::Real | ScalarType::Integer => {
+                    // a Python integer) and below 1e-4; a whole Real with its decimal point
+                    ScalarType::Real => {
+                        let _ = std::fmt::Write::write_fmt(
+                            &mut line,
+                            format_args!("{}", crate::show::real(v)),
+                        );
+                    }
+                    ScalarType::Integer => {
                         let _ = std::fmt::Write::write_fmt(
                             &mut line,
                             format_args!("{}", crate::show::num(v)),
@@ -741,8 +747,8 @@ mod tests {
         assert_eq!(
             std::fs::read_to_string(&p).unwrap(),
             "time [s],a.x [m],a.n,a.b,a.e,a.e (item),a.s\n\
-             0,1.5,3,1,2,\"Option, 2\",\"Set me!\"\n\
-             0.5,-2,-4,0,1,Option 1,\"say \"\"hi\"\"\"\n"
+             0.0,1.5,3,1,2,\"Option, 2\",\"Set me!\"\n\
+             0.5,-2.0,-4,0,1,Option 1,\"say \"\"hi\"\"\"\n"
         );
     }
 

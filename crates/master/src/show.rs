@@ -71,6 +71,28 @@ impl fmt::Display for Num {
     }
 }
 
+/// A Real value of a results file: [`num`]'s form, with `.0` on a whole number (`300.0`, not
+/// `300`), so that a reader that infers a column's type from its text (pandas) reads a Real
+/// column as floating point whatever its values, as from the Parquet file.
+pub fn real(x: f64) -> Real {
+    Real(x)
+}
+
+/// See [`real`].
+pub struct Real(f64);
+
+impl fmt::Display for Real {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        let plain = x == 0.0 || (1e-4..1e16).contains(&x.abs());
+        if plain && x.fract() == 0.0 {
+            write!(f, "{x}.0")
+        } else {
+            Num(x).fmt(f)
+        }
+    }
+}
+
 impl fmt::Debug for Num {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         fmt::Display::fmt(self, f)
@@ -80,6 +102,24 @@ impl fmt::Debug for Num {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A whole Real keeps a decimal point (a reader inferring types takes `300` for an
+    /// integer); others are written as [`num`] writes them.
+    #[test]
+    fn a_whole_real_keeps_its_decimal_point() {
+        let shown = |x: f64| real(x).to_string();
+        assert_eq!(shown(300.0), "300.0");
+        assert_eq!(shown(0.0), "0.0");
+        assert_eq!(shown(-0.0), "-0.0");
+        assert_eq!(shown(-2.0), "-2.0");
+        assert_eq!(shown(0.001), "0.001");
+        assert_eq!(shown(1e20), "1e20");
+        assert_eq!(shown(2.5e-7), "2.5e-7");
+        assert_eq!(shown(f64::NAN), "NaN");
+        for x in [300.0, 0.0, -2.0, 1e15, 1e20, 0.1] {
+            assert_eq!(shown(x).parse::<f64>().unwrap(), x);
+        }
+    }
 
     #[test]
     fn a_long_text_is_shown_by_its_beginning_and_its_length() {

@@ -1064,8 +1064,8 @@ fn results_files_follow_the_umask_and_huge_numbers_stay_floats() {
     assert!(position.len() < 30, "{position}");
     let x: f64 = position.parse().unwrap();
     assert!((x / 1e300 - 1.0).abs() < 1e-3, "{x}");
-    // ordinary numbers stay as they were
-    assert_eq!(row[0], "0");
+    // ordinary numbers stay as they were, a whole Real (the time) with its decimal point
+    assert_eq!(row[0], "0.0");
 }
 
 /// An FMU's message in a run set names the run it comes from (runs in parallel interleave
