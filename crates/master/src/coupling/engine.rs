@@ -243,10 +243,17 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
     }
 
     /// The connected outputs of instance `i` must be finite (first offender in plan order).
+    #[inline]
     fn check_outputs(&self, time: f64, i: usize) -> Result<(), SimError> {
         if self.outputs[i].iter().all(|x| x.is_finite()) {
             return Ok(());
         }
+        self.non_finite_output(time, i)
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn non_finite_output(&self, time: f64, i: usize) -> Result<(), SimError> {
         let src = &self.exchange.sources[i];
         for (&x, &ci) in self.outputs[i].iter().zip(&src.connections) {
             if !x.is_finite() {
@@ -766,10 +773,11 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         let r = match w.run {
             Some((s, k)) => self.slaves[j].set_reals(&w.vrs, &self.outputs[s][k..k + w.vrs.len()]),
             None => {
-                self.inputs.clear();
-                let outputs = &self.outputs;
-                self.inputs
-                    .extend(w.from.iter().map(|&(s, k)| outputs[s][k]));
+                // in place (an extend from an iterator took about 35 instructions per value)
+                self.inputs.resize(w.from.len(), 0.0);
+                for (x, &(s, k)) in self.inputs.iter_mut().zip(&w.from) {
+                    *x = self.outputs[s][k];
+                }
                 self.slaves[j].set_reals(&w.vrs, &self.inputs)
             }
         };
