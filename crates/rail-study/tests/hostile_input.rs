@@ -548,6 +548,48 @@ fn an_exported_ssp_runs_whatever_its_instance_names_and_keeps_its_coupling_setti
     );
 }
 
+/// A bare .ssd reads its parameter files beside it: a run's results or summary named as one
+/// of them is refused before anything is written, as for the .ssd itself (the results
+/// replaced the parameter set, and the system no longer loaded).
+#[test]
+fn a_run_does_not_write_over_the_parameter_files_of_a_bare_ssd() {
+    let c = Case::new();
+    hostile_fmu(&c, HOSTILE_MD);
+    c.write(
+        "p.json",
+        r#"{"instances": [{"name": "h", "fmu": "Hostile.fmu", "parameters": {"gain": 2}}],
+            "stop_time": 0.01, "step": 0.001}"#,
+    );
+    c.master_ok(&["export-ssp", "p.json", "p.ssp"]);
+    let mut zip = zip::ZipArchive::new(std::fs::File::open(c.path("p.ssp")).unwrap()).unwrap();
+    zip.extract(c.path("un")).unwrap();
+    let ssv = c.path("un/resources/h.ssv");
+    let before = std::fs::read(&ssv).unwrap();
+    for args in [
+        vec![
+            "run",
+            "un/SystemStructure.ssd",
+            "-o",
+            "un/resources/h.ssv",
+            "--format",
+            "csv",
+        ],
+        vec![
+            "run",
+            "un/SystemStructure.ssd",
+            "-o",
+            "r.csv",
+            "--summary",
+            "un/resources/h.ssv",
+        ],
+    ] {
+        let e = c.fails(&args, &[]);
+        assert!(e.contains("is the same file as the input"), "{e}");
+        assert_eq!(std::fs::read(&ssv).unwrap(), before);
+    }
+    c.master_ok(&["run", "un/SystemStructure.ssd", "-o", "r.csv"]);
+}
+
 /// The FMUs inside an SSP unpack within the FMU limit, checked before a byte is written: a
 /// small archive wrote its declared gigabytes to the temporary folder and was refused only
 /// after (a limit of 4 GiB per entry, MASTER_FMU_MAX_UNPACKED_BYTES ignored).

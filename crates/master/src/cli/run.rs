@@ -169,9 +169,11 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         sys.apply_overrides(&args.overrides())?;
         (sys, None)
     };
-    // the files it reads: the system file and every FMU (those of an archive are unpacked)
+    // the files it reads: the system file, every FMU (those of an archive are unpacked) and
+    // the parameter and mapping files beside a bare .ssd
     let inputs: Vec<PathBuf> = std::iter::once(args.system.clone())
         .chain((0..sys.desc.instances.len()).map(|i| sys.fmu_path(i)))
+        .chain(imported.iter().flat_map(|i| i.files_read.iter().cloned()))
         .collect();
     let written = |output: &PathBuf, format: ResultsFormat| {
         let mut files = vec![output.clone()];

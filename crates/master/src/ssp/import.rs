@@ -203,6 +203,7 @@ pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, S
     Ok(ImportedSsp {
         system: LoadedSystem::from_description(desc, &base_dir, &imp.pkg.label()),
         version: ssd.version,
+        files_read: imp.pkg.files_read().to_vec(),
         _unpacked: unpacked,
     })
 }

@@ -91,6 +91,9 @@ pub struct ImportedSsp {
     pub system: LoadedSystem,
     /// The SSD's `version` attribute.
     pub version: String,
+    /// The parameter (.ssv) and mapping (.ssm) files read beside a bare .ssd: inputs of a run
+    /// as much as the .ssd and the FMUs.
+    pub files_read: Vec<PathBuf>,
     _unpacked: Option<crate::fmu::extract::ExtractionDir>,
 }
 

@@ -26,6 +26,9 @@ pub(super) enum Package {
     Dir {
         ssd: PathBuf,
         dir: PathBuf,
+        /// The parameter and mapping files read beside the .ssd (inputs a run must not
+        /// overwrite with its results).
+        read: Vec<PathBuf>,
     },
 }
 
@@ -87,6 +90,7 @@ impl Package {
                 Ok(Package::Dir {
                     ssd: path.to_path_buf(),
                     dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+                    read: Vec::new(),
                 })
             }
             _ => Err(read_err(
@@ -155,7 +159,21 @@ impl Package {
                     reason: "not UTF-8 text".into(),
                 })
             }
-            Package::Dir { dir, .. } => read_file_limited(&dir.join(rel), MAX_XML_BYTES),
+            Package::Dir { dir, read, .. } => {
+                let file = dir.join(rel);
+                let text = read_file_limited(&file, MAX_XML_BYTES)?;
+                read.push(file);
+                Ok(text)
+            }
+        }
+    }
+
+    /// The files other than the .ssd and the FMUs read from a folder (none from an archive,
+    /// whose members are not files of their own).
+    pub fn files_read(&self) -> &[PathBuf] {
+        match self {
+            Package::Zip { .. } => &[],
+            Package::Dir { read, .. } => read,
         }
     }
 

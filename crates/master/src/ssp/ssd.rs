@@ -4,7 +4,7 @@
 use roxmltree::Node;
 
 use super::ssv::{self, Mapping, ParameterSet};
-use super::xml::{self, elements, is, Ctx, NS_SSC, NS_SSD};
+use super::xml::{self, check_single_children, elements, is, is_meta, Ctx, NS_SSC, NS_SSD};
 use super::SspError;
 use crate::show;
 
@@ -193,7 +193,8 @@ pub(super) fn parse(file: &str, text: &str) -> Result<Ssd, SspError> {
     let mut system = None;
     let mut units = Vec::new();
     let (mut start, mut stop, mut base_step) = (None, None, None);
-    for c in elements(root) {
+    check_single_children(ctx, root)?;
+    for c in elements(root).filter(|c| !is_meta(*c)) {
         match c.tag_name().name() {
             "System" if is(c, NS_SSD, "System") => system = Some(parse_system(ctx, c)?),
             "Units" if is(c, NS_SSD, "Units") => units = parse_units(ctx, c)?,
@@ -208,8 +209,7 @@ pub(super) fn parse(file: &str, text: &str) -> Result<Ssd, SspError> {
                     }
                 }
             }
-            "Annotations" | "MetaData" | "Signature"
-                if c.tag_name().namespace() == Some(NS_SSD) => {}
+            "Annotations" if c.tag_name().namespace() == Some(NS_SSD) => {}
             _ => return Err(ctx.unexpected(c)),
         }
     }
@@ -291,7 +291,8 @@ fn parse_system(ctx: Ctx, n: Node) -> Result<System, SspError> {
         step_s: None,
         coupling: CouplingSettings::default(),
     };
-    for c in elements(n) {
+    check_single_children(ctx, n)?;
+    for c in elements(n).filter(|c| !is_meta(*c)) {
         if c.tag_name().namespace() != Some(NS_SSD) {
             return Err(ctx.unexpected(c));
         }
@@ -351,9 +352,8 @@ fn parse_system(ctx: Ctx, n: Node) -> Result<System, SspError> {
                     }
                 }
             }
-            // graphics and meta data do not change the simulation
-            "ElementGeometry" | "SystemGeometry" | "GraphicalElements" | "MetaData"
-            | "Signature" => {}
+            // graphics do not change the simulation
+            "ElementGeometry" | "SystemGeometry" | "GraphicalElements" => {}
             _ => return Err(ctx.unexpected(c)),
         }
     }
@@ -394,7 +394,8 @@ fn parse_component(ctx: Ctx, n: Node) -> Result<Component, SspError> {
         step_size_hint_s: None,
         line: ctx.line(n),
     };
-    for c in elements(n) {
+    check_single_children(ctx, n)?;
+    for c in elements(n).filter(|c| !is_meta(*c)) {
         if c.tag_name().namespace() != Some(NS_SSD) {
             return Err(ctx.unexpected(c));
         }
@@ -410,7 +411,7 @@ fn parse_component(ctx: Ctx, n: Node) -> Result<Component, SspError> {
                     }
                 }
             }
-            "ElementGeometry" | "MetaData" | "Signature" => {}
+            "ElementGeometry" => {}
             _ => return Err(ctx.unexpected(c)),
         }
     }
@@ -459,15 +460,19 @@ fn parse_connectors(ctx: Ctx, n: Node) -> Result<Vec<Connector>, SspError> {
             ));
         }
         let mut ty = None;
-        for t in elements(c) {
+        check_single_children(ctx, c)?;
+        for t in elements(c).filter(|t| !is_meta(*t)) {
+            // SSP 1.0 has no arrays; 2.0 gives their size as <ssc:Dimension>
+            if t.tag_name().name() == "Dimension" {
+                return Err(ctx.unsupported(t, format!("array connector '{name}'")));
+            }
             if t.tag_name().namespace() == Some(NS_SSC) {
                 ty = Some(connector_type(ctx, t, &name)?);
                 continue;
             }
             match t.tag_name().name() {
-                "ConnectorGeometry" | "Annotations" | "MetaData" | "Signature"
-                    if t.tag_name().namespace() == Some(NS_SSD) => {}
-                "Dimension" => return Err(ctx.unsupported(t, format!("array connector '{name}'"))),
+                "ConnectorGeometry" | "Annotations" if t.tag_name().namespace() == Some(NS_SSD) => {
+                }
                 _ => return Err(ctx.unexpected(t)),
             }
         }
@@ -505,7 +510,8 @@ fn parse_connection(ctx: Ctx, e: Node) -> Result<Connection, SspError> {
             return Err(ctx.unsupported(e, format!("connection attribute '{attr}' (arrays)")));
         }
     }
-    for t in elements(e) {
+    check_single_children(ctx, e)?;
+    for t in elements(e).filter(|t| !is_meta(*t)) {
         match t.tag_name().name() {
             "LinearTransformation" if is(t, NS_SSC, "LinearTransformation") => {
                 let factor = ctx.f64(t, "factor")?.unwrap_or(1.0);
@@ -532,8 +538,7 @@ fn parse_connection(ctx: Ctx, e: Node) -> Result<Connection, SspError> {
                     format!("connection transformation <ssc:{}>", t.tag_name().name()),
                 ))
             }
-            "ConnectionGeometry" | "Annotations" | "MetaData" | "Signature"
-                if t.tag_name().namespace() == Some(NS_SSD) => {}
+            "ConnectionGeometry" | "Annotations" if t.tag_name().namespace() == Some(NS_SSD) => {}
             _ => return Err(ctx.unexpected(t)),
         }
     }
@@ -581,7 +586,8 @@ fn parse_bindings(ctx: Ctx, n: Node) -> Result<Vec<Binding>, SspError> {
         check_source_base(ctx, b)?;
         let mut inline = None;
         let mut mapping = None;
-        for c in elements(b) {
+        check_single_children(ctx, b)?;
+        for c in elements(b).filter(|c| !is_meta(*c)) {
             match c.tag_name().name() {
                 "ParameterValues" if is(c, NS_SSD, "ParameterValues") => {
                     let mut sets = elements(c);

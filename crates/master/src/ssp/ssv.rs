@@ -3,7 +3,10 @@
 
 use roxmltree::Node;
 
-use super::xml::{self, elements, is, qualified, scalar, Ctx, NS_SSC, NS_SSM, NS_SSV};
+use super::xml::{
+    self, check_single_children, elements, is, is_meta, qualified, scalar, Ctx, NS_SSC, NS_SSM,
+    NS_SSV,
+};
 use super::SspError;
 use crate::show;
 
@@ -105,7 +108,8 @@ pub(super) fn parse_set(ctx: Ctx, n: Node) -> Result<ParameterSet, SspError> {
     };
     // SSV 1.0 6: a parameter's name "MUST be unique within the parameter set"
     let mut seen: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
-    for c in elements(n) {
+    check_single_children(ctx, n)?;
+    for c in elements(n).filter(|c| !is_meta(*c)) {
         match c.tag_name().name() {
             "Parameters" if is(c, NS_SSV, "Parameters") => {
                 for p in elements(c) {
@@ -130,8 +134,7 @@ pub(super) fn parse_set(ctx: Ctx, n: Node) -> Result<ParameterSet, SspError> {
             "Units" if is(c, NS_SSV, "Units") => {
                 set.units = super::ssd::parse_units(ctx, c)?;
             }
-            "Enumerations" | "Annotations" | "MetaData" | "Signature"
-                if c.tag_name().namespace() == Some(NS_SSV) => {}
+            "Enumerations" | "Annotations" if c.tag_name().namespace() == Some(NS_SSV) => {}
             _ => return Err(ctx.unexpected(c)),
         }
     }
@@ -142,7 +145,11 @@ fn parse_parameter(ctx: Ctx, p: Node) -> Result<Parameter, SspError> {
     let name = ctx.req(p, "name")?.to_string();
     let mut value = None;
     let mut unit = None;
-    for t in elements(p) {
+    for t in elements(p).filter(|t| !is_meta(*t)) {
+        // SSP 1.0 has no arrays; 2.0 gives their size as <ssc:Dimension>
+        if t.tag_name().name() == "Dimension" {
+            return Err(ctx.unsupported(t, format!("array parameter '{name}'")));
+        }
         if t.tag_name().namespace() != Some(NS_SSV) {
             return Err(ctx.unexpected(t));
         }
@@ -154,7 +161,6 @@ fn parse_parameter(ctx: Ctx, p: Node) -> Result<Parameter, SspError> {
         };
         let v = match t.tag_name().name() {
             "Annotations" => continue,
-            "Dimension" => return Err(ctx.unsupported(t, format!("array parameter '{name}'"))),
             "Real" | "Float64" => {
                 unit = t.attribute("unit").map(str::to_string);
                 let s = scalar(ctx, t)?;
@@ -237,7 +243,18 @@ pub(super) fn parse_mapping(ctx: Ctx, n: Node) -> Result<Mapping, SspError> {
         match e.tag_name().name() {
             "MappingEntry" if is(e, NS_SSM, "MappingEntry") => {
                 let mut transformation = None;
-                for t in elements(e) {
+                // one transformation at most: a second replaced the first
+                let second = elements(e)
+                    .filter(|t| t.tag_name().namespace() == Some(NS_SSC) && !is_meta(*t))
+                    .nth(1);
+                if let Some(second) = second {
+                    return Err(ctx.err(
+                        second,
+                        "a <ssm:MappingEntry> holds more than one transformation",
+                    ));
+                }
+                check_single_children(ctx, e)?;
+                for t in elements(e).filter(|t| !is_meta(*t)) {
                     if t.tag_name().namespace() == Some(NS_SSM)
                         && t.tag_name().name() == "Annotations"
                     {
@@ -267,8 +284,7 @@ pub(super) fn parse_mapping(ctx: Ctx, n: Node) -> Result<Mapping, SspError> {
                     line: ctx.line(e),
                 });
             }
-            "Annotations" | "MetaData" | "Signature"
-                if e.tag_name().namespace() == Some(NS_SSM) => {}
+            "Annotations" if e.tag_name().namespace() == Some(NS_SSM) => {}
             _ => return Err(ctx.unexpected(e)),
         }
     }

@@ -441,6 +441,8 @@ fn a_bare_ssd_next_to_its_fmus() {
     let imp = import(&ssd, &ImportOptions::default()).unwrap();
     assert_eq!(imp.system.desc.instances[0].parameters.len(), 2);
     assert!(imp.system.fmu_path(0).exists());
+    // the parameter file is an input of a run, as the .ssd and the FMUs are
+    assert_eq!(imp.files_read, vec![d.path().join("a_params.ssv")]);
     assert!(is_ssp_path(&ssd) && !is_ssp_path(Path::new("x.json")));
 }
 
@@ -870,4 +872,65 @@ fn a_unit_of_another_name_is_the_fmus_when_their_definitions_agree() {
     );
     let md = crate::model_description::ModelDescription::parse(MASS_SPRING).unwrap();
     assert_eq!(md.units["m"].exponents, [0, 1, 0, 0, 0, 0, 0, 0]);
+}
+
+/// An element the schemas allow once is refused when given twice (the reader kept the last:
+/// a second `<ssd:ParameterBindings>` dropped the first's parameters without a word, a second
+/// `<ssd:System>` replaced the first); SSP 2.0's meta data (`ssc:MetaData`, several allowed)
+/// is skipped wherever it may stand, and its array dimension is refused as an array.
+#[test]
+fn an_element_given_twice_is_refused_and_ssp2_meta_data_is_skipped() {
+    let files = |ssd: String| {
+        vec![
+            ("SystemStructure.ssd", ssd),
+            ("resources/ms.fmu", String::new()),
+            ("a_params.ssv", A_SSV.to_string()),
+        ]
+    };
+    let with = |from: &str, to: &str| {
+        assert!(OSP_SSD.contains(from), "fixture lacks {from}");
+        format!("{HEAD}{}", OSP_SSD.replacen(from, to, 1))
+    };
+    let bindings_end = "</ssd:ParameterBindings>";
+    let second_bindings = r#"</ssd:ParameterBindings>
+        <ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>
+          <ssv:ParameterSet version="1.0" name="other"><ssv:Parameters>
+            <ssv:Parameter name="d"><ssv:Real value="1"/></ssv:Parameter>
+          </ssv:Parameters></ssv:ParameterSet>
+        </ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>"#;
+    let e = import_err(&refs(&files(with(bindings_end, second_bindings))));
+    assert!(
+        e.contains("<ssd:ParameterBindings> is given twice in <ssd:Component> (first at line"),
+        "{e}"
+    );
+    let e = import_err(&refs(&files(with(
+        "</ssd:System>",
+        r#"</ssd:System><ssd:System name="second"><ssd:Elements/></ssd:System>"#,
+    ))));
+    assert!(
+        e.contains("<ssd:System> is given twice in <ssd:SystemStructureDescription>"),
+        "{e}"
+    );
+    let connectors_end = "</ssd:Connectors>";
+    let e = import_err(&refs(&files(with(
+        connectors_end,
+        r#"</ssd:Connectors><ssd:Connectors><ssd:Connector name="x" kind="input"><ssc:Real unit="furlong"/></ssd:Connector></ssd:Connectors>"#,
+    ))));
+    assert!(e.contains("<ssd:Connectors> is given twice"), "{e}");
+    // SSP 2.0 meta data, twice in the root and once in a component: skipped
+    let meta = r#"<ssc:MetaData kind="general" type="text/plain" source="readme.txt"/>"#;
+    let v2 = with(r#"version="1.0""#, r#"version="2.0""#)
+        .replacen(
+            "</ssd:SystemStructureDescription>",
+            &format!("{meta}{meta}</ssd:SystemStructureDescription>"),
+            1,
+        )
+        .replacen("</ssd:Component>", &format!("{meta}</ssd:Component>"), 1);
+    import_ok(&refs(&files(v2)));
+    // an SSP 2.0 array connector is refused as one
+    let e = import_err(&refs(&files(with(
+        r#"<ssc:Real/></ssd:Connector>"#,
+        r#"<ssc:Real/><ssc:Dimension size="1"/></ssd:Connector>"#,
+    ))));
+    assert!(e.contains("array connector 'position'"), "{e}");
 }

@@ -118,6 +118,42 @@ pub(super) fn elements<'a, 'i>(n: Node<'a, 'i>) -> impl Iterator<Item = Node<'a,
     n.children().filter(|c| c.is_element())
 }
 
+/// Meta data and signatures do not change the simulation: skipped wherever the schemas allow
+/// them (SSP 1.0 has them in each file's own namespace, 2.0 as `ssc:MetaData` and
+/// `ssc:Signature`, several of each).
+pub(super) fn is_meta(n: Node) -> bool {
+    matches!(n.tag_name().name(), "MetaData" | "Signature")
+        && matches!(
+            n.tag_name().namespace(),
+            Some(NS_SSD | NS_SSC | NS_SSV | NS_SSM)
+        )
+}
+
+/// Refuses a child of `n` given twice where the schemas allow one (every child but meta data,
+/// signatures and array dimensions): the readers keep one of each, so a second
+/// `<ssd:ParameterBindings>` or `<ssd:System>` dropped the first's content without a word.
+pub(super) fn check_single_children(ctx: Ctx, n: Node) -> Result<(), SspError> {
+    let mut seen: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
+    for c in elements(n) {
+        if is_meta(c) || c.tag_name().name() == "Dimension" {
+            continue;
+        }
+        let name = qualified(c);
+        if let Some(first) = seen.get(&name) {
+            return Err(ctx.err(
+                c,
+                format!(
+                    "<{name}> is given twice in <{}> (first at line {first}); the schema allows \
+                     one",
+                    qualified(n)
+                ),
+            ));
+        }
+        seen.insert(name, ctx.line(c));
+    }
+    Ok(())
+}
+
 /// `name` with its namespace's usual SSP prefix, for messages.
 pub(super) fn qualified(n: Node) -> String {
     let prefix = match n.tag_name().namespace() {
