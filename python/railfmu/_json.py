@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from typing import Any, List, Optional
 
 import numpy as np
@@ -13,12 +14,22 @@ from . import _railfmu
 
 
 def _plain(value: Any) -> Any:
-    """NumPy numbers and arrays as the Python numbers and lists JSON writes."""
+    """NumPy numbers and arrays, pandas Series and ranges as the Python numbers and lists JSON
+    writes, paths as their text; anything else is a TypeError naming its type."""
     if isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, np.generic):
         return value.item()
-    raise TypeError
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    if isinstance(value, range):
+        return list(value)
+    tolist = getattr(value, "tolist", None)  # a pandas Series or Index
+    if callable(tolist):
+        return tolist()
+    shown = repr(value)
+    shown = shown if len(shown) <= 60 else shown[:57] + "..."
+    raise TypeError(f"{type(value).__name__} {shown} is not a value JSON holds (a number, text, list or dict)")
 
 
 def _first_bad(value: Any, path: List[str]) -> Optional[str]:

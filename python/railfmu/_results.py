@@ -183,7 +183,13 @@ class Results:
         column (and ``time``) to its unit, ``df.attrs["summary"]`` holds the run statistics."""
         import pandas as pd
 
-        df = pd.DataFrame(self.values[:, 1:], columns=self.names[1:], index=pd.Index(self.values[:, 0], name=self.names[0]))
+        # a copy: the values are a read-only view of the results' bytes, which pandas 2 keeps
+        # (every in-place edit of the frame failed) and pandas 3 copies on write
+        df = pd.DataFrame(
+            self.values[:, 1:].copy(),
+            columns=self.names[1:],
+            index=pd.Index(self.values[:, 0].copy(), name=self.names[0]),
+        )
         for n, t in self.texts.items():
             df[n] = t
         df.attrs["units"] = dict(self.units)

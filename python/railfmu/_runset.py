@@ -69,11 +69,17 @@ class RunSet:
         self._label = label
         self._jobs_json = list(jobs_json)
         self._names = [json.loads(j)["name"] for j in self._jobs_json]
+        # the files the set reads (its run-set file, its base system, the FMUs): a set must not
+        # write over them, nor replace or remove a run folder that holds one
+        fmus = [i.get("fmu", "") for i in json.loads(base_json).get("instances", [])]
+        self._inputs = [p for p in [label, *fmus] if isinstance(p, str) and os.path.isfile(p)]
 
     @classmethod
     def load(cls, path: PathLike) -> "RunSet":
         """Reads a run-set file (``base`` or inline ``system``, ``product``, ``runs``)."""
-        return cls(*_railfmu.load_run_set(os.fspath(path)))
+        rs = cls(*_railfmu.load_run_set(os.fspath(path)))
+        rs._inputs.append(os.fspath(path))
+        return rs
 
     @classmethod
     def from_dict(cls, runset: Mapping[str, Any], base_dir: PathLike = ".", label: str = "<dict>") -> "RunSet":
@@ -186,12 +192,6 @@ class RunSet:
         # one set at a time in a folder (the lock `master sweep` takes too): a second one
         # would mix its runs into this one's
         with _folder_lock(out):
-            # this set's runs only: nothing of the user's is replaced by a run folder, and an
-            # earlier set's other runs are removed (the kept ones are in this set)
-            _railfmu.prepare_run_folder(os.fspath(out), self._jobs_json)
-            # the earlier set's report goes with its runs: a set that fails before its first run
-            # (an unreadable FMU) leaves no report of runs that are no longer there
-            remove_sweep_report(out)
             reports: List[Optional[str]] = [None] * len(self)
             if resume:
                 # decided over every job before the kept runs, as a fresh run set decides it
@@ -200,6 +200,18 @@ class RunSet:
                 for i, j in enumerate(self._jobs_json):
                     reports[i] = _railfmu.completed_report(os.fspath(out), j, format)
             todo = [i for i, r in enumerate(reports) if r is None]
+            # before anything is removed: the report would not replace an input (a run-set file
+            # saved as <out>/sweep.json), and no input lies in a run folder the set replaces or
+            # removes (an earlier run's system.json as the base)
+            _railfmu.check_run_set_inputs(
+                os.fspath(out), self._inputs, self._jobs_json, [self._jobs_json[i] for i in todo]
+            )
+            # this set's runs only: nothing of the user's is replaced by a run folder, and an
+            # earlier set's other runs are removed (the kept ones are in this set)
+            _railfmu.prepare_run_folder(os.fspath(out), self._jobs_json)
+            # the earlier set's report goes with its runs: a set that fails before its first run
+            # (an unreadable FMU) leaves no report of runs that are no longer there
+            remove_sweep_report(out)
             # the earlier runs of the names about to be computed go before the first starts:
             # a set killed midway leaves none of them beside this set's (a file of the user's
             # in such a folder is refused first)
@@ -218,6 +230,8 @@ class RunSet:
 
                 if todo:
                     jobs = [self._jobs_json[i] for i in todo]
+                    # the runs kept by a resume: their parameters are columns of every table
+                    kept = [j for j, r in zip(self._jobs_json, reports) if r is not None]
                     new: List[Optional[str]] = [None] * len(jobs)
                     local_runs = False
                     try:
@@ -227,7 +241,7 @@ class RunSet:
                             threads = min(threads or _usable_cores(), len(jobs))
                             local_runs = True
                             with forwarded():
-                                new = system.run_jobs(jobs, os.fspath(out), threads, on_done, format)
+                                new = system.run_jobs(jobs, os.fspath(out), threads, on_done, format, kept)
                         else:
                             from .dask import run_jobs_on_cluster
 
@@ -242,6 +256,7 @@ class RunSet:
                                 retries=retries,
                                 format=format,
                                 reports=new,
+                                kept_json=kept,
                             )
                     except BaseException:
                         # stopped part way (Ctrl-C, an exception of `progress`, ...): the runners

@@ -353,6 +353,7 @@ def run_jobs_on_cluster(
     retries: int = 3,
     format: Optional[str] = None,
     reports: Optional[List[Optional[str]]] = None,
+    kept_json: Optional[List[str]] = None,
 ) -> List[str]:
     """Submits one task per job to ``client``, writes each run's folder as its result arrives
     and returns the reports (JSON) in job order. ``format``: "csv" or "parquet"; None chooses
@@ -364,7 +365,10 @@ def run_jobs_on_cluster(
     run's folder is written. A set stopped part way (Ctrl-C, an exception of ``on_done``, a
     client that fails) ends as a local run set does: the remaining tasks are cancelled, each
     run not finished gets its report in ``reports`` as cancelled but no folder (an earlier
-    set's folder of its name is removed), and the exception is raised."""
+    set's folder of its name is removed), and the exception is raised.
+
+    ``kept_json``: the jobs of the set that a resume keeps; their parameters are columns of
+    every run's table too (a Parquet folder reads with its first file's columns)."""
     from distributed import as_completed
 
     from ._runset import remove_sweep_report
@@ -372,7 +376,7 @@ def run_jobs_on_cluster(
     if format is None:
         format = results_format(client, base_json, label, jobs_json, ship_fmus=ship_fmus, retries=retries)
     fmus_arg = _scatter_fmus(client, base_json) if ship_fmus else None
-    writer = _railfmu.RunWriter(os.fspath(outdir), jobs_json, format, base_json, label)
+    writer = _railfmu.RunWriter(os.fspath(outdir), jobs_json, format, base_json, label, kept_json)
     if reports is None:
         reports = [None] * len(jobs_json)
     # keys unique per submission: a key resubmitted while the scheduler still releases it from

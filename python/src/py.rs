@@ -552,8 +552,11 @@ impl PySystem {
     /// Runs jobs of this system's run set on `threads` threads, writing `<outdir>/<run>/` per
     /// job and `<outdir>/sweep.json` (the master's run-set folder), the results in `format`
     /// ("csv" or "parquet"; None: by size, as `master sweep`); `on_done(name, error)` is
-    /// called as each run finishes. Returns each job's report as JSON, in job order.
-    #[pyo3(signature = (jobs_json, outdir, threads, on_done=None, format=None))]
+    /// called as each run finishes; `kept_json`: the jobs of the set a resume keeps (their
+    /// parameters are columns of every run's table too). Returns each job's report as JSON,
+    /// in job order.
+    #[pyo3(signature = (jobs_json, outdir, threads, on_done=None, format=None, kept_json=None))]
+    #[allow(clippy::too_many_arguments)]
     fn run_jobs(
         &self,
         py: Python<'_>,
@@ -562,8 +565,10 @@ impl PySystem {
         threads: usize,
         on_done: Option<Py<PyAny>>,
         format: Option<&str>,
+        kept_json: Option<Vec<String>>,
     ) -> PyResult<Vec<String>> {
         let jobs = parse_jobs(&jobs_json)?;
+        let kept = parse_jobs(&kept_json.unwrap_or_default())?;
         let results = ResultsOptions {
             format: match format {
                 Some(f) => parse_format(f)?,
@@ -571,7 +576,8 @@ impl PySystem {
             },
             integer_columns: self
                 .prepared
-                .integer_parameters(jobs.iter().flat_map(|j| j.parameters.keys())),
+                .integer_parameters(jobs.iter().chain(&kept).flat_map(|j| j.parameters.keys())),
+            kept_parameters: kept.into_iter().map(|j| j.parameters).collect(),
             ..ResultsOptions::default()
         };
         let cancel = AtomicBool::new(false);
@@ -642,6 +648,24 @@ fn prepare_run_folder(outdir: PathBuf, jobs_json: Vec<String>) -> PyResult<()> {
 fn clear_earlier_runs(outdir: PathBuf, jobs_json: Vec<String>) -> PyResult<()> {
     let jobs = parse_jobs(&jobs_json)?;
     master::runset::clear_earlier_runs(&jobs, &outdir).map_err(|e| sweep_err(&e))
+}
+
+/// Before a run set writes into `outdir`: refuses it when its report would replace one of
+/// `inputs` (the run-set file, its base system, the FMUs), or when one of them lies in a run
+/// folder the set replaces (`todo_json`: the runs it computes) or removes (an earlier set's
+/// run not among `jobs_json`), as `master sweep` does.
+#[pyfunction]
+fn check_run_set_inputs(
+    outdir: PathBuf,
+    inputs: Vec<PathBuf>,
+    jobs_json: Vec<String>,
+    todo_json: Vec<String>,
+) -> PyResult<()> {
+    master::output::check_outputs_apart(&inputs, &[outdir.join("sweep.json")])
+        .map_err(|e| OutputError::new_err(e.to_string()))?;
+    let (jobs, todo) = (parse_jobs(&jobs_json)?, parse_jobs(&todo_json)?);
+    master::runset::check_inputs_outside_runs(&inputs, &jobs, &todo, &outdir)
+        .map_err(|e| sweep_err(&e))
 }
 
 fn report_json(r: &RunReport) -> PyResult<String> {
@@ -799,14 +823,17 @@ impl PyRunWriter {
     /// `base_json` and `label`: the run set's base system (resolved JSON), whose FMUs' model
     /// descriptions say which parameters are Integers or Enumerations.
     #[new]
+    #[pyo3(signature = (outdir, jobs_json, format, base_json, label, kept_json=None))]
     fn new(
         outdir: PathBuf,
         jobs_json: Vec<String>,
         format: &str,
         base_json: &str,
         label: &str,
+        kept_json: Option<Vec<String>>,
     ) -> PyResult<Self> {
         let jobs = parse_jobs(&jobs_json)?;
+        let kept = parse_jobs(&kept_json.unwrap_or_default())?;
         let format = parse_format(format)?;
         // FMUs this process cannot read (workers reading their own paths; a broken FMU,
         // which fails every run on the workers) say nothing here: the tables then type each
@@ -814,14 +841,18 @@ impl PyRunWriter {
         let integers = LoadedSystem::from_json_str(base_json, Path::new(""), label)
             .ok()
             .and_then(|base| {
-                runs::integer_parameters(&base, jobs.iter().flat_map(|j| j.parameters.keys())).ok()
+                runs::integer_parameters(
+                    &base,
+                    jobs.iter().chain(&kept).flat_map(|j| j.parameters.keys()),
+                )
+                .ok()
             })
             .unwrap_or_default();
         std::fs::create_dir_all(&outdir).map_err(|e| {
             OutputError::new_err(format!("cannot create '{}': {e}", outdir.display()))
         })?;
         Ok(PyRunWriter {
-            writer: runs::RunSetWriter::new(&outdir, &jobs, format, integers),
+            writer: runs::RunSetWriter::new(&outdir, &jobs, &kept, format, integers),
         })
     }
 
@@ -1063,6 +1094,7 @@ fn _railfmu(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyRunWriter>()?;
     m.add_function(wrap_pyfunction!(prepare_run_folder, m)?)?;
     m.add_function(wrap_pyfunction!(clear_earlier_runs, m)?)?;
+    m.add_function(wrap_pyfunction!(check_run_set_inputs, m)?)?;
     m.add_function(wrap_pyfunction!(read_results, m)?)?;
     m.add_function(wrap_pyfunction!(write_results_file, m)?)?;
     Ok(())

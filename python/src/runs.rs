@@ -89,10 +89,12 @@ impl RunSetWriter {
     pub fn new(
         outdir: &Path,
         jobs: &[Job],
+        kept: &[Job],
         format: ResultsFormat,
         integer_columns: BTreeSet<String>,
     ) -> Self {
-        let parameters = || jobs.iter().flat_map(|j| &j.parameters);
+        // the constant columns of the whole set, the runs a resume keeps too
+        let parameters = || jobs.iter().chain(kept).flat_map(|j| &j.parameters);
         RunSetWriter {
             outdir: outdir.to_path_buf(),
             kinds: with_integer_kinds(constant_kinds(parameters()), &integer_columns, parameters()),
@@ -166,13 +168,14 @@ mod tests {
         let writer = RunSetWriter::new(
             dir.path(),
             std::slice::from_ref(&j),
+            &[],
             ResultsFormat::Csv,
             BTreeSet::new(),
         );
         let report = writer.write(&j, Ok(output()));
         assert!(report.ok, "{report:?}");
         let csv = std::fs::read_to_string(dir.path().join("run-000/results.csv")).unwrap();
-        assert_eq!(csv, "time [s],ms.x [m]\n0,1\n0.001,0.5\n0.002,0.25\n");
+        assert_eq!(csv, "time [s],ms.x [m]\n0.0,1.0\n0.001,0.5\n0.002,0.25\n");
         assert_eq!(
             completed(dir.path(), &j, ResultsFormat::Csv),
             Some(report.clone())
@@ -202,6 +205,7 @@ mod tests {
         let writer = RunSetWriter::new(
             dir.path(),
             &[a.clone(), b],
+            &[],
             ResultsFormat::Parquet,
             BTreeSet::new(),
         );
@@ -232,6 +236,7 @@ mod tests {
         let writer = RunSetWriter::new(
             dir.path(),
             std::slice::from_ref(&j),
+            &[],
             ResultsFormat::Csv,
             BTreeSet::new(),
         );

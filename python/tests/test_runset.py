@@ -448,6 +448,74 @@ def test_descriptions_given_as_python_values(dist, tmp_path):
     system["step"] = float("inf")
     with pytest.raises(railfmu.SystemDescriptionError, match="step: inf"):
         railfmu.System.from_dict(system)
+    # a range, a pandas Series and a path are what they read as; anything else is named by its
+    # type (the message was empty)
+    import pandas as pd
+
+    rs["product"] = {"bogie.track.seed": range(1, 3), "bogie.vehicle.speed": pd.Series([50.0, 60.0])}
+    assert len(railfmu.RunSet.from_dict(rs)) == 4
+    system = speed_set(dist, [50.0], stop_time=0.2)["system"]
+    system["instances"][1]["fmu"] = Path(system["instances"][1]["fmu"])
+    assert railfmu.System.from_dict(system)
+    rs["product"] = {"bogie.track.seed": {1, 2}}
+    with pytest.raises(railfmu.SystemDescriptionError, match="set {1, 2} is not a value JSON holds"):
+        railfmu.RunSet.from_dict(rs)
+
+
+def test_a_run_set_does_not_write_over_or_remove_its_own_inputs(dist, tmp_path):
+    """As `master sweep`: a run-set file saved as <out>/sweep.json is not replaced by the report,
+    and a base system in a run folder the set replaces is refused, before anything changes."""
+    out = tmp_path / "out"
+    out.mkdir()
+    set_file = out / "sweep.json"
+    text = json.dumps(speed_set(dist, [50.0, 60.0], stop_time=0.05))
+    set_file.write_text(text)
+    with pytest.raises(railfmu.OutputError, match="same file as the input"):
+        railfmu.run_set(set_file, out)
+    assert set_file.read_text() == text
+    railfmu.run_set(speed_set(dist, [50.0, 60.0], stop_time=0.05), tmp_path / "b", format="csv")
+    base = tmp_path / "b" / "run-001" / "system.json"
+    before = base.read_bytes()
+    (tmp_path / "rs_b.json").write_text(json.dumps({"base": str(base), "product": {"bogie.track.seed": [3, 4]}}))
+    with pytest.raises(railfmu.OutputError, match="run-001"):
+        railfmu.run_set(tmp_path / "rs_b.json", tmp_path / "b")
+    assert base.read_bytes() == before
+    assert sorted(p.name for p in (tmp_path / "b").iterdir()) == ["run-000", "run-001", "sweep.json"]
+
+
+def test_a_resumed_parquet_set_keeps_every_runs_parameter_columns(dist, master_cmd, tmp_path):
+    """A resume writes the runs it makes with the constant columns of the whole set: a Parquet
+    folder reads with its first file's columns, so a parameter only a kept run has was dropped
+    from every run (locally, and by `master sweep --resume`)."""
+    import pandas as pd
+
+    def runs(speeds):
+        return {
+            **speed_set(dist, speeds, stop_time=0.1),
+            "runs": [{"name": "soft", "parameters": {"bogie.vehicle.speed": 60.0, "bogie.suspension.lateral_stiffness": 1e5}}],
+        }
+
+    def soft_stiffness(folder: Path):
+        table = pd.read_parquet(folder / "results")
+        assert "bogie.suspension.lateral_stiffness" in table.columns, list(table.columns)
+        return table[table["run"] == "soft"]["bogie.suspension.lateral_stiffness"].unique().tolist()
+
+    out = tmp_path / "py"
+    railfmu.run_set(runs([50.0, 60.0]), out, format="parquet")
+    assert soft_stiffness(out) == [1e5]
+    # run-000 is computed again (its speed changed), the others kept
+    ran = []
+    railfmu.RunSet.from_dict(runs([55.0, 60.0])).run(out, resume=True, format="parquet", progress=lambda d, t, n, e: ran.append(n))
+    assert [n for n in ran if n] == ["run-000"]
+    assert soft_stiffness(out) == [1e5]
+    cli = tmp_path / "cli"
+    set_file = tmp_path / "set.json"
+    for speeds in ([50.0, 60.0], [55.0, 60.0]):
+        set_file.write_text(json.dumps(runs(speeds)))
+        r = run_master(master_cmd, "sweep", set_file, "-o", cli, "--resume", "--format", "parquet")
+        assert r.returncode == 0, r.stderr
+    assert "2 complete run(s) kept, 1 run" in r.stdout
+    assert soft_stiffness(cli) == [1e5]
 
 
 def test_malformed_run_set_summaries_are_named(dist, tmp_path):

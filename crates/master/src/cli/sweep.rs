@@ -123,10 +123,17 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
     let mut fresh = Vec::new();
     if let Some(system) = system {
         let cancel = ctx.cancel;
+        // the columns of the whole set, the kept runs' too
         let results = ResultsOptions {
             format,
             integer_columns: system
-                .integer_parameters(todo.iter().flat_map(|j| j.parameters.keys())),
+                .integer_parameters(jobs.iter().flat_map(|j| j.parameters.keys())),
+            kept_parameters: jobs
+                .iter()
+                .zip(&kept)
+                .filter(|(_, k)| k.is_some())
+                .map(|(j, _)| j.parameters.clone())
+                .collect(),
             ..ResultsOptions::default()
         };
         fresh = run_all(

@@ -140,6 +140,11 @@ pub struct ResultsOptions {
     /// nature (a track seed): their Parquet columns are INT32 where every run gives a whole
     /// number, not float64.
     pub integer_columns: BTreeSet<String>,
+    /// The parameters of the set's runs a resume keeps (not among the jobs run): each run's
+    /// Parquet file gets the constant columns of the whole set, as a fresh set writes them (a
+    /// folder reads with the first file's columns, so a column only the kept runs have was
+    /// dropped from every run).
+    pub kept_parameters: Vec<BTreeMap<String, Value>>,
 }
 
 impl Default for ResultsOptions {
@@ -148,6 +153,7 @@ impl Default for ResultsOptions {
             format: ResultsFormat::Csv,
             labels: BTreeMap::new(),
             integer_columns: BTreeSet::new(),
+            kept_parameters: Vec::new(),
         }
     }
 }
@@ -245,18 +251,20 @@ where
     F: Fn(&Job) -> Result<SimOutput, E> + Sync,
     E: Into<FailedRun<String>>,
 {
+    // the constant columns of the whole set: the jobs run now and the runs a resume keeps
+    let constants = || {
+        jobs.iter()
+            .flat_map(|j| {
+                j.parameters
+                    .iter()
+                    .chain(results.labels.get(&j.name).into_iter().flatten())
+            })
+            .chain(results.kept_parameters.iter().flatten())
+    };
     let kinds = with_integer_kinds(
-        constant_kinds(jobs.iter().flat_map(|j| {
-            j.parameters
-                .iter()
-                .chain(results.labels.get(&j.name).into_iter().flatten())
-        })),
+        constant_kinds(constants()),
         &results.integer_columns,
-        jobs.iter().flat_map(|j| {
-            j.parameters
-                .iter()
-                .chain(results.labels.get(&j.name).into_iter().flatten())
-        }),
+        constants(),
     );
     let dir_err = |source| SweepError::Dir {
         path: outdir.to_path_buf(),
