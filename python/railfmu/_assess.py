@@ -150,7 +150,9 @@ def assess_stability(
     )
     if isinstance(source, Results):
         data = np.ascontiguousarray(source.values, dtype=np.float64).tobytes()
-        answer = _railfmu.assess_columns(source.header, data, source.full_rate, options)
+        # the sampling and running speed its metadata records, as for the file it came from
+        meta = None if source.metadata is None else json.dumps(source.metadata, default=str)
+        answer = _railfmu.assess_columns(source.header, data, source.full_rate, options, meta)
     else:
         answer = _railfmu.assess_file(os.fspath(source), options)
     a = json.loads(answer)

@@ -1038,18 +1038,32 @@ fn assess_file(py: Python<'_>, path: PathBuf, options_json: &str) -> PyResult<St
 /// EN 14363 assessment of columns held by the caller: `names` (the first is the time) and the
 /// row-major float64 `data`; `full_rate`: every communication point of a run (no decimation).
 #[pyfunction]
+#[pyo3(signature = (names, data, full_rate, options_json, metadata_json=None))]
 fn assess_columns(
     py: Python<'_>,
     names: Vec<String>,
     data: &[u8],
     full_rate: bool,
     options_json: &str,
+    metadata_json: Option<&str>,
 ) -> PyResult<String> {
     let options = assess_options(options_json)?;
+    // the results' metadata (read back from a file, or of a run): their sampling and running
+    // speed, as `master assess` reads them beside a file; metadata of another form (made by
+    // hand) is left out, as a file without metadata
+    let metadata = metadata_json
+        .and_then(|m| serde_json::from_str::<master::results::ResultsMetadata>(m).ok());
     let answer = py
         .detach(|| {
-            assess::table_from_rows(names, &f64_from_bytes(data)?, full_rate)
-                .and_then(|t| assess::assess(&t, &options))
+            let table = assess::table_from_rows(names, &f64_from_bytes(data)?, full_rate)?;
+            let table = match metadata {
+                // a run's own results without a recorded sampling keep their full rate
+                Some(m) if m.sampling.is_some() || !full_rate => {
+                    table.with_metadata(Some(m)).map_err(|e| e.to_string())?
+                }
+                _ => table,
+            };
+            assess::assess(&table, &options)
         })
         .map_err(AssessmentError::new_err)?;
     assess_answer_json(&answer)

@@ -173,3 +173,32 @@ def test_a_file_with_text_columns_is_assessed_on_its_numeric_signals(dist, hunti
     assert f.max_rms == pytest.approx(a.max_rms, rel=1e-12)
     with pytest.raises(railfmu.AssessmentError, match=r"column 'bogie.contact.table' is not a number.*is not numeric"):
         railfmu.assess_stability(path, ["bogie.contact.table"], 320.0, skip_s=5.0)
+
+
+def test_results_read_back_are_assessed_with_the_sampling_their_metadata_records(hunting, tmp_path):
+    """A table decimated too far for the band is refused as a file and as `Results` read back
+    from it alike (in memory, the metadata's sampling was ignored and the aliased rms assessed);
+    and the running speed it records is checked against `speed_kmh` as for the file."""
+    import copy
+
+    meta = copy.deepcopy(hunting.metadata)
+    meta["sampling"] = {
+        "rate_hz": 20.0,
+        "passband_hz": 4.5,
+        "decimation": {"factor": 50, "source_rate_hz": 1000.0, "filter": "butterworth low-pass, forward-backward", "filter_order": 4, "cutoff_hz": 4.0},
+    }
+    path = tmp_path / "dec.csv"
+    railfmu.Results(hunting.header, hunting.values[::50], summary=hunting.summary, metadata=meta).to_csv(path)
+    with pytest.raises(railfmu.AssessmentError, match="carry"):
+        railfmu.assess_stability(path, SIGNALS, 320.0, skip_s=5.0)
+    back = railfmu.read_results(path)
+    assert back.metadata["sampling"]["rate_hz"] == 20.0
+    with pytest.raises(railfmu.AssessmentError, match="carry"):
+        railfmu.assess_stability(back, SIGNALS, 320.0, skip_s=5.0)
+    # the full-rate file read back: assessed as the run in memory, its speed checked
+    hunting.to_csv(tmp_path / "full.csv")
+    full = railfmu.read_results(tmp_path / "full.csv")
+    a, b = (railfmu.assess_stability(r, SIGNALS, 320.0, skip_s=5.0) for r in (hunting, full))
+    assert a.max_rms == b.max_rms
+    with pytest.raises(railfmu.AssessmentError, match="not the running speed its metadata records"):
+        railfmu.assess_stability(full, SIGNALS, 320.0 / 3.6, skip_s=5.0)

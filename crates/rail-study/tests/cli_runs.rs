@@ -292,6 +292,11 @@ fn run_changes_a_system_from_the_command_line() {
             "system.json with --stop: stop_time: must be greater than start_time (0), got -1",
         ),
         (
+            // greater than the start, but no time to end at
+            vec!["--stop", "inf"],
+            "system.json with --stop: stop_time: must be a finite number, got inf",
+        ),
+        (
             vec!["--record", "ms.nothing"],
             "system.json with --record: record[0]: unknown variable 'ms.nothing'",
         ),

@@ -588,6 +588,13 @@ fn a_run_does_not_write_over_the_parameter_files_of_a_bare_ssd() {
         assert_eq!(std::fs::read(&ssv).unwrap(), before);
     }
     c.master_ok(&["run", "un/SystemStructure.ssd", "-o", "r.csv"]);
+    // an archive into a folder that is not there is named as such (the error named the
+    // write's hidden temporary file)
+    let e = c.fails(&["export-ssp", "p.json", "nodir/x.ssp"], &[]);
+    assert!(
+        e.contains("nodir") && !e.contains(".master-unfinished"),
+        "{e}"
+    );
 }
 
 /// The FMUs inside an SSP unpack within the FMU limit, checked before a byte is written: a

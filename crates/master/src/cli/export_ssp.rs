@@ -37,6 +37,8 @@ pub fn execute(args: &Args, _ctx: &Context) -> Result<(), CommandError> {
         .chain((0..sys.desc.instances.len()).map(|i| sys.fmu_path(i)))
         .collect();
     crate::output::check_outputs_apart(&inputs, std::slice::from_ref(&args.output))?;
+    // a missing folder named as such (the write's error named its hidden temporary file)
+    crate::output::check_folders_exist(std::slice::from_ref(&args.output))?;
     // a zip under another name is read as that (a .json as text, "not valid UTF-8")
     if !args
         .output

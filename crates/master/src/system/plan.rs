@@ -334,7 +334,14 @@ impl LoadedSystem {
     /// The stop time is after the start time and a whole number of steps away from it.
     pub(super) fn check_stop_time(&self, stop_time: f64) -> Result<(), SystemError> {
         let d = &self.desc;
-        if !(d.start_time.is_finite() && stop_time.is_finite() && stop_time > d.start_time) {
+        if !stop_time.is_finite() {
+            return Err(self.invalid(
+                "stop_time",
+                "stop_time",
+                format!("must be a finite number, got {}", num(stop_time)),
+            ));
+        }
+        if !(d.start_time.is_finite() && stop_time > d.start_time) {
             return Err(self.invalid(
                 "stop_time",
                 "stop_time",

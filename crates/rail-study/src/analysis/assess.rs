@@ -276,12 +276,19 @@ impl ResultsTable {
         // a regular file of bounded size (a FIFO or /dev/zero would hang the command)
         let text = master::input::read_text_file(path, master::input::MAX_TEXT_FILE_BYTES)
             .map_err(|e| AnalysisError::Input(format!("{}: {e}", path.display())))?;
-        let mut table = Self::parse(&text, path)?;
+        let table = Self::parse(&text, path)?;
         let meta = read_metadata(path).map_err(|e| input(&e))?;
-        table.described = meta.is_some();
-        table.recorded_speed = meta.as_ref().and_then(recorded_speed);
-        table.sampling = meta.and_then(|m| m.sampling);
-        table.check_recorded_rate()
+        table.with_metadata(meta)
+    }
+
+    /// The table as its results metadata describes it (its sampling, the running speed it
+    /// records), when it has any: a file's, or that of results held in memory (Python's
+    /// `Results.metadata`), whose sampling must be the time column's.
+    pub fn with_metadata(mut self, meta: Option<ResultsMetadata>) -> Result<Self, AnalysisError> {
+        self.described = meta.is_some();
+        self.recorded_speed = meta.as_ref().and_then(recorded_speed);
+        self.sampling = meta.and_then(|m| m.sampling);
+        self.check_recorded_rate()
     }
 
     /// The rate the metadata records is the time column's: metadata of another recording (a
