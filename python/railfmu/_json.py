@@ -35,10 +35,10 @@ def _plain(value: Any) -> Any:
 def _first_bad(value: Any, path: List[str]) -> Optional[str]:
     """Where in ``value`` the first number JSON has no form for (NaN, an infinity) is, and what
     it is; None if there is none."""
-    if isinstance(value, np.ndarray):
-        value = value.tolist()
-    elif isinstance(value, np.generic):
+    if isinstance(value, np.generic):
         value = value.item()
+    elif not isinstance(value, (dict, list, tuple, str)) and callable(getattr(value, "tolist", None)):
+        value = value.tolist()  # a NumPy array, a pandas Series or Index: as _plain reads them
     if isinstance(value, float) and not math.isfinite(value):
         return f"{'.'.join(path) or 'the value'}: {value} (JSON has no such number)"
     if isinstance(value, dict):

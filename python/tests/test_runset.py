@@ -457,6 +457,9 @@ def test_descriptions_given_as_python_values(dist, tmp_path):
     system = speed_set(dist, [50.0], stop_time=0.2)["system"]
     system["instances"][1]["fmu"] = Path(system["instances"][1]["fmu"])
     assert railfmu.System.from_dict(system)
+    rs["product"] = {"bogie.track.seed": [1], "bogie.vehicle.speed": pd.Series([50.0, float("nan")])}
+    with pytest.raises(railfmu.SystemDescriptionError, match=r"product\.bogie\.vehicle\.speed\[1\]: nan"):
+        railfmu.RunSet.from_dict(rs)
     rs["product"] = {"bogie.track.seed": {1, 2}}
     with pytest.raises(railfmu.SystemDescriptionError, match="set {1, 2} is not a value JSON holds"):
         railfmu.RunSet.from_dict(rs)

@@ -78,7 +78,18 @@ impl Registry {
         self.guids.get_or_init(|| {
             self.models
                 .iter()
-                .map(|e| (e.describe)().map(|d| d.guid).map_err(|e| e.to_string()))
+                .map(|e| {
+                    // a model whose description panics is refused on its own, not every model
+                    // of the binary at every instantiation
+                    match catch_unwind(e.describe) {
+                        Ok(d) => d.map(|d| d.guid).map_err(|err| err.to_string()),
+                        Err(payload) => Err(format!(
+                            "internal error: the description of model '{}' panicked ({})",
+                            e.name,
+                            panic_text(payload.as_ref())
+                        )),
+                    }
+                })
                 .collect()
         })
     }
@@ -328,16 +339,31 @@ pub unsafe fn instantiate(
     }));
     call_count::leave();
     result.unwrap_or_else(|payload| {
-        let _ = catch_unwind(AssertUnwindSafe(|| {
-            let msg = format!(
-                "fmi2Instantiate: internal error (panic caught at the C boundary: {}); no \
-                 instance was created",
-                panic_text(payload.as_ref())
-            );
-            early_log(functions, instance_name, &msg);
+        let msg = format!(
+            "fmi2Instantiate: internal error (panic caught at the C boundary: {}); no instance \
+             was created",
+            panic_text(payload.as_ref())
+        );
+        let logged = catch_unwind(AssertUnwindSafe(|| {
+            let has_logger = !functions.is_null() && (*functions).logger.is_some();
+            if has_logger {
+                early_log(functions, instance_name, &msg);
+            }
+            has_logger
         }));
+        if !matches!(logged, Ok(true)) {
+            report_on_stderr(&msg);
+        }
         std::ptr::null_mut()
     })
+}
+
+/// A panic the host's logger cannot be told of (no logger, the report itself panicked, the
+/// instance being freed): written to the process's stderr, as the standard hook would (the
+/// hook of an FMU binary is silent, [`call_count`]); a failed write is ignored.
+fn report_on_stderr(message: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "FMU: {message}");
 }
 
 /// The instances this binary gave out and has not freed. Only fmi2Instantiate and
@@ -356,9 +382,10 @@ fn live_instances() -> std::sync::MutexGuard<'static, Vec<usize>> {
 /// Whether a panic now is one that [`with`] catches and reports through the host's logger, so
 /// the panic hook stays silent for it.
 ///
-/// In an FMU's binary (feature `fmu-library`, which each FMU crate's `fmi-export` turns on)
-/// every panic is one: its standard library is its own, no thread of its own runs, and every
-/// entry point catches and reports its panics, so nothing is counted (a locked increment and
+/// In an FMU's binary (feature `fmu-library`, which package-fmus turns on) every panic is one:
+/// its standard library is its own, no thread of its own runs, and every entry point catches
+/// its panics and reports them through the host's logger, or on stderr where there is none
+/// ([`report_on_stderr`]), so nothing is counted (a locked increment and
 /// decrement on every call took about 3 % of a coupled run's wall time, and a thread-local
 /// lookup through `__tls_get_addr` more). Where the glue is linked into a Rust program
 /// calling the C API in-process (its tests), the calls running in any thread are counted, so
@@ -432,9 +459,15 @@ pub unsafe fn free_instance(c: fmi2Component) {
         };
         live.swap_remove(i);
     }
-    let _ = catch_unwind(AssertUnwindSafe(|| {
+    let dropped = catch_unwind(AssertUnwindSafe(|| {
         drop(Box::from_raw(c as *mut CComponent));
     }));
+    if let Err(payload) = dropped {
+        report_on_stderr(&format!(
+            "fmi2FreeInstance: internal error (panic caught at the C boundary: {})",
+            panic_text(payload.as_ref())
+        ));
+    }
 }
 
 /// Run `f` on the component behind `c`, catching panics: the call returns fmi2Error and the
@@ -449,22 +482,28 @@ pub unsafe fn with(
         return FMI2_ERROR;
     }
     let cc = &mut *(c as *mut CComponent);
-    cc.component.trace(call);
     call_count::enter();
-    let result = catch_unwind(AssertUnwindSafe(|| f(&mut *cc)));
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        cc.component.trace(call);
+        f(&mut *cc)
+    }));
     call_count::leave();
     match result {
         Ok(s) => to_c(s),
         Err(payload) => {
             let cc = &mut *(c as *mut CComponent);
-            let _ = catch_unwind(AssertUnwindSafe(|| {
+            let msg = format!(
+                "{call}: internal error (panic caught at the C boundary: {}); the instance is \
+                 in the Error state (fmi2Reset, or fmi2SetFMUstate of a saved state)",
+                panic_text(payload.as_ref())
+            );
+            let reported = catch_unwind(AssertUnwindSafe(|| {
                 cc.component.enter_error_state();
-                cc.component.error(&format!(
-                    "{call}: internal error (panic caught at the C boundary: {}); the instance \
-                     is in the Error state (fmi2Reset, or fmi2SetFMUstate of a saved state)",
-                    panic_text(payload.as_ref())
-                ));
+                cc.component.error(&msg);
             }));
+            if reported.is_err() {
+                report_on_stderr(&msg);
+            }
             FMI2_ERROR
         }
     }

@@ -559,7 +559,8 @@ pub fn check_run_folders(jobs: &[Job], outdir: &Path) -> Result<(), SweepError> 
 /// Refuses an input (the run-set file, its base system, an FMU) that lies in what a set of
 /// `jobs` (of which it writes `writes`) into `outdir` replaces or removes: the folder of a run
 /// it writes, an earlier run's folder not in the set (sweeping around the `system.json` of an
-/// earlier run into the same folder would remove the file being read, or rewrite it).
+/// earlier run into the same folder would remove the file being read, or rewrite it), or the
+/// run's own files of such a folder that also holds the user's (which stay).
 pub fn check_inputs_outside_runs(
     inputs: &[PathBuf],
     jobs: &[Job],
@@ -582,14 +583,22 @@ pub fn check_inputs_outside_runs(
             continue;
         };
         let mut parts = rest.components();
-        let (Some(first), Some(_)) = (parts.next(), parts.next()) else {
+        let (Some(first), Some(second)) = (parts.next(), parts.next()) else {
             continue;
         };
+        let directly_in_folder = parts.next().is_none();
         let first = first.as_os_str().to_string_lossy();
         let folder = out.join(&*first);
+        // an earlier run's folder with the user's files in it keeps them (only the run's own
+        // files go, see prepare_run_folder)
+        let own_file = || {
+            directly_in_folder
+                && RUN_FOLDER_FILES.contains(&second.as_os_str().to_string_lossy().as_ref())
+        };
         let replaced = written.contains(&*first)
             || (!set.contains(&*first)
-                && (is_earlier_run_folder(&folder) || added_to_run_folder(&folder).is_some()));
+                && (is_earlier_run_folder(&folder)
+                    || (added_to_run_folder(&folder).is_some() && own_file())));
         if replaced {
             return Err(SweepError::InputInRunFolder {
                 input: input.clone(),

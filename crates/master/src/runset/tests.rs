@@ -682,6 +682,22 @@ fn earlier_runs_go_before_the_first_run_and_a_users_files_stay() {
         let user_file = out.join("base.json");
         std::fs::write(&user_file, "{}").unwrap();
         assert!(check_inputs_outside_runs(&[user_file], &j, &j, out).is_ok());
+        // an earlier run's folder not in the set that also holds a file of the user's keeps
+        // that file (only the run's own files go): an input there is refused only when it is
+        // one of the run's own files
+        let mine = out.join(&j[0].name).join("mybase.json");
+        std::fs::write(&mine, "{}").unwrap();
+        let elsewhere = vec![j[2].clone()];
+        assert!(check_inputs_outside_runs(
+            std::slice::from_ref(&mine),
+            &elsewhere,
+            &elsewhere,
+            out
+        )
+        .is_ok());
+        let own = out.join(&j[0].name).join("system.json");
+        assert!(check_inputs_outside_runs(&[own], &elsewhere, &elsewhere, out).is_err());
+        std::fs::remove_file(&mine).unwrap();
         // an earlier run's folder that is a link (to an archive) with a note in it: nothing is
         // removed through the link
         let archive = tempfile::tempdir().unwrap();

@@ -467,7 +467,16 @@ fn parse_connectors(ctx: Ctx, n: Node) -> Result<Vec<Connector>, SspError> {
                 return Err(ctx.unsupported(t, format!("array connector '{name}'")));
             }
             if t.tag_name().namespace() == Some(NS_SSC) {
-                ty = Some(connector_type(ctx, t, &name)?);
+                // one type: a second (<ssc:Integer/><ssc:Real/>) replaced the first
+                if ty.replace(connector_type(ctx, t, &name)?).is_some() {
+                    return Err(ctx.err(
+                        t,
+                        format!(
+                            "connector '{}' has more than one type",
+                            crate::show::text(&name)
+                        ),
+                    ));
+                }
                 continue;
             }
             match t.tag_name().name() {

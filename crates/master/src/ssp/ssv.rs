@@ -239,7 +239,7 @@ pub(super) fn parse_mapping(ctx: Ctx, n: Node) -> Result<Mapping, SspError> {
     check_version(ctx, n)?;
     let mut entries = Vec::new();
     let mut targets: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
-    for e in elements(n) {
+    for e in elements(n).filter(|e| !is_meta(*e)) {
         match e.tag_name().name() {
             "MappingEntry" if is(e, NS_SSM, "MappingEntry") => {
                 let mut transformation = None;

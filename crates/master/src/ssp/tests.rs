@@ -927,10 +927,26 @@ fn an_element_given_twice_is_refused_and_ssp2_meta_data_is_skipped() {
         )
         .replacen("</ssd:Component>", &format!("{meta}</ssd:Component>"), 1);
     import_ok(&refs(&files(v2)));
-    // an SSP 2.0 array connector is refused as one
+    // an SSP 2.0 array connector is refused as one, and a connector of two types
     let e = import_err(&refs(&files(with(
         r#"<ssc:Real/></ssd:Connector>"#,
         r#"<ssc:Real/><ssc:Dimension size="1"/></ssd:Connector>"#,
     ))));
     assert!(e.contains("array connector 'position'"), "{e}");
+    let e = import_err(&refs(&files(with(
+        r#"<ssc:Real/></ssd:Connector>"#,
+        r#"<ssc:Integer/><ssc:Real/></ssd:Connector>"#,
+    ))));
+    assert!(
+        e.contains("connector 'position' has more than one type"),
+        "{e}"
+    );
+    // and in a parameter mapping's root (SSP 2.0 allows meta data there too)
+    let d = tempfile::tempdir().unwrap();
+    let mapped = MAP_SSM.replacen(
+        "<ssm:MappingEntry",
+        &format!("{meta}\n  <ssm:MappingEntry"),
+        1,
+    );
+    import(&v2_archive(d.path(), BARE_SSV, &mapped), &stepped()).unwrap_or_else(|e| panic!("{e}"));
 }

@@ -363,7 +363,14 @@ fn cargo_build(root: &Path, build: &Build, crates: &[String]) -> Result<(), Stri
     cmd.current_dir(filesystem_root)
         .arg("--manifest-path")
         .arg(&manifest)
-        .args(["--release", "--lib", "--features", "fmi-export"]);
+        // the glue built into a shared library of its own (see model-description's feature
+        // `fmu-library`): not turned on by `fmi-export`, which in-process tests use too
+        .args([
+            "--release",
+            "--lib",
+            "--features",
+            "fmi-export,model-description/fmu-library",
+        ]);
     for c in crates {
         cmd.args(["-p", c]);
     }

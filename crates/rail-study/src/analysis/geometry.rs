@@ -663,29 +663,44 @@ impl GeometryResults {
         a.add_lines("tan_gamma.svg", &tg)?;
         // an amplitude whose turning point lies on the climbing flange gives the geometry's
         // number, not a running wheelset's: the three methods are drawn up to the flange
-        // limit, the reference method beyond it in grey (every value is in conicity.csv)
+        // limit (when at least two amplitudes lie within it), the reference method beyond it
+        // in grey (every value is in conicity.csv)
         let within: Vec<&ConicityPoint> = self
             .conicity
             .iter()
             .filter(|p| !p.beyond_flange_limit)
             .collect();
-        let split = !within.is_empty() && within.len() < self.conicity.len();
+        let any_beyond = within.len() < self.conicity.len();
+        let lines = !any_beyond || within.len() >= 2;
         let pts = |f: fn(&ConicityPoint) -> f64| -> Vec<(f64, f64)> {
             self.conicity
                 .iter()
-                .filter(|p| !split || !p.beyond_flange_limit)
+                .filter(|p| !any_beyond || !p.beyond_flange_limit)
                 .map(|p| (p.amplitude_m * 1e3, f(p)))
                 .collect()
         };
+        let title =
+            if lines {
+                format!("Equivalent conicity (EN 15302, {conv})")
+            } else {
+                format!(
+                "Equivalent conicity (EN 15302, {conv}): the turning points lie on the climbing \
+                 flange at {} amplitudes",
+                if within.is_empty() { "all" } else { "all but one" }
+            )
+            };
         let mut con = Chart::new(
-            &format!("Equivalent conicity (EN 15302, {conv})"),
+            &title,
             "amplitude [mm]",
             "equivalent conicity tan gamma_e [-]",
-        )
-        .with_series("reference method (Annex B)", pts(|p| p.tan_gamma_e))
-        .with_series("linear regression (Annex C)", pts(|p| p.regression))
-        .with_series("harmonic linearisation", pts(|p| p.harmonic));
-        if split {
+        );
+        if lines {
+            con = con
+                .with_series("reference method (Annex B)", pts(|p| p.tan_gamma_e))
+                .with_series("linear regression (Annex C)", pts(|p| p.regression))
+                .with_series("harmonic linearisation", pts(|p| p.harmonic));
+        }
+        if any_beyond {
             // from the last amplitude within the limit, so that the grey line continues it
             let beyond = within
                 .last()
@@ -866,6 +881,25 @@ mod tests {
         let (svg, beyond, rows) = chart(9e-3);
         assert!(beyond > 0 && beyond < rows, "{beyond} of {rows}");
         assert!(svg.contains(BEYOND_FLANGE_LIMIT), "{svg}");
+        // a wheelset so narrow in this gauge that every amplitude's turning point lies on the
+        // flange: the grey line alone, and the title says so
+        let narrow = GeometryInputs {
+            gauge_m: 1.425,
+            back_to_back: Some((1.364, NOMINAL_BACK_TO_BACK_M.1)),
+            amplitude_max_m: 6e-3,
+            ..GeometryInputs::default()
+        };
+        let r = contact_geometry(&narrow, &AtomicBool::new(false)).unwrap();
+        assert!(r.conicity.iter().all(|p| p.beyond_flange_limit));
+        let mut a = Artefacts::default();
+        r.add_artefacts(&mut a).unwrap();
+        let svg = a.files.iter().find(|(n, _)| n == "conicity.svg").unwrap();
+        let svg = String::from_utf8_lossy(&svg.1);
+        assert!(svg.contains(BEYOND_FLANGE_LIMIT), "{svg}");
+        assert!(
+            svg.contains("flange at all amplitudes") && !svg.contains("Annex C"),
+            "{svg}"
+        );
     }
 
     /// A table that stops short of flange contact (here a --y-max of 3 mm) is written, with a
