@@ -546,6 +546,16 @@ fn an_exported_ssp_runs_whatever_its_instance_names_and_keeps_its_coupling_setti
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // the results name the FMU by the archive and its member, not by the unpacked copy that
+    // went with the run
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(c.path("odd.meta.json")).unwrap()).unwrap();
+    let fmu = meta["system"]["instances"][0]["fmu"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let archive = c.path("odd.ssp").canonicalize().unwrap();
+    assert_eq!(fmu, format!("{}:resources/Hostile.fmu", archive.display()));
 }
 
 /// A bare .ssd reads its parameter files beside it: a run's results or summary named as one

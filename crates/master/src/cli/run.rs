@@ -273,12 +273,18 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
             check_outputs_apart(&inputs, &written(&output, format))?;
             crate::output::check_folders_exist(&written(&output, format))?;
         }
-        // FMU paths absolute, so that the description runs again from wherever it is saved (an
-        // SSP's FMUs lie in a temporary folder: its description is kept as imported)
-        let described = if imported.is_some() {
-            sys.desc.clone()
-        } else {
-            sys.resolved()
+        // FMU paths absolute, so that the description runs again from wherever it is saved; an
+        // SSP's FMUs were unpacked into a temporary folder that goes after the run: each is
+        // named by the archive and member it comes from
+        let described = match &imported {
+            Some(i) => {
+                let mut d = sys.desc.clone();
+                for (inst, source) in d.instances.iter_mut().zip(&i.fmu_sources) {
+                    inst.fmu.clone_from(source);
+                }
+                d
+            }
+            None => sys.resolved(),
         };
         let run_context = RunContext {
             system: serde_json::to_value(&described).ok(),

@@ -55,6 +55,7 @@ pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, S
     };
     let mut instances = Vec::new();
     let mut models = Vec::new();
+    let mut fmu_sources = Vec::new();
     for (i, c) in ssd.system.components.iter().enumerate() {
         if c.name.is_empty() || c.name.contains('.') {
             return Err(SspError::Unsupported {
@@ -87,6 +88,7 @@ pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, S
             fmu_error: Box::new(source),
         })?;
         models.push(archive.model);
+        fmu_sources.push(pkg.source_of(&rel));
         instances.push(InstanceSpec {
             name: c.name.clone(),
             fmu: file,
@@ -204,6 +206,7 @@ pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, S
         system: LoadedSystem::from_description(desc, &base_dir, &imp.pkg.label()),
         version: ssd.version,
         files_read: imp.pkg.files_read().to_vec(),
+        fmu_sources,
         _unpacked: unpacked,
     })
 }

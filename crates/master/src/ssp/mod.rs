@@ -94,6 +94,10 @@ pub struct ImportedSsp {
     /// The parameter (.ssv) and mapping (.ssm) files read beside a bare .ssd: inputs of a run
     /// as much as the .ssd and the FMUs.
     pub files_read: Vec<PathBuf>,
+    /// Where each instance's FMU comes from, as messages name it (`x.ssp:resources/a.fmu`, or
+    /// the file beside a bare .ssd): the system's own FMU paths name the unpacked copies,
+    /// which go with the import.
+    pub fmu_sources: Vec<PathBuf>,
     _unpacked: Option<crate::fmu::extract::ExtractionDir>,
 }
 

@@ -115,6 +115,19 @@ impl Package {
         }
     }
 
+    /// Where file `rel` of the package comes from, for the record of a run: the archive's
+    /// absolute path and the member (`/work/x.ssp:resources/a.fmu`), or the file's absolute
+    /// path beside a bare .ssd.
+    pub fn source_of(&self, rel: &str) -> PathBuf {
+        let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+        match self {
+            Package::Zip { path, .. } => {
+                PathBuf::from(format!("{}:{rel}", absolute(path).display()))
+            }
+            Package::Dir { dir, .. } => absolute(&dir.join(rel)),
+        }
+    }
+
     /// The SSD's text and its label.
     pub fn read_ssd(&mut self) -> Result<(String, String), SspError> {
         match self {
