@@ -302,8 +302,8 @@ impl PySystem {
         format!("{} with the run's arguments", self.prepared.system().file)
     }
 
-    /// The description (FMU paths absolute) with a run's start values and stop time, as
-    /// JSON.
+    /// The description (FMU paths absolute; an SSP's as archive and member) with a run's
+    /// start values and stop time, as JSON: the record of a run.
     fn run_description(
         &self,
         params: &BTreeMap<String, Value>,
@@ -316,6 +316,13 @@ impl PySystem {
         }
         if let Some(t) = stop_time {
             desc.stop_time = t;
+        }
+        // an SSP's FMUs were unpacked into a temporary folder that goes with the system: each
+        // is named by the archive and member it comes from, as `master run` records them
+        if let Some(imported) = &self._ssp {
+            for (inst, source) in desc.instances.iter_mut().zip(&imported.fmu_sources) {
+                inst.fmu.clone_from(source);
+            }
         }
         serde_json::to_value(&desc)
             .map_err(|e| Error::new_err(format!("internal: description: {e}")))

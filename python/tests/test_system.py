@@ -243,6 +243,10 @@ def test_an_ssp_loads_and_runs_as_the_command_line_runs_it(passive_file, master_
     cli = railfmu.read_results(cli_csv)
     assert cli.header == res.header
     assert np.array_equal(bits(cli.values), bits(res.values))
+    # both record each FMU by the archive and member it comes from (not its unpacked copy)
+    fmus = [i["fmu"] for i in res.metadata["system"]["instances"]]
+    assert fmus == [i["fmu"] for i in cli.metadata["system"]["instances"]]
+    assert fmus[0] == f"{ssp.resolve()}:resources/Bogie2Dof.fmu", fmus
     assert np.max(np.abs(res["bogie.wheelset_front.lateral_displacement_relative"])) > 1e-6
     # the variables to record, as `master run --record` names them: the same columns and values
     names = ["bogie.wheelset_front.lateral_displacement_relative", "damper_left.damper.force"]
