@@ -13,20 +13,27 @@ import numpy as np
 from . import _railfmu
 
 
-def _plain(value: Any) -> Any:
-    """NumPy numbers and arrays, pandas Series and ranges as the Python numbers and lists JSON
-    writes, paths as their text; anything else is a TypeError naming its type."""
-    if isinstance(value, np.ndarray):
-        return value.tolist()
+def _python(value: Any) -> Any:
+    """A NumPy number or array, a pandas Series or Index as the Python number or list JSON
+    writes; anything else as it is."""
     if isinstance(value, np.generic):
         return value.item()
+    if not isinstance(value, (dict, list, tuple, str)) and callable(getattr(value, "tolist", None)):
+        return value.tolist()
+    return value
+
+
+def _plain(value: Any) -> Any:
+    """What ``json.dumps`` cannot write by itself: NumPy and pandas values as :func:`_python`
+    reads them, ranges as lists, paths as their text; anything else is a TypeError naming its
+    type."""
+    converted = _python(value)
+    if converted is not value:
+        return converted
     if isinstance(value, os.PathLike):
         return os.fspath(value)
     if isinstance(value, range):
         return list(value)
-    tolist = getattr(value, "tolist", None)  # a pandas Series or Index
-    if callable(tolist):
-        return tolist()
     shown = repr(value)
     shown = shown if len(shown) <= 60 else shown[:57] + "..."
     raise TypeError(f"{type(value).__name__} {shown} is not a value JSON holds (a number, text, list or dict)")
@@ -35,10 +42,7 @@ def _plain(value: Any) -> Any:
 def _first_bad(value: Any, path: List[str]) -> Optional[str]:
     """Where in ``value`` the first number JSON has no form for (NaN, an infinity) is, and what
     it is; None if there is none."""
-    if isinstance(value, np.generic):
-        value = value.item()
-    elif not isinstance(value, (dict, list, tuple, str)) and callable(getattr(value, "tolist", None)):
-        value = value.tolist()  # a NumPy array, a pandas Series or Index: as _plain reads them
+    value = _python(value)
     if isinstance(value, float) and not math.isfinite(value):
         return f"{'.'.join(path) or 'the value'}: {value} (JSON has no such number)"
     if isinstance(value, dict):

@@ -320,9 +320,7 @@ impl PySystem {
         // an SSP's FMUs were unpacked into a temporary folder that goes with the system: each
         // is named by the archive and member it comes from, as `master run` records them
         if let Some(imported) = &self._ssp {
-            for (inst, source) in desc.instances.iter_mut().zip(&imported.fmu_sources) {
-                inst.fmu.clone_from(source);
-            }
+            imported.name_fmu_sources(&mut desc);
         }
         serde_json::to_value(&desc)
             .map_err(|e| Error::new_err(format!("internal: description: {e}")))

@@ -279,9 +279,7 @@ pub fn execute(args: &Args, ctx: &Context) -> Result<(), CommandError> {
         let described = match &imported {
             Some(i) => {
                 let mut d = sys.desc.clone();
-                for (inst, source) in d.instances.iter_mut().zip(&i.fmu_sources) {
-                    inst.fmu.clone_from(source);
-                }
+                i.name_fmu_sources(&mut d);
                 d
             }
             None => sys.resolved(),

@@ -101,6 +101,17 @@ pub struct ImportedSsp {
     _unpacked: Option<crate::fmu::extract::ExtractionDir>,
 }
 
+impl ImportedSsp {
+    /// `desc` (this SSP's system, as run) with each instance's FMU named by the archive and
+    /// member it comes from ([`Self::fmu_sources`]), not by its unpacked copy, which goes with
+    /// the import: the record of a run.
+    pub fn name_fmu_sources(&self, desc: &mut crate::system::SystemDescription) {
+        for (inst, source) in desc.instances.iter_mut().zip(&self.fmu_sources) {
+            inst.fmu.clone_from(source);
+        }
+    }
+}
+
 /// Whether `path` names an SSP (`.ssp` or `.ssd`) rather than a JSON system description.
 pub fn is_ssp_path(path: &Path) -> bool {
     path.extension()

@@ -4,7 +4,7 @@
 use roxmltree::Node;
 
 use super::ssv::{self, Mapping, ParameterSet};
-use super::xml::{self, check_single_children, elements, is, is_meta, Ctx, NS_SSC, NS_SSD};
+use super::xml::{self, check_single_children, content, elements, is, Ctx, NS_SSC, NS_SSD};
 use super::SspError;
 use crate::show;
 
@@ -194,7 +194,7 @@ pub(super) fn parse(file: &str, text: &str) -> Result<Ssd, SspError> {
     let mut units = Vec::new();
     let (mut start, mut stop, mut base_step) = (None, None, None);
     check_single_children(ctx, root)?;
-    for c in elements(root).filter(|c| !is_meta(*c)) {
+    for c in content(root) {
         match c.tag_name().name() {
             "System" if is(c, NS_SSD, "System") => system = Some(parse_system(ctx, c)?),
             "Units" if is(c, NS_SSD, "Units") => units = parse_units(ctx, c)?,
@@ -292,7 +292,7 @@ fn parse_system(ctx: Ctx, n: Node) -> Result<System, SspError> {
         coupling: CouplingSettings::default(),
     };
     check_single_children(ctx, n)?;
-    for c in elements(n).filter(|c| !is_meta(*c)) {
+    for c in content(n) {
         if c.tag_name().namespace() != Some(NS_SSD) {
             return Err(ctx.unexpected(c));
         }
@@ -395,7 +395,7 @@ fn parse_component(ctx: Ctx, n: Node) -> Result<Component, SspError> {
         line: ctx.line(n),
     };
     check_single_children(ctx, n)?;
-    for c in elements(n).filter(|c| !is_meta(*c)) {
+    for c in content(n) {
         if c.tag_name().namespace() != Some(NS_SSD) {
             return Err(ctx.unexpected(c));
         }
@@ -461,7 +461,7 @@ fn parse_connectors(ctx: Ctx, n: Node) -> Result<Vec<Connector>, SspError> {
         }
         let mut ty = None;
         check_single_children(ctx, c)?;
-        for t in elements(c).filter(|t| !is_meta(*t)) {
+        for t in content(c) {
             // SSP 1.0 has no arrays; 2.0 gives their size as <ssc:Dimension>
             if t.tag_name().name() == "Dimension" {
                 return Err(ctx.unsupported(t, format!("array connector '{name}'")));
@@ -520,7 +520,7 @@ fn parse_connection(ctx: Ctx, e: Node) -> Result<Connection, SspError> {
         }
     }
     check_single_children(ctx, e)?;
-    for t in elements(e).filter(|t| !is_meta(*t)) {
+    for t in content(e) {
         match t.tag_name().name() {
             "LinearTransformation" if is(t, NS_SSC, "LinearTransformation") => {
                 let factor = ctx.f64(t, "factor")?.unwrap_or(1.0);
@@ -596,7 +596,7 @@ fn parse_bindings(ctx: Ctx, n: Node) -> Result<Vec<Binding>, SspError> {
         let mut inline = None;
         let mut mapping = None;
         check_single_children(ctx, b)?;
-        for c in elements(b).filter(|c| !is_meta(*c)) {
+        for c in content(b) {
             match c.tag_name().name() {
                 "ParameterValues" if is(c, NS_SSD, "ParameterValues") => {
                     let mut sets = elements(c);

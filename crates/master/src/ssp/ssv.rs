@@ -4,7 +4,7 @@
 use roxmltree::Node;
 
 use super::xml::{
-    self, check_single_children, elements, is, is_meta, qualified, scalar, Ctx, NS_SSC, NS_SSM,
+    self, check_single_children, content, elements, is, qualified, scalar, Ctx, NS_SSC, NS_SSM,
     NS_SSV,
 };
 use super::SspError;
@@ -109,7 +109,7 @@ pub(super) fn parse_set(ctx: Ctx, n: Node) -> Result<ParameterSet, SspError> {
     // SSV 1.0 6: a parameter's name "MUST be unique within the parameter set"
     let mut seen: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
     check_single_children(ctx, n)?;
-    for c in elements(n).filter(|c| !is_meta(*c)) {
+    for c in content(n) {
         match c.tag_name().name() {
             "Parameters" if is(c, NS_SSV, "Parameters") => {
                 for p in elements(c) {
@@ -145,7 +145,7 @@ fn parse_parameter(ctx: Ctx, p: Node) -> Result<Parameter, SspError> {
     let name = ctx.req(p, "name")?.to_string();
     let mut value = None;
     let mut unit = None;
-    for t in elements(p).filter(|t| !is_meta(*t)) {
+    for t in content(p) {
         // SSP 1.0 has no arrays; 2.0 gives their size as <ssc:Dimension>
         if t.tag_name().name() == "Dimension" {
             return Err(ctx.unsupported(t, format!("array parameter '{name}'")));
@@ -239,22 +239,11 @@ pub(super) fn parse_mapping(ctx: Ctx, n: Node) -> Result<Mapping, SspError> {
     check_version(ctx, n)?;
     let mut entries = Vec::new();
     let mut targets: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
-    for e in elements(n).filter(|e| !is_meta(*e)) {
+    for e in content(n) {
         match e.tag_name().name() {
             "MappingEntry" if is(e, NS_SSM, "MappingEntry") => {
                 let mut transformation = None;
-                // one transformation at most: a second replaced the first
-                let second = elements(e)
-                    .filter(|t| t.tag_name().namespace() == Some(NS_SSC) && !is_meta(*t))
-                    .nth(1);
-                if let Some(second) = second {
-                    return Err(ctx.err(
-                        second,
-                        "a <ssm:MappingEntry> holds more than one transformation",
-                    ));
-                }
-                check_single_children(ctx, e)?;
-                for t in elements(e).filter(|t| !is_meta(*t)) {
+                for t in content(e) {
                     if t.tag_name().namespace() == Some(NS_SSM)
                         && t.tag_name().name() == "Annotations"
                     {
@@ -263,8 +252,17 @@ pub(super) fn parse_mapping(ctx: Ctx, n: Node) -> Result<Mapping, SspError> {
                     if t.tag_name().namespace() != Some(NS_SSC) {
                         return Err(ctx.unexpected(t));
                     }
-                    transformation = Some(parse_transformation(ctx, t)?);
+                    // one transformation at most: a second replaced the first
+                    if transformation
+                        .replace(parse_transformation(ctx, t)?)
+                        .is_some()
+                    {
+                        return Err(
+                            ctx.err(t, "a <ssm:MappingEntry> holds more than one transformation")
+                        );
+                    }
                 }
+                check_single_children(ctx, e)?;
                 let target = ctx.req(e, "target")?.to_string();
                 // SSM 1.0 7: multiple parameters MUST NOT be mapped to the same name
                 if let Some(first) = targets.insert(target.clone(), ctx.line(e)) {

@@ -129,13 +129,18 @@ pub(super) fn is_meta(n: Node) -> bool {
         )
 }
 
+/// The element children of `n` but its meta data ([`is_meta`]): what a reader uses or refuses.
+pub(super) fn content<'a, 'i>(n: Node<'a, 'i>) -> impl Iterator<Item = Node<'a, 'i>> {
+    elements(n).filter(|c| !is_meta(*c))
+}
+
 /// Refuses a child of `n` given twice where the schemas allow one (every child but meta data,
 /// signatures and array dimensions): the readers keep one of each, so a second
 /// `<ssd:ParameterBindings>` or `<ssd:System>` dropped the first's content without a word.
 pub(super) fn check_single_children(ctx: Ctx, n: Node) -> Result<(), SspError> {
     let mut seen: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
-    for c in elements(n) {
-        if is_meta(c) || c.tag_name().name() == "Dimension" {
+    for c in content(n) {
+        if c.tag_name().name() == "Dimension" {
             continue;
         }
         let name = qualified(c);

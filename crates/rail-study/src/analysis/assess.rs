@@ -349,12 +349,12 @@ impl ResultsTable {
             path: path.to_path_buf(),
             names,
             columns: values,
-            described: meta.is_some(),
-            recorded_speed: meta.as_ref().and_then(recorded_speed),
-            sampling: meta.and_then(|m| m.sampling),
+            described: false,
+            recorded_speed: None,
+            sampling: None,
             text_columns,
         }
-        .check_recorded_rate()
+        .with_metadata(meta)
     }
 
     /// Index of a column by full name or by name without its ` [unit]`.
