@@ -121,6 +121,8 @@ fn a_gauss_seidel_system_and_its_order_import_back_bit_for_bit() {
         sys.desc.stop_time = STOP_TIME_S;
         sys.desc.init_sweeps = 5;
         sys.desc.max_step_halvings = 2;
+        // a connection passing its value unchanged travels as suppressUnitConversion="true"
+        sys.desc.connections[0].convert_units = false;
         assert_eq!(sys.desc.algorithm, Algorithm::GaussSeidel, "{name}");
         assert!(sys.desc.order.is_some(), "{name} names its order");
         let dir = tempfile::tempdir().unwrap();
@@ -133,6 +135,7 @@ fn a_gauss_seidel_system_and_its_order_import_back_bit_for_bit() {
         assert_eq!(back.algorithm, Algorithm::GaussSeidel, "{name}");
         assert_eq!(back.order, sys.desc.order, "{name}");
         assert_eq!((back.init_sweeps, back.max_step_halvings), (5, 2), "{name}");
+        assert_eq!(back.connections, sys.desc.connections, "{name}");
         let (ours, again) = (run(&sys), run(&imported.system));
         for v in recorded(&sys) {
             assert_eq!(

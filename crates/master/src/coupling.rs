@@ -47,7 +47,7 @@ mod plan;
 pub use plan::{
     check_plan, step_below_resolution, topological_order, Algorithm, ColumnInfo, CouplingPlan,
     Failure, PlanConnection, PlanInstance, Recorded, RunLimits, SimError, SimOutput, Summary,
-    Terminated, MAX_RECORDED_VALUES_VAR, MAX_STEPS_VAR,
+    Terminated, UnitConversion, MAX_RECORDED_VALUES_VAR, MAX_STEPS_VAR,
 };
 
 /// Options of one run.

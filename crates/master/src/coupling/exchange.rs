@@ -2,7 +2,7 @@
 //! connected outputs are read with one call per type, every slave's connected inputs written
 //! with one call per type, every slave's recorded variables read with one call per type.
 
-use super::CouplingPlan;
+use super::{CouplingPlan, UnitConversion};
 use crate::slave::{VarBatch, VarRef};
 
 /// The connected outputs of one instance and where they go.
@@ -20,6 +20,9 @@ pub(super) struct Source {
     /// Per output: it may change within a step when the instance's inputs are set
     /// (`PlanConnection::source_depends_on_inputs`).
     pub varies: Vec<bool>,
+    /// The outputs passed on in another unit: (position in `outputs`, conversion), applied
+    /// to the value as it is read (each connection has its own position).
+    pub conversions: Vec<(usize, UnitConversion)>,
 }
 
 /// Inputs of one instance written together.
@@ -269,6 +272,10 @@ impl Exchange {
                     varies: mine()
                         .map(|(_, (c, _))| c.source_depends_on_inputs)
                         .collect(),
+                    conversions: mine()
+                        .enumerate()
+                        .filter_map(|(k, (_, (c, _)))| c.conversion.map(|u| (k, u)))
+                        .collect(),
                     dests: dests(group(mine().map(|(_, (c, at))| (c.to_instance, c.to, at)))),
                     feeds_through: {
                         let mut f: Vec<usize> = mine()
@@ -303,11 +310,17 @@ impl Exchange {
         .map(|g| RecordGroup {
             instance: g.instance,
             from_outputs: {
-                let outputs = sources[g.instance].outputs.vars();
+                // a value converted for its destination is not the variable's own
+                let src = &sources[g.instance];
+                let own = |k: &usize| !src.conversions.iter().any(|(c, _)| c == k);
                 g.vars
                     .vars()
                     .iter()
-                    .map(|v| outputs.iter().position(|o| o == v))
+                    .map(|v| {
+                        (0..src.outputs.vars().len())
+                            .filter(own)
+                            .find(|&k| src.outputs.vars()[k] == *v)
+                    })
                     .collect()
             },
             vars: g.vars,

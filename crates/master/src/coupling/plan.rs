@@ -39,6 +39,35 @@ pub struct PlanConnection {
     /// declared dependencies: yes) on a connected input of its own instance: setting that
     /// input within a Gauss-Seidel step may change it.
     pub source_depends_on_inputs: bool,
+    /// The source's value in the target's unit, when the two units differ (None: passed
+    /// unchanged).
+    pub conversion: Option<UnitConversion>,
+}
+
+/// A Real value in one unit expressed in another of the same base units (FMI 2.0, 2.2.2:
+/// value in SI = BaseUnit factor * value + BaseUnit offset, for either unit):
+/// `target = factor * source + offset`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct UnitConversion {
+    pub factor: f64,
+    pub offset: f64,
+}
+
+impl UnitConversion {
+    /// From a unit with BaseUnit (`factor`, `offset`) `from` to one with `to` (both in the
+    /// same SI base units); None when the two are the same unit under two names.
+    pub fn between(from: (f64, f64), to: (f64, f64)) -> Option<Self> {
+        let c = UnitConversion {
+            factor: from.0 / to.0,
+            offset: (from.1 - to.1) / to.0,
+        };
+        (c.factor != 1.0 || c.offset != 0.0).then_some(c)
+    }
+
+    #[inline]
+    pub fn apply(&self, x: f64) -> f64 {
+        self.factor * x + self.offset
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]

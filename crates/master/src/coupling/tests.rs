@@ -269,6 +269,7 @@ pub fn two_mass_plan(alg: Algorithm, order: Vec<usize>, h: f64, stop: f64) -> Co
         label: l.into(),
         feedthrough: false,
         source_depends_on_inputs: true,
+        conversion: None,
     };
     CouplingPlan {
         start_time: 0.0,
@@ -382,6 +383,47 @@ fn gauss_seidel_in_feedthrough_order_beats_jacobi() {
         1.0,
     ));
     assert!(eg < ej, "GS {eg} vs Jacobi {ej}");
+}
+
+#[test]
+fn a_connection_converts_the_value_to_the_target_unit_and_records_the_source_in_its_own() {
+    for alg in [Algorithm::GaussSeidel, Algorithm::Jacobi] {
+        let mut plan = two_mass_plan(alg, vec![0, 1], 1e-3, 0.02);
+        // ms.position [m] -> sdm.input_position as if that were in a unit of 1 mm, 5 mm off
+        plan.connections[0].conversion = Some(UnitConversion {
+            factor: 1000.0,
+            offset: 5.0,
+        });
+        plan.record.push(Recorded {
+            instance: 1,
+            var: r(3),
+            label: "sdm.input_position".into(),
+            info: Default::default(),
+        });
+        let (out, _, _) = run(&plan);
+        let mut rows = 0;
+        for row in out.rows() {
+            // ms.position is read once for the exchange and the record: recorded in metres
+            assert_eq!(row[4], 1000.0 * row[1] + 5.0, "{alg:?}, t = {}", row[0]);
+            rows += 1;
+        }
+        assert_eq!(rows, 21);
+        assert_eq!(out.rows().next().unwrap()[1], 0.1);
+    }
+}
+
+#[test]
+fn unit_conversion_by_base_units() {
+    // degree Celsius (K, offset 273.15) to kelvin and back
+    let c = UnitConversion::between((1.0, 273.15), (1.0, 0.0)).unwrap();
+    assert_eq!(c.apply(20.0), 293.15);
+    let k = UnitConversion::between((1.0, 0.0), (1.0, 273.15)).unwrap();
+    assert!((k.apply(293.15) - 20.0).abs() < 1e-12);
+    // km/h (1/3.6 m/s) to m/s
+    let v = UnitConversion::between((1.0 / 3.6, 0.0), (1.0, 0.0)).unwrap();
+    assert!((v.apply(360.0) - 100.0).abs() < 1e-12);
+    // the same unit under two names: nothing to convert
+    assert_eq!(UnitConversion::between((0.001, 0.0), (0.001, 0.0)), None);
 }
 
 #[test]
@@ -781,6 +823,7 @@ fn two_sources_plan(stop: f64) -> CouplingPlan {
         label: l.into(),
         feedthrough: false,
         source_depends_on_inputs: true,
+        conversion: None,
     };
     plan.connections = vec![
         conn(0, 4, 1, 3, "ms.position"),
@@ -875,6 +918,7 @@ fn an_input_driven_by_two_connections_is_refused() {
         label: "ms2.position".into(),
         feedthrough: false,
         source_depends_on_inputs: false,
+        conversion: None,
     });
     let e = check_plan(&plan, 3).unwrap_err().to_string();
     assert!(
@@ -923,6 +967,7 @@ fn common_case_and_general(
                 feedthrough: ti == 1 && force_read,
                 // the coupling force is the only output that depends on an input
                 source_depends_on_inputs: (fi, fv) == (1, 5),
+                conversion: None,
             })
         })
         .collect();
@@ -942,6 +987,7 @@ fn common_case_and_general(
             label: "ms.m".into(),
             feedthrough: false,
             source_depends_on_inputs: false,
+            conversion: None,
         });
     }
     let run = |general_engine: bool| {
@@ -1107,6 +1153,7 @@ fn chain_plan(alg: Algorithm) -> CouplingPlan {
         feedthrough,
         // the gain's output depends on its input; the clock has none
         source_depends_on_inputs: fi == 0,
+        conversion: None,
     };
     let inst = |name: &str| PlanInstance {
         name: name.into(),

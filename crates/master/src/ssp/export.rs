@@ -293,11 +293,17 @@ pub(super) fn export(sys: &LoadedSystem, out: &Path) -> Result<ExportSummary, Ss
             };
             let _ = writeln!(
                 ssd,
-                r#"      <ssd:Connection startElement="{}" startConnector="{}" endElement="{}" endConnector="{}"/>"#,
+                r#"      <ssd:Connection startElement="{}" startConnector="{}" endElement="{}" endConnector="{}"{}/>"#,
                 escape(fi),
                 escape(fv),
                 escape(ti),
-                escape(tv)
+                escape(tv),
+                // SSP converts between connectors of different units unless told not to
+                if c.convert_units {
+                    ""
+                } else {
+                    r#" suppressUnitConversion="true""#
+                }
             );
         }
         let _ = writeln!(ssd, "    </ssd:Connections>");

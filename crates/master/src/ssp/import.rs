@@ -351,11 +351,11 @@ impl Importer {
             let (_, ec, e_fmu, e_declared) = end_of(ee, &c.end_connector)?;
             let start = format!("{se}.{}", c.start_connector);
             let end = format!("{ee}.{}", c.end_connector);
-            // Two FMU variables with their own units are compared by the system's plan (a
-            // mismatch refused there, whatever the SSD says). A unit only a connector declares
-            // (its FMU variable has none; check_connectors makes a declared unit agree with
-            // the FMU's) would need a conversion the master does not make: refused, unless the
-            // connection suppresses conversion.
+            // Two FMU variables with their own units are converted by the system's plan (SSP
+            // 1.0, 5.3.2), unless the connection suppresses conversion. A unit only a
+            // connector declares (its FMU variable has none; check_connectors makes a declared
+            // unit agree with the FMU's) would need a conversion of a value the FMU gives no
+            // unit: refused, unless the connection suppresses conversion.
             let both_from_fmus = s_fmu.is_some() && e_fmu.is_some();
             let (su, eu) = (s_declared.or(s_fmu), e_declared.or(e_fmu));
             if let (Some(su), Some(eu), false, false) =
@@ -380,7 +380,11 @@ impl Importer {
             } else {
                 (start, end)
             };
-            out.push(ConnectionSpec { from, to });
+            out.push(ConnectionSpec {
+                from,
+                to,
+                convert_units: !c.suppress_unit_conversion,
+            });
         }
         Ok(out)
     }

@@ -149,6 +149,12 @@ fn omsimulator_style_system_binding_with_hierarchical_names() {
     assert_eq!(d.connections.len(), 2);
     assert_eq!(d.connections[0].from, "ms1.position");
     assert_eq!(d.connections[0].to, "ms2.force");
+    // suppressUnitConversion="true" (and "1"): the value passes unchanged
+    assert!(d.connections.iter().all(|c| !c.convert_units));
+    let mut files = oms_files();
+    files[0].1 = files[0].1.replace(r#" suppressUnitConversion="1""#, "");
+    let d = import_ok(&refs(&files)).system.desc;
+    assert!(!d.connections[0].convert_units && d.connections[1].convert_units);
     assert_eq!(d.step, 0.002);
     assert_eq!(d.stop_time, 2.0);
     assert_eq!(d.start_time, 0.0);

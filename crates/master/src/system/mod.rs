@@ -131,6 +131,19 @@ pub struct InstanceSpec {
 pub struct ConnectionSpec {
     pub from: String,
     pub to: String,
+    /// Between variables of different units (each defined by a BaseUnit in its FMU's
+    /// UnitDefinitions), the value is converted to the target's unit; `false` passes it
+    /// unchanged whatever the units (SSP's `suppressUnitConversion="true"`).
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub convert_units: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+fn is_true(b: &bool) -> bool {
+    *b
 }
 
 /// A problem with a system description; always names the file and field.

@@ -8,8 +8,9 @@ use serde_json::Value;
 use super::{json_value_for, type_of, LoadedSystem, SystemError};
 use crate::coupling::{
     topological_order, Algorithm, ColumnInfo, CouplingPlan, PlanConnection, PlanInstance, Recorded,
+    UnitConversion,
 };
-use crate::model_description::{Causality, ModelDescription, VarType};
+use crate::model_description::{BaseUnit, Causality, ModelDescription, VarType, BASE_UNIT_NAMES};
 use crate::show::{num, text};
 use crate::slave::VarRef;
 
@@ -145,18 +146,21 @@ impl LoadedSystem {
                     ),
                 ));
             }
-            if let (Some(uf), Some(ut)) = (&fv.unit, &tv.unit) {
-                if uf != ut {
-                    return Err(self.invalid(
-                        format!("connections[{ci}]"),
-                        &c.to,
-                        format!(
-                            "unit mismatch: '{}' is in [{uf}] but '{}' is in [{ut}]",
-                            c.from, c.to
-                        ),
-                    ));
+            let conversion = match (&fv.unit, &tv.unit) {
+                (Some(uf), Some(ut)) if uf != ut && c.convert_units => {
+                    unit_conversion((models[fi], uf), (models[ti], ut)).map_err(|why| {
+                        self.invalid(
+                            format!("connections[{ci}]"),
+                            &c.to,
+                            format!(
+                                "unit mismatch: '{}' is in [{uf}] but '{}' is in [{ut}]: {why}",
+                                c.from, c.to
+                            ),
+                        )
+                    })?
                 }
-            }
+                _ => None,
+            };
             if let Some(prev) = inputs_taken.insert((ti, tvi), ci) {
                 return Err(self.invalid(
                     tf,
@@ -183,6 +187,7 @@ impl LoadedSystem {
                 label: c.from.clone(),
                 feedthrough: false,
                 source_depends_on_inputs: false,
+                conversion,
             });
         }
         // Gauss-Seidel reads a target's outputs again after setting this input only if one of
@@ -449,4 +454,59 @@ pub(super) fn start_value(
         },
         x,
     ))
+}
+
+/// The conversion of a value in unit `from` (of its model) to unit `to` (of its model), by
+/// the BaseUnit each model's UnitDefinitions give its unit; `Err`: why there is none.
+fn unit_conversion(
+    (from_model, from): (&ModelDescription, &str),
+    (to_model, to): (&ModelDescription, &str),
+) -> Result<Option<UnitConversion>, String> {
+    const UNCHANGED: &str =
+        "(\"convert_units\": false on the connection passes the value unchanged)";
+    let base = |md: &ModelDescription, unit: &str| {
+        md.units.get(unit).copied().ok_or_else(|| {
+            format!(
+                "model '{}' gives [{unit}] no BaseUnit in its UnitDefinitions, so the value \
+                 cannot be converted {UNCHANGED}",
+                md.model_name
+            )
+        })
+    };
+    let (f, t) = (base(from_model, from)?, base(to_model, to)?);
+    if f.exponents != t.exponents {
+        return Err(format!(
+            "they measure different quantities ([{from}] = {}, [{to}] = {}) {UNCHANGED}",
+            base_units_text(&f),
+            base_units_text(&t)
+        ));
+    }
+    if !(f.factor.is_finite() && t.factor.is_finite() && f.factor != 0.0 && t.factor != 0.0) {
+        return Err(format!("a BaseUnit factor of 0 or not finite {UNCHANGED}"));
+    }
+    Ok(UnitConversion::between(
+        (f.factor, f.offset),
+        (t.factor, t.offset),
+    ))
+}
+
+/// A BaseUnit's SI base units, e.g. `kg m s-2` (`1` for none).
+fn base_units_text(b: &BaseUnit) -> String {
+    let parts: Vec<String> = BASE_UNIT_NAMES
+        .iter()
+        .zip(b.exponents)
+        .filter(|(_, e)| *e != 0)
+        .map(|(n, e)| {
+            if e == 1 {
+                n.to_string()
+            } else {
+                format!("{n}{e}")
+            }
+        })
+        .collect();
+    if parts.is_empty() {
+        "1".into()
+    } else {
+        parts.join(" ")
+    }
 }

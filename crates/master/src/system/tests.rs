@@ -181,6 +181,68 @@ fn causality_type_and_unit_checks() {
 }
 
 #[test]
+fn connected_variables_of_different_units_are_converted_by_their_base_units() {
+    let with_units = |units: &str, input_unit: &str| {
+        SDM.replace(
+            "  <ModelVariables>",
+            &format!("  <UnitDefinitions>{units}</UnitDefinitions>\n  <ModelVariables>"),
+        )
+        .replace(
+            r#"name="input_position" valueReference="3" causality="input"><Real start="0" unit="m"/>"#,
+            &format!(
+                r#"name="input_position" valueReference="3" causality="input"><Real start="0" unit="{input_unit}"/>"#
+            ),
+        )
+    };
+    let plan = |sdm: &str, text: &str| {
+        let a = ModelDescription::parse(sdm).unwrap();
+        let b = ModelDescription::parse(MASS_SPRING).unwrap();
+        LoadedSystem::from_json_str(text, Path::new("/x"), "sys.json")?.plan(&[&a, &b])
+    };
+    // ms.position [m] -> sdm.input_position [mm]: x 1000
+    let mm = with_units(
+        r#"<Unit name="mm"><BaseUnit m="1" factor="0.001"/></Unit>"#,
+        "mm",
+    );
+    let p = plan(&mm, SYS).unwrap();
+    let c = p.connections[0].conversion.unwrap();
+    assert_eq!((c.factor, c.offset), (1000.0, 0.0));
+    assert_eq!(p.connections[1].conversion, None);
+    // a unit of the same base units under another name converts by nothing
+    let metre = with_units(r#"<Unit name="metre"><BaseUnit m="1"/></Unit>"#, "metre");
+    assert_eq!(plan(&metre, SYS).unwrap().connections[0].conversion, None);
+    // no BaseUnit for the target's unit: refused, saying how to pass the value unchanged
+    let undefined = with_units("", "mm");
+    let e = plan(&undefined, SYS).unwrap_err().to_string();
+    assert!(
+        e.contains(
+            "connections[0]: unit mismatch: 'ms.position' is in [m] but 'sdm.input_position' is \
+             in [mm]: model 'SpringDamperMass' gives [mm] no BaseUnit"
+        ) && e.contains(r#""convert_units": false"#),
+        "{e}"
+    );
+    // different quantities: refused with both units' base units
+    let speed = with_units(r#"<Unit name="m/s"><BaseUnit m="1" s="-1"/></Unit>"#, "m/s");
+    let e = plan(&speed, SYS).unwrap_err().to_string();
+    assert!(
+        e.contains("they measure different quantities ([m] = m, [m/s] = m s-1)"),
+        "{e}"
+    );
+    // "convert_units": false passes the value unchanged whatever the units
+    let unchanged = SYS.replace(
+        r#""to": "sdm.input_position"}"#,
+        r#""to": "sdm.input_position", "convert_units": false}"#,
+    );
+    assert_ne!(unchanged, SYS);
+    for sdm in [&mm, &undefined, &speed] {
+        assert_eq!(
+            plan(sdm, &unchanged).unwrap().connections[0].conversion,
+            None
+        );
+    }
+}
+
+#[test]
 fn parameter_value_checks() {
     let t = SYS.replace("\"mode\": 1", "\"mode\": 1.5");
     assert!(err_of(&t).contains("instances[0].parameters.mode: 1.5 is not a 32-bit integer"));
