@@ -154,6 +154,76 @@ fn a_gauss_seidel_system_and_its_order_import_back_bit_for_bit() {
     }
 }
 
+/// A value an imported SSP gives that the system refuses is named where the SSP gives it (the
+/// .ssv line of a parameter, the .ssd line of a connection, the DefaultExperiment), not by the
+/// field of the description it becomes; a value given beside it by the one who gives it.
+#[test]
+fn refused_values_of_an_ssp_are_named_in_its_own_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = export(&system("passive.json"), dir.path());
+    let unpacked = dir.path().join("unpacked");
+    let mut zip = zip::ZipArchive::new(std::fs::File::open(&file).unwrap()).unwrap();
+    zip.extract(&unpacked).unwrap();
+    let ssd = unpacked.join("SystemStructure.ssd");
+    let ssv = unpacked.join("resources/bogie.ssv");
+    let (ssd_text, ssv_text) = (
+        std::fs::read_to_string(&ssd).unwrap(),
+        std::fs::read_to_string(&ssv).unwrap(),
+    );
+    let refused = |ssd_edit: (&str, &str), ssv_edit: (&str, &str), set: &[&str]| {
+        assert!(ssd_text.contains(ssd_edit.0) && ssv_text.contains(ssv_edit.0));
+        std::fs::write(&ssd, ssd_text.replacen(ssd_edit.0, ssd_edit.1, 1)).unwrap();
+        std::fs::write(&ssv, ssv_text.replacen(ssv_edit.0, ssv_edit.1, 1)).unwrap();
+        let mut sys = ssp::import(&ssd, &ImportOptions::default()).unwrap().system;
+        let overrides = master::system::SystemOverrides {
+            set: set.iter().map(|s| s.to_string()).collect(),
+            ..Default::default()
+        };
+        sys.apply_overrides(&overrides).unwrap();
+        match master::system::PreparedSystem::prepare(&sys) {
+            Ok(_) => panic!("{ssd_edit:?} {ssv_edit:?} {set:?} accepted"),
+            Err(e) => e.to_string(),
+        }
+    };
+    let line_of =
+        |text: &str, needle: &str| text.lines().position(|l| l.contains(needle)).unwrap() + 1;
+    let speed = r#"value="83.33333333333333""#;
+    let e = refused(("", ""), (speed, r#"value="-5""#), &[]);
+    let line = line_of(&ssv_text, speed);
+    assert!(
+        e.contains("SystemStructure.ssd: parameter 'vehicle.speed' of set 'initial' (")
+            && e.contains(&format!(
+                "resources/bogie.ssv line {line}): -5 m/s is below its minimum 0 m/s"
+            )),
+        "{e}"
+    );
+    // the same value given on the command line is named so
+    let e = refused(("", ""), ("", ""), &["bogie.vehicle.speed=-3"]);
+    assert!(
+        e.contains("with --set: --set bogie.vehicle.speed: -3 m/s"),
+        "{e}"
+    );
+    // a connection to an output
+    let input = r#"endConnector="damper.elongation""#;
+    let e = refused((input, r#"endConnector="damper.force""#), ("", ""), &[]);
+    let line = line_of(&ssd_text, input);
+    assert!(
+        e.contains("connection 'bogie.damper_left.elongation' -> 'damper_left.damper.force' (")
+            && e.contains(&format!(
+                "SystemStructure.ssd line {line}): 'damper_left.damper.force' has causality 'output'"
+            )),
+        "{e}"
+    );
+    // the stop time
+    let stop = r#"stopTime="2.0""#;
+    let e = refused((stop, r#"stopTime="-1""#), ("", ""), &[]);
+    assert!(
+        e.contains("the DefaultExperiment's stopTime (")
+            && e.contains("SystemStructure.ssd): must be greater"),
+        "{e}"
+    );
+}
+
 /// Enumeration parameters given by item name are exported as ssv:Integer with the item's
 /// value, as a number would be: libcosim aborts on ssv:Enumeration (ssp_parser "Internal
 /// error"), Ecos refuses it ("Unknown XML node in ssv:Parameter") and fmpy reads every

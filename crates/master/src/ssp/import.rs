@@ -19,6 +19,8 @@ use crate::system::{ConnectionSpec, InstanceSpec, LoadedSystem, SystemDescriptio
 type Supplied = (String, Value, Parameter, String);
 
 struct Importer {
+    /// Where each field of the description comes from ([`LoadedSystem::origins`]).
+    origins: BTreeMap<String, String>,
     pkg: Package,
     ssd_label: String,
     models: Vec<ModelDescription>,
@@ -100,7 +102,18 @@ pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, S
     if instances.is_empty() {
         return Err(invalid(1, "the system has no components".into()));
     }
+    let origins = ssd
+        .system
+        .components
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let what = format!("component '{}' ({ssd_label} line {})", c.name, c.line);
+            (format!("instances[{i}]"), what)
+        })
+        .collect();
     let mut imp = Importer {
+        origins,
         pkg,
         ssd_label: ssd_label.clone(),
         models,
@@ -160,6 +173,33 @@ pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, S
             instances[i].step_multiple = m as u32;
         }
     }
+    for (field, from_ssd, what) in [
+        (
+            "start_time",
+            ssd.start_time_s.is_some(),
+            "the DefaultExperiment's startTime",
+        ),
+        (
+            "stop_time",
+            opts.stop_time.is_none() && ssd.stop_time_s.is_some(),
+            "the DefaultExperiment's stopTime",
+        ),
+        (
+            "step",
+            opts.step.is_none() && ssd.base_step_s.is_some(),
+            "libcosim's osp:FixedStepAlgorithm baseStepSize",
+        ),
+        (
+            "step",
+            opts.step.is_none() && ssd.base_step_s.is_none() && ssd.system.step_s.is_some(),
+            "OMSimulator's oms:FixedStepMaster stepSize",
+        ),
+    ] {
+        if from_ssd {
+            imp.origins
+                .insert(field.into(), format!("{what} ({})", imp.ssd_label));
+        }
+    }
     let coupling = &ssd.system.coupling;
     // the master's own settings where its export kept them (annotation), else what libcosim,
     // Ecos and fmpy do: Jacobi
@@ -202,8 +242,10 @@ pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, S
         init_sweeps: coupling.init_sweeps.unwrap_or(3),
         max_step_halvings: coupling.max_step_halvings.unwrap_or(0),
     };
+    let mut system = LoadedSystem::from_description(desc, &base_dir, &imp.pkg.label());
+    system.origins = std::mem::take(&mut imp.origins);
     Ok(ImportedSsp {
-        system: LoadedSystem::from_description(desc, &base_dir, &imp.pkg.label()),
+        system,
         version: ssd.version,
         files_read: imp.pkg.files_read().to_vec(),
         fmu_sources,
@@ -306,7 +348,7 @@ impl Importer {
         Ok(())
     }
 
-    fn connections(&self, ssd: &Ssd) -> Result<Vec<ConnectionSpec>, SspError> {
+    fn connections(&mut self, ssd: &Ssd) -> Result<Vec<ConnectionSpec>, SspError> {
         let mut out = Vec::new();
         for c in &ssd.system.connections {
             let (Some(se), Some(ee)) = (&c.start_element, &c.end_element) else {
@@ -380,6 +422,13 @@ impl Importer {
             } else {
                 (start, end)
             };
+            self.origins.insert(
+                format!("connections[{}]", out.len()),
+                format!(
+                    "connection '{se}.{}' -> '{ee}.{}' ({} line {})",
+                    c.start_connector, c.end_connector, self.ssd_label, c.line
+                ),
+            );
             out.push(ConnectionSpec {
                 from,
                 to,
@@ -510,6 +559,8 @@ impl Importer {
                         ));
                     }
                     let bound = self.convert(ssd, &set, i, &target, &v, &p, &origin)?;
+                    self.origins
+                        .insert(format!("instances[{i}].parameters.{target}"), origin);
                     out[i].insert(target, bound);
                 }
             }
@@ -536,6 +587,8 @@ impl Importer {
                     };
                     if self.models[i].variable(var).is_some() {
                         let bound = self.convert(ssd, &set, i, var, &v, &p, &origin)?;
+                        self.origins
+                            .insert(format!("instances[{i}].parameters.{var}"), origin.clone());
                         out[i].insert(var.to_string(), bound);
                         hit = true;
                     }

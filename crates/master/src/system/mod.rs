@@ -218,6 +218,11 @@ pub struct LoadedSystem {
     pub base_dir: PathBuf,
     /// JSON text, if any, for line numbers in messages.
     pub text: Option<String>,
+    /// For a description converted from another format (an SSP): where a field (a key as
+    /// messages name it, `instances[0].parameters.k`, `connections[2]`) comes from in that
+    /// format's own files, e.g. "parameter 'k' of set 'bogie' (resources/bogie.ssv line 10)";
+    /// a message about the field, or about a part of it, names that instead.
+    pub origins: BTreeMap<String, String>,
 }
 
 /// Splits `instance.variable` at the first dot.
@@ -336,6 +341,7 @@ impl LoadedSystem {
             file: file.to_string(),
             base_dir: base_dir.to_path_buf(),
             text: Some(text.to_string()),
+            origins: BTreeMap::new(),
         })
     }
 
@@ -346,7 +352,29 @@ impl LoadedSystem {
             file: file.to_string(),
             base_dir: base_dir.to_path_buf(),
             text: None,
+            origins: BTreeMap::new(),
         }
+    }
+
+    /// Where `field` comes from in the files of a converted description ([`Self::origins`]):
+    /// its own entry, else that of the nearest field holding it, followed by the rest of the
+    /// name (a connection's `from` and `to` are in its entry already).
+    fn origin_of(&self, field: &str) -> Option<String> {
+        if let Some(o) = self.origins.get(field) {
+            return Some(o.clone());
+        }
+        let mut head = field;
+        while let Some(cut) = head.rfind(['.', '[']) {
+            head = &head[..cut];
+            if let Some(o) = self.origins.get(head) {
+                let rest = field[cut..].trim_start_matches('.');
+                return Some(match rest {
+                    "from" | "to" => o.clone(),
+                    _ => format!("{o}: {rest}"),
+                });
+            }
+        }
+        None
     }
 
     /// Line of the value at `field` (`instances[3].name`) in the JSON text, else of the first
@@ -365,6 +393,14 @@ impl LoadedSystem {
         reason: impl Into<String>,
     ) -> SystemError {
         let field = field.into();
+        if let Some(origin) = self.origin_of(&field) {
+            return SystemError::Invalid {
+                file: self.file.clone(),
+                line: None,
+                field: origin,
+                reason: reason.into(),
+            };
+        }
         SystemError::Invalid {
             file: self.file.clone(),
             line: self.line_of(&field, needle),

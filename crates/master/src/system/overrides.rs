@@ -135,6 +135,31 @@ impl LoadedSystem {
         if o.logging {
             desc.instances.iter_mut().for_each(|i| i.logging = true);
         }
+        if !self.origins.is_empty() {
+            // a field given here no longer comes from the converted files: named as given
+            let python = o.from == OverridesFrom::PythonLoad;
+            let name = |cli: &str, py: &str| if python { py } else { cli }.to_string();
+            for (field, cli, given) in [
+                ("start_time", "--start", o.start_time.is_some()),
+                ("stop_time", "--stop", o.stop_time.is_some()),
+                ("step", "--step", o.step.is_some()),
+            ] {
+                if given {
+                    self.origins.insert(field.into(), name(cli, field));
+                }
+            }
+            for (key, _) in o.start_values().unwrap_or_default() {
+                let Some((inst, var)) = super::split_ref(&key) else {
+                    continue;
+                };
+                if let Some(i) = desc.instances.iter().position(|x| x.name == inst) {
+                    self.origins.insert(
+                        format!("instances[{i}].parameters.{var}"),
+                        name(&format!("--set {key}"), &format!("parameters '{key}'")),
+                    );
+                }
+            }
+        }
         self.desc = desc;
         self.file = label;
         self.text = None;
