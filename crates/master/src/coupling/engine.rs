@@ -238,18 +238,18 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
         values.resize(src.outputs.len(), 0.0);
         let r = self.get_batch(i, &src.outputs, &mut values);
         self.outputs[i] = values;
-        self.convert_units(i);
+        if !src.conversions.is_empty() {
+            self.convert_units(i);
+        }
         self.read_at[i] = if r.is_ok() { self.changes[i] } else { u64::MAX };
         r.map_err(|e| self.slave_err(time, i, e))
     }
 
-    /// The outputs of instance `i` just read, in their destinations' units where those differ.
-    #[inline]
+    /// The outputs of instance `i` just read, in their destinations' units where those differ
+    /// (out of line: most systems convert nothing).
+    #[inline(never)]
     fn convert_units(&mut self, i: usize) {
         let conversions = &self.exchange.sources[i].conversions;
-        if conversions.is_empty() {
-            return;
-        }
         let out = &mut self.outputs[i];
         for &(k, u) in conversions {
             if let Some(x) = out.get_mut(k) {
@@ -712,7 +712,9 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
                 let r = self.slaves[i].get(&src.outputs, out);
                 self.read_at[i] = if r.is_ok() { self.changes[i] } else { u64::MAX };
                 r.map_err(|e| self.slave_err(te, i, e))?;
-                self.convert_units(i);
+                if !src.conversions.is_empty() {
+                    self.convert_units(i);
+                }
                 self.check_outputs(te, i)?;
             }
             for (dest, _) in src
