@@ -516,3 +516,28 @@ def test_the_command_line_reports_an_unreachable_scheduler_and_bad_options_as_er
     assert "Traceback" not in r.stderr
     r = subprocess.run(cmd + ["-j", "0"], capture_output=True, text=True, check=False)
     assert r.returncode == 2 and "must be 1 or more, got 0" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_a_parquet_set_resumed_on_the_cluster_keeps_every_runs_parameter_columns(dist, client, tmp_path):
+    """The cluster's writer gets the constant columns of the whole set as the local one does:
+    a Parquet folder reads with its first file's columns, and a parameter only a kept run
+    has was dropped from every run written on the resume."""
+
+    def runs(speeds):
+        return {
+            **speed_set(dist, speeds, stop_time=0.1),
+            "runs": [{"name": "soft", "parameters": {"bogie.vehicle.speed": 60.0, "bogie.suspension.lateral_stiffness": 1e5}}],
+        }
+
+    out = tmp_path / "dask"
+    railfmu.run_set(runs([50.0, 60.0]), out, format="parquet", client=client)
+    ran = []
+    again = railfmu.RunSet.from_dict(runs([55.0, 60.0])).run(
+        out, resume=True, format="parquet", client=client, progress=lambda d, t, n, e: ran.append(n)
+    )
+    assert again.ok and [n for n in ran if n] == ["run-000"]
+    table = pd.read_parquet(out / "results")
+    assert "bogie.suspension.lateral_stiffness" in table.columns, list(table.columns)
+    assert table[table["run"] == "soft"]["bogie.suspension.lateral_stiffness"].unique().tolist() == [1e5]
+    # the file the cluster wrote on the resume has the column itself
+    assert "bogie.suspension.lateral_stiffness" in pq.read_schema(out / "results" / "run-000.parquet").names
