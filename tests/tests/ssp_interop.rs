@@ -214,6 +214,31 @@ fn refused_values_of_an_ssp_are_named_in_its_own_files() {
             )),
         "{e}"
     );
+    // a unit refused: the SSP's way to pass the value unchanged
+    let e = refused(
+        (input, r#"endConnector="damper.elongation_velocity""#),
+        ("", ""),
+        &[],
+    );
+    assert!(
+        e.contains("is in [m] but 'damper_left.damper.elongation_velocity' is in [m/s]")
+            && e.contains("suppressUnitConversion=\"true\" on the connection")
+            && !e.contains("convert_units"),
+        "{e}"
+    );
+    // a run's own stop time is the run's, not the SSD's
+    std::fs::write(&ssd, &ssd_text).unwrap();
+    std::fs::write(&ssv, &ssv_text).unwrap();
+    let sys = ssp::import(&ssd, &ImportOptions::default()).unwrap().system;
+    let prepared = master::system::PreparedSystem::prepare(&sys).unwrap();
+    let e = prepared
+        .changes(&Default::default(), Some(-1.0), "run-x")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("run-x: stop_time: must be greater") && !e.contains("DefaultExperiment"),
+        "{e}"
+    );
     // the stop time
     let stop = r#"stopTime="2.0""#;
     let e = refused((stop, r#"stopTime="-1""#), ("", ""), &[]);

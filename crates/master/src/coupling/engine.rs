@@ -280,9 +280,19 @@ impl<'p, 's, 'd, 'o> Engine<'p, 's, 'd, 'o> {
     }
 
     fn non_finite(&self, time: f64, connection: usize, value: f64) -> SimError {
+        let c = &self.plan.connections[connection];
         SimError::NonFinite {
             time,
-            label: self.plan.connections[connection].label.clone(),
+            label: match c.conversion {
+                // the FMU's own value may be finite: the conversion overflowed
+                Some(u) => format!(
+                    "{} (converted to its input's unit: x {} + {})",
+                    c.label,
+                    crate::show::num(u.factor),
+                    crate::show::num(u.offset)
+                ),
+                None => c.label.clone(),
+            },
             value,
         }
     }

@@ -413,6 +413,25 @@ fn a_connection_converts_the_value_to_the_target_unit_and_records_the_source_in_
 }
 
 #[test]
+fn a_conversion_that_overflows_is_named_as_such() {
+    let mut plan = two_mass_plan(Algorithm::GaussSeidel, vec![0, 1], 1e-3, 0.02);
+    plan.connections[0].conversion = Some(UnitConversion {
+        factor: f64::MAX,
+        offset: f64::MAX,
+    });
+    let (mut a, mut b) = slaves();
+    let e = simulate(&plan, &mut [&mut a, &mut b], &RunOptions::default())
+        .unwrap_err()
+        .to_string();
+    // the FMU's own value (0.1 m) is finite: the message says the conversion made it inf
+    assert!(
+        e.contains("'ms.position (converted to its input's unit: x ")
+            && e.contains("not finite (inf)"),
+        "{e}"
+    );
+}
+
+#[test]
 fn unit_conversion_by_base_units() {
     // degree Celsius (K, offset 273.15) to kelvin and back
     let c = UnitConversion::between((1.0, 273.15), (1.0, 0.0)).unwrap();

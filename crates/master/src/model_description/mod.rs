@@ -189,6 +189,9 @@ pub struct Variable {
     /// fmi2SetXXX, in every run).
     pub min: Option<f64>,
     pub max: Option<f64>,
+    /// A Real's `relativeQuantity` (its own, else its declared type's): the value is a
+    /// difference, converted between units without their BaseUnit offsets (FMI 2.0, 2.2.7).
+    pub relative_quantity: bool,
 }
 
 /// One `<Item>` of an Enumeration type.

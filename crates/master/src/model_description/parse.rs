@@ -73,6 +73,10 @@ impl Elem<'_> {
             Some(v) => Err(self.invalid(key, v, "expected true or false")),
         }
     }
+    /// A boolean attribute that may be absent.
+    fn optional_bool(&self, key: &str) -> Result<Option<bool>, ModelDescriptionError> {
+        self.get(key).map(|_| self.bool(key)).transpose()
+    }
     /// The value of `key` must read as a value of type `t` (xs:double, xs:int, xs:boolean; a
     /// String anything), as the FMI 2.0 schema types them: a start value or bound that does
     /// not is a broken modelDescription.xml, not a value to guess at (FMI Library would read
@@ -174,6 +178,7 @@ struct PendingVar {
     start: Option<String>,
     min: Option<f64>,
     max: Option<f64>,
+    relative_quantity: Option<bool>,
 }
 
 impl ModelDescription {
@@ -198,6 +203,8 @@ impl ModelDescription {
         // SimpleType name -> unit, and a Real's or Integer's (min, max)
         let mut type_units: HashMap<String, Option<String>> = HashMap::new();
         let mut type_ranges: HashMap<String, (Option<f64>, Option<f64>)> = HashMap::new();
+        // a Real SimpleType's relativeQuantity
+        let mut type_relative: HashMap<String, bool> = HashMap::new();
         // bounds are checked to be numbers of their type where they are read
         let bound = |e: &Elem, key: &str| e.get(key).and_then(|x| x.trim().parse::<f64>().ok());
         let mut current_type: Option<String> = None;
@@ -343,6 +350,9 @@ impl ModelDescription {
                                     type_units.insert(t.clone(), e.get("unit").map(String::from));
                                     type_ranges
                                         .insert(t.clone(), (bound(&e, "min"), bound(&e, "max")));
+                                    if let Some(r) = e.optional_bool("relativeQuantity")? {
+                                        type_relative.insert(t.clone(), r);
+                                    }
                                 }
                             }
                             ("SimpleType", "Integer") => {
@@ -433,6 +443,10 @@ impl ModelDescription {
                                     if matches!(t, VarType::Real | VarType::Integer) {
                                         v.min = bound(&e, "min");
                                         v.max = bound(&e, "max");
+                                    }
+                                    if t == VarType::Real {
+                                        v.relative_quantity =
+                                            e.optional_bool("relativeQuantity")?;
                                     }
                                 }
                             }
@@ -560,6 +574,14 @@ impl ModelDescription {
                 .copied()
                 .unwrap_or_default();
             let (min, max) = (p.min.or(type_min), p.max.or(type_max));
+            let relative_quantity = p
+                .relative_quantity
+                .or_else(|| {
+                    p.declared_type
+                        .as_ref()
+                        .and_then(|d| type_relative.get(d).copied())
+                })
+                .unwrap_or(false);
             if let (Some(lo), Some(hi)) = (min, max) {
                 if lo > hi {
                     return Err(ModelDescriptionError::InvalidVariable {
@@ -605,6 +627,7 @@ impl ModelDescription {
                 declared_type: p.declared_type,
                 min,
                 max,
+                relative_quantity,
             });
         }
         let views: Vec<rules::AliasView> = md

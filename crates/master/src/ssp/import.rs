@@ -559,8 +559,7 @@ impl Importer {
                         ));
                     }
                     let bound = self.convert(ssd, &set, i, &target, &v, &p, &origin)?;
-                    self.origins
-                        .insert(format!("instances[{i}].parameters.{target}"), origin);
+                    self.origins.insert(parameter_field(i, &target), origin);
                     out[i].insert(target, bound);
                 }
             }
@@ -587,8 +586,7 @@ impl Importer {
                     };
                     if self.models[i].variable(var).is_some() {
                         let bound = self.convert(ssd, &set, i, var, &v, &p, &origin)?;
-                        self.origins
-                            .insert(format!("instances[{i}].parameters.{var}"), origin.clone());
+                        self.origins.insert(parameter_field(i, var), origin.clone());
                         out[i].insert(var.to_string(), bound);
                         hit = true;
                     }
@@ -678,6 +676,15 @@ impl Importer {
         };
         Ok(value)
     }
+}
+
+/// The field of the description a start value becomes, as the system's messages name it (a
+/// long or odd name shortened), the key of its origin.
+fn parameter_field(instance: usize, name: &str) -> String {
+    format!(
+        "instances[{instance}].parameters.{}",
+        crate::show::text(name)
+    )
 }
 
 /// The unit a component's connector `name` declares (a Real connector's `unit`).

@@ -154,7 +154,7 @@ impl LoadedSystem {
                 };
                 if let Some(i) = desc.instances.iter().position(|x| x.name == inst) {
                     self.origins.insert(
-                        format!("instances[{i}].parameters.{var}"),
+                        format!("instances[{i}].parameters.{}", text(var)),
                         name(&format!("--set {key}"), &format!("parameters '{key}'")),
                     );
                 }

@@ -147,13 +147,40 @@ impl LoadedSystem {
                 ));
             }
             let conversion = match (&fv.unit, &tv.unit) {
-                (Some(uf), Some(ut)) if uf != ut && c.convert_units => {
-                    unit_conversion((models[fi], uf), (models[ti], ut)).map_err(|why| {
+                (Some(uf), Some(ut)) if c.convert_units => {
+                    // an SSP connection is told otherwise than a JSON one
+                    let unchanged = if self.origins.contains_key(&format!("connections[{ci}]")) {
+                        "suppressUnitConversion=\"true\" on the connection passes the value unchanged"
+                    } else {
+                        "\"convert_units\": false on the connection passes the value unchanged"
+                    };
+                    let from = End {
+                        model: models[fi],
+                        unit: uf,
+                        relative: fv.relative_quantity,
+                    };
+                    let to = End {
+                        model: models[ti],
+                        unit: ut,
+                        relative: tv.relative_quantity,
+                    };
+                    let converted = if fv.var_type == VarType::Real {
+                        unit_conversion(&from, &to)
+                    } else if uf == ut {
+                        Ok(None)
+                    } else {
+                        Err(format!(
+                            "{} values are not converted (FMI 2.0 gives only a Real a unit)",
+                            fv.var_type
+                        ))
+                    };
+                    converted.map_err(|why| {
                         self.invalid(
                             format!("connections[{ci}]"),
                             &c.to,
                             format!(
-                                "unit mismatch: '{}' is in [{uf}] but '{}' is in [{ut}]: {why}",
+                                "unit mismatch: '{}' is in [{uf}] but '{}' is in [{ut}]: {why} \
+                                 ({unchanged})",
                                 c.from, c.to
                             ),
                         )
@@ -336,19 +363,25 @@ impl LoadedSystem {
         })
     }
 
-    /// The stop time is after the start time and a whole number of steps away from it.
-    pub(super) fn check_stop_time(&self, stop_time: f64) -> Result<(), SystemError> {
+    /// The description's stop time is after the start time and a whole number of steps away
+    /// from it.
+    fn check_stop_time(&self, stop_time: f64) -> Result<(), SystemError> {
+        self.stop_time_problem(stop_time)
+            .map_err(|(field, reason)| self.invalid(field, field, reason))
+    }
+
+    /// Why `stop_time` cannot end a run of this description: (the field at fault, `stop_time`
+    /// or `step`, and the reason).
+    pub(super) fn stop_time_problem(&self, stop_time: f64) -> Result<(), (&'static str, String)> {
         let d = &self.desc;
         if !stop_time.is_finite() {
-            return Err(self.invalid(
-                "stop_time",
+            return Err((
                 "stop_time",
                 format!("must be a finite number, got {}", num(stop_time)),
             ));
         }
         if !(d.start_time.is_finite() && stop_time > d.start_time) {
-            return Err(self.invalid(
-                "stop_time",
+            return Err((
                 "stop_time",
                 format!(
                     "must be greater than start_time ({}), got {}",
@@ -358,19 +391,15 @@ impl LoadedSystem {
             ));
         }
         let span = stop_time - d.start_time;
-        let limits =
-            crate::coupling::RunLimits::from_env().map_err(|r| self.invalid("step", "step", r))?;
-        limits
-            .steps(span, d.step)
-            .map_err(|r| self.invalid("step", "step", r))?;
+        let limits = crate::coupling::RunLimits::from_env().map_err(|r| ("step", r))?;
+        limits.steps(span, d.step).map_err(|r| ("step", r))?;
         if let Some(why) = crate::coupling::step_below_resolution(d.start_time, stop_time, d.step) {
-            return Err(self.invalid("step", "step", why));
+            return Err(("step", why));
         }
         let n = (span / d.step).round();
         // a span shorter than half a step rounds to no step, which the run refuses too
         if n < 1.0 || (n * d.step - span).abs() > 1e-9 * span.max(d.step) {
-            return Err(self.invalid(
-                "step",
+            return Err((
                 "step",
                 format!(
                     "stop_time - start_time = {} s is not an integer multiple of step = {} s",
@@ -456,38 +485,65 @@ pub(super) fn start_value(
     ))
 }
 
-/// The conversion of a value in unit `from` (of its model) to unit `to` (of its model), by
-/// the BaseUnit each model's UnitDefinitions give its unit; `Err`: why there is none.
-fn unit_conversion(
-    (from_model, from): (&ModelDescription, &str),
-    (to_model, to): (&ModelDescription, &str),
-) -> Result<Option<UnitConversion>, String> {
-    const UNCHANGED: &str =
-        "(\"convert_units\": false on the connection passes the value unchanged)";
-    let base = |md: &ModelDescription, unit: &str| {
-        md.units.get(unit).copied().ok_or_else(|| {
-            format!(
-                "model '{}' gives [{unit}] no BaseUnit in its UnitDefinitions, so the value \
-                 cannot be converted {UNCHANGED}",
-                md.model_name
-            )
-        })
+/// One end of a connection, for [`unit_conversion`].
+struct End<'a> {
+    model: &'a ModelDescription,
+    unit: &'a str,
+    /// FMI 2.0 `relativeQuantity`: a difference, converted without the BaseUnit offsets.
+    relative: bool,
+}
+
+/// The conversion of a Real from one end's unit to the other's, by the BaseUnit each model's
+/// UnitDefinitions give its unit (FMI 2.0, 2.2.2): None when the values need none (the same
+/// unit, or one name defined alike, or a unit a model does not define under a name both
+/// use); `Err`: why there is none.
+fn unit_conversion(from: &End, to: &End) -> Result<Option<UnitConversion>, String> {
+    let defined = |e: &End| e.model.units.get(e.unit).copied();
+    let (f, t) = match (defined(from), defined(to)) {
+        (Some(f), Some(t)) => (f, t),
+        // one name, not defined by both: taken as the same unit, as before units converted
+        _ if from.unit == to.unit => return Ok(None),
+        (None, _) => return Err(undefined(from)),
+        (_, None) => return Err(undefined(to)),
     };
-    let (f, t) = (base(from_model, from)?, base(to_model, to)?);
     if f.exponents != t.exponents {
         return Err(format!(
-            "they measure different quantities ([{from}] = {}, [{to}] = {}) {UNCHANGED}",
+            "they measure different quantities ([{}] = {}, [{}] = {})",
+            from.unit,
             base_units_text(&f),
+            to.unit,
             base_units_text(&t)
         ));
     }
     if !(f.factor.is_finite() && t.factor.is_finite() && f.factor != 0.0 && t.factor != 0.0) {
-        return Err(format!("a BaseUnit factor of 0 or not finite {UNCHANGED}"));
+        return Err("a BaseUnit factor is 0 or not finite".into());
+    }
+    let (mut f_offset, mut t_offset) = (f.offset, t.offset);
+    match (from.relative, to.relative) {
+        // differences: the offsets do not apply (FMI 2.0, 2.2.7: 10 degC = 10 K)
+        (true, true) => (f_offset, t_offset) = (0.0, 0.0),
+        (false, false) => {}
+        _ if f_offset == 0.0 && t_offset == 0.0 => {}
+        _ => {
+            return Err(
+                "one is a relative quantity (a difference) and the other is not, and the \
+                 units' offsets differ"
+                    .into(),
+            )
+        }
     }
     Ok(UnitConversion::between(
-        (f.factor, f.offset),
-        (t.factor, t.offset),
+        (f.factor, f_offset),
+        (t.factor, t_offset),
     ))
+}
+
+fn undefined(e: &End) -> String {
+    format!(
+        "model '{}' gives [{}] no BaseUnit in its UnitDefinitions, so the value cannot be \
+         converted",
+        e.model.model_name, e.unit
+    )
 }
 
 /// A BaseUnit's SI base units, e.g. `kg m s-2` (`1` for none).

@@ -168,10 +168,9 @@ impl PreparedSystem {
         if let Some(t) = stop_time {
             if t != self.system.desc.stop_time {
                 // said of this run's stop time, not at the line of the description's
-                self.system.check_stop_time(t).map_err(|e| match e {
-                    SystemError::Invalid { field, reason, .. } => invalid(field, "", reason),
-                    other => other,
-                })?;
+                self.system
+                    .stop_time_problem(t)
+                    .map_err(|(field, reason)| invalid(field.into(), "", reason))?;
                 // the recorded values of the longer run, refused now as a description's are,
                 // not when the run starts
                 let limits = crate::coupling::RunLimits::from_env()

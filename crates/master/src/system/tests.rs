@@ -243,6 +243,105 @@ fn connected_variables_of_different_units_are_converted_by_their_base_units() {
 }
 
 #[test]
+fn relative_quantities_convert_without_offsets_and_only_reals_convert() {
+    // sdm.input_position in a unit of 1 mm whose zero lies 0.5 m off
+    let sdm = |relative: &str| {
+        SDM.replace(
+            "  <ModelVariables>",
+            r#"  <UnitDefinitions><Unit name="mm0"><BaseUnit m="1" factor="0.001" offset="0.5"/></Unit></UnitDefinitions>
+  <ModelVariables>"#,
+        )
+        .replace(
+            r#"name="input_position" valueReference="3" causality="input"><Real start="0" unit="m"/>"#,
+            &format!(
+                r#"name="input_position" valueReference="3" causality="input"><Real start="0" unit="mm0"{relative}/>"#
+            ),
+        )
+    };
+    // ms.position is a Position, a SimpleType: relative through its type
+    let ms_relative = MASS_SPRING.replace(
+        r#"<Real quantity="Length" unit="m"/>"#,
+        r#"<Real quantity="Length" unit="m" relativeQuantity="true"/>"#,
+    );
+    assert_ne!(ms_relative, MASS_SPRING);
+    let plan = |sdm: &str, ms: &str| {
+        let a = ModelDescription::parse(sdm).unwrap();
+        let b = ModelDescription::parse(ms).unwrap();
+        LoadedSystem::from_json_str(SYS, Path::new("/x"), "sys.json")?.plan(&[&a, &b])
+    };
+    let conversion = |sdm: &str, ms: &str| plan(sdm, ms).unwrap().connections[0].conversion;
+    // absolute: x [m] = 0.001 y + 0.5, so y = 1000 x - 500
+    let c = conversion(&sdm(""), MASS_SPRING).unwrap();
+    assert_eq!((c.factor, c.offset), (1000.0, -500.0));
+    // two differences: the offsets do not apply (FMI 2.0, 2.2.7)
+    let c = conversion(&sdm(r#" relativeQuantity="true""#), &ms_relative).unwrap();
+    assert_eq!((c.factor, c.offset), (1000.0, 0.0));
+    // a difference into an absolute value of a unit with an offset: refused
+    for (s, m) in [
+        (sdm(r#" relativeQuantity="true""#), MASS_SPRING.to_string()),
+        (sdm(""), ms_relative.clone()),
+    ] {
+        let e = plan(&s, &m).unwrap_err().to_string();
+        assert!(e.contains("one is a relative quantity"), "{e}");
+    }
+    // an Integer carrying units (FMI 2.0 gives it none) is never converted
+    let int_units = |unit: &str| {
+        SDM.replace(
+            r#"name="mode" valueReference="8" causality="parameter" variability="fixed"><Integer start="0"/>"#,
+            &format!(r#"name="mode" valueReference="8" causality="input"><Integer start="0" unit="{unit}"/>"#),
+        )
+    };
+    let ms_count = MASS_SPRING
+        .replace(
+            r#"<ScalarVariable name="n_steps" valueReference="0" causality="local"><Integer/>"#,
+            r#"<ScalarVariable name="n_steps" valueReference="0" causality="output"><Integer unit="m"/>"#,
+        )
+        .replace(
+            r#"<Unknown index="6" dependencies=""/>"#,
+            r#"<Unknown index="6" dependencies=""/><Unknown index="7" dependencies=""/>"#,
+        );
+    assert_ne!(ms_count, MASS_SPRING);
+    let counting = SYS.replace(
+        r#"{"from": "sdm.coupling_force", "to": "ms.force"}"#,
+        r#"{"from": "sdm.coupling_force", "to": "ms.force"}, {"from": "ms.n_steps", "to": "sdm.mode"}"#,
+    );
+    let with_km = r#"<UnitDefinitions><Unit name="km"><BaseUnit m="1" factor="1000"/></Unit></UnitDefinitions>
+  <ModelVariables>"#;
+    let a =
+        ModelDescription::parse(&int_units("km").replace("  <ModelVariables>", with_km)).unwrap();
+    let b = ModelDescription::parse(&ms_count).unwrap();
+    let sys = |t: &str| LoadedSystem::from_json_str(t, Path::new("/x"), "sys.json").unwrap();
+    // mode is an input here: no start value of the description
+    let counting = counting.replace(", \"mode\": 1", "");
+    let e = sys(&counting).plan(&[&a, &b]).unwrap_err().to_string();
+    assert!(
+        e.contains("[m] but 'sdm.mode' is in [km]: Integer values are not converted"),
+        "{e}"
+    );
+    let a = ModelDescription::parse(&int_units("m")).unwrap();
+    let p = sys(&counting).plan(&[&a, &b]).unwrap();
+    assert_eq!(p.connections[3].conversion, None);
+}
+
+#[test]
+fn one_unit_name_defined_differently_by_two_fmus_is_converted() {
+    // SpringDamperMass's "m" is a millimetre
+    let sdm = SDM.replace(
+        "  <ModelVariables>",
+        r#"  <UnitDefinitions><Unit name="m"><BaseUnit m="1" factor="0.001"/></Unit></UnitDefinitions>
+  <ModelVariables>"#,
+    );
+    let a = ModelDescription::parse(&sdm).unwrap();
+    let b = ModelDescription::parse(MASS_SPRING).unwrap();
+    let p = LoadedSystem::from_json_str(SYS, Path::new("/x"), "sys.json")
+        .unwrap()
+        .plan(&[&a, &b])
+        .unwrap();
+    let c = p.connections[0].conversion.unwrap();
+    assert_eq!((c.factor, c.offset), (1000.0, 0.0));
+}
+
+#[test]
 fn parameter_value_checks() {
     let t = SYS.replace("\"mode\": 1", "\"mode\": 1.5");
     assert!(err_of(&t).contains("instances[0].parameters.mode: 1.5 is not a 32-bit integer"));
