@@ -173,11 +173,11 @@ impl FmuModel for Bogie2Dof {
             /// p: half wheelbase (seed: wheelbase 2.5 m)
             parameter "geometry.half_wheelbase" [unit = "m", min = 0.0] => params.half_wheelbase_m;
             /// s: half distance between the contact points (MPE 2019: 0.7465 m)
-            parameter "wheelset.half_contact_gauge" [unit = "m", min = 0.0] => params.half_contact_gauge_m;
+            parameter "wheelset.half_contact_gauge" [unit = "m", range = 0.3..=1.0] => params.half_contact_gauge_m;
             /// b: lateral arm of the yaw dampers and of k_ssx (MPE 2019: 1.35 m)
             parameter "damper.lateral_arm" [unit = "m", min = 0.0] => params.damper_arm_m;
             /// R0: nominal rolling radius (Manchester: 0.46 m)
-            parameter "wheelset.wheel_radius" [unit = "m", min = 0.0] => params.wheel_radius_m;
+            parameter "wheelset.wheel_radius" [unit = "m", range = 0.2..=0.8] => params.wheel_radius_m;
             /// P: static vertical load per wheel (70 kN; Table 4-1's 27.52 kN per wheelset is not
             /// plausible)
             parameter "wheelset.wheel_load" [unit = "N", display_unit = "kN", min = 0.0] => params.wheel_load_n;

@@ -276,6 +276,7 @@ impl Bogie {
     /// As [`Self::new`] with an explicit contact table (ignores `params.contact`).
     pub fn with_table(params: Params, table: GeometryTable) -> Result<Self, ModelError> {
         params.validate()?;
+        table.check_for_wheel(params.wheel_radius_m)?;
         let generator = match params.track {
             TrackSource::Internal { level, seed } => Some(TrackGenerator::new(level, seed)),
             _ => None,

@@ -23,7 +23,7 @@
 //! below (this module imports no other module of the crate).
 
 use serde::{Deserialize, Serialize};
-use vehicle_elements::{finite, non_negative, positive};
+use vehicle_elements::{finite, in_range, non_negative, positive};
 
 pub use vehicle_elements::ParamError;
 
@@ -194,9 +194,22 @@ impl Params {
             self.wheelset_spin_inertia_kgm2,
         )?;
         positive("half_wheelbase_m", self.half_wheelbase_m)?;
-        positive("half_contact_gauge_m", self.half_contact_gauge_m)?;
+        // the coach's ranges (fmu-vehicle): a rail wheel, a standard or broad gauge
+        in_range(
+            "half_contact_gauge_m",
+            self.half_contact_gauge_m,
+            0.3,
+            1.0,
+            "rail gauges",
+        )?;
         positive("damper_arm_m", self.damper_arm_m)?;
-        positive("wheel_radius_m", self.wheel_radius_m)?;
+        in_range(
+            "wheel_radius_m",
+            self.wheel_radius_m,
+            0.2,
+            0.8,
+            "rail wheels",
+        )?;
         non_negative("k_ssy_n_per_m", self.k_ssy_n_per_m)?;
         non_negative("k_ssx_n_per_m", self.k_ssx_n_per_m)?;
         non_negative("conicity", self.conicity)?;

@@ -638,6 +638,21 @@ fn bad_params_and_inputs_rejected() {
                 ..Params::default()
             },
         ),
+        // no rail wheel, no rail gauge (the coach's ranges)
+        (
+            "wheel_radius_m",
+            Params {
+                wheel_radius_m: 1e-300,
+                ..Params::default()
+            },
+        ),
+        (
+            "half_contact_gauge_m",
+            Params {
+                half_contact_gauge_m: 10.0,
+                ..Params::default()
+            },
+        ),
     ];
     for (name, p) in cases {
         let e = p.validate().unwrap_err();
@@ -906,6 +921,26 @@ fn the_contact_table_bounds_the_non_linear_model() {
     let e = Bogie::with_table(nonlinear.clone(), tread.clone()).unwrap_err();
     assert!(matches!(e, ModelError::FlangeNotCovered(_)), "{e}");
     assert!(e.to_string().contains("does not cover the flange"), "{e}");
+    // a table reaching 1 m out, or with a rolling radius of -0.5 m, fits no wheelset
+    for (text, why) in [
+        (
+            "-1.0,-0.0006,0.0006,0.05,0.05\n0.003,0.0006,-0.0006,0.05,0.05\n",
+            "reaches 1000.0 mm",
+        ),
+        (
+            "-0.003,-0.96,0.0006,0.05,0.05\n0.003,0.0006,-0.0006,0.05,0.05\n",
+            "rolling radius of -0.5000 m",
+        ),
+    ] {
+        let t = GeometryTable::parse_csv(
+            &format!("y_m,delta_r_left_m,delta_r_right_m,tan_gamma_left,tan_gamma_right\n{text}"),
+            "bad.csv",
+        )
+        .unwrap();
+        let e = Bogie::with_table(nonlinear.clone(), t).unwrap_err();
+        assert!(matches!(e, ModelError::Contact(_)), "{e}");
+        assert!(e.to_string().contains(why), "{e}");
+    }
     // the linear model does not use the table
     let linear = Params {
         model: ModelKind::Linear,

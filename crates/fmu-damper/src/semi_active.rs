@@ -193,10 +193,13 @@ impl SemiActiveParams {
     fn velocity_flow_with(&self, v: f64, velocity_ref_cbrt: f64) -> f64 {
         let vl = self.velocity_linear_mps;
         let m = v.abs().max(vl);
-        if m < SQUARE_SAFE {
+        if (SQUARE_TINY..SQUARE_SAFE).contains(&m) {
             self.velocity_flow_ref_m3ps * v / (velocity_ref_cbrt * (v * v + vl * vl).cbrt())
+        } else if m == 0.0 {
+            0.0
         } else {
-            // v^2 would overflow (and give f = 0): scale by m, (v^2 + vl^2)^(1/3) = m^(2/3) (..)^(1/3).
+            // v^2 would overflow (f = 0) or underflow (0/0 at rest with a tiny v_lin): scale by
+            // m, (v^2 + vl^2)^(1/3) = m^(2/3) (..)^(1/3).
             let (a, b) = (v / m, vl / m);
             let c = m.cbrt();
             self.velocity_flow_ref_m3ps * (v / (c * c * velocity_ref_cbrt * (a * a + b * b).cbrt()))
@@ -212,19 +215,22 @@ impl SemiActiveParams {
 /// `g(dP) = dP / (dP^2 + dP_t^2)^(1/4)`: signed square root with a laminar core.
 pub fn orifice_law(dp: f64, dp_t: f64) -> f64 {
     let m = dp.abs().max(dp_t.abs());
-    if m < SQUARE_SAFE {
+    if (SQUARE_TINY..SQUARE_SAFE).contains(&m) {
         dp / (dp * dp + dp_t * dp_t).sqrt().sqrt()
+    } else if m == 0.0 {
+        0.0
     } else {
-        // dp^2 would overflow (and give g = 0): scale by m.
+        // dp^2 would overflow (g = 0) or underflow (0/0 at dP = 0 with a tiny dP_t): scale by m.
         let (a, b) = (dp / m, dp_t / m);
         dp / (m.sqrt() * (a * a + b * b).sqrt().sqrt())
     }
 }
 
-/// Below this magnitude a square cannot overflow (the plain formulas are used, bit for bit);
-/// above it the regularised laws are evaluated in scaled form instead of silently returning 0
-/// for absurd but finite inputs.
+/// Between these magnitudes a square neither overflows nor underflows (the plain formulas are
+/// used, bit for bit); outside, the regularised laws are evaluated in scaled form instead of
+/// silently returning 0, or 0/0, for absurd but finite inputs and parameters.
 const SQUARE_SAFE: f64 = 1e150;
+const SQUARE_TINY: f64 = 1e-150;
 
 /// Inputs of one communication step (held constant over the step).
 #[derive(Clone, Copy, Debug, PartialEq, Default, Serialize, Deserialize)]

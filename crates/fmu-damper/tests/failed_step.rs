@@ -253,6 +253,22 @@ fn regularised_laws_do_not_collapse_to_zero_for_huge_arguments() {
         assert!((f / expect - 1.0).abs() < 1e-12);
         assert!((orifice_law(x, 3e5) / x.sqrt() - 1.0).abs() < 1e-12);
     }
+    // Tiny regularisations: a damper at rest gives 0, not 0/0 (v^2 + v_lin^2 underflowed)
+    let tiny = SemiActiveParams {
+        velocity_linear_mps: 1e-300,
+        laminar_pressure_pa: 1e-300,
+        ..p
+    };
+    assert_eq!(tiny.velocity_flow(0.0), 0.0);
+    assert_eq!(tiny.orifice_law(0.0), 0.0);
+    for x in [1e-300, 1e-200, 1e-151] {
+        let f = tiny.velocity_flow(x);
+        let expect = p.velocity_flow_ref_m3ps * (x / p.velocity_ref_mps).cbrt();
+        assert!(f.is_finite() && f > 0.0 && f < 2.0 * expect, "f({x}) = {f}");
+        let g = tiny.orifice_law(x);
+        assert!(g.is_finite() && g > 0.0 && g <= x.sqrt(), "g({x}) = {g}");
+        assert_eq!(tiny.orifice_law(-x), -g);
+    }
     // Normal range unchanged: the plain formula, bit for bit.
     let v: f64 = 0.05;
     let vl = p.velocity_linear_mps;

@@ -335,6 +335,7 @@ impl Vehicle {
     /// As [`Self::new`] with an explicit contact table (`params.contact` is ignored).
     pub fn with_table(params: VehicleParams, table: GeometryTable) -> Result<Self, ModelError> {
         params.validate()?;
+        table.check_for_wheel(params.wheelset.wheel_radius_m)?;
         table.check_flange()?;
         let consts = Consts::new(&params, &table);
         let positions = Positions::new(&params);

@@ -246,6 +246,64 @@ fn derailment_is_reported_and_the_model_is_unchanged() {
     );
 }
 
+/// Tables the vehicle cannot run on are refused by name at initialisation: a flange on the
+/// wrong side, a reach beyond any rail, a rolling radius no wheel has.
+#[test]
+fn tables_that_do_not_fit_a_wheelset_are_refused() {
+    let table = worn_surrogate_table().unwrap();
+    let rows: Vec<[f64; 5]> = table.rows().collect();
+    let columns = |rows: &[[f64; 5]]| {
+        let col = |k: usize| rows.iter().map(|r| r[k]).collect::<Vec<f64>>();
+        GeometryTable::from_columns(col(0), col(1), col(2), col(3), col(4)).unwrap()
+    };
+    let refused = |t: GeometryTable| {
+        Vehicle::with_table(VehicleParams::default(), t)
+            .unwrap_err()
+            .to_string()
+    };
+    // the shipped table passes
+    assert!(Vehicle::with_table(VehicleParams::default(), table.clone()).is_ok());
+    // the left wheel without its flange on the left (capped where y <= 0): only its field
+    // side reaches tan gamma 1.2, which used to pass
+    let mut left_missing = rows.clone();
+    for r in left_missing.iter_mut() {
+        if r[0] <= 0.0 {
+            r[3] = r[3].min(0.5);
+        } else if r[0] > 9e-3 {
+            r[3] = 1.2;
+        }
+    }
+    let e = refused(columns(&left_missing));
+    assert!(
+        e.contains("on the left wheel tan(gamma) reaches only 0.500"),
+        "{e}"
+    );
+    // the two wheels' columns swapped: both flanges on the wrong side
+    let mirrored: Vec<[f64; 5]> = rows
+        .iter()
+        .map(|r| [r[0], r[2], r[1], r[4], r[3]])
+        .collect();
+    assert!(refused(columns(&mirrored)).contains("does not cover the flange"));
+    // reaching 1 m from the track centre
+    let mut wide = rows.clone();
+    wide.insert(0, [-1.0, rows[0][1], rows[0][2], rows[0][3], rows[0][4]]);
+    let e = refused(columns(&wide));
+    assert!(
+        e.contains("reaches 1000.0 mm from the track centre, beyond 50 mm"),
+        "{e}"
+    );
+    // delta r in mm taken as m: a rolling radius far below the wheel's
+    let mm: Vec<[f64; 5]> = rows
+        .iter()
+        .map(|r| [r[0], r[1] * 1e3, r[2] * 1e3, r[3], r[4]])
+        .collect();
+    let e = refused(columns(&mm));
+    assert!(
+        e.contains("rolling radius of") && e.contains("below half the nominal"),
+        "{e}"
+    );
+}
+
 #[test]
 fn a_table_without_flange_is_refused() {
     let tread_only = GeometryTable::synthetic(0.2, 7e-3, 5e-4, 0.5).unwrap();

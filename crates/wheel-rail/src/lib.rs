@@ -120,5 +120,5 @@ pub use creep::{
 pub use profile::{Profile, ProfileError, MIN_POINTS};
 pub use table::{
     write_csv, ContactGeometry, CsvNumbers, CsvRow, FlangeNotCovered, GeometryTable, SegmentHint,
-    TableError, BOGIE_CSV_HEADER, FLANGE_TAN_GAMMA,
+    TableError, BOGIE_CSV_HEADER, FLANGE_TAN_GAMMA, MAX_TABLE_REACH_M,
 };

@@ -117,7 +117,44 @@ pub enum TableError {
         /// Lengths of y, delta_r_left, delta_r_right, tan_gamma_left, tan_gamma_right.
         lengths: [usize; 5],
     },
+    /// The table reaches farther from the track centre than a wheel can stand on its rail
+    /// ([`MAX_TABLE_REACH_M`]): its end, where a wheelset counts as derailed, would be
+    /// meaningless.
+    #[error(
+        "contact table reaches {reach_mm:.1} mm from the track centre, beyond {} mm: a \
+         wheelset that far out has left its rails (write the table to at most {} mm, e.g. \
+         contact-geometry --y-max)",
+        MAX_TABLE_REACH_M * 1e3,
+        MAX_TABLE_REACH_M * 1e3
+    )]
+    Reach {
+        /// The larger of |y| at the two ends \[mm\].
+        reach_mm: f64,
+    },
+    /// A rolling-radius difference of the table takes a wheel's rolling radius below half
+    /// its nominal radius (a table in mm taken as m, or of another wheel).
+    #[error(
+        "contact table gives the {side} wheel a rolling radius of {radius_m:.4} m at y = \
+         {y_mm:.2} mm (nominal {nominal_m:.4} m, delta_r {delta_r_m:.4} m): below half the \
+         nominal radius, no wheel's"
+    )]
+    RollingRadius {
+        /// "left" or "right".
+        side: &'static str,
+        /// y of the row \[mm\].
+        y_mm: f64,
+        /// Nominal rolling radius \[m\].
+        nominal_m: f64,
+        /// The row's rolling-radius difference \[m\].
+        delta_r_m: f64,
+        /// nominal + delta_r \[m\].
+        radius_m: f64,
+    },
 }
+
+/// Farthest a contact table may reach from the track centre \[m\]: the linear model's
+/// derailment limit; flange contact begins within about 10 mm.
+pub const MAX_TABLE_REACH_M: f64 = 0.05;
 
 /// How [`write_csv`] prints the numbers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -473,13 +510,19 @@ impl GeometryTable {
     }
 
     /// The table reaches flange contact ([`FLANGE_TAN_GAMMA`]) on both sides, so that a
-    /// wheelset leaving its range has climbed a flange.
+    /// wheelset leaving its range has climbed a flange: the left wheel's flange on the side of
+    /// negative y (the wheelset moved towards the left rail), the right wheel's on the side of
+    /// positive y.
     pub fn check_flange(&self) -> Result<(), FlangeNotCovered> {
         let (lo, hi) = self.y_range();
         let (mut left, mut right) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
-        for [_, _, _, tl, tr] in self.rows() {
-            left = left.max(tl);
-            right = right.max(tr);
+        for [y, _, _, tl, tr] in self.rows() {
+            if y <= 0.0 {
+                left = left.max(tl);
+            }
+            if y >= 0.0 {
+                right = right.max(tr);
+            }
         }
         for (side, max_tan_gamma, range) in [("left", left, lo), ("right", right, hi)] {
             if max_tan_gamma < FLANGE_TAN_GAMMA {
@@ -488,6 +531,34 @@ impl GeometryTable {
                     max_tan_gamma,
                     range_mm: range * 1e3,
                 });
+            }
+        }
+        Ok(())
+    }
+
+    /// The table fits a wheelset of nominal rolling radius `wheel_radius_m`: it reaches no
+    /// farther than [`MAX_TABLE_REACH_M`] from the track centre, and no row takes a wheel's
+    /// rolling radius below half the nominal one.
+    pub fn check_for_wheel(&self, wheel_radius_m: f64) -> Result<(), TableError> {
+        let (lo, hi) = self.y_range();
+        let reach = lo.abs().max(hi.abs());
+        if reach > MAX_TABLE_REACH_M {
+            return Err(TableError::Reach {
+                reach_mm: reach * 1e3,
+            });
+        }
+        for [y, dl, dr, _, _] in self.rows() {
+            for (side, delta_r) in [("left", dl), ("right", dr)] {
+                let radius = wheel_radius_m + delta_r;
+                if !(radius >= 0.5 * wheel_radius_m) {
+                    return Err(TableError::RollingRadius {
+                        side,
+                        y_mm: y * 1e3,
+                        nominal_m: wheel_radius_m,
+                        delta_r_m: delta_r,
+                        radius_m: radius,
+                    });
+                }
             }
         }
         Ok(())

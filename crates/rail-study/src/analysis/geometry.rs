@@ -830,6 +830,15 @@ impl GeometryResults {
                  flange)\n"
             ));
         }
+        if i.y_max_m > wheel_rail::MAX_TABLE_REACH_M {
+            s.push_str(&format!(
+                "note: wheel_rail_table.csv reaches +-{:.2} mm (--y-max), beyond the {} mm the \
+                 vehicle FMUs take as a contact table's reach: they refuse it as their \
+                 contact.table\n",
+                i.y_max_m * 1e3,
+                wheel_rail::MAX_TABLE_REACH_M * 1e3
+            ));
+        }
         s
     }
 }
