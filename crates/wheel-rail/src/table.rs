@@ -550,7 +550,7 @@ impl GeometryTable {
         for [y, dl, dr, _, _] in self.rows() {
             for (side, delta_r) in [("left", dl), ("right", dr)] {
                 let radius = wheel_radius_m + delta_r;
-                if !(radius >= 0.5 * wheel_radius_m) {
+                if radius.is_nan() || radius < 0.5 * wheel_radius_m {
                     return Err(TableError::RollingRadius {
                         side,
                         y_mm: y * 1e3,
