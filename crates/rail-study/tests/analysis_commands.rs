@@ -265,6 +265,43 @@ fn contact_geometry_defaults_to_e1() {
     assert!((0.15..=0.25).contains(&c3), "conicity at 3 mm: {c3}");
 }
 
+/// No conicity is given for an amplitude of fewer than 10 table steps (a 5 mm --step gave
+/// 0.298 at 1, 3 and 5 mm beside EN 15302's 0.125 / 0.188 / 0.254, exit 0).
+#[test]
+fn contact_geometry_gives_no_conicity_below_ten_table_steps() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("cg");
+    let r = master(&[
+        "contact-geometry",
+        "--step",
+        "0.4",
+        "--amplitude-max",
+        "7",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}\n{}", r.stdout, r.stderr);
+    assert!(
+        r.stdout
+            .contains("none below 4 mm: 10 table steps of --step 0.4 mm"),
+        "{}",
+        r.stdout
+    );
+    assert!(!r.stdout.contains("tan gamma_e at 1 mm") && !r.stdout.contains("tan gamma_e at 3 mm"));
+    assert!(r.stdout.contains("tan gamma_e at 5 mm") && r.stdout.contains("tan gamma_e at 7 mm"));
+    let curve = std::fs::read_to_string(out.join("conicity.csv")).unwrap();
+    let first: f64 = curve
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(first >= 4.0 - 1e-9, "{curve}");
+}
+
 #[test]
 fn contact_geometry_from_files_matches_the_built_in_case() {
     let d = tempfile::tempdir().unwrap();

@@ -182,9 +182,12 @@ impl Profile {
             if content.is_empty() {
                 continue;
             }
+            // three fields at most: a third says the line is wrong (a 64 MB line of numbers
+            // took 1 GB split and parsed whole)
             let fields: Vec<&str> = content
                 .split(|c: char| c.is_whitespace() || c == ',' || c == ';')
                 .filter(|f| !f.is_empty())
+                .take(3)
                 .collect();
             let parsed: Vec<Result<f64, _>> = fields.iter().map(|f| f.parse::<f64>()).collect();
             let first_content = !seen_content;
@@ -197,7 +200,11 @@ impl Profile {
                     line_no,
                     format!(
                         "expected 2 fields (lateral vertical, mm), found {}: {:?}",
-                        fields.len(),
+                        if fields.len() > 2 {
+                            "more".to_string()
+                        } else {
+                            fields.len().to_string()
+                        },
                         clip(content)
                     ),
                 ));

@@ -32,6 +32,16 @@ fn malformed_number_names_file_and_line() {
         matches!(e, ProfileError::Malformed { line: 2, .. }),
         "{e:?}"
     );
+    // a line of a million numbers is refused on its third field, not split whole
+    let long = format!("0 0\n{}\n", vec!["1.5"; 1_000_000].join(" "));
+    let e = Profile::from_file(write(&long).path())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(":2: expected 2 fields (lateral vertical, mm), found more"),
+        "{}",
+        &e[..e.len().min(300)]
+    );
 }
 
 #[test]

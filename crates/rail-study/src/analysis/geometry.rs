@@ -216,6 +216,14 @@ pub fn conicity_at(d: &DeltaR, a: f64) -> Result<ConicityPoint, AnalysisError> {
     })
 }
 
+/// The smallest amplitude with an equivalent conicity worth the name on a table of `step_m`:
+/// an oscillation of a few table steps has none (at 0.0001 mm Annex B gave tan(gamma_e) = 0
+/// beside 0.107 from the other two methods; at 1 mm on a 5 mm step all three gave 0.298
+/// against EN 15302's 0.125): 0.5 mm and 10 steps.
+pub fn lowest_amplitude_m(step_m: f64) -> f64 {
+    (0.5e-3f64).max(10.0 * step_m)
+}
+
 /// Amplitudes of the conicity curve: from 1 mm (or the largest amplitude, if smaller) in
 /// steps of `step` \[m\] on the grid 1 mm + k step (so that 3 mm, the standard's figure, is
 /// one of them whenever the step divides 2 mm), the largest amplitude last even off the grid;
@@ -391,9 +399,7 @@ pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
             "must be > 0 mm",
         ));
     }
-    // an oscillation of a few table steps has no equivalent conicity worth the name: at
-    // 0.0001 mm Annex B gave tan(gamma_e) = 0 beside 0.107 from the other two methods
-    let lowest_m = (0.5e-3f64).max(10.0 * inputs.step_m);
+    let lowest_m = lowest_amplitude_m(inputs.step_m);
     if !(inputs.amplitude_max_m.is_finite()
         && inputs.amplitude_max_m >= lowest_m
         && inputs.amplitude_max_m < inputs.y_max_m)
@@ -481,8 +487,10 @@ pub fn contact_geometry(
         table_over_grid(&rigid, inputs, cancel).map_err(profiles)?
     };
     let d = DeltaR::from_table(&table);
+    let lowest_m = lowest_amplitude_m(inputs.step_m) - 1e-12;
     let conicity = curve_amplitudes(inputs.amplitude_max_m, inputs.conicity_step_m)
         .into_iter()
+        .filter(|&a| a >= lowest_m)
         .map(|a| {
             conicity_at(&d, a).map_err(|e| {
                 AnalysisError::Input(format!(
@@ -495,7 +503,7 @@ pub fn contact_geometry(
         .collect::<Result<Vec<_>, _>>()?;
     let summary_conicity = SUMMARY_AMPLITUDES_MM
         .iter()
-        .filter(|a| **a * 1e-3 <= inputs.amplitude_max_m + 1e-12)
+        .filter(|a| **a * 1e-3 <= inputs.amplitude_max_m + 1e-12 && **a * 1e-3 >= lowest_m)
         .map(|a| conicity_at(&d, a * 1e-3))
         .collect::<Result<Vec<_>, _>>()?;
     Ok(GeometryResults {
@@ -515,14 +523,21 @@ struct DetailRow {
 }
 
 fn detail_rows(table: &ContactTable) -> Vec<DetailRow> {
+    // the flange-climbing state by y (a scan of them per row was quadratic: minutes for a
+    // fine --step over a wide --y-max); + 0.0 makes -0 and 0 one key, as == does
+    let key = |y: f64| (y + 0.0).to_bits();
+    let mut climbs: std::collections::HashMap<u64, &ContactRow> = std::collections::HashMap::new();
+    for c in &table.flange_climb_rows {
+        climbs.entry(key(c.y_m)).or_insert(c);
+    }
     let mut out: Vec<DetailRow> = table
         .rows
         .iter()
         .map(|r| {
-            let climb = table
-                .flange_climb_rows
-                .iter()
-                .find(|c| r.beyond_flange_limit && c.y_m == r.y_m);
+            let climb = climbs
+                .get(&key(r.y_m))
+                .filter(|_| r.beyond_flange_limit)
+                .copied();
             DetailRow {
                 row: *climb.unwrap_or(r),
                 two_point: None,
@@ -799,6 +814,15 @@ impl GeometryResults {
         s.push_str(&format!(
             "equivalent conicity (EN 15302 Annex B; Annex C regression in brackets; {conv}):\n"
         ));
+        let lowest = lowest_amplitude_m(i.step_m);
+        if lowest > 1e-3 + 1e-12 {
+            s.push_str(&format!(
+                "  none below {} mm: 10 table steps of --step {} mm (a finer --step gives the \
+                 smaller amplitudes)\n",
+                master::show::num(lowest * 1e3),
+                master::show::num(i.step_m * 1e3)
+            ));
+        }
         for p in &self.summary_conicity {
             let a_mm = p.amplitude_m * 1e3;
             s.push_str(&format!(

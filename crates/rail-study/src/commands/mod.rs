@@ -117,6 +117,8 @@ pub(crate) fn write_analysis_with(
     check_cancel(cancel).map_err(failed)?;
     let mut files = Artefacts::default();
     add(&mut files).map_err(failed)?;
+    // an interrupt while the files were made: nothing is written (exit status 130)
+    check_cancel(cancel).map_err(failed)?;
     let written: Vec<String> = files.names().iter().map(|n| n.to_string()).collect();
     if let Some(n) = written.iter().find(|n| !(command.owns)(n)) {
         return Err(CommandError::Failed(format!(
@@ -166,6 +168,9 @@ pub(crate) fn write_analysis_with(
     let mut list = manifest(&with_stale)?;
     let mut staged = files.stage_all(out)?;
     staged.extend(list.stage_all(out)?);
+    // the last point at which an interrupt leaves the earlier files: the staged ones are
+    // removed as they are dropped
+    check_cancel(cancel).map_err(failed)?;
     crate::analysis::commit_all(staged)?;
     for name in &stale {
         if let Err(e) = master::output::remove_stale_file(&out.join(name)) {
@@ -223,4 +228,44 @@ pub(crate) fn written_before(out: &Path, command: &AnalysisCommand) -> Vec<Strin
         .filter(|n| bare(n) && (command.owns)(n))
         .map(str::to_string)
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::Ordering;
+
+    /// An interrupt that arrives while the files are made leaves the earlier ones as they
+    /// were (the command then exits 130): nothing is committed.
+    #[test]
+    fn an_interrupt_while_the_files_are_made_writes_nothing() {
+        const COMMAND: AnalysisCommand = AnalysisCommand {
+            name: "probe",
+            owns: |n| n == "probe.csv",
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let earlier = dir.path().join("probe.csv");
+        std::fs::write(&earlier, "earlier\n").unwrap();
+        let cancel = AtomicBool::new(false);
+        let r = write_analysis(&COMMAND, dir.path(), &[], &cancel, "s", |f| {
+            f.add_text("probe.csv", "new\n".into());
+            cancel.store(true, Ordering::SeqCst);
+            Ok(())
+        });
+        assert!(r.is_err());
+        assert_eq!(std::fs::read_to_string(&earlier).unwrap(), "earlier\n");
+        let names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("probe.csv")]);
+        // not interrupted: written
+        cancel.store(false, Ordering::SeqCst);
+        write_analysis(&COMMAND, dir.path(), &[], &cancel, "s", |f| {
+            f.add_text("probe.csv", "new\n".into());
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(std::fs::read_to_string(&earlier).unwrap(), "new\n");
+    }
 }
