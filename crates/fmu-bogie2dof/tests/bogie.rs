@@ -937,9 +937,15 @@ fn the_contact_table_bounds_the_non_linear_model() {
             "bad.csv",
         )
         .unwrap();
-        let e = Bogie::with_table(nonlinear.clone(), t).unwrap_err();
+        let e = Bogie::with_table(nonlinear.clone(), t.clone()).unwrap_err();
         assert!(matches!(e, ModelError::Contact(_)), "{e}");
         assert!(e.to_string().contains(why), "{e}");
+        // the linear model, which uses no table, runs
+        let linear = Params {
+            model: ModelKind::Linear,
+            ..nonlinear.clone()
+        };
+        assert!(Bogie::with_table(linear, t).is_ok(), "{why}");
     }
     // the linear model does not use the table
     let linear = Params {

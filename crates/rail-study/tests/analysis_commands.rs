@@ -843,6 +843,23 @@ fn contact_geometry_fleet_table_and_figure() {
         r.stderr
     );
     assert!(!out4.exists());
+    // a step too coarse for the table's 1 mm column is refused before any profile is read
+    let out5 = d.path().join("cg5");
+    let r = master(&[
+        "contact-geometry",
+        "--wheels",
+        cylinder.to_str().unwrap(),
+        "--step",
+        "0.2",
+        "--out",
+        out5.to_str().unwrap(),
+    ]);
+    assert!(
+        !r.ok && r.stderr.contains("--step") && r.stderr.contains("at most 0.1 mm"),
+        "{}",
+        r.stderr
+    );
+    assert!(!out5.exists());
     // --wheels and --wheel cannot be mixed
     let r = master(&["contact-geometry", "--wheels", "a.dat", "--wheel", "b.dat"]);
     assert!(!r.ok && r.stderr.contains("--wheel"), "{}", r.stderr);

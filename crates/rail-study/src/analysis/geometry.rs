@@ -401,7 +401,7 @@ pub fn check_options(inputs: &GeometryInputs) -> Result<(), AnalysisError> {
     }
     let lowest_m = lowest_amplitude_m(inputs.step_m);
     if !(inputs.amplitude_max_m.is_finite()
-        && inputs.amplitude_max_m >= lowest_m
+        && inputs.amplitude_max_m >= lowest_m - 1e-12
         && inputs.amplitude_max_m < inputs.y_max_m)
     {
         return Err(bad(
@@ -488,9 +488,12 @@ pub fn contact_geometry(
     };
     let d = DeltaR::from_table(&table);
     let lowest_m = lowest_amplitude_m(inputs.step_m) - 1e-12;
-    let conicity = curve_amplitudes(inputs.amplitude_max_m, inputs.conicity_step_m)
+    let amplitudes = curve_amplitudes(inputs.amplitude_max_m, inputs.conicity_step_m);
+    let last = amplitudes.last().copied();
+    let conicity = amplitudes
         .into_iter()
-        .filter(|&a| a >= lowest_m)
+        // the largest amplitude, checked against the same bound, stays whatever its rounding
+        .filter(|&a| a >= lowest_m || Some(a) == last)
         .map(|a| {
             conicity_at(&d, a).map_err(|e| {
                 AnalysisError::Input(format!(

@@ -162,6 +162,16 @@ pub fn fleet(
             reason: "must be at least 3 mm for the fleet table (its figure is at 3 mm)".into(),
         });
     }
+    // the fleet table gives the conicity from 1 mm: at least 10 table steps there
+    if super::lowest_amplitude_m(inputs.step_m) > 1e-3 + 1e-12 {
+        return Err(AnalysisError::Option {
+            option: "--step",
+            value: master::show::num(inputs.step_m * 1e3).to_string(),
+            reason: "must be at most 0.1 mm for the fleet table (its conicity from 1 mm needs \
+                     10 table steps there)"
+                .into(),
+        });
+    }
     let n_amp = (inputs.amplitude_max_m * 1e3 + 1e-9).floor() as usize;
     let amplitudes_m: Vec<f64> = (1..=n_amp).map(|k| k as f64 * 1e-3).collect();
     let results: Vec<Result<FleetRow, AnalysisError>> = wheels
