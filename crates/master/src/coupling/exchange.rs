@@ -312,15 +312,12 @@ impl Exchange {
             from_outputs: {
                 // a value converted for its destination is not the variable's own
                 let src = &sources[g.instance];
-                let own = |k: &usize| !src.conversions.iter().any(|(c, _)| c == k);
+                let own = |k: usize| !src.conversions.iter().any(|&(c, _)| c == k);
+                let outputs = src.outputs.vars();
                 g.vars
                     .vars()
                     .iter()
-                    .map(|v| {
-                        (0..src.outputs.vars().len())
-                            .filter(own)
-                            .find(|&k| src.outputs.vars()[k] == *v)
-                    })
+                    .map(|v| (0..outputs.len()).find(|&k| outputs[k] == *v && own(k)))
                     .collect()
             },
             vars: g.vars,

@@ -147,17 +147,28 @@ pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, S
             );
         }
     }
-    let step = opts
-        .step
-        .or(ssd.base_step_s)
-        .or(ssd.system.step_s)
-        .ok_or_else(|| {
-            invalid(
-                1,
-                "no communication step: neither libcosim's osp:FixedStepAlgorithm baseStepSize nor OMSimulator's oms:FixedStepMaster stepSize is given (give one with --step)"
-                    .into(),
-            )
-        })?;
+    // the step with where it comes from (None: the options)
+    let (step, step_from) = [
+        (opts.step, None),
+        (
+            ssd.base_step_s,
+            Some("libcosim's osp:FixedStepAlgorithm baseStepSize"),
+        ),
+        (
+            ssd.system.step_s,
+            Some("OMSimulator's oms:FixedStepMaster stepSize"),
+        ),
+    ]
+    .into_iter()
+    .find_map(|(step, from)| step.map(|h| (h, from)))
+    .ok_or_else(|| {
+        invalid(
+            1,
+            "no communication step: neither libcosim's osp:FixedStepAlgorithm baseStepSize nor \
+             OMSimulator's oms:FixedStepMaster stepSize is given (give one with --step)"
+                .into(),
+        )
+    })?;
     for (i, c) in imp.components.iter().enumerate() {
         if let Some(h) = c.step_size_hint_s {
             let m = (h / step).round();
@@ -173,29 +184,21 @@ pub(super) fn import(path: &Path, opts: &ImportOptions) -> Result<ImportedSsp, S
             instances[i].step_multiple = m as u32;
         }
     }
-    for (field, from_ssd, what) in [
+    // where the timing comes from, when the SSD gives it
+    for (field, from_ssd) in [
         (
             "start_time",
-            ssd.start_time_s.is_some(),
-            "the DefaultExperiment's startTime",
+            ssd.start_time_s
+                .map(|_| "the DefaultExperiment's startTime"),
         ),
         (
             "stop_time",
-            opts.stop_time.is_none() && ssd.stop_time_s.is_some(),
-            "the DefaultExperiment's stopTime",
+            (opts.stop_time.is_none() && ssd.stop_time_s.is_some())
+                .then_some("the DefaultExperiment's stopTime"),
         ),
-        (
-            "step",
-            opts.step.is_none() && ssd.base_step_s.is_some(),
-            "libcosim's osp:FixedStepAlgorithm baseStepSize",
-        ),
-        (
-            "step",
-            opts.step.is_none() && ssd.base_step_s.is_none() && ssd.system.step_s.is_some(),
-            "OMSimulator's oms:FixedStepMaster stepSize",
-        ),
+        ("step", step_from),
     ] {
-        if from_ssd {
+        if let Some(what) = from_ssd {
             imp.origins
                 .insert(field.into(), format!("{what} ({})", imp.ssd_label));
         }
@@ -559,7 +562,8 @@ impl Importer {
                         ));
                     }
                     let bound = self.convert(ssd, &set, i, &target, &v, &p, &origin)?;
-                    self.origins.insert(parameter_field(i, &target), origin);
+                    self.origins
+                        .insert(crate::system::parameter_field(i, &target), origin);
                     out[i].insert(target, bound);
                 }
             }
@@ -586,7 +590,8 @@ impl Importer {
                     };
                     if self.models[i].variable(var).is_some() {
                         let bound = self.convert(ssd, &set, i, var, &v, &p, &origin)?;
-                        self.origins.insert(parameter_field(i, var), origin.clone());
+                        self.origins
+                            .insert(crate::system::parameter_field(i, var), origin.clone());
                         out[i].insert(var.to_string(), bound);
                         hit = true;
                     }
@@ -676,15 +681,6 @@ impl Importer {
         };
         Ok(value)
     }
-}
-
-/// The field of the description a start value becomes, as the system's messages name it (a
-/// long or odd name shortened), the key of its origin.
-fn parameter_field(instance: usize, name: &str) -> String {
-    format!(
-        "instances[{instance}].parameters.{}",
-        crate::show::text(name)
-    )
 }
 
 /// The unit a component's connector `name` declares (a Real connector's `unit`).

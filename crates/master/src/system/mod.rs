@@ -225,6 +225,13 @@ pub struct LoadedSystem {
     pub origins: BTreeMap<String, String>,
 }
 
+/// The field a start value of instance `instance` is named by in messages
+/// (`instances[0].parameters.k`, a long or odd name shortened): also the key of its origin
+/// in a converted description ([`LoadedSystem::origins`]).
+pub(crate) fn parameter_field(instance: usize, name: &str) -> String {
+    format!("instances[{instance}].parameters.{}", text(name))
+}
+
 /// Splits `instance.variable` at the first dot.
 pub fn split_ref(s: &str) -> Option<(&str, &str)> {
     let (a, b) = s.split_once('.')?;

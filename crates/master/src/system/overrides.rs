@@ -4,7 +4,7 @@
 
 use serde_json::Value;
 
-use super::{parse_set, LoadedSystem, StartValueError, SystemError};
+use super::{parameter_field, parse_set, split_ref, LoadedSystem, StartValueError, SystemError};
 use crate::coupling::Algorithm;
 use crate::show::text;
 
@@ -113,7 +113,24 @@ impl LoadedSystem {
             let reason = "not of the form instance.variable=VALUE".to_string();
             invalid(&text(s).to_string(), reason)
         })?;
+        // a field given here no longer comes from a converted description's files: named as
+        // given (applied with the description, once every change is accepted)
+        let python = o.from == OverridesFrom::PythonLoad;
+        let given_as = |cli: &str, py: &str| if python { py } else { cli }.to_string();
+        let mut origins = Vec::new();
         for (key, value) in start_values {
+            if !self.origins.is_empty() {
+                let at = split_ref(&key).and_then(|(inst, var)| {
+                    let i = desc.instances.iter().position(|x| x.name == inst)?;
+                    Some((i, var))
+                });
+                if let Some((i, var)) = at {
+                    origins.push((
+                        parameter_field(i, var),
+                        given_as(&format!("--set {key}"), &format!("parameters '{key}'")),
+                    ));
+                }
+            }
             desc.set_start_value(&key, value).map_err(|e| {
                 let names: Vec<&str> = desc.instances.iter().map(|i| i.name.as_str()).collect();
                 invalid(
@@ -136,29 +153,16 @@ impl LoadedSystem {
             desc.instances.iter_mut().for_each(|i| i.logging = true);
         }
         if !self.origins.is_empty() {
-            // a field given here no longer comes from the converted files: named as given
-            let python = o.from == OverridesFrom::PythonLoad;
-            let name = |cli: &str, py: &str| if python { py } else { cli }.to_string();
             for (field, cli, given) in [
                 ("start_time", "--start", o.start_time.is_some()),
                 ("stop_time", "--stop", o.stop_time.is_some()),
                 ("step", "--step", o.step.is_some()),
             ] {
                 if given {
-                    self.origins.insert(field.into(), name(cli, field));
+                    origins.push((field.into(), given_as(cli, field)));
                 }
             }
-            for (key, _) in o.start_values().unwrap_or_default() {
-                let Some((inst, var)) = super::split_ref(&key) else {
-                    continue;
-                };
-                if let Some(i) = desc.instances.iter().position(|x| x.name == inst) {
-                    self.origins.insert(
-                        format!("instances[{i}].parameters.{}", text(var)),
-                        name(&format!("--set {key}"), &format!("parameters '{key}'")),
-                    );
-                }
-            }
+            self.origins.extend(origins);
         }
         self.desc = desc;
         self.file = label;

@@ -148,12 +148,6 @@ impl LoadedSystem {
             }
             let conversion = match (&fv.unit, &tv.unit) {
                 (Some(uf), Some(ut)) if c.convert_units => {
-                    // an SSP connection is told otherwise than a JSON one
-                    let unchanged = if self.origins.contains_key(&format!("connections[{ci}]")) {
-                        "suppressUnitConversion=\"true\" on the connection passes the value unchanged"
-                    } else {
-                        "\"convert_units\": false on the connection passes the value unchanged"
-                    };
                     let from = End {
                         model: models[fi],
                         unit: uf,
@@ -175,8 +169,16 @@ impl LoadedSystem {
                         ))
                     };
                     converted.map_err(|why| {
+                        let field = format!("connections[{ci}]");
+                        // an SSP connection is told otherwise than a JSON one
+                        let unchanged = if self.origins.contains_key(&field) {
+                            "suppressUnitConversion=\"true\" on the connection passes the value \
+                             unchanged"
+                        } else {
+                            "\"convert_units\": false on the connection passes the value unchanged"
+                        };
                         self.invalid(
-                            format!("connections[{ci}]"),
+                            field,
                             &c.to,
                             format!(
                                 "unit mismatch: '{}' is in [{uf}] but '{}' is in [{ut}]: {why} \
@@ -425,7 +427,7 @@ pub(super) fn start_value(
     strings: &mut Vec<String>,
     invalid: &Invalid,
 ) -> Result<(VarRef, f64), SystemError> {
-    let field = format!("instances[{i}].parameters.{}", text(name));
+    let field = super::parameter_field(i, name);
     let Some((_, v)) = md.variable(name) else {
         let hint = md
             .suggest(name)
